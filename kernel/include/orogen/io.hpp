@@ -1,0 +1,86 @@
+// orogen/io.hpp — writing files so that a failed run loses nothing.
+//
+// Every output goes to a temporary name beside its target and is renamed over
+// it only once it is complete (rename(2) is atomic within a folder), so a run
+// that fails half way never leaves a half-written file and never clobbers a
+// good one. Formats that are several files (.gltf + .bin, .pvd + .vtp...) use
+// one AtomicFile each and commit them together with commit_all().
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace orogen {
+
+class AtomicFile;
+void commit_all(std::span<AtomicFile*> files);
+
+class AtomicFile {
+public:
+    /// Prepare to write `target`. Throws orogen::Error (failed_run) if the
+    /// temporary file cannot be created, naming the folder and the reason.
+    explicit AtomicFile(std::filesystem::path target);
+    ~AtomicFile();  ///< removes the temporary file unless committed
+    AtomicFile(const AtomicFile&) = delete;
+    AtomicFile& operator=(const AtomicFile&) = delete;
+    AtomicFile(AtomicFile&&) noexcept;
+
+    const std::filesystem::path& target() const { return target_; }
+    /// The temporary file: hand it to a library that writes by file name.
+    const std::filesystem::path& temporary() const { return temporary_; }
+    /// A stream on the temporary file (binary).
+    std::ofstream& stream();
+    void write(std::span<const std::uint8_t> bytes);
+    /// Flush, fsync and rename over the target. Throws orogen::Error on failure
+    /// (disk full, folder gone...); the target is then untouched.
+    void commit();
+    bool committed() const { return committed_; }
+
+private:
+    friend void commit_all(std::span<AtomicFile*> files);
+    std::filesystem::path target_;
+    std::filesystem::path temporary_;
+    std::ofstream stream_;
+    bool committed_ = false;
+};
+
+/// Commit several files together: all are flushed first, so a failure while
+/// flushing leaves every target untouched.
+void commit_all(std::span<AtomicFile*> files);
+
+/// Write `bytes` to `target` atomically.
+void write_file_atomically(const std::filesystem::path& target, std::span<const std::uint8_t> bytes);
+
+/// Read a whole file; throws orogen::BadInput naming the file if it cannot be read.
+std::vector<std::uint8_t> read_file(const std::filesystem::path& path);
+
+/// SHA-256 of a file as 64 lowercase hex digits (as `sha256sum` prints it).
+std::string sha256_file(const std::filesystem::path& path);
+std::string sha256_hex(std::span<const std::uint8_t> bytes);
+
+// ---------------------------------------------------------------- PNG codec
+
+/// A decoded grayscale PNG: `bits` 8 or 16, samples row-major, 0..255 or 0..65535.
+struct GrayImage {
+    int width = 0, height = 0;
+    int bits = 8;
+    std::vector<std::uint16_t> samples;
+};
+
+/// Decode a grayscale PNG (colour type 0, or 4 with alpha ignored). Throws
+/// orogen::BadInput naming the file for anything else: not a PNG, truncated,
+/// colour, palette.
+GrayImage read_gray_png(const std::filesystem::path& path);
+/// Read only the header: size and bit depth, same checks as read_gray_png minus decoding.
+GrayImage read_gray_png_header(const std::filesystem::path& path);
+
+/// Encode a grayscale PNG (8 or 16 bits) to `file` (usually AtomicFile::stream()).
+void write_gray_png(std::ostream& file, int width, int height, int bits, std::span<const std::uint16_t> samples);
+/// Encode an 8-bit RGBA PNG.
+void write_rgba_png(std::ostream& file, int width, int height, std::span<const std::uint8_t> rgba);
+
+}  // namespace orogen

@@ -1,0 +1,84 @@
+// orogen/plugin.hpp — the one seam between the kernel and a plugin.
+//
+// A plugin is a shared library exporting one `extern "C"` function,
+// `orogen_plugin_info`, that returns a plain struct: the plugin API version it
+// was built against, its name and version, and a callback that adds its nodes
+// to the registry. (The model is LLVM's llvmGetPassPluginInfo.) The kernel
+// refuses a library whose API version differs from its own, naming the file
+// and both versions, and goes on loading the others.
+//
+// Write a plugin with the macro:
+//
+//   #include <orogen/plugin.hpp>
+//   OROGEN_PLUGIN("my-plugin", "1.0.0", registry) {
+//       registry.add({ .kind = "generate", .name = "my-node", ... });
+//   }
+#pragma once
+
+#include <orogen/node.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+/// Bumped whenever a public header changes in a way that breaks plugins built
+/// against the previous one (layout of a shared type, a virtual function...).
+#define OROGEN_PLUGIN_API_VERSION 1
+
+namespace orogen {
+
+/// The node table. Plugins add to it; the kernel reads it.
+class Registry {
+public:
+    Registry();
+    ~Registry();
+    Registry(const Registry&) = delete;
+    Registry& operator=(const Registry&) = delete;
+
+    /// Add a node. A second node with the same kind:name is refused (the
+    /// error names both plugins' files); the first one stays.
+    void add(NodeDescriptor node);
+
+    const NodeDescriptor* find(std::string_view qualified_name) const;
+    /// All nodes, sorted by kind then name.
+    std::vector<const NodeDescriptor*> nodes() const;
+    /// The file of the plugin that registered `qualified_name` ("" if built in).
+    std::string provider(std::string_view qualified_name) const;
+
+    /// Set by the loader while a plugin's callback runs.
+    void set_current_plugin(std::string plugin_name, std::string file);
+    /// Errors met while adding (duplicates, malformed descriptors).
+    const std::vector<std::string>& errors() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace orogen
+
+extern "C" {
+
+/// What a plugin returns from `orogen_plugin_info`.
+struct OrogenPluginInfo {
+    std::uint32_t api_version;  ///< OROGEN_PLUGIN_API_VERSION at build time
+    const char* plugin_name;    ///< kebab-case
+    const char* plugin_version; ///< the plugin's own version, free form ("1.2.0")
+    void (*register_nodes)(orogen::Registry& registry);
+};
+
+/// The entry point's type; its symbol name is "orogen_plugin_info".
+typedef OrogenPluginInfo (*OrogenPluginInfoFn)(void);
+}
+
+#define OROGEN_PLUGIN_ENTRY_SYMBOL "orogen_plugin_info"
+
+#define OROGEN_PLUGIN(NAME, VERSION, REGISTRY)                                          \
+    static void orogen_register_nodes_(orogen::Registry& REGISTRY);                     \
+    extern "C" __attribute__((visibility("default"))) OrogenPluginInfo orogen_plugin_info(void) { \
+        return {OROGEN_PLUGIN_API_VERSION, NAME, VERSION, &orogen_register_nodes_};      \
+    }                                                                                    \
+    static void orogen_register_nodes_(orogen::Registry& REGISTRY)

@@ -1,0 +1,107 @@
+#include <orogen/error.hpp>
+#include <orogen/node.hpp>
+
+#include <cmath>
+#include <sstream>
+
+namespace orogen {
+
+std::string_view to_string(ParamType type) {
+    switch (type) {
+        case ParamType::integer: return "integer";
+        case ParamType::real: return "number";
+        case ParamType::boolean: return "boolean";
+        case ParamType::string: return "string";
+        case ParamType::choice: return "choice";
+        case ParamType::point: return "point";
+        case ParamType::points: return "points";
+        case ParamType::path: return "path";
+    }
+    return "?";
+}
+
+Param Param::integer(std::string name, std::optional<std::int64_t> def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::integer;
+    if (def) p.default_value = *def;
+    return p;
+}
+
+Param Param::real(std::string name, std::optional<double> def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::real;
+    if (def) p.default_value = *def;
+    return p;
+}
+
+Param Param::boolean(std::string name, bool def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::boolean;
+    p.default_value = def;
+    return p;
+}
+
+Param Param::string(std::string name, std::optional<std::string> def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::string;
+    if (def) p.default_value = *def;
+    return p;
+}
+
+Param Param::choice(std::string name, std::vector<std::string> options, std::string def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::choice;
+    p.choices = std::move(options);
+    p.default_value = std::move(def);
+    return p;
+}
+
+Param Param::point(std::string name, std::optional<Point2> def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::point;
+    if (def) p.default_value = *def;
+    return p;
+}
+
+Param Param::points(std::string name, std::optional<std::vector<Point2>> def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::points;
+    if (def) p.default_value = *def;
+    return p;
+}
+
+Param Param::path(std::string name, PathRole role, std::vector<std::string> extensions, std::optional<std::string> def) {
+    Param p;
+    p.name = std::move(name);
+    p.type = ParamType::path;
+    p.path_role = role;
+    p.choices = std::move(extensions);
+    if (def) p.default_value = *def;
+    return p;
+}
+
+const Param* NodeDescriptor::find_param(std::string_view n) const {
+    for (const auto& p : params)
+        if (p.name == n) return &p;
+    return nullptr;
+}
+
+void NodeContext::check_finite(std::span<const float> data, std::string_view what, std::int64_t step) const {
+    for (std::size_t i = 0; i < data.size(); ++i) {
+        if (!std::isfinite(data[i])) {
+            std::ostringstream msg;
+            msg << "non-finite " << what << " (" << data[i] << ") at sample " << i << " after step " << step
+                << "; the simulation became unstable";
+            throw Error(msg.str());
+        }
+    }
+}
+
+}  // namespace orogen

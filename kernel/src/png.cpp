@@ -1,0 +1,189 @@
+// PNG codec on libpng (16-bit grayscale needs it; stb writes only 8 bits).
+// libpng reports errors by longjmp: each function below keeps only plain data
+// alive across setjmp and turns the recorded message into an exception after.
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#include <png.h>
+
+#include <csetjmp>
+#include <cstring>
+#include <ostream>
+
+namespace orogen {
+
+namespace {
+
+struct ErrorSlot {
+    char message[256] = {0};
+};
+
+void on_error(png_structp png, png_const_charp msg) {
+    auto* slot = static_cast<ErrorSlot*>(png_get_error_ptr(png));
+    std::snprintf(slot->message, sizeof slot->message, "%s", msg);
+    png_longjmp(png, 1);
+}
+void on_warning(png_structp, png_const_charp) {}
+
+struct MemoryReader {
+    const std::uint8_t* data;
+    std::size_t size;
+    std::size_t offset;
+};
+
+void read_from_memory(png_structp png, png_bytep out, png_size_t n) {
+    auto* r = static_cast<MemoryReader*>(png_get_io_ptr(png));
+    if (r->offset + n > r->size) png_error(png, "the file is truncated (it ends in the middle of the image data)");
+    std::memcpy(out, r->data + r->offset, n);
+    r->offset += n;
+}
+
+/// Plain-data decoder. Returns 0 on success, else fills err. colour_type/bit_depth always set if the header was read.
+int decode(const std::uint8_t* bytes, std::size_t size, bool header_only, ErrorSlot& err, png_uint_32& w,
+           png_uint_32& h, int& bit_depth, int& colour_type, std::uint16_t* out, std::size_t out_capacity,
+           bool& wrong_format) {
+    MemoryReader reader{bytes, size, 0};
+    png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info) {
+        std::snprintf(err.message, sizeof err.message, "out of memory");
+        return 1;
+    }
+    png_bytep volatile row = nullptr;  // volatile: it must survive the longjmp
+    if (setjmp(png_jmpbuf(png))) {
+        std::free(static_cast<void*>(row));
+        png_destroy_read_struct(&png, &info, nullptr);
+        return 1;
+    }
+    png_set_read_fn(png, &reader, read_from_memory);
+    png_read_info(png, info);
+    w = png_get_image_width(png, info);
+    h = png_get_image_height(png, info);
+    bit_depth = png_get_bit_depth(png, info);
+    colour_type = png_get_color_type(png, info);
+    wrong_format = colour_type != PNG_COLOR_TYPE_GRAY && colour_type != PNG_COLOR_TYPE_GRAY_ALPHA;
+    if (header_only || wrong_format || std::size_t(w) * h > out_capacity) {
+        png_destroy_read_struct(&png, &info, nullptr);
+        return 0;
+    }
+    if (bit_depth < 8) png_set_expand_gray_1_2_4_to_8(png);
+    if (colour_type & PNG_COLOR_MASK_ALPHA) png_set_strip_alpha(png);
+    if (bit_depth == 16) png_set_swap(png);  // PNG stores big-endian; we want host order
+    const int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    const std::size_t rowbytes = png_get_rowbytes(png, info);
+    row = static_cast<png_bytep>(std::malloc(rowbytes));
+    for (int pass = 0; pass < passes; ++pass) {
+        for (png_uint_32 y = 0; y < h; ++y) {
+            std::uint16_t* dst = out + std::size_t(y) * w;
+            if (pass > 0) {  // interlaced: feed back the row we have so far
+                if (bit_depth == 16) std::memcpy(row, dst, std::size_t(w) * 2);
+                else for (png_uint_32 x = 0; x < w; ++x) row[x] = png_byte(dst[x]);
+            }
+            png_read_row(png, row, nullptr);
+            if (bit_depth == 16) std::memcpy(dst, row, std::size_t(w) * 2);
+            else for (png_uint_32 x = 0; x < w; ++x) dst[x] = row[x];
+        }
+    }
+    png_read_end(png, nullptr);
+    std::free(static_cast<void*>(row));
+    png_destroy_read_struct(&png, &info, nullptr);
+    return 0;
+}
+
+GrayImage read_png(const std::filesystem::path& path, bool header_only) {
+    const std::vector<std::uint8_t> bytes = read_file(path);
+    static const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    if (bytes.size() < 8 || std::memcmp(bytes.data(), signature, 8) != 0)
+        throw BadInput("cannot read " + path.string() + ": not a PNG file (it does not start with the PNG signature)");
+    ErrorSlot err;
+    png_uint_32 w = 0, h = 0;
+    int bit_depth = 0, colour_type = 0;
+    bool wrong_format = false;
+    // Header first, to size the buffer and check the format before decoding.
+    if (decode(bytes.data(), bytes.size(), true, err, w, h, bit_depth, colour_type, nullptr, 0, wrong_format) != 0)
+        throw BadInput("cannot read " + path.string() + ": damaged PNG (" + err.message + ")");
+    if (wrong_format) {
+        const char* what = colour_type == PNG_COLOR_TYPE_PALETTE ? "a palette (indexed colour) image"
+                           : (colour_type & PNG_COLOR_MASK_ALPHA) ? "an RGBA colour image"
+                                                                  : "an RGB colour image";
+        throw BadInput("cannot read " + path.string() + ": it is " + what +
+                       ", but a heightmap must be a grayscale PNG (8 or 16 bits); convert it, e.g. "
+                       "`convert in.png -colorspace gray -depth 16 out.png`");
+    }
+    GrayImage image;
+    image.width = int(w);
+    image.height = int(h);
+    image.bits = bit_depth == 16 ? 16 : 8;
+    if (header_only) return image;
+    image.samples.resize(std::size_t(w) * h);
+    if (decode(bytes.data(), bytes.size(), false, err, w, h, bit_depth, colour_type, image.samples.data(),
+               image.samples.size(), wrong_format) != 0)
+        throw BadInput("cannot read " + path.string() + ": damaged PNG (" + err.message + ")");
+    if (bit_depth < 8) {  // expanded to 8 bits without rescaling: scale 0..2^d-1 to 0..255
+        const int max = (1 << bit_depth) - 1;
+        for (auto& s : image.samples) s = std::uint16_t((s * 255 + max / 2) / max);
+    }
+    return image;
+}
+
+void write_to_stream(png_structp png, png_bytep data, png_size_t n) {
+    auto* out = static_cast<std::ostream*>(png_get_io_ptr(png));
+    out->write(reinterpret_cast<const char*>(data), std::streamsize(n));
+    if (!*out) png_error(png, "write failed (disk full?)");
+}
+void flush_stream(png_structp png) { static_cast<std::ostream*>(png_get_io_ptr(png))->flush(); }
+
+int encode(std::ostream& file, int width, int height, int bits, int colour_type, const std::uint8_t* rows,
+           std::size_t row_stride, bool swap16, ErrorSlot& err) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
+    png_infop info = png ? png_create_info_struct(png) : nullptr;
+    if (!png || !info) {
+        std::snprintf(err.message, sizeof err.message, "out of memory");
+        return 1;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return 1;
+    }
+    png_set_write_fn(png, &file, write_to_stream, flush_stream);
+    png_set_compression_level(png, 6);
+    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), bits, colour_type, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_write_info(png, info);
+    if (swap16) png_set_swap(png);
+    for (int y = 0; y < height; ++y) png_write_row(png, const_cast<png_bytep>(rows + std::size_t(y) * row_stride));
+    png_write_end(png, nullptr);
+    png_destroy_write_struct(&png, &info);
+    return 0;
+}
+
+}  // namespace
+
+GrayImage read_gray_png(const std::filesystem::path& path) { return read_png(path, false); }
+GrayImage read_gray_png_header(const std::filesystem::path& path) { return read_png(path, true); }
+
+void write_gray_png(std::ostream& file, int width, int height, int bits, std::span<const std::uint16_t> samples) {
+    if (bits != 8 && bits != 16) throw Error("internal error: PNG bit depth must be 8 or 16");
+    if (samples.size() != std::size_t(width) * std::size_t(height)) throw Error("internal error: PNG sample count");
+    ErrorSlot err;
+    int rc;
+    if (bits == 16) {
+        rc = encode(file, width, height, 16, PNG_COLOR_TYPE_GRAY, reinterpret_cast<const std::uint8_t*>(samples.data()),
+                    std::size_t(width) * 2, true, err);
+    } else {
+        std::vector<std::uint8_t> bytes(samples.size());
+        for (std::size_t i = 0; i < samples.size(); ++i) bytes[i] = std::uint8_t(samples[i] > 255 ? 255 : samples[i]);
+        rc = encode(file, width, height, 8, PNG_COLOR_TYPE_GRAY, bytes.data(), std::size_t(width), false, err);
+    }
+    if (rc != 0) throw Error(std::string("PNG encoding failed: ") + err.message);
+}
+
+void write_rgba_png(std::ostream& file, int width, int height, std::span<const std::uint8_t> rgba) {
+    if (rgba.size() != std::size_t(width) * std::size_t(height) * 4) throw Error("internal error: RGBA byte count");
+    ErrorSlot err;
+    if (encode(file, width, height, 8, PNG_COLOR_TYPE_RGB_ALPHA, rgba.data(), std::size_t(width) * 4, false, err) != 0)
+        throw Error(std::string("PNG encoding failed: ") + err.message);
+}
+
+}  // namespace orogen

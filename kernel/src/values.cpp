@@ -1,0 +1,81 @@
+#include <orogen/error.hpp>
+#include <orogen/values.hpp>
+
+#include <algorithm>
+
+namespace orogen {
+
+std::string_view to_string(ValueType type) {
+    switch (type) {
+        case ValueType::none: return "nothing";
+        case ValueType::heightmap: return "heightmap";
+        case ValueType::image: return "image";
+        case ValueType::particles: return "particles";
+        case ValueType::plates: return "plates";
+    }
+    return "?";
+}
+
+Heightmap::Heightmap(int width, int height, double cell, float elevation)
+    : width_(width), height_(height), cell_(cell), heights_(std::size_t(width) * std::size_t(height), elevation) {}
+
+bool Heightmap::has_layer(std::string_view name) const { return layers_.find(name) != layers_.end(); }
+
+GridView Heightmap::layer(std::string_view name, float fill) {
+    auto it = layers_.find(name);
+    if (it == layers_.end()) it = layers_.emplace(std::string(name), std::vector<float>(size(), fill)).first;
+    return {it->second.data(), width_, height_, cell_};
+}
+
+ConstGridView Heightmap::layer(std::string_view name) const {
+    auto it = layers_.find(name);
+    if (it == layers_.end()) {
+        std::string known;
+        for (const auto& [n, _] : layers_) known += (known.empty() ? "" : ", ") + n;
+        throw BadInput("the heightmap has no layer '" + std::string(name) + "' (it has " +
+                       (known.empty() ? std::string("no layers") : known) + ")");
+    }
+    return {it->second.data(), width_, height_, cell_};
+}
+
+void Heightmap::remove_layer(std::string_view name) {
+    auto it = layers_.find(name);
+    if (it != layers_.end()) layers_.erase(it);
+}
+
+std::vector<std::string> Heightmap::layer_names() const {
+    std::vector<std::string> names;
+    for (const auto& [n, _] : layers_) names.push_back(n);
+    return names;
+}
+
+std::size_t ParticleFrame::count() const {
+    auto it = attributes.find("position");
+    return it == attributes.end() ? 0 : it->second.data.size() / 3;
+}
+
+namespace {
+[[noreturn]] void wrong_type(ValueType want, ValueType have) {
+    throw Error("internal error: expected a " + std::string(to_string(want)) + " value, got " +
+                std::string(to_string(have)));
+}
+}  // namespace
+
+const std::shared_ptr<const Heightmap>& Value::heightmap() const {
+    if (type() != ValueType::heightmap) wrong_type(ValueType::heightmap, type());
+    return std::get<1>(v_);
+}
+const std::shared_ptr<const Image>& Value::image() const {
+    if (type() != ValueType::image) wrong_type(ValueType::image, type());
+    return std::get<2>(v_);
+}
+const std::shared_ptr<const ParticleSeries>& Value::particles() const {
+    if (type() != ValueType::particles) wrong_type(ValueType::particles, type());
+    return std::get<3>(v_);
+}
+const std::shared_ptr<const PlateHistory>& Value::plates() const {
+    if (type() != ValueType::plates) wrong_type(ValueType::plates, type());
+    return std::get<4>(v_);
+}
+
+}  // namespace orogen
