@@ -1,0 +1,132 @@
+// erode:thermal — registers Olsen's thermal erosion (thermal.hpp) with the kernel.
+#include "thermal.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/plugin.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using namespace orogen;
+
+std::string known_layers(const ValueInfo& info) {
+    if (info.layers.empty()) return "the input has no layers";
+    std::string s = "the input's layers are: ";
+    bool first = true;
+    for (const auto& l : info.layers) {
+        s += (first ? "" : ", ") + l;
+        first = false;
+    }
+    return s;
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    auto hm = ctx.take_heightmap(0);
+    thermal::Settings s;
+    s.neighbourhood = thermal::parse_neighbourhood(ctx.text("neighbourhood"));
+    s.talus_slope = std::tan(ctx.real("talus") * std::numbers::pi / 180.0);
+    s.talus_height = ctx.real("talus_height") > 0.0 ? ctx.real("talus_height") : -1.0;
+    s.rate = ctx.real("rate");
+    const std::string& hardness = ctx.text("hardness");
+    const float* layer = nullptr;
+    if (hardness == "constant") {
+        s.hardness = thermal::Hardness::constant;
+    } else if (hardness == "height") {
+        s.hardness = thermal::Hardness::height;
+        const auto [lo, hi] = std::minmax_element(hm->heights().begin(), hm->heights().end());
+        s.height_min = hm->heights().empty() ? 0.0f : *lo;
+        s.height_max = hm->heights().empty() ? 1.0f : *hi;
+    } else {
+        s.hardness = thermal::Hardness::layer;
+        if (!hm->has_layer(hardness))
+            throw BadInput("hardness: the input has no layer '" + hardness + "'");
+        layer = std::as_const(*hm).layer(hardness).data;
+    }
+
+    const std::vector<float> before = hm->heights();
+    const std::int64_t iterations = ctx.integer("iterations");
+    thermal::erode(hm->view(), iterations, s, layer, [&](std::int64_t i, ConstGridView current) {
+        ctx.check_cancelled();
+        if (i % 64 == 0 || i == iterations) {
+            ctx.check_finite(current.span(), "height", i);
+            ctx.progress(double(i) / double(iterations));
+        }
+    });
+
+    // eroded: net change in metres, added to an earlier eroder's if present.
+    GridView eroded = hm->layer("eroded", 0.0f);
+    const std::vector<float>& after = hm->heights();
+    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
+    if (s.hardness == thermal::Hardness::height) {
+        GridView k = hm->layer("hardness", 0.0f);
+        for (std::size_t i = 0; i < after.size(); ++i)
+            k.data[i] = thermal::height_hardness(after[i], s.height_min, s.height_max);
+    }
+    return hm;
+}
+
+void check(CheckContext& ctx) {
+    if (ctx.given("talus") && ctx.given("talus_height"))
+        ctx.error("talus_height", "give either talus (an angle) or talus_height (Olsen's height difference), not both");
+    const std::string& hardness = ctx.text("hardness");
+    if (hardness == "height") {
+        ctx.output().layers.insert("hardness");
+    } else if (hardness != "constant") {
+        const ValueInfo* in = ctx.input(0);
+        if (in && in->layers_known && !in->layers.contains(hardness))
+            ctx.error("hardness", "no layer '" + hardness + "' on the input (" + known_layers(*in) +
+                                      "); use constant, height or the name of an existing layer");
+    }
+    ctx.output().layers.insert("eroded");
+}
+
+}  // namespace
+
+OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
+    registry.add({
+        .kind = "erode",
+        .name = "thermal",
+        .summary = "Olsen's thermal erosion: material slides to lower neighbours steeper than the talus angle",
+        .description =
+            "A cellular automaton (thesis section 3.4, after Olsen 2004). Each step, a cell whose drop d_i to a "
+            "neighbour exceeds the talus threshold T_i gives rate * (max_i(d_i - T_i)) of material, shared among "
+            "those neighbours in proportion to d_i. The threshold is tan(talus) * distance (distance = cell, or "
+            "cell * sqrt 2 for diagonal neighbours), or one height difference for all (talus_height). Material "
+            "is conserved exactly; the result is the same for any thread count. Adds the layer eroded (net change, "
+            "m) and, with hardness=height, hardness.",
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"}},
+        .output = ValueType::heightmap,
+        .params =
+            {
+                Param::integer("iterations", 50).min(0).max(10'000'000).help("number of steps"),
+                Param::real("talus", 35.0)
+                    .min(0.0, true)
+                    .max(90.0, true)
+                    .unit("°")
+                    .help("talus angle: slopes steeper than this shed material"),
+                Param::real("talus_height", 0.0)
+                    .min(0.0)
+                    .unit("m")
+                    .help("Olsen's form: one height difference for every neighbour, instead of talus (0 = use talus)"),
+                Param::real("rate", 0.5)
+                    .min(0.0, true)
+                    .max(1.0)
+                    .help("fraction of the excess above the threshold moved per step (Olsen 0.5, the thesis 0.01)"),
+                Param::choice("neighbourhood", {"von-neumann", "rotated", "moore"}, "rotated")
+                    .help("neighbours considered: the 4 axis ones, the 4 diagonals (the thesis's rotated von "
+                          "Neumann), or all 8"),
+                Param::string("hardness", "constant")
+                    .help("constant; height (the thesis's height-aware hardness: high ground is hard, "
+                          "softness ((max - h)/(max - min))^2); or the name of a layer holding hardness 0..1"),
+            },
+        .adds_layers = {"eroded"},
+        .check = check,
+        .run = run,
+    });
+}

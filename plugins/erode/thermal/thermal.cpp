@@ -1,0 +1,229 @@
+#include "thermal.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/parallel.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace orogen::thermal {
+
+Neighbourhood parse_neighbourhood(std::string_view name) {
+    if (name == "von-neumann") return Neighbourhood::von_neumann;
+    if (name == "rotated") return Neighbourhood::rotated;
+    if (name == "moore") return Neighbourhood::moore;
+    throw BadInput("unknown neighbourhood '" + std::string(name) + "': use von-neumann, rotated or moore");
+}
+
+namespace {
+
+struct Offset {
+    int dx, dy;
+    bool diagonal;
+};
+
+constexpr Offset kVonNeumann[] = {{1, 0, false}, {-1, 0, false}, {0, 1, false}, {0, -1, false}};
+constexpr Offset kRotated[] = {{1, 1, true}, {-1, 1, true}, {1, -1, true}, {-1, -1, true}};
+constexpr Offset kMoore[] = {{1, 0, false}, {-1, 0, false}, {0, 1, false}, {0, -1, false},
+                             {1, 1, true},  {-1, 1, true},  {1, -1, true},  {-1, -1, true}};
+
+template <Neighbourhood N>
+constexpr auto& offsets() {
+    if constexpr (N == Neighbourhood::von_neumann) return kVonNeumann;
+    else if constexpr (N == Neighbourhood::rotated) return kRotated;
+    else return kMoore;
+}
+
+/// Per-step constants shared by every row.
+struct Rule {
+    float t_axis = 0.0f;  ///< threshold to an axis neighbour, metres
+    float t_diag = 0.0f;  ///< threshold to a diagonal neighbour, metres
+    float rate = 0.5f;
+    Hardness hardness = Hardness::constant;
+    float h_min = 0.0f, h_max = 1.0f;
+    const float* hardness_layer = nullptr;
+
+    float threshold(bool diagonal) const { return diagonal ? t_diag : t_axis; }
+};
+
+Rule make_rule(const Settings& s, double cell) {
+    Rule r;
+    if (s.talus_height >= 0.0) {
+        r.t_axis = r.t_diag = float(s.talus_height);
+    } else {
+        r.t_axis = float(s.talus_slope * cell);
+        r.t_diag = float(s.talus_slope * cell * std::sqrt(2.0));
+    }
+    r.rate = float(s.rate);
+    r.hardness = s.hardness;
+    r.h_min = s.height_min;
+    r.h_max = s.height_max;
+    return r;
+}
+
+/// Softness (0..1) of the cell at index i with height h: scales what it gives.
+inline float softness(const Rule& r, float h, std::size_t i) {
+    switch (r.hardness) {
+        case Hardness::constant: return 1.0f;
+        case Hardness::height: return 1.0f - height_hardness(h, r.h_min, r.h_max);
+        case Hardness::layer: {
+            const float k = r.hardness_layer[i];
+            return 1.0f - (k < 0.0f ? 0.0f : (k > 1.0f ? 1.0f : k));
+        }
+    }
+    return 1.0f;
+}
+
+/// Olsen's factor F for one cell from its excess and the sum of its lower drops.
+inline float factor_from(const Rule& r, float soft, float excess, float sum) {
+    return excess > 0.0f ? r.rate * soft * excess / std::max(sum, 1e-30f) : 0.0f;
+}
+
+/// F for cell (x, y) with bounds checks (edge cells).
+template <Neighbourhood N>
+float factor_checked(ConstGridView in, const Rule& r, int x, int y) {
+    const float h = in.at(x, y);
+    float excess = 0.0f, sum = 0.0f;
+    for (const Offset& o : offsets<N>()) {
+        const int nx = x + o.dx, ny = y + o.dy;
+        if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
+        const float t = r.threshold(o.diagonal);
+        const float d = h - in.at(nx, ny);
+        excess = std::max(excess, d - t);
+        sum += d > t ? d : 0.0f;
+    }
+    return factor_from(r, softness(r, h, std::size_t(y) * std::size_t(in.width) + std::size_t(x)), excess, sum);
+}
+
+/// F for every cell of row y into f[0..width).
+template <Neighbourhood N>
+void factor_row(ConstGridView in, const Rule& r, int y, float* f) {
+    const int w = in.width;
+    if (y == 0 || y == in.height - 1 || w < 3) {
+        for (int x = 0; x < w; ++x) f[x] = factor_checked<N>(in, r, x, y);
+        return;
+    }
+    f[0] = factor_checked<N>(in, r, 0, y);
+    f[w - 1] = factor_checked<N>(in, r, w - 1, y);
+    const float* rows[3] = {in.row(y - 1), in.row(y), in.row(y + 1)};
+    const float* c = rows[1];
+    const std::size_t base = std::size_t(y) * std::size_t(w);
+    for (int x = 1; x < w - 1; ++x) {
+        const float h = c[x];
+        float excess = 0.0f, sum = 0.0f;
+#pragma GCC unroll 8
+        for (const Offset& o : offsets<N>()) {
+            const float t = r.threshold(o.diagonal);
+            const float d = h - rows[1 + o.dy][x + o.dx];
+            excess = std::max(excess, d - t);
+            sum += d > t ? d : 0.0f;
+        }
+        f[x] = factor_from(r, softness(r, h, base + std::size_t(x)), excess, sum);
+    }
+}
+
+/// New height of cell (x, y) with bounds checks. frow(dy) gives F of row y+dy.
+template <Neighbourhood N, typename FRow>
+float update_checked(ConstGridView in, const Rule& r, int x, int y, const FRow& frow) {
+    const float h = in.at(x, y);
+    const float fc = frow(0)[x];
+    float out = 0.0f, gain = 0.0f;
+    for (const Offset& o : offsets<N>()) {
+        const int nx = x + o.dx, ny = y + o.dy;
+        if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
+        const float t = r.threshold(o.diagonal);
+        const float hn = in.at(nx, ny);
+        const float d = h - hn;   // drop to the neighbour
+        const float e = hn - h;   // drop from the neighbour
+        out += d > t ? fc * d : 0.0f;
+        gain += e > t ? frow(o.dy)[nx] * e : 0.0f;
+    }
+    return h - out + gain;
+}
+
+template <Neighbourhood N>
+void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const float* const f[3]) {
+    const int w = in.width;
+    float* dst = outv.row(y);
+    auto frow = [&](int dy) { return f[1 + dy]; };
+    if (y == 0 || y == in.height - 1 || w < 3) {
+        for (int x = 0; x < w; ++x) dst[x] = update_checked<N>(in, r, x, y, frow);
+        return;
+    }
+    dst[0] = update_checked<N>(in, r, 0, y, frow);
+    dst[w - 1] = update_checked<N>(in, r, w - 1, y, frow);
+    const float* rows[3] = {in.row(y - 1), in.row(y), in.row(y + 1)};
+    const float* c = rows[1];
+    const float* fc = f[1];
+    for (int x = 1; x < w - 1; ++x) {
+        const float h = c[x];
+        float out = 0.0f, gain = 0.0f;
+#pragma GCC unroll 8
+        for (const Offset& o : offsets<N>()) {
+            const float t = r.threshold(o.diagonal);
+            const float hn = rows[1 + o.dy][x + o.dx];
+            const float d = h - hn;
+            const float e = hn - h;
+            out += d > t ? fc[x] * d : 0.0f;
+            gain += e > t ? f[1 + o.dy][x + o.dx] * e : 0.0f;
+        }
+        dst[x] = h - out + gain;
+    }
+}
+
+template <Neighbourhood N>
+void step_impl(ConstGridView in, GridView out, const Rule& r) {
+    const int w = in.width, h = in.height;
+    // Rows in parallel. Each chunk recomputes F for its one-row halo; F of a
+    // row is the same pure function of `in` wherever it is computed, so the
+    // result does not depend on the chunking.
+    const std::int64_t grain = std::max<std::int64_t>(8, h / 64);
+    parallel_for(0, h, grain, [&](std::int64_t y0, std::int64_t y1) {
+        std::vector<float> ring(std::size_t(w) * 3);
+        auto slot = [&](std::int64_t y) { return ring.data() + std::size_t(((y % 3) + 3) % 3) * std::size_t(w); };
+        if (y0 > 0) factor_row<N>(in, r, int(y0 - 1), slot(y0 - 1));
+        factor_row<N>(in, r, int(y0), slot(y0));
+        for (std::int64_t y = y0; y < y1; ++y) {
+            if (y + 1 < h) factor_row<N>(in, r, int(y + 1), slot(y + 1));
+            // Rows outside the grid are never read (update_* checks bounds there).
+            const float* f[3] = {slot(y - 1), slot(y), slot(y + 1)};
+            update_row<N>(in, out, r, int(y), f);
+        }
+    });
+}
+
+}  // namespace
+
+void step(ConstGridView in, GridView out, const Settings& settings, const float* hardness) {
+    if (in.width != out.width || in.height != out.height)
+        throw Error("thermal::step: input and output grids differ in size");
+    if (settings.hardness == Hardness::layer && hardness == nullptr)
+        throw Error("thermal::step: hardness layer mode needs a hardness layer");
+    Rule r = make_rule(settings, in.cell);
+    r.hardness_layer = hardness;
+    switch (settings.neighbourhood) {
+        case Neighbourhood::von_neumann: step_impl<Neighbourhood::von_neumann>(in, out, r); break;
+        case Neighbourhood::rotated: step_impl<Neighbourhood::rotated>(in, out, r); break;
+        case Neighbourhood::moore: step_impl<Neighbourhood::moore>(in, out, r); break;
+    }
+}
+
+void erode(GridView heights, std::int64_t iterations, const Settings& settings, const float* hardness,
+           const std::function<void(std::int64_t, ConstGridView)>& on_step) {
+    if (iterations <= 0) return;
+    std::vector<float> scratch(heights.size());
+    GridView a = heights;
+    GridView b{scratch.data(), heights.width, heights.height, heights.cell};
+    for (std::int64_t i = 1; i <= iterations; ++i) {
+        step(a, b, settings, hardness);
+        std::swap(a, b);
+        if (on_step) on_step(i, a);
+    }
+    if (a.data != heights.data) std::memcpy(heights.data, a.data, heights.size() * sizeof(float));
+}
+
+}  // namespace orogen::thermal

@@ -1,0 +1,178 @@
+// Tests of Olsen's thermal erosion core: mass, convergence to the talus
+// slope, hardness, determinism across thread counts.
+#include "thermal.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/random.hpp>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <numbers>
+#include <vector>
+
+namespace {
+
+using namespace orogen;
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+std::vector<float> noise_terrain(int w, int h, std::uint64_t seed, float amplitude) {
+    std::vector<float> v(std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            v[std::size_t(y) * w + x] = amplitude * float(random::uniform(seed, x, y)) +
+                                        0.2f * amplitude * std::sin(0.1f * float(x)) * std::cos(0.07f * float(y));
+    return v;
+}
+
+double total(const std::vector<float>& v) {
+    double s = 0.0;
+    for (float x : v) s += x;
+    return s;
+}
+
+double max_abs(const std::vector<float>& v) {
+    double m = 0.0;
+    for (float x : v) m = std::max(m, double(std::fabs(x)));
+    return m;
+}
+
+class ThermalNeighbourhoods : public ::testing::TestWithParam<thermal::Neighbourhood> {};
+
+TEST_P(ThermalNeighbourhoods, ConservesMaterialToRoundOff) {
+    const int w = 97, h = 83;
+    auto v = noise_terrain(w, h, 7, 50.0f);
+    const double before = total(v);
+    thermal::Settings s;
+    s.neighbourhood = GetParam();
+    s.talus_slope = std::tan(30 * kDeg);
+    thermal::erode(GridView{v.data(), w, h, 2.0}, 300, s);
+    // Round-off bound: a few ulps of the largest value per cell and step, summed.
+    EXPECT_NEAR(total(v), before, 1e-6 * max_abs(v) * double(w) * double(h));
+    EXPECT_NE(total(v), 0.0);
+}
+
+TEST_P(ThermalNeighbourhoods, TallColumnBecomesPileAtTalusSlope) {
+    const int n = 129, c = 64;
+    const double cell = 1.0;
+    const double talus = 30.0;
+    std::vector<float> v(std::size_t(n) * n, 0.0f);
+    v[std::size_t(c) * n + c] = 20000.0f;
+    thermal::Settings s;
+    s.neighbourhood = GetParam();
+    s.talus_slope = std::tan(talus * kDeg);
+    s.rate = 0.5;
+    thermal::erode(GridView{v.data(), n, n, cell}, 6000, s);
+    auto at = [&](int x, int y) { return double(v[std::size_t(y) * n + x]); };
+
+    // No neighbour drop exceeds its threshold (to a small tolerance).
+    const bool diag = GetParam() != thermal::Neighbourhood::von_neumann;
+    const bool axis = GetParam() != thermal::Neighbourhood::rotated;
+    const double t_axis = std::tan(talus * kDeg) * cell, t_diag = t_axis * std::sqrt(2.0);
+    double worst = 0.0;
+    for (int y = 1; y < n - 1; ++y)
+        for (int x = 1; x < n - 1; ++x) {
+            if (axis) worst = std::max({worst, at(x, y) - at(x + 1, y) - t_axis, at(x, y) - at(x, y + 1) - t_axis,
+                                        at(x + 1, y) - at(x, y) - t_axis, at(x, y + 1) - at(x, y) - t_axis});
+            if (diag) worst = std::max({worst, at(x, y) - at(x + 1, y + 1) - t_diag, at(x + 1, y + 1) - at(x, y) - t_diag,
+                                        at(x + 1, y) - at(x, y + 1) - t_diag, at(x, y + 1) - at(x + 1, y) - t_diag});
+        }
+    EXPECT_LT(worst, 1e-3);
+
+    // The flank: mean slope along the steepest ray from the peak, over the
+    // middle half of the flank, equals the talus angle within 1°.
+    const int dx = axis ? 1 : 1, dy = axis ? 0 : 1;
+    const double step_len = cell * std::sqrt(double(dx * dx + dy * dy));
+    int foot = 0;
+    while (c + (foot + 1) * dx < n && at(c + (foot + 1) * dx, c + (foot + 1) * dy) > 0.0) ++foot;
+    ASSERT_GT(foot, 12) << "the pile is too small to measure";
+    const int k0 = foot / 4, k1 = 3 * foot / 4;
+    const double drop = at(c + k0 * dx, c + k0 * dy) - at(c + k1 * dx, c + k1 * dy);
+    const double slope_deg = std::atan(drop / (double(k1 - k0) * step_len)) / kDeg;
+    EXPECT_NEAR(slope_deg, talus, 1.0) << "foot at " << foot << " cells";
+}
+
+INSTANTIATE_TEST_SUITE_P(All, ThermalNeighbourhoods,
+                         ::testing::Values(thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated,
+                                           thermal::Neighbourhood::moore));
+
+TEST(Thermal, TalusHeightFormBoundsEveryNeighbourDifference) {
+    const int n = 65;
+    auto v = noise_terrain(n, n, 3, 30.0f);
+    thermal::Settings s;
+    s.neighbourhood = thermal::Neighbourhood::moore;
+    s.talus_height = 2.0;
+    thermal::erode(GridView{v.data(), n, n, 10.0}, 3000, s);
+    double worst = 0.0;
+    for (int y = 0; y + 1 < n; ++y)
+        for (int x = 0; x + 1 < n; ++x) {
+            const float a = v[std::size_t(y) * n + x];
+            for (float b : {v[std::size_t(y) * n + x + 1], v[std::size_t(y + 1) * n + x], v[std::size_t(y + 1) * n + x + 1]})
+                worst = std::max(worst, std::fabs(double(a) - double(b)));
+            worst = std::max(worst, std::fabs(double(v[std::size_t(y) * n + x + 1]) - double(v[std::size_t(y + 1) * n + x])));
+        }
+    EXPECT_LT(worst, 2.0 + 1e-3);
+}
+
+TEST(Thermal, HardLayerStopsErosion) {
+    const int n = 65;
+    auto v = noise_terrain(n, n, 5, 40.0f);
+    const auto before = v;
+    std::vector<float> hard(v.size(), 1.0f);
+    thermal::Settings s;
+    s.hardness = thermal::Hardness::layer;
+    thermal::erode(GridView{v.data(), n, n, 1.0}, 50, s, hard.data());
+    EXPECT_EQ(v, before);
+}
+
+TEST(Thermal, HeightAwareHardnessKeepsTheSummit) {
+    const int n = 65;
+    auto v = noise_terrain(n, n, 9, 40.0f);
+    const auto before = v;
+    thermal::Settings s;
+    s.hardness = thermal::Hardness::height;
+    s.height_min = *std::min_element(v.begin(), v.end());
+    s.height_max = *std::max_element(v.begin(), v.end());
+    const std::size_t top = std::size_t(std::max_element(v.begin(), v.end()) - v.begin());
+    thermal::erode(GridView{v.data(), n, n, 1.0}, 1, s);
+    // The highest cell gives nothing in the first step (softness 0); it may only gain.
+    EXPECT_GE(v[top], before[top]);
+    EXPECT_EQ(thermal::height_hardness(s.height_max, s.height_min, s.height_max), 1.0f);
+    EXPECT_EQ(thermal::height_hardness(s.height_min, s.height_min, s.height_max), 0.0f);
+    // Low ground (soft) still erodes: the terrain changed.
+    EXPECT_NE(v, before);
+}
+
+TEST(Thermal, SameBytesOnOneAndTwoThreads) {
+    const int w = 301, h = 257;
+    auto a = noise_terrain(w, h, 11, 60.0f);
+    auto b = a;
+    thermal::Settings s;
+    s.neighbourhood = thermal::Neighbourhood::moore;
+    s.hardness = thermal::Hardness::height;
+    s.height_max = 60.0f;
+    {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        thermal::erode(GridView{a.data(), w, h, 1.0}, 40, s);
+    }
+    {
+        tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+        thermal::erode(GridView{b.data(), w, h, 1.0}, 40, s);
+    }
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+}
+
+TEST(Thermal, UnknownNeighbourhoodIsBadInput) {
+    try {
+        thermal::parse_neighbourhood("hexagonal");
+        FAIL();
+    } catch (const BadInput& e) {
+        EXPECT_STREQ(e.what(), "unknown neighbourhood 'hexagonal': use von-neumann, rotated or moore");
+    }
+}
+
+}  // namespace
