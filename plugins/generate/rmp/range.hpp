@@ -1,0 +1,34 @@
+// range.hpp — the advanced RMP of the thesis's section 3.6.2: a mountain range
+// between two points.
+//
+// The Voronoi cells crossed on the way from a to b are raised together. The
+// thesis walked the colour labels along a Bresenham line; here the cells are
+// the union of (1) the cells of the Bresenham line's vertices, as the thesis
+// did, and (2) every cell the continuous segment passes through (an exact
+// walk from cell to cell across the bisector it leaves by), so the raised
+// band contains the whole segment and every vertex of its raster line.
+//
+// Used by generate:range (iterated, a fresh diagram each time) and by the
+// plate simulation (one call per collision). Link orogen_core_rmp.
+#pragma once
+
+#include <orogen/grid.hpp>
+
+#include <cstdint>
+
+namespace orogen::rmp {
+
+struct RangeParams {
+    int cones = 100;      // Voronoi sites over the whole grid
+    double height = 1.0;  // metres raised per call
+    double jitter = 0.0;  // 0: every crossed cell by `height`; >0: each cell by height*(1 + jitter*u), u in [-1,1)
+};
+
+/// Raise every Voronoi cell crossed by the Bresenham line from a to b (sample coordinates,
+/// clamped to the grid). Sites come from `seed`. Cost is proportional to the area of the raised
+/// cells, not to the grid. If `uplift` is non-null the same amounts are added to it.
+/// Returns the number of cells raised.
+int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
+                GridView* uplift = nullptr);
+
+}  // namespace orogen::rmp
