@@ -1,1 +1,341 @@
-int main(){return 0;}
+// The `orogen` command: run | check | list | help | version.
+// Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
+// usage), 130 interrupted.
+#include "../src/loader.hpp"
+#include "../src/plan.hpp"
+#include "../src/progress.hpp"
+#include "../src/runner.hpp"
+#include "../src/spec.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <cstring>
+#include <iostream>
+#include <sstream>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace orogen;
+
+namespace {
+
+constexpr int exit_ok = 0, exit_failed = 1, exit_bad_input = 2;
+
+std::atomic<bool> g_cancel{false};
+extern "C" void on_interrupt(int) {
+    g_cancel.store(true);
+    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends at once
+}
+
+const char* usage_text =
+    "usage:\n"
+    "  orogen run SPEC [--out DIR] [--seed N] [--threads N] [--set NAME.PARAM=VALUE]... [--quiet]\n"
+    "  orogen check SPEC [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
+    "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
+    "  orogen help NODE                                a node's inputs and parameters\n"
+    "  orogen version                                  kernel, plugin API and plugin versions\n"
+    "\n"
+    "Output paths in a spec are relative to --out (default: out/). Plugins are loaded from\n"
+    "<prefix>/lib/orogen/plugins and from OROGEN_PLUGIN_PATH (folders or .so files, ':'-separated).\n";
+
+int usage_error(const std::string& message) {
+    std::fprintf(stderr, "orogen: error: %s\n%s", message.c_str(), usage_text);
+    return exit_bad_input;
+}
+
+fs::path self_path(const char* argv0) {
+    std::error_code ec;
+    fs::path p = fs::read_symlink("/proc/self/exe", ec);
+    return ec ? fs::absolute(argv0) : p;
+}
+
+void print_problems(const PluginSet& plugins) {
+    for (const auto& p : plugins.problems()) std::fprintf(stderr, "orogen: warning: plugin %s\n", p.c_str());
+}
+
+struct Args {
+    std::string command;
+    std::vector<std::string> positional;
+    std::string out = "out";
+    std::optional<std::uint64_t> seed;
+    int threads = 0;
+    bool quiet = false;
+    std::vector<std::string> overrides;
+};
+
+std::optional<std::uint64_t> parse_u64(const std::string& s) {
+    if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 20) return std::nullopt;
+    errno = 0;
+    char* end = nullptr;
+    const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+    if (errno == ERANGE) return std::nullopt;
+    return std::uint64_t(v);
+}
+
+/// Parse options; returns an exit code on error.
+std::optional<int> parse_args(int argc, char** argv, Args& a) {
+    for (int i = 2; i < argc; ++i) {
+        std::string arg = argv[i];
+        auto value = [&](const std::string& name) -> std::optional<std::string> {
+            const auto eq = arg.find('=');
+            if (eq != std::string::npos && arg.substr(0, eq) == name) return arg.substr(eq + 1);
+            if (arg == name) {
+                if (i + 1 >= argc) return std::nullopt;
+                return std::string(argv[++i]);
+            }
+            return std::nullopt;
+        };
+        auto is = [&](const std::string& name) { return arg == name || arg.rfind(name + "=", 0) == 0; };
+        if (is("--out")) {
+            auto v = value("--out");
+            if (!v || v->empty()) return usage_error("--out needs a folder");
+            a.out = *v;
+        } else if (is("--seed")) {
+            auto v = value("--seed");
+            auto n = v ? parse_u64(*v) : std::nullopt;
+            if (!n) return usage_error("--seed needs a whole number from 0 to 2^64-1" + (v ? ", got '" + *v + "'" : std::string()));
+            a.seed = n;
+        } else if (is("--threads")) {
+            auto v = value("--threads");
+            auto n = v ? parse_u64(*v) : std::nullopt;
+            if (!n || *n < 1 || *n > 1024)
+                return usage_error("--threads needs a number from 1 to 1024" + (v ? ", got '" + *v + "'" : std::string()));
+            a.threads = int(*n);
+        } else if (is("--set")) {
+            auto v = value("--set");
+            if (!v) return usage_error("--set needs NAME.PARAM=VALUE");
+            a.overrides.push_back(*v);
+        } else if (arg == "--quiet" || arg == "-q") {
+            a.quiet = true;
+        } else if (arg.size() > 1 && arg[0] == '-') {
+            return usage_error("unknown option '" + arg + "'");
+        } else {
+            a.positional.push_back(arg);
+        }
+    }
+    return std::nullopt;
+}
+
+/// Read, parse and check a spec. Prints diagnostics; returns nullopt on error.
+std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins, const Args& args) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) {
+        std::fprintf(stderr, "orogen: error: cannot read spec %s: no such file\n", path.c_str());
+        return std::nullopt;
+    }
+    if (fs::is_directory(path, ec)) {
+        std::fprintf(stderr, "orogen: error: cannot read spec %s: it is a folder; give a .orogen file\n", path.c_str());
+        return std::nullopt;
+    }
+    std::string text;
+    try {
+        const auto bytes = read_file(path);
+        text.assign(bytes.begin(), bytes.end());
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "orogen: error: %s\n", e.what());
+        return std::nullopt;
+    }
+    auto source = std::make_shared<spec::Source>(path, std::move(text));
+    spec::Diagnostics diags;
+    spec::Spec parsed = spec::parse(source, diags);
+    if (diags.has_errors()) {  // syntax first: semantic errors on a broken tree would be noise
+        std::fputs(diags.format().c_str(), stderr);
+        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s", path.c_str());
+        return std::nullopt;
+    }
+    CheckOptions options;
+    options.overrides = args.overrides;
+    options.seed = args.seed;
+    Plan plan = check(parsed, plugins.registry(), path, options, diags);
+    if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
+    if (diags.has_errors()) {
+        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s", path.c_str());
+        return std::nullopt;
+    }
+    return plan;
+}
+
+int cmd_check(const Args& args, const PluginSet& plugins) {
+    if (args.positional.size() != 1) return usage_error("check needs one spec file");
+    auto plan = load_spec(args.positional[0], plugins, args);
+    if (!plan) return exit_bad_input;
+    std::printf("%s: ok (%zu node%s, grid %dx%d, cell %g m, seed %llu)\n", args.positional[0].c_str(),
+                plan->nodes.size(), plan->nodes.size() == 1 ? "" : "s", plan->grid.width, plan->grid.height,
+                plan->grid.cell, static_cast<unsigned long long>(plan->seed));
+    return exit_ok;
+}
+
+int cmd_run(const Args& args, const PluginSet& plugins) {
+    if (args.positional.size() != 1) return usage_error("run needs one spec file");
+    auto plan = load_spec(args.positional[0], plugins, args);
+    if (!plan) return exit_bad_input;
+    std::signal(SIGINT, on_interrupt);
+    std::signal(SIGTERM, on_interrupt);
+    ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, args.quiet);
+    RunOptions options;
+    options.out_dir = args.out;
+    options.threads = args.threads;
+    options.progress = &progress;
+    options.plugins = plugins.plugins();
+    options.cancel = &g_cancel;
+    RunResult result = run(*plan, options);
+    if (result.exit_code != 0) {
+        std::fputs(result.error.c_str(), stderr);
+        return result.exit_code;
+    }
+    if (!args.quiet) {
+        std::printf("wrote %zu file%s to %s:\n", result.outputs.size(), result.outputs.size() == 1 ? "" : "s",
+                    args.out.c_str());
+        for (const auto& f : result.outputs) std::printf("  %s\n", f.string().c_str());
+        std::printf("\n%s", format_timings(result).c_str());
+    }
+    return exit_ok;
+}
+
+int cmd_list(const Args& args, const PluginSet& plugins) {
+    if (args.positional.size() > 1) return usage_error("list takes at most one kind");
+    const std::string kind = args.positional.empty() ? "" : args.positional[0];
+    static const std::vector<std::string> kinds = {"generate", "erode", "tectonics", "render", "export", "import"};
+    if (!kind.empty() && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) {
+        std::string msg = "unknown kind '" + kind + "' (kinds: generate, erode, tectonics, render, export, import)";
+        const std::string guess = spec::closest(kind, kinds);
+        if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+        std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
+        return exit_bad_input;
+    }
+    for (const auto* n : plugins.registry().nodes()) {
+        if (!kind.empty() && n->kind != kind) continue;
+        std::printf("%-26s %s\n", n->qualified_name().c_str(), n->summary.c_str());
+    }
+    return exit_ok;
+}
+
+std::string value_text(const ParamValue& v, const Param& p) {
+    std::ostringstream s;
+    std::visit(
+        [&](const auto& x) {
+            using T = std::decay_t<decltype(x)>;
+            if constexpr (std::is_same_v<T, std::monostate>) s << "(required)";
+            else if constexpr (std::is_same_v<T, bool>) s << (x ? "true" : "false");
+            else if constexpr (std::is_same_v<T, std::string>)
+                s << (p.type == ParamType::choice ? x : "\"" + x + "\"");
+            else if constexpr (std::is_same_v<T, Point2>) s << "(" << x.x << ", " << x.y << ")";
+            else if constexpr (std::is_same_v<T, std::vector<Point2>>) {
+                s << "[";
+                for (std::size_t i = 0; i < x.size(); ++i) s << (i ? ", " : "") << "(" << x[i].x << ", " << x[i].y << ")";
+                s << "]";
+            } else s << x;
+        },
+        v);
+    return s.str();
+}
+
+int cmd_help(const Args& args, const PluginSet& plugins) {
+    if (args.positional.size() != 1) return usage_error("help needs a node, e.g. `orogen help generate:fault`");
+    const std::string& name = args.positional[0];
+    const NodeDescriptor* n = plugins.registry().find(name);
+    if (!n) {
+        std::vector<std::string> names;
+        for (const auto* d : plugins.registry().nodes()) {
+            names.push_back(d->qualified_name());
+            if (d->name == name) n = d;  // `orogen help fault` is fine too
+        }
+        if (!n) {
+            std::string msg = "unknown node '" + name + "'";
+            const std::string guess = spec::closest(name, names);
+            msg += guess.empty() ? "; `orogen list` shows them all" : "; did you mean '" + guess + "'?";
+            std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
+            return exit_bad_input;
+        }
+    }
+    std::printf("%s — %s\n", n->qualified_name().c_str(), n->summary.c_str());
+    if (!n->description.empty()) std::printf("\n%s\n", n->description.c_str());
+    std::printf("\ninputs:%s\n", n->inputs.empty() ? " none" : "");
+    for (std::size_t i = 0; i < n->inputs.size(); ++i) {
+        const auto& in = n->inputs[i];
+        std::printf("  %zu. %-14s %s%s%s\n", i + 1, in.name.c_str(), std::string(to_string(in.type)).c_str(),
+                    in.need == Need::optional ? ", optional" : "", in.help.empty() ? "" : (" — " + in.help).c_str());
+    }
+    std::printf("output: %s\n", std::string(to_string(n->output)).c_str());
+    if (!n->adds_layers.empty()) {
+        std::string layers;
+        for (const auto& l : n->adds_layers) layers += (layers.empty() ? "" : ", ") + l;
+        std::printf("adds layers: %s\n", layers.c_str());
+    }
+    for (const auto& s : n->side_outputs)
+        std::printf("side value: NAME.%s (%s)%s\n", s.name.c_str(), std::string(to_string(s.type)).c_str(),
+                    s.help.empty() ? "" : (" — " + s.help).c_str());
+    std::printf("\nparameters:%s\n", n->params.empty() ? " none" : "");
+    for (const auto& p : n->params) {
+        std::string type = std::string(to_string(p.type));
+        if (p.type == ParamType::choice) {
+            type = "";
+            for (const auto& c : p.choices) type += (type.empty() ? "" : "|") + c;
+        }
+        std::string range;
+        if (p.minimum || p.maximum) {
+            range = std::string(p.minimum ? (p.minimum_exclusive ? "(" : "[") : "(") +
+                    (p.minimum ? value_text(*p.minimum, p) : "-inf") + ", " +
+                    (p.maximum ? value_text(*p.maximum, p) : "inf") + (p.maximum ? (p.maximum_exclusive ? ")" : "]") : ")");
+        }
+        std::printf("  %-16s %-12s default %-12s%s%s\n", p.name.c_str(), type.c_str(), value_text(p.default_value, p).c_str(),
+                    range.empty() ? "" : ("  range " + range).c_str(), p.unit_text.empty() ? "" : ("  unit " + p.unit_text).c_str());
+        if (!p.help_text.empty()) std::printf("      %s\n", p.help_text.c_str());
+    }
+    std::printf("\nprovided by %s\n", plugins.registry().provider(n->qualified_name()).c_str());
+    return exit_ok;
+}
+
+int cmd_version(const PluginSet& plugins) {
+    std::printf("orogen %s (plugin API %d)\n", OROGEN_VERSION, OROGEN_PLUGIN_API_VERSION);
+    std::printf("plugins:\n");
+    for (const auto& p : plugins.plugins())
+        std::printf("  %-22s %-10s %s\n", p.name.c_str(), p.version.c_str(), p.file.c_str());
+    if (plugins.plugins().empty()) std::printf("  (none found)\n");
+    std::printf("searched:\n");
+    for (const auto& f : plugins.searched()) std::printf("  %s\n", f.string().c_str());
+    return exit_ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    if (argc < 2) return usage_error("no command given");
+    Args args;
+    args.command = argv[1];
+    if (args.command == "--help" || args.command == "-h" || args.command == "help" && argc == 2) {
+        std::fputs(usage_text, stdout);
+        return exit_ok;
+    }
+    if (args.command == "--version") args.command = "version";
+    static const std::vector<std::string> commands = {"run", "check", "list", "help", "version"};
+    if (std::find(commands.begin(), commands.end(), args.command) == commands.end()) {
+        std::string msg = "unknown command '" + args.command + "'";
+        const std::string guess = spec::closest(args.command, commands);
+        if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+        return usage_error(msg);
+    }
+    if (auto rc = parse_args(argc, argv, args)) return *rc;
+
+    PluginSet plugins;
+    plugins.load_all(self_path(argv[0]));
+    print_problems(plugins);
+
+    try {
+        if (args.command == "run") return cmd_run(args, plugins);
+        if (args.command == "check") return cmd_check(args, plugins);
+        if (args.command == "list") return cmd_list(args, plugins);
+        if (args.command == "help") return cmd_help(args, plugins);
+        return cmd_version(plugins);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "orogen: error: %s\n", e.what());
+        return e.kind() == Error::Kind::bad_input ? exit_bad_input : exit_failed;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "orogen: error: %s\n", e.what());
+        return exit_failed;
+    }
+}

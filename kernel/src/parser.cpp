@@ -1,0 +1,386 @@
+#include "spec.hpp"
+
+#include <cmath>
+
+namespace orogen::spec {
+
+std::string describe(const Literal& l) {
+    switch (l.kind) {
+        case Literal::Kind::number: return (l.integer ? "the integer " : "the number ") + l.text;
+        case Literal::Kind::string: return "the string \"" + l.text + "\"";
+        case Literal::Kind::boolean: return l.boolean ? "true" : "false";
+        case Literal::Kind::word: return "the word '" + l.text + "'";
+        case Literal::Kind::point: return "a point";
+        case Literal::Kind::list: return "a list";
+    }
+    return "a value";
+}
+
+namespace {
+
+class Parser {
+public:
+    Parser(std::vector<Token> tokens, Diagnostics& diags) : t_(std::move(tokens)), diags_(diags) {}
+
+    Spec parse_spec(const std::shared_ptr<const Source>& source) {
+        Spec spec;
+        spec.source = source;
+        while (peek().kind != Tok::eof) {
+            if (peek().kind == Tok::newline) {
+                ++p_;
+                continue;
+            }
+            const std::size_t errors_before = std::size_t(diags_.error_count());
+            statement(spec);
+            if (std::size_t(diags_.error_count()) != errors_before) {
+                skip_line();
+                continue;
+            }
+            if (peek().kind != Tok::newline && peek().kind != Tok::eof) {
+                error(peek(), "expected the end of the line after this statement, found " + what(peek()));
+                skip_line();
+            }
+        }
+        return spec;
+    }
+
+    std::optional<Override> parse_override() {
+        Override o;
+        const Token& name = peek();
+        if (name.kind != Tok::word) {
+            error(name, "expected NAME.PARAM=VALUE, e.g. --set rivers.steps=500");
+            return std::nullopt;
+        }
+        o.target = name.text;
+        o.target_where = name.where;
+        ++p_;
+        if (!expect(Tok::dot, "'.' between the value name and the parameter (NAME.PARAM=VALUE)")) return std::nullopt;
+        const Token& param = peek();
+        if (param.kind != Tok::word) {
+            error(param, "expected a parameter name after '.'");
+            return std::nullopt;
+        }
+        o.param = param.text;
+        o.param_where = param.where;
+        ++p_;
+        if (!expect(Tok::equals, "'=' and a value (NAME.PARAM=VALUE)")) return std::nullopt;
+        auto value = literal();
+        if (!value) return std::nullopt;
+        o.value = std::move(*value);
+        if (peek().kind != Tok::eof && peek().kind != Tok::newline) {
+            error(peek(), "unexpected " + what(peek()) + " after the value");
+            return std::nullopt;
+        }
+        return o;
+    }
+
+private:
+    const Token& peek(std::size_t ahead = 0) const { return t_[std::min(p_ + ahead, t_.size() - 1)]; }
+    const Token& next() { return t_[std::min(p_++, t_.size() - 1)]; }
+    void skip_line() {
+        while (peek().kind != Tok::newline && peek().kind != Tok::eof) ++p_;
+    }
+    void error(const Token& at, std::string message) {
+        if (at.kind == Tok::bad) return;  // the lexer has said it already
+        diags_.error(at.where, std::move(message));
+    }
+    static std::string what(const Token& t) {
+        switch (t.kind) {
+            case Tok::word: return "'" + t.text + "'";
+            case Tok::number: return "the number " + t.text;
+            case Tok::string: return "a string";
+            case Tok::newline: return "the end of the line";
+            case Tok::eof: return "the end of the file";
+            default: return "'" + t.text + "'";
+        }
+    }
+    bool expect(Tok kind, const std::string& wanted) {
+        if (peek().kind == kind) {
+            ++p_;
+            return true;
+        }
+        error(peek(), "expected " + wanted + ", found " + what(peek()));
+        return false;
+    }
+
+    void statement(Spec& spec) {
+        const Token& first = peek();
+        if (first.kind != Tok::word) {
+            error(first, "expected a statement (orogen, seed, grid, NAME = kind:node(...), or kind:node(...)), found " +
+                             what(first));
+            return;
+        }
+        if (peek(1).kind == Tok::equals) {  // NAME = call
+            Statement st;
+            st.name = first.text;
+            st.name_where = first.where;
+            p_ += 2;
+            if (auto call = parse_call()) {
+                st.call = std::move(*call);
+                spec.statements.push_back(std::move(st));
+            }
+            return;
+        }
+        if (peek(1).kind == Tok::colon) {  // unnamed call
+            if (auto call = parse_call()) spec.statements.push_back(Statement{"", {}, std::move(*call)});
+            return;
+        }
+        if (first.text == "orogen") {
+            ++p_;
+            const Token& v = peek();
+            if (v.kind != Tok::number || !v.integer) {
+                error(v, "expected the format version after 'orogen' (this orogen reads `orogen 1`)");
+                return;
+            }
+            ++p_;
+            if (spec.version) {
+                error(first, "the format version is given twice");
+                return;
+            }
+            spec.version = int(v.number);
+            spec.version_where = v.where;
+            return;
+        }
+        if (first.text == "seed") {
+            ++p_;
+            const Token& v = peek();
+            if (v.kind != Tok::number || !v.integer || v.number < 0 || v.number > 18446744073709551615.0) {
+                error(v, "expected a whole number from 0 to 2^64-1 after 'seed', found " + what(v));
+                return;
+            }
+            ++p_;
+            if (spec.seed) {
+                error(first, "the seed is given twice");
+                return;
+            }
+            spec.seed = std::stoull(v.text[0] == '+' ? v.text.substr(1) : v.text);
+            spec.seed_where = v.where;
+            return;
+        }
+        if (first.text == "grid") {
+            grid(spec);
+            return;
+        }
+        if (peek(1).kind == Tok::lparen) {
+            error(first, "a node is called as kind:node(...), e.g. generate:" + first.text + "(...)");
+            return;
+        }
+        error(first, "unknown statement '" + first.text +
+                         "'; expected orogen, seed, grid, NAME = kind:node(...), or kind:node(...)");
+    }
+
+    void grid(Spec& spec) {
+        const Token& kw = next();
+        if (spec.has_grid) {
+            error(kw, "the grid is given twice");
+            return;
+        }
+        const Token& w = peek();
+        if (w.kind != Tok::number || !w.integer) {
+            error(w, "expected the grid size in vertices after 'grid', e.g. `grid 513 cell=30` or `grid 513x257`");
+            return;
+        }
+        ++p_;
+        double width = w.number, height = w.number;
+        // "513x257" lexes as the number 513 and the word x257, written without a space.
+        const Token& x = peek();
+        if (x.kind == Tok::word && x.where.line == w.where.line && x.where.column == w.where.column + w.where.length &&
+            x.text.size() > 1 && x.text[0] == 'x' && x.text.find_first_not_of("0123456789", 1) == std::string::npos) {
+            height = std::stod(x.text.substr(1));
+            ++p_;
+        }
+        spec.has_grid = true;
+        spec.grid_where = w.where;
+        spec.grid_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - w.where.column;
+        if (width < 2 || height < 2) {
+            diags_.error(spec.grid_where, "the grid needs at least 2 vertices a side, got " + std::to_string(long(width)) + "x" +
+                                      std::to_string(long(height)));
+            return;
+        }
+        spec.grid_width = width > 2e9 ? 2000000000 : int(width);
+        spec.grid_height = height > 2e9 ? 2000000000 : int(height);
+        while (peek().kind == Tok::word) {
+            const Token& key = next();
+            if (!expect(Tok::equals, "'=' after '" + key.text + "'")) return;
+            const Token& value = peek();
+            if (key.text != "cell") {
+                error(key, "unknown grid option '" + key.text + "'; the grid takes cell=METRES");
+                return;
+            }
+            if (value.kind != Tok::number || !(value.number > 0) || !std::isfinite(value.number)) {
+                error(value, "cell must be a positive number of metres, found " + what(value));
+                return;
+            }
+            ++p_;
+            spec.grid_cell = value.number;
+        }
+    }
+
+    std::optional<Call> parse_call() {
+        Call call;
+        const Token& kind = peek();
+        if (kind.kind != Tok::word) {
+            error(kind, "expected a node call kind:node(...), found " + what(kind));
+            return std::nullopt;
+        }
+        ++p_;
+        if (!expect(Tok::colon, "':' between the node's kind and name (e.g. generate:fault)")) return std::nullopt;
+        const Token& node = peek();
+        if (node.kind != Tok::word) {
+            error(node, "expected the node's name after '" + kind.text + ":'");
+            return std::nullopt;
+        }
+        ++p_;
+        call.kind = kind.text;
+        call.node = node.text;
+        call.where = kind.where;
+        call.where.length = node.where.column + node.where.length - kind.where.column;
+        if (!expect(Tok::lparen, "'(' after " + call.qualified() + " (a call with no arguments is written " +
+                                     call.qualified() + "())"))
+            return std::nullopt;
+        if (peek().kind == Tok::rparen) {
+            ++p_;
+            return call;
+        }
+        bool seen_param = false;
+        while (true) {
+            const Token& a = peek();
+            if (a.kind != Tok::word) {
+                error(a, "expected an input name or key=value, found " + what(a));
+                return std::nullopt;
+            }
+            if (peek(1).kind == Tok::equals) {
+                p_ += 2;
+                auto value = literal();
+                if (!value) return std::nullopt;
+                call.params.push_back(Argument{a.text, a.where, std::move(*value)});
+                seen_param = true;
+            } else {
+                if (seen_param) {
+                    error(a, "inputs come first: move input '" + a.text + "' before the key=value parameters");
+                    return std::nullopt;
+                }
+                ++p_;
+                Input in{a.text, "", a.where};
+                if (peek().kind == Tok::dot) {
+                    ++p_;
+                    const Token& side = peek();
+                    if (side.kind != Tok::word) {
+                        error(side, "expected a side value's name after '" + a.text + ".'");
+                        return std::nullopt;
+                    }
+                    ++p_;
+                    in.side = side.text;
+                    in.where.length = side.where.column + side.where.length - a.where.column;
+                }
+                call.inputs.push_back(std::move(in));
+            }
+            if (peek().kind == Tok::comma) {
+                ++p_;
+                continue;
+            }
+            if (peek().kind == Tok::rparen) {
+                ++p_;
+                return call;
+            }
+            error(peek(), "expected ',' or ')' in the call to " + call.qualified() + ", found " + what(peek()));
+            return std::nullopt;
+        }
+    }
+
+    std::optional<Literal> literal() {
+        const Token& t = peek();
+        Literal l;
+        l.where = t.where;
+        switch (t.kind) {
+            case Tok::number:
+                ++p_;
+                l.kind = Literal::Kind::number;
+                l.number = t.number;
+                l.integer = t.integer;
+                l.text = t.text;
+                return l;
+            case Tok::string:
+                ++p_;
+                l.kind = Literal::Kind::string;
+                l.text = t.text;
+                return l;
+            case Tok::word:
+                ++p_;
+                if (t.text == "true" || t.text == "false") {
+                    l.kind = Literal::Kind::boolean;
+                    l.boolean = t.text == "true";
+                } else {
+                    l.kind = Literal::Kind::word;
+                }
+                l.text = t.text;
+                return l;
+            case Tok::lparen: {
+                ++p_;
+                l.kind = Literal::Kind::point;
+                for (int i = 0; i < 2; ++i) {
+                    const Token& n = peek();
+                    if (n.kind != Tok::number) {
+                        error(n, "a point is written (x, y) with two numbers, found " + what(n));
+                        return std::nullopt;
+                    }
+                    ++p_;
+                    Literal c;
+                    c.kind = Literal::Kind::number;
+                    c.where = n.where;
+                    c.number = n.number;
+                    c.integer = n.integer;
+                    c.text = n.text;
+                    l.items.push_back(c);
+                    if (i == 0 && !expect(Tok::comma, "',' between the point's x and y")) return std::nullopt;
+                }
+                if (!expect(Tok::rparen, "')' closing the point (x, y)")) return std::nullopt;
+                l.where.length = std::max(1, t_[p_ - 1].where.column + 1 - t.where.column);
+                return l;
+            }
+            case Tok::lbracket: {
+                ++p_;
+                l.kind = Literal::Kind::list;
+                if (peek().kind == Tok::rbracket) {
+                    ++p_;
+                    return l;
+                }
+                while (true) {
+                    auto item = literal();
+                    if (!item) return std::nullopt;
+                    l.items.push_back(std::move(*item));
+                    if (peek().kind == Tok::comma) {
+                        ++p_;
+                        continue;
+                    }
+                    if (!expect(Tok::rbracket, "',' or ']' in the list")) return std::nullopt;
+                    if (t_[p_ - 1].where.line == t.where.line)
+                        l.where.length = std::max(1, t_[p_ - 1].where.column + 1 - t.where.column);
+                    return l;
+                }
+            }
+            default:
+                error(t, "expected a value (a number, \"string\", true/false, a word, (x, y) or [list]), found " + what(t));
+                return std::nullopt;
+        }
+    }
+
+    std::vector<Token> t_;
+    std::size_t p_ = 0;
+    Diagnostics& diags_;
+};
+
+}  // namespace
+
+Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags) {
+    Parser parser(lex(source, diags), diags);
+    return parser.parse_spec(source);
+}
+
+std::optional<Override> parse_override(const std::shared_ptr<const Source>& source, Diagnostics& diags) {
+    Parser parser(lex(source, diags), diags);
+    if (diags.has_errors()) return std::nullopt;
+    return parser.parse_override();
+}
+
+}  // namespace orogen::spec

@@ -1,0 +1,56 @@
+// The checked form of a spec: what the runner executes. Produced by check(),
+// which resolves every node against the registry, converts and range-checks
+// every parameter, binds inputs to earlier values and runs each node's check
+// hook; nothing runs until all of that passed.
+#pragma once
+
+#include "spec.hpp"
+
+#include <orogen/plugin.hpp>
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace orogen {
+
+struct PlannedNode {
+    const NodeDescriptor* node = nullptr;
+    std::string label;       ///< value name, or kind:node for unnamed calls
+    std::string value_name;  ///< "" if unnamed
+    spec::Location where;    ///< the call
+    std::vector<std::string> inputs;  ///< value keys ("base", "sim.particles"), "" for an optional input not given
+    std::map<std::string, ParamValue, std::less<>> params;  ///< every declared parameter, defaults filled in
+    std::set<std::string, std::less<>> given;               ///< parameters set in the spec or by --set
+    std::vector<std::string> output_files;                   ///< output path parameters' values
+};
+
+struct Plan {
+    std::filesystem::path spec_path;
+    std::filesystem::path spec_folder;  ///< input paths are relative to it
+    std::shared_ptr<const spec::Source> source;
+    std::uint64_t seed = 0;
+    GridSpec grid;
+    std::vector<PlannedNode> nodes;
+    std::vector<std::string> overrides;  ///< as given on the command line
+    /// For each value key, the index of the last node that reads it.
+    std::map<std::string, std::size_t, std::less<>> last_use;
+};
+
+struct CheckOptions {
+    std::vector<std::string> overrides;  ///< "NAME.PARAM=VALUE"
+    std::optional<std::uint64_t> seed;   ///< --seed, overrides the spec's
+    /// Memory a single heightmap may take before the grid is refused, bytes (0: a quarter of physical memory).
+    std::uint64_t heightmap_memory_limit = 0;
+};
+
+/// Check `parsed` against `registry`. Errors go to `diags`; the plan is only
+/// meaningful if !diags.has_errors().
+Plan check(const spec::Spec& parsed, const Registry& registry, const std::filesystem::path& spec_path,
+           const CheckOptions& options, spec::Diagnostics& diags);
+
+/// "3.6 TiB", "512 MiB".
+std::string human_bytes(double bytes);
+
+}  // namespace orogen

@@ -1,0 +1,108 @@
+// The pipeline spec language: tokens, syntax tree, lexer and parser.
+//
+//   spec       := { [statement] [# comment] newline }
+//   statement  := "orogen" INT                      format version (1)
+//               | "seed" INT
+//               | "grid" INT ["x" INT] { key "=" literal }     vertices; grid 513 cell=30
+//               | name "=" call                     a named value
+//               | call                              (an exporter, usually)
+//   call       := kind ":" node "(" [ arg { "," arg } ] ")"   newlines allowed inside ( ) and [ ]
+//   arg        := ref                               an input: a value name, or name.side
+//               | key "=" literal                   a parameter
+//   literal    := number | "string" | true | false | word | point | list
+//   point      := "(" number "," number ")"
+//   list       := "[" [ literal { "," literal } ] "]"
+//
+// Words and names may contain letters, digits, '_' and '-' (von-neumann).
+#pragma once
+
+#include "diagnostics.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace orogen::spec {
+
+enum class Tok { word, number, string, lparen, rparen, lbracket, rbracket, comma, equals, colon, dot, newline, eof, bad };
+
+struct Token {
+    Tok kind = Tok::eof;
+    std::string text;     ///< as written (strings: the decoded value)
+    double number = 0.0;  ///< for numbers
+    bool integer = false; ///< a number written without '.', exponent
+    Location where;
+};
+
+/// Split `source` into tokens. Lexical errors (a stray character, an unclosed
+/// string) go to `diags` and become Tok::bad tokens.
+std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics& diags);
+
+struct Literal {
+    enum class Kind { number, string, boolean, word, point, list };
+    Kind kind = Kind::number;
+    Location where;
+    double number = 0.0;
+    bool integer = false;
+    std::string text;  ///< string/word value; the number as written
+    bool boolean = false;
+    std::vector<Literal> items;  ///< point: 2 numbers; list: elements
+};
+
+/// "a number", "the string \"x\"", "the word nan", ...
+std::string describe(const Literal& literal);
+
+struct Input {
+    std::string name;  ///< the value name
+    std::string side;  ///< "particles" in sim.particles, else ""
+    Location where;
+    std::string full() const { return side.empty() ? name : name + "." + side; }
+};
+
+struct Argument {
+    std::string key;
+    Location key_where;
+    Literal value;
+};
+
+struct Call {
+    std::string kind, node;  ///< "generate", "diamond-square"
+    Location where;          ///< spans kind:node
+    std::vector<Input> inputs;
+    std::vector<Argument> params;
+    std::string qualified() const { return kind + ":" + node; }
+};
+
+struct Statement {
+    std::string name;  ///< "" for an unnamed call
+    Location name_where;
+    Call call;
+};
+
+struct Spec {
+    std::shared_ptr<const Source> source;
+    std::optional<int> version;
+    Location version_where;
+    std::optional<std::uint64_t> seed;
+    Location seed_where;
+    bool has_grid = false;
+    int grid_width = 513, grid_height = 513;
+    double grid_cell = 1.0;
+    Location grid_where;
+    std::vector<Statement> statements;
+};
+
+/// Parse a whole spec. Syntax errors go to `diags`; the parser recovers at the
+/// next line so that every error is reported at once.
+Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags);
+
+/// Parse a command-line override "NAME.PARAM=VALUE" (source name "--set").
+struct Override {
+    std::string target;  ///< NAME
+    std::string param;   ///< PARAM
+    Location target_where, param_where;
+    Literal value;
+};
+std::optional<Override> parse_override(const std::shared_ptr<const Source>& source, Diagnostics& diags);
+
+}  // namespace orogen::spec

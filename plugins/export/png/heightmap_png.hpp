@@ -1,0 +1,25 @@
+// Heightmap ⇄ grayscale samples for PNG files (thesis Listing 3.6, fixed).
+//
+// The thesis scaled (h − min)/(max − min) by 256, so the highest point
+// wrapped to black; here it is scaled by 255 (8-bit) or 65535 (16-bit) and
+// rounded, so min → 0 and max → full white exactly.
+#pragma once
+
+#include <orogen/grid.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace orogen::png_export {
+
+struct Range {
+    float low = 0.0f, high = 0.0f;
+};
+
+/// The minimum and maximum of `grid` (NaN samples ignored).
+Range range_of(ConstGridView grid);
+
+/// Min–max normalise to 0..2^bits−1 (bits 8 or 16). A flat grid maps to 0.
+std::vector<std::uint16_t> quantise(ConstGridView grid, int bits, Range range);
+
+}  // namespace orogen::png_export
