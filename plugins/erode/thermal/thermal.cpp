@@ -6,9 +6,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
+
+// The row loops are built for plain x86-64 and for AVX2, picked at run time.
+// Both compute every lane with the same operations in the same order (and no
+// FMA contraction, see CMakeLists.txt), so the results are bit-identical.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define OROGEN_THERMAL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define OROGEN_THERMAL_CLONES
+#endif
 
 namespace orogen::thermal {
 
@@ -99,9 +109,26 @@ float factor_checked(ConstGridView in, const Rule& r, int x, int y) {
     return factor_from(r, softness(r, h, std::size_t(y) * std::size_t(in.width) + std::size_t(x)), excess, sum);
 }
 
+/// Softness of interior cells, with the hardness mode fixed at compile time
+/// so the row loops vectorise.
+template <Hardness H>
+inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
+    if constexpr (H == Hardness::constant) {
+        return 1.0f;
+    } else if constexpr (H == Hardness::height) {
+        const float inv = r.h_max > r.h_min ? 1.0f / (r.h_max - r.h_min) : 0.0f;
+        float t = (r.h_max - h) * inv;
+        t = std::min(std::max(t, 0.0f), 1.0f);
+        return r.h_max > r.h_min ? t * t : 1.0f;
+    } else {
+        const float k = std::min(std::max(layer[x], 0.0f), 1.0f);
+        return 1.0f - k;
+    }
+}
+
 /// F for every cell of row y into f[0..width).
-template <Neighbourhood N>
-void factor_row(ConstGridView in, const Rule& r, int y, float* f) {
+template <Neighbourhood N, Hardness H>
+OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, float* __restrict f) {
     const int w = in.width;
     if (y == 0 || y == in.height - 1 || w < 3) {
         for (int x = 0; x < w; ++x) f[x] = factor_checked<N>(in, r, x, y);
@@ -109,20 +136,31 @@ void factor_row(ConstGridView in, const Rule& r, int y, float* f) {
     }
     f[0] = factor_checked<N>(in, r, 0, y);
     f[w - 1] = factor_checked<N>(in, r, w - 1, y);
-    const float* rows[3] = {in.row(y - 1), in.row(y), in.row(y + 1)};
-    const float* c = rows[1];
-    const std::size_t base = std::size_t(y) * std::size_t(w);
+    constexpr auto& offs = offsets<N>();
+    constexpr int K = int(std::size(offs));
+    const float* __restrict nb[K];
+    float t[K];
+    for (int k = 0; k < K; ++k) {
+        nb[k] = in.row(y + offs[k].dy) + offs[k].dx;
+        t[k] = r.threshold(offs[k].diagonal);
+    }
+    const float* __restrict c = in.row(y);
+    const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(w) : nullptr;
+    const float rate = r.rate;
+    // The destination row never overlaps the sources: no alias checks needed.
+#pragma GCC ivdep
     for (int x = 1; x < w - 1; ++x) {
         const float h = c[x];
         float excess = 0.0f, sum = 0.0f;
 #pragma GCC unroll 8
-        for (const Offset& o : offsets<N>()) {
-            const float t = r.threshold(o.diagonal);
-            const float d = h - rows[1 + o.dy][x + o.dx];
-            excess = std::max(excess, d - t);
-            sum += d > t ? d : 0.0f;
+        for (int k = 0; k < K; ++k) {
+            const float d = h - nb[k][x];
+            excess = std::max(excess, d - t[k]);
+            sum += d > t[k] ? d : 0.0f;
         }
-        f[x] = factor_from(r, softness(r, h, base + std::size_t(x)), excess, sum);
+        const float soft = softness_fast<H>(r, h, layer, x);
+        const float fx = rate * soft * excess / std::max(sum, 1e-30f);
+        f[x] = excess > 0.0f ? fx : 0.0f;
     }
 }
 
@@ -146,9 +184,9 @@ float update_checked(ConstGridView in, const Rule& r, int x, int y, const FRow& 
 }
 
 template <Neighbourhood N>
-void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const float* const f[3]) {
+OROGEN_THERMAL_CLONES void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const float* const f[3]) {
     const int w = in.width;
-    float* dst = outv.row(y);
+    float* __restrict dst = outv.row(y);
     auto frow = [&](int dy) { return f[1 + dy]; };
     if (y == 0 || y == in.height - 1 || w < 3) {
         for (int x = 0; x < w; ++x) dst[x] = update_checked<N>(in, r, x, y, frow);
@@ -156,39 +194,51 @@ void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const flo
     }
     dst[0] = update_checked<N>(in, r, 0, y, frow);
     dst[w - 1] = update_checked<N>(in, r, w - 1, y, frow);
-    const float* rows[3] = {in.row(y - 1), in.row(y), in.row(y + 1)};
-    const float* c = rows[1];
-    const float* fc = f[1];
+    constexpr auto& offs = offsets<N>();
+    constexpr int K = int(std::size(offs));
+    const float* __restrict nb[K];
+    const float* __restrict nf[K];
+    float t[K];
+    for (int k = 0; k < K; ++k) {
+        nb[k] = in.row(y + offs[k].dy) + offs[k].dx;
+        nf[k] = f[1 + offs[k].dy] + offs[k].dx;
+        t[k] = r.threshold(offs[k].diagonal);
+    }
+    const float* __restrict c = in.row(y);
+    const float* __restrict fc = f[1];
+    // The destination row never overlaps the sources: no alias checks needed.
+#pragma GCC ivdep
     for (int x = 1; x < w - 1; ++x) {
         const float h = c[x];
+        const float fx = fc[x];
         float out = 0.0f, gain = 0.0f;
 #pragma GCC unroll 8
-        for (const Offset& o : offsets<N>()) {
-            const float t = r.threshold(o.diagonal);
-            const float hn = rows[1 + o.dy][x + o.dx];
-            const float d = h - hn;
-            const float e = hn - h;
-            out += d > t ? fc[x] * d : 0.0f;
-            gain += e > t ? f[1 + o.dy][x + o.dx] * e : 0.0f;
+        for (int k = 0; k < K; ++k) {
+            const float hn = nb[k][x];
+            const float fn = nf[k][x];  // loaded unconditionally so the loop vectorises
+            const float d = h - hn;     // drop to the neighbour
+            const float e = hn - h;     // drop from the neighbour
+            out += d > t[k] ? fx * d : 0.0f;
+            gain += e > t[k] ? fn * e : 0.0f;
         }
         dst[x] = h - out + gain;
     }
 }
 
-template <Neighbourhood N>
+template <Neighbourhood N, Hardness H>
 void step_impl(ConstGridView in, GridView out, const Rule& r) {
     const int w = in.width, h = in.height;
     // Rows in parallel. Each chunk recomputes F for its one-row halo; F of a
     // row is the same pure function of `in` wherever it is computed, so the
     // result does not depend on the chunking.
-    const std::int64_t grain = std::max<std::int64_t>(8, h / 64);
+    const std::int64_t grain = std::max<std::int64_t>(16, h / 32);
     parallel_for(0, h, grain, [&](std::int64_t y0, std::int64_t y1) {
         std::vector<float> ring(std::size_t(w) * 3);
         auto slot = [&](std::int64_t y) { return ring.data() + std::size_t(((y % 3) + 3) % 3) * std::size_t(w); };
-        if (y0 > 0) factor_row<N>(in, r, int(y0 - 1), slot(y0 - 1));
-        factor_row<N>(in, r, int(y0), slot(y0));
+        if (y0 > 0) factor_row<N, H>(in, r, int(y0 - 1), slot(y0 - 1));
+        factor_row<N, H>(in, r, int(y0), slot(y0));
         for (std::int64_t y = y0; y < y1; ++y) {
-            if (y + 1 < h) factor_row<N>(in, r, int(y + 1), slot(y + 1));
+            if (y + 1 < h) factor_row<N, H>(in, r, int(y + 1), slot(y + 1));
             // Rows outside the grid are never read (update_* checks bounds there).
             const float* f[3] = {slot(y - 1), slot(y), slot(y + 1)};
             update_row<N>(in, out, r, int(y), f);
@@ -205,10 +255,17 @@ void step(ConstGridView in, GridView out, const Settings& settings, const float*
         throw Error("thermal::step: hardness layer mode needs a hardness layer");
     Rule r = make_rule(settings, in.cell);
     r.hardness_layer = hardness;
+    auto with_hardness = [&]<Neighbourhood N>() {
+        switch (settings.hardness) {
+            case Hardness::constant: step_impl<N, Hardness::constant>(in, out, r); break;
+            case Hardness::height: step_impl<N, Hardness::height>(in, out, r); break;
+            case Hardness::layer: step_impl<N, Hardness::layer>(in, out, r); break;
+        }
+    };
     switch (settings.neighbourhood) {
-        case Neighbourhood::von_neumann: step_impl<Neighbourhood::von_neumann>(in, out, r); break;
-        case Neighbourhood::rotated: step_impl<Neighbourhood::rotated>(in, out, r); break;
-        case Neighbourhood::moore: step_impl<Neighbourhood::moore>(in, out, r); break;
+        case Neighbourhood::von_neumann: with_hardness.template operator()<Neighbourhood::von_neumann>(); break;
+        case Neighbourhood::rotated: with_hardness.template operator()<Neighbourhood::rotated>(); break;
+        case Neighbourhood::moore: with_hardness.template operator()<Neighbourhood::moore>(); break;
     }
 }
 
