@@ -1,0 +1,60 @@
+// cones.hpp — the thesis's Voronoi trick (section 3.3.2, after the OpenGL Red
+// Book): one flat cone per site, seen from above through an orthographic
+// projection with a depth test; where cones overlap the nearest apex wins,
+// so the visible colours are the Voronoi cells. Drawn offscreen with OSMesa
+// (Mesa's llvmpipe, no display), one pixel per grid vertex, pixel centres on
+// the vertices; each cone's colour encodes its site index.
+//
+// Each cone's depth is its exact distance to its apex, written per fragment,
+// so the diagram is exact up to float rounding on cell borders (the thesis's
+// 64-segment cones bent every border by up to 0.1 %). Cones are sized to the
+// covering radius of the sites (every vertex lies within it of its nearest
+// site, see SiteIndex::covering_radius), so every vertex is covered: the
+// thesis's radius-1 cones left the map's corners bare.
+//
+// Library orogen_core_rmp_gl; the OSMesa headers stay in cones_gl.cpp.
+#pragma once
+
+#include "rmp.hpp"
+
+#include <orogen/grid.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace orogen::rmp {
+
+class ConeRenderer {
+public:
+    /// An OSMesa GL 3.3 core context and a width × height offscreen target.
+    /// Throws orogen::Error (failed run) if OSMesa cannot create or bind the
+    /// context, orogen::BadInput if the grid is larger than it can draw.
+    ConeRenderer(int width, int height);
+    ~ConeRenderer();
+    ConeRenderer(const ConeRenderer&) = delete;
+    ConeRenderer& operator=(const ConeRenderer&) = delete;
+
+    /// Draw one cone of `radius` samples per site (sample coordinates) and
+    /// read the frame back: the returned row-major ids hold, per vertex, the
+    /// index of the site on top plus one (0: no cone reached the vertex).
+    /// Valid until the next call.
+    const std::vector<std::uint32_t>& render(std::span<const Point2> sites, double radius);
+
+    /// render() then labels: site index per vertex, -1 where no cone reached.
+    std::vector<std::int32_t> labels(std::span<const Point2> sites, double radius);
+
+    /// "llvmpipe (LLVM 15.0.6, 256 bits)", for benchmark records.
+    std::string renderer_name() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// RMP with the cone-rasterised Voronoi diagram: the same sites as
+/// rmp_voronoi for the same seed; every vertex with the colour under a peak rises.
+void rmp_cones(GridView terrain, const RmpParams& params, std::uint64_t seed, const IterationHook& hook = {});
+
+}  // namespace orogen::rmp
