@@ -1,0 +1,297 @@
+#include "hydraulic.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/parallel.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <utility>
+#include <vector>
+
+// Row loops built for plain x86-64 and for AVX2, chosen at run time; same
+// operations per lane in the same order (no FMA contraction), same bits.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define OROGEN_HYDRAULIC_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define OROGEN_HYDRAULIC_CLONES
+#endif
+
+namespace orogen::hydraulic {
+namespace {
+
+struct Rule {
+    float rain, solubility, keep /* 1 − evaporation */, capacity;
+    Hardness hardness;
+    const float* hardness_layer;
+    float inv_cell;
+};
+
+/// One row of the state after rain and dissolving (steps 1 and 2).
+struct PrepRow {
+    float *h, *w, *s, *a;  // terrain, water, sediment, altitude a = h + w (m)
+};
+/// One row of Olsen's flow factors: water moved to a lower neighbour = F·drop, sediment = G·drop.
+struct FactorRow {
+    float *f, *g;
+};
+
+// ---------------------------------------------------------------- step 1 + 2
+
+template <Hardness H>
+inline float softness(float gx, float gy, const float* layer, int x) {
+    if constexpr (H == Hardness::steepness) {
+        const float ny = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);  // |n_y| of the unit normal
+        const float t = 1.0f - ny;
+        return t * t * t;
+    } else if constexpr (H == Hardness::constant) {
+        return 1.0f;
+    } else {
+        return 1.0f - std::min(std::max(layer[x], 0.0f), 1.0f);
+    }
+}
+
+template <Hardness H>
+inline void prep_cell(const Rule& r, float h, float w, float s, float gx, float gy, const float* layer, int x,
+                      const PrepRow& out) {
+    const float w1 = w + r.rain;
+    const float dissolved = r.solubility * w1 * softness<H>(gx, gy, layer, x);
+    const float h1 = h - dissolved;
+    out.h[x] = h1;
+    out.w[x] = w1;
+    out.s[x] = s + dissolved;
+    out.a[x] = h1 + w1;
+}
+
+template <Hardness H>
+OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y, const PrepRow& out) {
+    const int w = in.height.width, rows = in.height.height;
+    const std::size_t base = std::size_t(y) * std::size_t(w);
+    // Central differences inside, one-sided at the edges (metres per metre).
+    const int yu = std::max(y - 1, 0), yd = std::min(y + 1, rows - 1);
+    const float sy = yd > yu ? r.inv_cell / float(yd - yu) : 0.0f;
+    const float* __restrict hu = in.height.row(yu);
+    const float* __restrict hd = in.height.row(yd);
+    const float* __restrict hc = in.height.row(y);
+    const float* __restrict wc = in.water.data + base;
+    const float* __restrict sc = in.sediment.data + base;
+    const float* layer = r.hardness_layer ? r.hardness_layer + base : nullptr;
+    auto edge = [&](int x) {
+        const int xl = std::max(x - 1, 0), xr = std::min(x + 1, w - 1);
+        const float sx = xr > xl ? r.inv_cell / float(xr - xl) : 0.0f;
+        prep_cell<H>(r, hc[x], wc[x], sc[x], (hc[xr] - hc[xl]) * sx, (hd[x] - hu[x]) * sy, layer, x, out);
+    };
+    edge(0);
+    if (w > 1) edge(w - 1);
+    const float sx = 0.5f * r.inv_cell;
+#pragma GCC ivdep
+    for (int x = 1; x < w - 1; ++x)
+        prep_cell<H>(r, hc[x], wc[x], sc[x], (hc[x + 1] - hc[x - 1]) * sx, (hd[x] - hu[x]) * sy, layer, x, out);
+}
+
+// -------------------------------------------------------------- step 3 flow
+
+/// Olsen's flow factors for one cell from its altitude a, water w, sediment s
+/// and its neighbours' altitudes (absent neighbours: `has` false).
+inline void factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4], float& f, float& g) {
+    float drop_sum = 0.0f, lower_sum = 0.0f, lower_n = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        const float d = a - an[k];
+        const bool lower = has[k] && d > 0.0f;
+        drop_sum += lower ? d : 0.0f;
+        lower_sum += lower ? an[k] : 0.0f;
+        lower_n += lower ? 1.0f : 0.0f;
+    }
+    const float mean = (a + lower_sum) / (1.0f + lower_n);  // ā over the cell and its lower neighbours
+    // Olsen's two cases: level out (move a − ā) or drain completely (move w).
+    const float moved = std::min(w, a - mean);
+    const float ff = moved / std::max(drop_sum, 1e-30f);
+    f = moved > 0.0f ? ff : 0.0f;
+    const float gg = f * s / std::max(w, 1e-30f);
+    g = w > 0.0f ? gg : 0.0f;
+}
+
+OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, const PrepRow* dn, int w,
+                                        const FactorRow& out) {
+    auto edge = [&](int x) {
+        const float an[4] = {x > 0 ? c.a[x - 1] : 0.0f, x + 1 < w ? c.a[x + 1] : 0.0f, up ? up->a[x] : 0.0f,
+                             dn ? dn->a[x] : 0.0f};
+        const bool has[4] = {x > 0, x + 1 < w, up != nullptr, dn != nullptr};
+        factor_cell(c.a[x], c.w[x], c.s[x], an, has, out.f[x], out.g[x]);
+    };
+    if (!up || !dn || w < 3) {
+        for (int x = 0; x < w; ++x) edge(x);
+        return;
+    }
+    edge(0);
+    edge(w - 1);
+    const float* __restrict a = c.a;
+    const float* __restrict au = up->a;
+    const float* __restrict ad = dn->a;
+    const float* __restrict wc = c.w;
+    const float* __restrict sc = c.s;
+    float* __restrict f = out.f;
+    float* __restrict g = out.g;
+    constexpr bool all[4] = {true, true, true, true};
+#pragma GCC ivdep
+    for (int x = 1; x < w - 1; ++x) {
+        const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
+        float fx, gx;
+        factor_cell(a[x], wc[x], sc[x], an, all, fx, gx);
+        f[x] = fx;
+        g[x] = gx;
+    }
+}
+
+// ----------------------------------------------- step 3 gather + step 4
+
+/// One cell's new state: its own outflow, its neighbours' inflow, then evaporation.
+inline void output_cell(const Rule& r, float a, float h1, float w1, float s1, float f, float g, const float (&an)[4],
+                        const float (&fn)[4], const float (&gn)[4], const bool (&has)[4], float& h_out, float& w_out,
+                        float& s_out) {
+    float w_net = 0.0f, s_net = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        const float d = a - an[k];  // drop to neighbour k (giving)
+        const float e = an[k] - a;  // drop from neighbour k (receiving): the giver's own d
+        const bool give = has[k] && d > 0.0f;
+        const bool take = has[k] && e > 0.0f;
+        w_net += (take ? fn[k] * e : 0.0f) - (give ? f * d : 0.0f);
+        s_net += (take ? gn[k] * e : 0.0f) - (give ? g * d : 0.0f);
+    }
+    // Round-off can leave a drained cell at −1e-9 m: clamp, so that capacity
+    // never turns negative (the water lost is far below float resolution of the total).
+    const float w2 = std::max((w1 + w_net) * r.keep, 0.0f);
+    const float s2 = s1 + s_net;
+    const float excess = std::max(s2 - r.capacity * w2, 0.0f);  // deposited where water cannot hold it
+    w_out = w2;
+    s_out = s2 - excess;
+    h_out = h1 + excess;
+}
+
+OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const FactorRow* fup, const PrepRow& c,
+                                        const FactorRow& fc, const PrepRow* dn, const FactorRow* fdn, int w,
+                                        float* __restrict ho, float* __restrict wo, float* __restrict so) {
+    auto edge = [&](int x) {
+        const bool has[4] = {x > 0, x + 1 < w, up != nullptr, dn != nullptr};
+        const int xl = has[0] ? x - 1 : x, xr = has[1] ? x + 1 : x;
+        const float an[4] = {c.a[xl], c.a[xr], up ? up->a[x] : 0.0f, dn ? dn->a[x] : 0.0f};
+        const float fn[4] = {fc.f[xl], fc.f[xr], fup ? fup->f[x] : 0.0f, fdn ? fdn->f[x] : 0.0f};
+        const float gn[4] = {fc.g[xl], fc.g[xr], fup ? fup->g[x] : 0.0f, fdn ? fdn->g[x] : 0.0f};
+        output_cell(r, c.a[x], c.h[x], c.w[x], c.s[x], fc.f[x], fc.g[x], an, fn, gn, has, ho[x], wo[x], so[x]);
+    };
+    if (!up || !dn || w < 3) {
+        for (int x = 0; x < w; ++x) edge(x);
+        return;
+    }
+    edge(0);
+    edge(w - 1);
+    const float* __restrict a = c.a;
+    const float* __restrict au = up->a;
+    const float* __restrict ad = dn->a;
+    const float* __restrict f = fc.f;
+    const float* __restrict fu = fup->f;
+    const float* __restrict fd = fdn->f;
+    const float* __restrict g = fc.g;
+    const float* __restrict gu = fup->g;
+    const float* __restrict gd = fdn->g;
+    constexpr bool all[4] = {true, true, true, true};
+#pragma GCC ivdep
+    for (int x = 1; x < w - 1; ++x) {
+        const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
+        const float fn[4] = {f[x - 1], f[x + 1], fu[x], fd[x]};
+        const float gn[4] = {g[x - 1], g[x + 1], gu[x], gd[x]};
+        float hx, wx, sx;
+        output_cell(r, a[x], c.h[x], c.w[x], c.s[x], f[x], g[x], an, fn, gn, all, hx, wx, sx);
+        ho[x] = hx;
+        wo[x] = wx;
+        so[x] = sx;
+    }
+}
+
+template <Hardness H>
+void step_impl(const ConstState& in, const State& out, const Rule& r) {
+    const int w = in.height.width, rows = in.height.height;
+    // Rows in parallel; each chunk recomputes its halo rows (two rows of the
+    // rain/dissolve stage, one of the flow factors). Every row is the same
+    // pure function of `in` wherever it is computed: chunking cannot change
+    // the result.
+    const std::int64_t grain = std::max<std::int64_t>(16, rows / 32);
+    parallel_for(0, rows, grain, [&](std::int64_t y0, std::int64_t y1) {
+        constexpr int kPrep = 5, kFactor = 3;
+        std::vector<float> buffer(std::size_t(w) * (4 * kPrep + 2 * kFactor));
+        PrepRow prep[kPrep];
+        FactorRow fac[kFactor];
+        float* p = buffer.data();
+        for (auto& row : prep) {
+            row = {p, p + w, p + 2 * w, p + 3 * w};
+            p += 4 * w;
+        }
+        for (auto& row : fac) {
+            row = {p, p + w};
+            p += 2 * w;
+        }
+        auto prep_at = [&](std::int64_t y) -> PrepRow& { return prep[y % kPrep]; };
+        auto fac_at = [&](std::int64_t y) -> FactorRow& { return fac[y % kFactor]; };
+        std::int64_t next_prep = std::max<std::int64_t>(0, y0 - 2);
+        std::int64_t next_factor = std::max<std::int64_t>(0, y0 - 1);
+        for (std::int64_t y = y0; y < y1; ++y) {
+            for (; next_prep <= std::min<std::int64_t>(rows - 1, y + 2); ++next_prep)
+                prep_row<H>(in, r, int(next_prep), prep_at(next_prep));
+            for (; next_factor <= std::min<std::int64_t>(rows - 1, y + 1); ++next_factor) {
+                const std::int64_t fy = next_factor;
+                factor_row(fy > 0 ? &prep_at(fy - 1) : nullptr, prep_at(fy), fy + 1 < rows ? &prep_at(fy + 1) : nullptr,
+                           w, fac_at(fy));
+            }
+            const bool has_up = y > 0, has_dn = y + 1 < rows;
+            output_row(r, has_up ? &prep_at(y - 1) : nullptr, has_up ? &fac_at(y - 1) : nullptr, prep_at(y), fac_at(y),
+                       has_dn ? &prep_at(y + 1) : nullptr, has_dn ? &fac_at(y + 1) : nullptr, w, out.height.row(int(y)),
+                       out.water.row(int(y)), out.sediment.row(int(y)));
+        }
+    });
+}
+
+}  // namespace
+
+void step(const ConstState& in, const State& out, const Settings& settings, const float* hardness) {
+    const int w = in.height.width, h = in.height.height;
+    for (ConstGridView v : {in.water, in.sediment, ConstGridView(out.height), ConstGridView(out.water),
+                            ConstGridView(out.sediment)})
+        if (v.width != w || v.height != h) throw Error("hydraulic::step: state grids differ in size");
+    if (settings.hardness == Hardness::layer && hardness == nullptr)
+        throw Error("hydraulic::step: hardness layer mode needs a hardness layer");
+    const Rule r{float(settings.rain),
+                 float(settings.solubility),
+                 float(1.0 - settings.evaporation),
+                 float(settings.capacity),
+                 settings.hardness,
+                 hardness,
+                 float(1.0 / in.height.cell)};
+    switch (settings.hardness) {
+        case Hardness::steepness: step_impl<Hardness::steepness>(in, out, r); break;
+        case Hardness::constant: step_impl<Hardness::constant>(in, out, r); break;
+        case Hardness::layer: step_impl<Hardness::layer>(in, out, r); break;
+    }
+}
+
+void erode(const State& state, std::int64_t iterations, const Settings& settings, const float* hardness,
+           const std::function<void(std::int64_t, const ConstState&)>& on_step) {
+    if (iterations <= 0) return;
+    const std::size_t n = state.height.size();
+    std::vector<float> scratch(3 * n);
+    const int w = state.height.width, h = state.height.height;
+    const double cell = state.height.cell;
+    State a = state;
+    State b{{scratch.data(), w, h, cell}, {scratch.data() + n, w, h, cell}, {scratch.data() + 2 * n, w, h, cell}};
+    for (std::int64_t i = 1; i <= iterations; ++i) {
+        step({a.height, a.water, a.sediment}, b, settings, hardness);
+        std::swap(a, b);
+        if (on_step) on_step(i, {a.height, a.water, a.sediment});
+    }
+    if (a.height.data != state.height.data) {
+        std::memcpy(state.height.data, a.height.data, n * sizeof(float));
+        std::memcpy(state.water.data, a.water.data, n * sizeof(float));
+        std::memcpy(state.sediment.data, a.sediment.data, n * sizeof(float));
+    }
+}
+
+}  // namespace orogen::hydraulic
