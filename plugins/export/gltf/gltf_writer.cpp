@@ -1,0 +1,290 @@
+// The only translation unit that includes tinygltf (Debian ships its
+// implementation as libtinygltf.so, so no TINYGLTF_IMPLEMENTATION here).
+//
+// tinygltf builds and serialises the whole glTF document (accessors, views,
+// meshes, material, texture, image). The binary payload is streamed by us:
+// tinygltf's own GLB writer copies the buffer once more (buffer.data →
+// binBuffer), which would double the peak memory of a 4097² export (~700 MB
+// of vertex data). So the document is serialised with an empty buffer and
+// the buffer's byteLength (and, for .gltf, its uri) is set in the JSON text
+// afterwards; then each chunk's vertices are generated and written one
+// attribute at a time. Peak memory: the heightmap, the texture, one chunk.
+#include "gltf_writer.hpp"
+
+#include "terrain_mesh.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <optional>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace orogen::gltf {
+
+namespace {
+
+struct ChunkViews {
+    std::size_t positions = 0, normals = 0, texcoords = 0, indices = 0;  // byte offsets in the buffer
+    std::size_t vertex_count = 0, index_count = 0;
+    bool index16 = true;
+};
+
+std::size_t align4(std::size_t n) { return (n + 3) & ~std::size_t(3); }
+
+void put_u32(std::string& s, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) s.push_back(char((v >> (8 * i)) & 0xff));
+}
+
+template <typename T>
+void write_span(std::ostream& out, std::span<const T> data) {
+    out.write(reinterpret_cast<const char*>(data.data()), std::streamsize(data.size_bytes()));
+}
+
+void write_zeros(std::ostream& out, std::size_t n) {
+    static const char zeros[4] = {0, 0, 0, 0};
+    out.write(zeros, std::streamsize(n));
+}
+
+}  // namespace
+
+Summary write_gltf(ConstGridView heights, const Options& options, const fs::path& target) {
+    const std::string ext = target.extension().string();
+    const bool binary = ext == ".glb";
+    if (!binary && ext != ".gltf")
+        throw BadInput("export:gltf writes .glb or .gltf files; '" + target.filename().string() +
+                       "' has another extension");
+    if (options.texture_size < 1) throw BadInput("texture must be at least 1 pixel");
+
+    const terrain::TerrainMesh mesh = terrain::plan_mesh(heights, options.decimate, options.chunks, options.vertical_scale);
+
+    // Texture: no larger than the terrain's tile count (more pixels than tiles add nothing).
+    const int tw = std::max(1, std::min(options.texture_size, heights.width - 1));
+    const int th = std::max(1, std::min(options.texture_size, heights.height - 1));
+    std::string png;
+    {
+        const auto rgba = terrain::bake_splat_texture(heights, tw, th);
+        std::ostringstream s(std::ios::binary);
+        write_rgba_png(s, tw, th, rgba);
+        png = std::move(s).str();
+    }
+
+    // Buffer layout: per chunk positions, normals, texcoords, indices; then the PNG.
+    std::vector<ChunkViews> views;
+    std::size_t offset = 0;
+    for (const auto& c : mesh.chunks) {
+        ChunkViews v;
+        v.vertex_count = c.vertex_count();
+        v.index_count = c.triangle_count() * 3;
+        v.index16 = c.fits_16bit();
+        v.positions = offset;
+        offset += v.vertex_count * 12;
+        v.normals = offset;
+        offset += v.vertex_count * 12;
+        v.texcoords = offset;
+        offset += v.vertex_count * 4;  // 2 × uint16 normalised
+        v.indices = offset;
+        offset = align4(offset + v.index_count * (v.index16 ? 2 : 4));
+        views.push_back(v);
+    }
+    const std::size_t png_offset = offset;
+    const std::size_t buffer_length = align4(png_offset + png.size());
+
+    // ------------------------------------------------------------ document
+    tinygltf::Model model;
+    model.asset.version = "2.0";
+    model.asset.generator = "orogen export:gltf";
+    model.buffers.emplace_back();  // empty here; its length is set in the JSON below
+
+    auto add_view = [&](std::size_t off, std::size_t len, int target_kind) {
+        tinygltf::BufferView bv;
+        bv.buffer = 0;
+        bv.byteOffset = off;
+        bv.byteLength = len;
+        bv.target = target_kind;
+        model.bufferViews.push_back(bv);
+        return int(model.bufferViews.size() - 1);
+    };
+    auto add_accessor = [&](int view, int component, int type, std::size_t count, bool normalized) {
+        tinygltf::Accessor a;
+        a.bufferView = view;
+        a.byteOffset = 0;
+        a.componentType = component;
+        a.type = type;
+        a.count = count;
+        a.normalized = normalized;
+        model.accessors.push_back(a);
+        return int(model.accessors.size() - 1);
+    };
+
+    // Material: the baked splat colour as base colour, rough dielectric.
+    {
+        tinygltf::Image image;
+        image.name = "splat";
+        image.mimeType = "image/png";
+        image.bufferView = add_view(png_offset, png.size(), 0);
+        model.images.push_back(image);
+        tinygltf::Sampler sampler;
+        sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+        sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+        sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+        sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+        model.samplers.push_back(sampler);
+        tinygltf::Texture texture;
+        texture.sampler = 0;
+        texture.source = 0;
+        model.textures.push_back(texture);
+        tinygltf::Material material;
+        material.name = "terrain";
+        material.pbrMetallicRoughness.baseColorTexture.index = 0;
+        material.pbrMetallicRoughness.metallicFactor = 0.0;
+        material.pbrMetallicRoughness.roughnessFactor = 1.0;
+        model.materials.push_back(material);
+    }
+
+    tinygltf::Scene scene;
+    scene.name = "terrain";
+    const int per_row = int(std::count_if(mesh.chunks.begin(), mesh.chunks.end(),
+                                          [&](const auto& c) { return c.row_begin == mesh.chunks[0].row_begin; }));
+    for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
+        const auto& v = views[i];
+        const auto bounds = terrain::chunk_bounds(mesh, mesh.chunks[i]);
+        const int pos = add_accessor(add_view(v.positions, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
+        model.accessors[std::size_t(pos)].minValues.assign(bounds.min.begin(), bounds.min.end());
+        model.accessors[std::size_t(pos)].maxValues.assign(bounds.max.begin(), bounds.max.end());
+        const int nrm = add_accessor(add_view(v.normals, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
+        const int uv = add_accessor(add_view(v.texcoords, v.vertex_count * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, v.vertex_count, true);
+        const int idx = add_accessor(
+            add_view(v.indices, v.index_count * (v.index16 ? 2 : 4), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+            v.index16 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+            TINYGLTF_TYPE_SCALAR, v.index_count, false);
+        tinygltf::Primitive prim;
+        prim.attributes["POSITION"] = pos;
+        prim.attributes["NORMAL"] = nrm;
+        prim.attributes["TEXCOORD_0"] = uv;
+        prim.indices = idx;
+        prim.material = 0;
+        prim.mode = TINYGLTF_MODE_TRIANGLES;
+        tinygltf::Mesh m;
+        m.name = mesh.chunks.size() == 1
+                     ? std::string("terrain")
+                     : "terrain_" + std::to_string(int(i) % per_row) + "_" + std::to_string(int(i) / per_row);
+        m.primitives.push_back(prim);
+        model.meshes.push_back(m);
+        tinygltf::Node node;
+        node.name = m.name;
+        node.mesh = int(i);
+        model.nodes.push_back(node);
+        scene.nodes.push_back(int(i));
+    }
+    model.scenes.push_back(scene);
+    model.defaultScene = 0;
+
+    // Serialise with tinygltf (as a GLB without payload) and take its JSON chunk.
+    std::string json;
+    {
+        tinygltf::TinyGLTF writer;
+        std::ostringstream s(std::ios::binary);
+        if (!writer.WriteGltfSceneToStream(&model, s, false, true))
+            throw Error("tinygltf could not serialise the glTF document");
+        const std::string glb = std::move(s).str();
+        std::uint32_t json_length = 0;
+        if (glb.size() < 20) throw Error("tinygltf wrote a truncated GLB header");
+        std::memcpy(&json_length, glb.data() + 12, 4);
+        json = glb.substr(20, json_length);
+        while (!json.empty() && json.back() == ' ') json.pop_back();
+    }
+    const std::string placeholder = "\"buffers\":[{\"byteLength\":0}]";
+    const auto at = json.find(placeholder);
+    if (at == std::string::npos) throw Error("internal error: tinygltf's JSON has no empty buffer to fill in");
+    const fs::path bin_target = fs::path(target).replace_extension(".bin");
+    std::string buffer_json = "\"buffers\":[{\"byteLength\":" + std::to_string(buffer_length);
+    if (!binary) buffer_json += ",\"uri\":\"" + bin_target.filename().string() + "\"";
+    buffer_json += "}]";
+    json.replace(at, placeholder.size(), buffer_json);
+
+    // ------------------------------------------------------------ files
+    AtomicFile main_file(target);
+    std::optional<AtomicFile> bin_file;
+    std::ostream* payload = &main_file.stream();
+    if (binary) {
+        // GLB: 12-byte header, JSON chunk (padded with spaces), BIN chunk (padded with zeros).
+        const std::size_t json_padded = align4(json.size());
+        json.append(json_padded - json.size(), ' ');
+        const std::size_t total = 12 + 8 + json_padded + 8 + buffer_length;
+        if (total > 0xffffffffu)
+            throw BadInput("the GLB would be " + std::to_string(total >> 20) +
+                           " MiB, over the format's 4 GiB limit; use decimate=2 or more");
+        std::string head;
+        put_u32(head, 0x46546C67);  // "glTF"
+        put_u32(head, 2);
+        put_u32(head, std::uint32_t(total));
+        put_u32(head, std::uint32_t(json_padded));
+        put_u32(head, 0x4E4F534A);  // "JSON"
+        head += json;
+        put_u32(head, std::uint32_t(buffer_length));
+        put_u32(head, 0x004E4942);  // "BIN\0"
+        main_file.stream().write(head.data(), std::streamsize(head.size()));
+    } else {
+        main_file.stream().write(json.data(), std::streamsize(json.size()));
+        bin_file.emplace(bin_target);
+        payload = &bin_file->stream();
+    }
+
+    Summary summary;
+    summary.meshes = mesh.chunks.size();
+    summary.texture_width = tw;
+    summary.texture_height = th;
+    summary.bytes = buffer_length;
+    std::vector<float> floats;
+    std::vector<std::uint16_t> shorts;
+    std::vector<std::uint32_t> ints;
+    for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
+        const auto& c = mesh.chunks[i];
+        const auto& v = views[i];
+        summary.vertices += v.vertex_count;
+        summary.triangles += c.triangle_count();
+        floats.resize(v.vertex_count * 3);
+        terrain::chunk_positions(mesh, c, floats);
+        write_span<float>(*payload, floats);
+        terrain::chunk_normals(mesh, c, floats);
+        write_span<float>(*payload, floats);
+        shorts.resize(v.vertex_count * 2);
+        terrain::chunk_texcoords(mesh, c, std::span<std::uint16_t>(shorts));
+        write_span<std::uint16_t>(*payload, shorts);
+        std::size_t index_bytes = 0;
+        if (v.index16) {
+            shorts.resize(v.index_count);
+            terrain::chunk_indices(c, std::span<std::uint16_t>(shorts));
+            write_span<std::uint16_t>(*payload, shorts);
+            index_bytes = v.index_count * 2;
+        } else {
+            ints.resize(v.index_count);
+            terrain::chunk_indices(c, std::span<std::uint32_t>(ints));
+            write_span<std::uint32_t>(*payload, ints);
+            index_bytes = v.index_count * 4;
+        }
+        write_zeros(*payload, align4(index_bytes) - index_bytes);
+    }
+    payload->write(png.data(), std::streamsize(png.size()));
+    write_zeros(*payload, buffer_length - png_offset - png.size());
+
+    if (bin_file) {
+        AtomicFile* files[] = {&*bin_file, &main_file};  // the .bin in place before the .gltf names it
+        commit_all(files);
+    } else {
+        main_file.commit();
+    }
+    return summary;
+}
+
+}  // namespace orogen::gltf
