@@ -1,0 +1,180 @@
+// generate:rmp and generate:range — register the RMP cores as nodes.
+#include "cones.hpp"
+#include "range.hpp"
+#include "rmp.hpp"
+
+#include <orogen/plugin.hpp>
+
+#include <cmath>
+#include <sstream>
+
+using namespace orogen;
+
+namespace {
+
+std::shared_ptr<Heightmap> base_or_grid(NodeContext& ctx) {
+    return ctx.has_input(0) ? ctx.take_heightmap(0)
+                            : std::make_shared<Heightmap>(ctx.grid().width, ctx.grid().height, ctx.grid().cell);
+}
+
+std::string point_text(Point2 p) {
+    std::ostringstream s;
+    s << "(" << p.x << ", " << p.y << ")";
+    return s.str();
+}
+
+// Polygons n cuts can make at most (the lazy caterer's sequence, thesis eq. 4.1).
+std::int64_t max_polygons(std::int64_t cuts) { return (cuts * cuts + cuts + 2) / 2; }
+
+}  // namespace
+
+OROGEN_PLUGIN("rmp", "0.1.0", registry) {
+    registry.add({
+        .kind = "generate",
+        .name = "rmp",
+        .summary = "Repeated Magnification and Probing (thesis 3.3): mountains at given peaks",
+        .description =
+            "Each iteration cuts the map into random regions and raises the region under each peak\n"
+            "by `height` (times decay^iteration). More cones (or cuts) per iteration make a steeper,\n"
+            "narrower mountain; more iterations a higher one. Methods find the regions differently:\n"
+            "  voronoi  exact Voronoi cells on the CPU, only the raised ones (default, fastest)\n"
+            "  cones    the thesis's GPU trick: flat cones drawn from above through OSMesa\n"
+            "  graph    faces of `cuts` random lines; the first `regions` faces of a depth-first\n"
+            "           search from each peak's face rise\n"
+            "voronoi and cones use the same sites for a seed, so they give the same mountain.\n"
+            "With no input, starts from the spec's grid, flat at 0 m.",
+        .inputs = {{"base", ValueType::heightmap, Need::optional,
+                    "terrain to raise mountains on (default: the spec's grid, flat at 0 m)"}},
+        .output = ValueType::heightmap,
+        .params =
+            {
+                Param::choice("method", {"voronoi", "cones", "graph"}, "voronoi")
+                    .help("how the regions are found: exact Voronoi cells, OSMesa-drawn cones, or line cuts"),
+                Param::points("peaks", std::vector<Point2>{{0.5, 0.5}})
+                    .min(0)
+                    .max(1)
+                    .at_most(1024)
+                    .help("where the mountains stand, grid-relative (0..1 on both axes)"),
+                Param::integer("iterations", 100).min(1).max(1'000'000).help("raises; height grows with them"),
+                Param::integer("cones", 100)
+                    .min(1)
+                    .max(10'000'000)
+                    .help("Voronoi sites per iteration (voronoi, cones): more give a steeper, narrower mountain"),
+                Param::real("height", 5.0).min(-1e5).max(1e5).unit("m").help("raise of the first iteration"),
+                Param::real("decay", 1.0)
+                    .min(0, true)
+                    .max(1)
+                    .help("the raise is multiplied by this after each iteration (the thesis: 1 - 1/iterations)"),
+                Param::real("jitter", 0.0)
+                    .min(0)
+                    .max(1)
+                    .help("0: every region by the same amount; >0: each by height*(1 + jitter*u), u in [-1, 1) "
+                          "(the thesis's dynamic areal height, 4.2)"),
+                Param::integer("cuts", 5).min(1).max(5000).help("random lines per iteration (graph)"),
+                Param::integer("regions", 2)
+                    .min(1)
+                    .max(1'000'000)
+                    .help("polygons raised per peak per iteration, first in depth-first order (graph)"),
+            },
+        .check =
+            [](CheckContext& ctx) {
+                const std::string& method = ctx.text("method");
+                if (method == "graph") {
+                    const std::int64_t cuts = ctx.integer("cuts"), regions = ctx.integer("regions");
+                    if (regions > max_polygons(cuts))
+                        ctx.error("regions", "regions=" + std::to_string(regions) + " is more than the " +
+                                                 std::to_string(max_polygons(cuts)) + " polygons " +
+                                                 std::to_string(cuts) + " cuts can make at most (n(n+1)/2 + 1); "
+                                                 "lower regions or raise cuts");
+                }
+                if (method != "graph" && (ctx.given("cuts") || ctx.given("regions")))
+                    ctx.error(ctx.given("cuts") ? "cuts" : "regions",
+                              "cuts and regions apply to method=graph only; this node uses method=" + method);
+                if (method == "graph" && ctx.given("cones"))
+                    ctx.error("cones", "cones applies to method=voronoi and method=cones; method=graph uses cuts");
+                if (method == "cones" && ctx.integer("cones") > 16'777'214)
+                    ctx.error("cones", "method=cones encodes a cone's index in a 24-bit colour: at most 16777214 "
+                                       "cones; use method=voronoi for more");
+            },
+        .run = [](NodeContext& ctx) -> NodeOutputs {
+            auto hm = base_or_grid(ctx);
+            rmp::RmpParams p;
+            p.peaks = ctx.points("peaks");
+            p.iterations = int(ctx.integer("iterations"));
+            p.cones = int(ctx.integer("cones"));
+            p.height = ctx.real("height");
+            p.decay = ctx.real("decay");
+            p.jitter = ctx.real("jitter");
+            p.cuts = int(ctx.integer("cuts"));
+            p.regions = int(ctx.integer("regions"));
+            const auto hook = [&](int k) {
+                ctx.check_cancelled();
+                ctx.progress(double(k + 1) / p.iterations);
+            };
+            const std::string& method = ctx.text("method");
+            if (method == "voronoi") rmp::rmp_voronoi(hm->view(), p, ctx.seed(), hook);
+            else if (method == "cones") rmp::rmp_cones(hm->view(), p, ctx.seed(), hook);
+            else rmp::rmp_graph(hm->view(), p, ctx.seed(), hook);
+            ctx.check_finite(hm->heights(), "height", p.iterations);
+            return hm;
+        },
+    });
+
+    registry.add({
+        .kind = "generate",
+        .name = "range",
+        .summary = "A mountain range between two points: RMP along a line (thesis 3.6.2)",
+        .description =
+            "Each iteration draws a fresh Voronoi diagram of `cones` sites and raises every cell the\n"
+            "segment from `from` to `to` passes through (and every cell of its Bresenham line's\n"
+            "vertices), as the plate simulation does at each collision. With no input, starts from\n"
+            "the spec's grid, flat at 0 m.",
+        .inputs = {{"base", ValueType::heightmap, Need::optional,
+                    "terrain to raise the range on (default: the spec's grid, flat at 0 m)"}},
+        .output = ValueType::heightmap,
+        .params =
+            {
+                Param::point("from", Point2{0.2, 0.5}).min(0).max(1).help("one end of the range, grid-relative"),
+                Param::point("to", Point2{0.8, 0.5}).min(0).max(1).help("the other end, grid-relative"),
+                Param::integer("iterations", 50).min(1).max(1'000'000).help("raises, each with new cells"),
+                Param::integer("cones", 100)
+                    .min(1)
+                    .max(10'000'000)
+                    .help("Voronoi sites per iteration: more give a narrower range"),
+                Param::real("height", 5.0).min(-1e5).max(1e5).unit("m").help("raise per iteration"),
+                Param::real("jitter", 0.0)
+                    .min(0)
+                    .max(1)
+                    .help("0: every crossed cell by `height`; >0: each by height*(1 + jitter*u), u in [-1, 1)"),
+                Param::boolean("uplift", false).help("also add the raise to the heightmap's 'uplift' layer (m)"),
+            },
+        .check =
+            [](CheckContext& ctx) {
+                const Point2 a = std::get<Point2>(ctx.param("from")), b = std::get<Point2>(ctx.param("to"));
+                if (a == b)
+                    ctx.error("to", "the range's two end points are the same point " + point_text(a) +
+                                        "; give `from` and `to` different points");
+                if (ctx.flag("uplift")) ctx.output().layers.insert("uplift");
+            },
+        .run = [](NodeContext& ctx) -> NodeOutputs {
+            auto hm = base_or_grid(ctx);
+            const Point2 a = rmp::to_samples(ctx.point("from"), hm->width(), hm->height());
+            const Point2 b = rmp::to_samples(ctx.point("to"), hm->width(), hm->height());
+            rmp::RangeParams p;
+            p.cones = int(ctx.integer("cones"));
+            p.height = ctx.real("height");
+            p.jitter = ctx.real("jitter");
+            const int iterations = int(ctx.integer("iterations"));
+            GridView uplift;
+            if (ctx.flag("uplift")) uplift = hm->layer("uplift");
+            for (int k = 0; k < iterations; ++k) {
+                rmp::raise_range(hm->view(), a, b, p, rmp::iteration_seed(ctx.seed(), k),
+                                 ctx.flag("uplift") ? &uplift : nullptr);
+                ctx.check_cancelled();
+                ctx.progress(double(k + 1) / iterations);
+            }
+            ctx.check_finite(hm->heights(), "height", iterations);
+            return hm;
+        },
+    });
+}
