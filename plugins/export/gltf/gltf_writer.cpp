@@ -21,6 +21,8 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <future>
+#include <type_traits>
 #include <optional>
 #include <sstream>
 
@@ -67,13 +69,8 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     // Texture: no larger than the terrain's tile count (more pixels than tiles add nothing).
     const int tw = std::max(1, std::min(options.texture_size, heights.width - 1));
     const int th = std::max(1, std::min(options.texture_size, heights.height - 1));
-    std::string png;
-    {
-        const auto rgba = terrain::bake_splat_texture(heights, tw, th);
-        std::ostringstream s(std::ios::binary);
-        write_rgba_png(s, tw, th, rgba);
-        png = std::move(s).str();
-    }
+    const std::vector<std::uint8_t> png =
+        terrain::encode_png_fast(terrain::bake_splat_texture(heights, tw, th), tw, th);
 
     // Buffer layout: per chunk positions, normals, texcoords, indices; then the PNG.
     std::vector<ChunkViews> views;
@@ -245,37 +242,35 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     summary.texture_width = tw;
     summary.texture_height = th;
     summary.bytes = buffer_length;
-    std::vector<float> floats;
-    std::vector<std::uint16_t> shorts;
-    std::vector<std::uint32_t> ints;
-    for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
+    // Generate chunk i + 1 while chunk i is written: writing is a copy into the
+    // page cache on one core, generation runs on the others.
+    auto build = [&](std::size_t i) {
         const auto& c = mesh.chunks[i];
         const auto& v = views[i];
-        summary.vertices += v.vertex_count;
-        summary.triangles += c.triangle_count();
-        floats.resize(v.vertex_count * 3);
-        terrain::chunk_positions(mesh, c, floats);
-        write_span<float>(*payload, floats);
-        terrain::chunk_normals(mesh, c, floats);
-        write_span<float>(*payload, floats);
-        shorts.resize(v.vertex_count * 2);
-        terrain::chunk_texcoords(mesh, c, std::span<std::uint16_t>(shorts));
-        write_span<std::uint16_t>(*payload, shorts);
-        std::size_t index_bytes = 0;
-        if (v.index16) {
-            shorts.resize(v.index_count);
-            terrain::chunk_indices(c, std::span<std::uint16_t>(shorts));
-            write_span<std::uint16_t>(*payload, shorts);
-            index_bytes = v.index_count * 2;
-        } else {
-            ints.resize(v.index_count);
-            terrain::chunk_indices(c, std::span<std::uint32_t>(ints));
-            write_span<std::uint32_t>(*payload, ints);
-            index_bytes = v.index_count * 4;
-        }
-        write_zeros(*payload, align4(index_bytes) - index_bytes);
+        const std::size_t index_bytes = v.index_count * (v.index16 ? 2 : 4);
+        std::vector<std::uint8_t> bytes(v.vertex_count * 28 + align4(index_bytes), 0);
+        auto as = [&](std::size_t offset, auto* type, std::size_t n) {
+            using T = std::remove_pointer_t<decltype(type)>;
+            return std::span<T>(reinterpret_cast<T*>(bytes.data() + offset), n);
+        };
+        terrain::chunk_positions(mesh, c, as(0, (float*)nullptr, v.vertex_count * 3));
+        terrain::chunk_normals(mesh, c, as(v.vertex_count * 12, (float*)nullptr, v.vertex_count * 3));
+        terrain::chunk_texcoords(mesh, c, as(v.vertex_count * 24, (std::uint16_t*)nullptr, v.vertex_count * 2));
+        if (v.index16)
+            terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint16_t*)nullptr, v.index_count));
+        else
+            terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
+        return bytes;
+    };
+    std::future<std::vector<std::uint8_t>> next = std::async(std::launch::async, build, 0);
+    for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
+        std::vector<std::uint8_t> bytes = next.get();
+        if (i + 1 < mesh.chunks.size()) next = std::async(std::launch::async, build, i + 1);
+        summary.vertices += views[i].vertex_count;
+        summary.triangles += mesh.chunks[i].triangle_count();
+        write_span<std::uint8_t>(*payload, bytes);
     }
-    payload->write(png.data(), std::streamsize(png.size()));
+    payload->write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
     write_zeros(*payload, buffer_length - png_offset - png.size());
 
     if (bin_file) {
