@@ -235,7 +235,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
            Diagnostics& diags) {
     Plan plan;
     plan.spec_path = spec_path;
-    plan.spec_folder = spec_path.has_parent_path() ? spec_path.parent_path() : fs::path(".");
+    plan.spec_folder = spec_path.parent_path();  // "" for a spec in the current folder: paths stay as written
     plan.source = parsed.source;
     plan.overrides = options.overrides;
     const Location file_start{parsed.source, 1, 1, 1};
@@ -272,8 +272,9 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
         bool used = false;
     };
     std::vector<PendingOverride> overrides;
+    int override_order = 0;
     for (const auto& text : options.overrides) {
-        auto src = std::make_shared<spec::Source>("--set " + text, text);
+        auto src = std::make_shared<spec::Source>("--set " + text, text, ++override_order);
         if (auto o = spec::parse_override(src, diags)) overrides.push_back({std::move(*o)});
     }
 
@@ -281,6 +282,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
     std::map<std::string, ValueInfo, std::less<>> values;          // value key → info
     std::map<std::string, Location, std::less<>> defined_at;       // value name → statement
     std::map<std::string, Location, std::less<>> output_files;     // output path → where
+    std::map<std::string, int, std::less<>> unnamed_count;
     std::set<std::string, std::less<>> poisoned;                    // names whose node is unknown
     std::vector<std::string> all_nodes;
     for (const auto* n : registry.nodes()) all_nodes.push_back(n->qualified_name());
@@ -311,7 +313,10 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
         PlannedNode planned;
         planned.node = node;
         planned.value_name = st.name;
+        // Unnamed calls are labelled kind:node, then kind:node#2, #3...: the label seeds the node.
         planned.label = st.name.empty() ? call.qualified() : st.name;
+        if (st.name.empty() && ++unnamed_count[call.qualified()] > 1)
+            planned.label += "#" + std::to_string(unnamed_count[call.qualified()]);
         planned.where = call.where;
 
         // Inputs

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <sstream>
+#include <tuple>
 
 namespace orogen::spec {
 
-Source::Source(std::string n, std::string t) : name(std::move(n)), text(std::move(t)) {
+Source::Source(std::string n, std::string t, int o) : name(std::move(n)), text(std::move(t)), order(o) {
     line_starts.push_back(0);
     for (std::size_t i = 0; i < text.size(); ++i)
         if (text[i] == '\n') line_starts.push_back(i + 1);
@@ -43,7 +44,9 @@ std::string format(const Diagnostic& d) {
     out << d.where.source->name << ":" << d.where.line << ":" << d.where.column << ": " << sev << ": " << d.message
         << "\n";
     const std::string_view text = d.where.source->line(d.where.line);
-    if (!text.empty() || d.where.line >= 1) {
+    bool printable = d.where.length > 0;  // length 0: a place with no text worth showing  // a binary file's "line" is noise: say where, do not echo it
+    for (unsigned char c : text) printable = printable && (c >= 0x20 || c == '\t') && c != 0x7f;
+    if (printable) {
         out << "  " << text << "\n  ";
         // Keep tabs so the caret lines up under tab-indented text.
         for (int i = 1; i < d.where.column; ++i)
@@ -56,8 +59,15 @@ std::string format(const Diagnostic& d) {
 }
 
 std::string Diagnostics::format() const {
+    // In source order, whatever order the checks ran in.
+    auto rank = [](const Diagnostic& d) {
+        return std::make_tuple(d.where.source ? d.where.source->order : -1, d.where.line, d.where.column);
+    };
+    std::vector<const Diagnostic*> sorted;
+    for (const auto& d : list_) sorted.push_back(&d);
+    std::stable_sort(sorted.begin(), sorted.end(), [&](auto* a, auto* b) { return rank(*a) < rank(*b); });
     std::string s;
-    for (const auto& d : list_) s += spec::format(d);
+    for (const auto* d : sorted) s += spec::format(*d);
     return s;
 }
 

@@ -15,12 +15,14 @@ struct Source {
     std::string name;
     std::string text;
     std::vector<std::size_t> line_starts;  ///< offset of each line's first character
+    int order = 0;  ///< diagnostics are listed by (order, line, column): the spec 0, each --set after it
 
-    Source(std::string name, std::string text);
+    Source(std::string name, std::string text, int order = 0);
     std::string_view line(int line_number) const;  ///< 1-based, without the newline
 };
 
-/// A place in a source: 1-based line and column (in bytes), and the length to underline.
+/// A place in a source: 1-based line and column (in bytes), and the length to
+/// underline (0: print no source line, e.g. for a binary file).
 struct Location {
     std::shared_ptr<const Source> source;
     int line = 0;

@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <cstdlib>
 
 namespace orogen::spec {
@@ -20,7 +21,6 @@ std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics&
     std::size_t i = 0;
     int line = 1;
     std::size_t line_start = 0;
-    int depth = 0;  // inside ( ) or [ ]: newlines do not end the statement
 
     auto here = [&](std::size_t begin, std::size_t end) {
         return Location{source, line, int(begin - line_start) + 1, int(std::max<std::size_t>(1, end - begin))};
@@ -33,10 +33,28 @@ std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics&
         out.push_back(std::move(t));
     };
 
+    // A binary file (an image, an executable) passed by mistake: one error, not hundreds.
+    for (std::size_t k = 0; k < s.size() && k < (1u << 20); ++k) {
+        const auto b = static_cast<unsigned char>(s[k]);
+        if ((b < 0x20 && b != '\n' && b != '\t' && b != '\r') || b == 0x7f) {
+            char hex[8];
+            std::snprintf(hex, sizeof hex, "0x%02x", b);
+            diags.error(Location{source, 1, 1, 0}, "this is not a text spec: byte " + std::to_string(k) + " is " + hex +
+                                                       ", a control character; is it a binary file?");
+            Token bad;
+            bad.kind = Tok::bad;
+            bad.where = Location{source, 1, 1, 1};
+            out.push_back(bad);
+            Token eof;
+            eof.where = bad.where;
+            out.push_back(eof);
+            return out;
+        }
+    }
     while (i < s.size()) {
         const char c = s[i];
         if (c == '\n') {
-            if (depth == 0) push(Tok::newline, i, i + 1, "\n");
+            push(Tok::newline, i, i + 1, "\n");  // the parser skips it inside ( ) and [ ]
             ++i;
             ++line;
             line_start = i;
@@ -49,15 +67,6 @@ std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics&
         if (c == '#') {
             while (i < s.size() && s[i] != '\n') ++i;
             continue;
-        }
-        if (c == '\0' || (static_cast<unsigned char>(c) < 0x20) || c == 0x7f) {
-            // A binary file: report once, then stop (the rest is noise).
-            diags.error(here(i, i + 1), "this is not a text spec: it contains a control byte (0x" +
-                                            std::string(1, "0123456789abcdef"[(static_cast<unsigned char>(c) >> 4) & 15]) +
-                                            std::string(1, "0123456789abcdef"[static_cast<unsigned char>(c) & 15]) +
-                                            "); is it a binary file?");
-            push(Tok::bad, i, i + 1);
-            break;
         }
         const std::size_t begin = i;
         if (digit(c) || ((c == '-' || c == '+' || c == '.') && i + 1 < s.size() &&
@@ -122,10 +131,10 @@ std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics&
         }
         Tok kind = Tok::bad;
         switch (c) {
-            case '(': kind = Tok::lparen; ++depth; break;
-            case ')': kind = Tok::rparen; if (depth > 0) --depth; break;
-            case '[': kind = Tok::lbracket; ++depth; break;
-            case ']': kind = Tok::rbracket; if (depth > 0) --depth; break;
+            case '(': kind = Tok::lparen; break;
+            case ')': kind = Tok::rparen; break;
+            case '[': kind = Tok::lbracket; break;
+            case ']': kind = Tok::rbracket; break;
             case ',': kind = Tok::comma; break;
             case '=': kind = Tok::equals; break;
             case ':': kind = Tok::colon; break;

@@ -33,7 +33,7 @@ public:
             const std::size_t errors_before = std::size_t(diags_.error_count());
             statement(spec);
             if (std::size_t(diags_.error_count()) != errors_before) {
-                skip_line();
+                recover();
                 continue;
             }
             if (peek().kind != Tok::newline && peek().kind != Tok::eof) {
@@ -79,6 +79,29 @@ private:
     const Token& next() { return t_[std::min(p_++, t_.size() - 1)]; }
     void skip_line() {
         while (peek().kind != Tok::newline && peek().kind != Tok::eof) ++p_;
+    }
+    /// After an error: skip to the next line that starts a statement, so a
+    /// broken multi-line call does not produce one error per line.
+    void recover() {
+        while (peek().kind != Tok::eof) {
+            if (peek().kind == Tok::newline && starts_statement(p_ + 1)) {
+                ++p_;
+                return;
+            }
+            ++p_;
+        }
+    }
+    /// NAME = kind:node  |  kind:node(  |  orogen/seed/grid at the start of a line.
+    bool starts_statement(std::size_t at) const {
+        const Token& a = peek(at - p_);
+        if (a.kind != Tok::word) return false;
+        const Tok b = peek(at - p_ + 1).kind, c = peek(at - p_ + 2).kind, d = peek(at - p_ + 3).kind;
+        if (b == Tok::equals && c == Tok::word && d == Tok::colon) return true;
+        if (b == Tok::colon && c == Tok::word && d == Tok::lparen) return true;
+        return a.where.column == 1 && (a.text == "orogen" || a.text == "seed" || a.text == "grid");
+    }
+    void skip_newlines() {
+        while (peek().kind == Tok::newline) ++p_;
     }
     void error(const Token& at, std::string message) {
         if (at.kind == Tok::bad) return;  // the lexer has said it already
@@ -235,24 +258,43 @@ private:
         call.node = node.text;
         call.where = kind.where;
         call.where.length = node.where.column + node.where.length - kind.where.column;
+        const Token& open = peek();
         if (!expect(Tok::lparen, "'(' after " + call.qualified() + " (a call with no arguments is written " +
                                      call.qualified() + "())"))
             return std::nullopt;
+        // Inside ( ) newlines do not end a statement, so a missing ')' shows up lines later:
+        // then point at the '(' that was never closed.
+        auto unclosed = [&](const Token& at) {
+            if (at.kind == Tok::eof || (at.where.line > open.where.line && starts_statement(p_))) {
+                diags_.error(open.where, "this '(' of the call to " + call.qualified() + " is never closed; add ')'");
+                return true;
+            }
+            return false;
+        };
+        skip_newlines();
         if (peek().kind == Tok::rparen) {
             ++p_;
             return call;
         }
         bool seen_param = false;
         while (true) {
+            skip_newlines();
             const Token& a = peek();
+            if (unclosed(a)) return std::nullopt;
             if (a.kind != Tok::word) {
                 error(a, "expected an input name or key=value, found " + what(a));
                 return std::nullopt;
             }
             if (peek(1).kind == Tok::equals) {
                 p_ += 2;
+                skip_newlines();
                 auto value = literal();
                 if (!value) return std::nullopt;
+                if (value->kind == Literal::Kind::word && peek().kind == Tok::dot) {
+                    diags_.error(value->where, "a value with a '.' in it is a string: write it in quotes, " + a.text + "=\"" +
+                                            value->text + "." + (peek(1).kind == Tok::word ? peek(1).text : "") + "\"");
+                    return std::nullopt;
+                }
                 call.params.push_back(Argument{a.text, a.where, std::move(*value)});
                 seen_param = true;
             } else {
@@ -275,6 +317,7 @@ private:
                 }
                 call.inputs.push_back(std::move(in));
             }
+            skip_newlines();
             if (peek().kind == Tok::comma) {
                 ++p_;
                 continue;
@@ -283,6 +326,7 @@ private:
                 ++p_;
                 return call;
             }
+            if (unclosed(peek())) return std::nullopt;
             error(peek(), "expected ',' or ')' in the call to " + call.qualified() + ", found " + what(peek()));
             return std::nullopt;
         }
@@ -341,14 +385,17 @@ private:
             case Tok::lbracket: {
                 ++p_;
                 l.kind = Literal::Kind::list;
+                skip_newlines();
                 if (peek().kind == Tok::rbracket) {
                     ++p_;
                     return l;
                 }
                 while (true) {
+                    skip_newlines();
                     auto item = literal();
                     if (!item) return std::nullopt;
                     l.items.push_back(std::move(*item));
+                    skip_newlines();
                     if (peek().kind == Tok::comma) {
                         ++p_;
                         continue;

@@ -1,0 +1,351 @@
+// The `orogen` command end to end: diagnostics word for word, the plugin
+// seam's failure modes, the runner's error handling, determinism, outputs.
+#include <orogen/io.hpp>
+
+#include <gtest/gtest.h>
+
+#include "orogen_test.hpp"
+
+#include <algorithm>
+#include <regex>
+
+using namespace orogen;
+using namespace orogen::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+const fs::path bad_specs = fs::path(OROGEN_SOURCE_DIR) / "tests" / "specs" / "bad";
+const std::string fake_plugins = OROGEN_FAKE_PLUGIN_DIR;
+
+const char* issue_spec =
+    "orogen 1\n"
+    "seed 7\n"
+    "grid 513 cell=30\n"
+    "\n"
+    "base = generate:diamond-square(roughness=0.6, amplitude=800)\n"
+    "cut  = generate:fault(base, iterations=200, displacement=4)\n"
+    "export:png(cut, path=\"cut.png\", bits=16)\n"
+    "export:png(base, path=\"base.png\")\n";
+
+std::vector<fs::path> bad_spec_files() {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(bad_specs))
+        if (e.path().extension() == ".orogen") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------ diagnostics
+
+class BadSpec : public testing::TestWithParam<fs::path> {};
+
+// Each tests/specs/bad/NAME.orogen must give exactly NAME.expected on stderr
+// and exit code 2. (OROGEN_UPDATE_GOLDEN=1 rewrites the .expected files.)
+TEST_P(BadSpec, GivesExactlyTheExpectedDiagnostics) {
+    const fs::path spec = GetParam();
+    const RunResult r = run_orogen("check " + spec.filename().string(), "", bad_specs);
+    fs::path expected_file = spec;
+    expected_file.replace_extension(".expected");
+    if (std::getenv("OROGEN_UPDATE_GOLDEN")) std::ofstream(expected_file, std::ios::binary) << r.err;
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(r.err, slurp(expected_file));
+}
+
+INSTANTIATE_TEST_SUITE_P(Specs, BadSpec, testing::ValuesIn(bad_spec_files()),
+                         [](const testing::TestParamInfo<fs::path>& info) { return info.param.stem().string(); });
+
+TEST(Cli, AMissingSpecIsRefused) {
+    const RunResult r = run_orogen("run no-such.orogen");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err, "orogen: error: cannot read spec no-such.orogen: no such file\n");
+}
+
+TEST(Cli, AHugeGridIsRefusedBeforeAllocatingWithTheMemoryItNeeds) {
+    TempDir dir;
+    dir.write("big.orogen", "orogen 1\ngrid 1000000x1000000\nb = generate:fault()\nexport:png(b, path=\"b.png\")\n");
+    const RunResult r = run_orogen("run big.orogen --out out", "", dir.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("big.orogen:2:6: error: grid 1000000x1000000 needs 3.6 TiB for one heightmap (4 bytes a vertex)"),
+              std::string::npos)
+        << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out"));  // nothing ran, nothing written
+}
+
+TEST(Cli, OverridesAreCheckedLikeTheSpec) {
+    TempDir dir;
+    dir.write("s.orogen", issue_spec);
+    RunResult r = run_orogen("check s.orogen --set cut.iterations=-5 --set cut.displacment=3 --set cutt.iterations=3",
+                             "", dir.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err,
+              "--set cut.iterations=-5:1:16: error: 'iterations' of generate:fault is -5, out of range [1, 1e+06]\n"
+              "  cut.iterations=-5\n"
+              "                 ^~\n"
+              "--set cut.displacment=3:1:5: error: generate:fault ('cut') has no parameter 'displacment'; did you mean 'displacement'?\n"
+              "  cut.displacment=3\n"
+              "      ^~~~~~~~~~~\n"
+              "--set cutt.iterations=3:1:1: error: --set names 'cutt', but the spec defines no value of that name; did you mean 'cut'?\n"
+              "  cutt.iterations=3\n"
+              "  ^~~~\n"
+              "3 errors in s.orogen\n");
+    r = run_orogen("run s.orogen --out a --quiet", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_orogen("run s.orogen --out b --quiet --set cut.iterations=201", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(slurp(dir / "a/base.png"), slurp(dir / "b/base.png"));  // untouched node: same output
+    EXPECT_NE(slurp(dir / "a/cut.png"), slurp(dir / "b/cut.png"));
+}
+
+TEST(Cli, UsageErrorsExitWithTwo) {
+    EXPECT_EQ(run_orogen("frobnicate").exit_code, 2);
+    EXPECT_NE(run_orogen("chek x").err.find("unknown command 'chek'; did you mean 'check'?"), std::string::npos);
+    EXPECT_NE(run_orogen("run x.orogen --threads 0").err.find("--threads needs a number from 1 to 1024, got '0'"),
+              std::string::npos);
+    EXPECT_EQ(run_orogen("help generate:falt").err,
+              "orogen: error: unknown node 'generate:falt'; did you mean 'generate:fault'?\n");
+    EXPECT_EQ(run_orogen("list generat").exit_code, 2);
+}
+
+TEST(Cli, ListHelpAndVersionDescribeThePlugins) {
+    RunResult r = run_orogen("list generate");
+    ASSERT_EQ(r.exit_code, 0);
+    EXPECT_NE(r.out.find("generate:diamond-square"), std::string::npos);
+    EXPECT_NE(r.out.find("generate:fault"), std::string::npos);
+    EXPECT_EQ(r.out.find("export:png"), std::string::npos);  // filtered by kind
+
+    r = run_orogen("help generate:fault");
+    ASSERT_EQ(r.exit_code, 0);
+    EXPECT_NE(r.out.find("  iterations       integer      default 200           range [1, 1e+06]\n"
+                         "      number of fault lines\n"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("  displacement     number       default 1             range [0, 100000]  unit m\n"),
+              std::string::npos)
+        << r.out;
+
+    r = run_orogen("version");
+    ASSERT_EQ(r.exit_code, 0);
+    EXPECT_NE(r.out.find("(plugin API 1)"), std::string::npos);
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  fault +0\\.1\\.0 +.*orogen_generate_fault\\.so\n")));
+}
+
+// ------------------------------------------------------------- plugin seam
+
+TEST(PluginSeam, BrokenPluginsAreRefusedOneByOneAndTheRestStillLoad) {
+    TempDir dir;
+    dir.write("not-a-library.so", "this is text, not ELF");
+    const RunResult r =
+        run_orogen("version", "OROGEN_PLUGIN_PATH=" + fake_plugins + ":" + (dir / "not-a-library.so").string());
+    ASSERT_EQ(r.exit_code, 0);
+    const std::string w = "orogen: warning: plugin ";
+    EXPECT_NE(r.err.find(w + fake_plugins + "/wrong_version.so: wrong plugin API version in plugin 'future-plugin': "
+                             "got version 2, supported version is 1; rebuild the plugin against this orogen's headers; skipped\n"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find(w + fake_plugins + "/no_entry.so: not an orogen plugin: it has no entry point "
+                             "'orogen_plugin_info' (define one with OROGEN_PLUGIN(...)); skipped\n"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find(w + (dir / "not-a-library.so").string() + ": cannot load this library ("), std::string::npos)
+        << r.err;
+    EXPECT_TRUE(std::regex_search(
+        r.err, std::regex(w + "node 'generate:fault' is registered twice: by plugin 'fault' \\(.*/orogen_generate_fault\\.so\\) "
+                              "and by plugin 'fault-clone' \\(" + fake_plugins + "/duplicate_node\\.so\\); keeping the first\\. "
+                              "Duplicate library\\? Remove one of them from the plugin path\\.\n")))
+        << r.err;
+    EXPECT_NE(r.err.find(w + fake_plugins + "/throwing_register.so: plugin 'test-register-throws' failed while "
+                             "registering its nodes (cannot find my data files)"),
+              std::string::npos)
+        << r.err;
+    // The good ones, real and fake, are all there.
+    EXPECT_NE(r.out.find("  fault "), std::string::npos);
+    EXPECT_NE(r.out.find("  diamond-square "), std::string::npos);
+    EXPECT_NE(r.out.find("  test-throwing "), std::string::npos);
+    EXPECT_EQ(r.out.find("future-plugin"), std::string::npos);
+}
+
+TEST(PluginSeam, TheFirstOfTwoDuplicateNodesIsTheOneThatRuns) {
+    TempDir dir;
+    dir.write("s.orogen", issue_spec);
+    const RunResult a = run_orogen("run s.orogen --out a --quiet", "", dir.path());
+    const RunResult b = run_orogen("run s.orogen --out b --quiet", "OROGEN_PLUGIN_PATH=" + fake_plugins, dir.path());
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    EXPECT_EQ(slurp(dir / "a/cut.png"), slurp(dir / "b/cut.png"));
+}
+
+// ------------------------------------------------------------------ runner
+
+namespace {
+RunResult run_failing(const TempDir& dir, const std::string& node) {
+    dir.write("f.orogen", "orogen 1\ngrid 33\nok = generate:fault(iterations=3)\nexport:png(ok, path=\"ok.png\")\n"
+                          "bad = generate:" + node + "()\nexport:png(bad, path=\"bad.png\")\n");
+    return run_orogen("run f.orogen --out out --quiet", "OROGEN_PLUGIN_PATH=" + fake_plugins, dir.path());
+}
+}  // namespace
+
+TEST(Runner, ANodeErrorNamesTheNodeAndItsLineAndKeepsEarlierOutputs) {
+    TempDir dir;
+    RunResult r = run_failing(dir, "fails");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err.substr(r.err.find("f.orogen:")),
+              "f.orogen:5:7: error: node 'bad' (generate:fails) failed: the simulation diverged\n"
+              "  bad = generate:fails()\n"
+              "        ^~~~~~~~~~~~~~\n");
+    EXPECT_TRUE(fs::exists(dir / "out/ok.png"));
+    EXPECT_FALSE(fs::exists(dir / "out/bad.png"));
+    EXPECT_FALSE(fs::exists(dir / "out/manifest.json"));  // only a finished run has one
+    for (const auto& e : fs::directory_iterator(dir / "out"))
+        EXPECT_EQ(e.path().extension(), ".png") << "left behind: " << e.path();
+}
+
+TEST(Runner, ExitCodesFollowTheKindOfFailure) {
+    TempDir dir;
+    RunResult r = run_failing(dir, "bad-file");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("node 'bad' (generate:bad-file) failed: input.dat is not a heightmap\n"), std::string::npos);
+    r = run_failing(dir, "foreign");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("node 'bad' (generate:foreign) failed: vector::at out of range\n"), std::string::npos);
+    r = run_failing(dir, "nan");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("node 'bad' (generate:nan) failed: non-finite height (nan) at sample 5 after step 17; "
+                         "the simulation became unstable\n"),
+              std::string::npos)
+        << r.err;
+    r = run_failing(dir, "wrong-type");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("failed: internal error: it returned a nothing but declares a heightmap"), std::string::npos);
+}
+
+TEST(Runner, AnOutputFolderThatCannotBeMadeFailsWithExitOne) {
+    TempDir dir;
+    dir.write("s.orogen", issue_spec);
+    dir.write("a-file", "x");
+    const RunResult r = run_orogen("run s.orogen --out a-file/out", "", dir.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("orogen: error: cannot create the output folder a-file/out"), std::string::npos) << r.err;
+}
+
+TEST(Runner, AnOutputThatCannotBeWrittenKeepsEarlierOutputsIntact) {
+    TempDir dir;
+    dir.write("s.orogen", "orogen 1\ngrid 33\nok = generate:fault(iterations=3)\n"
+                          "export:png(ok, path=\"first.png\")\nexport:png(ok, path=\"blocked/second.png\")\n");
+    dir.write("out/blocked", "a file where a folder should be");
+    const RunResult r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("s.orogen:5:1: error: node 'export:png#2' (export:png) failed: cannot write out/blocked/second.png"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(read_gray_png(dir / "out/first.png").width, 33);
+    EXPECT_EQ(slurp(dir / "out/blocked"), "a file where a folder should be");
+}
+
+// ------------------------------------------------------------------ outputs
+
+TEST(Outputs, TheIssueSpecWritesBothPngsAndAManifestWithTheirHashes) {
+    TempDir dir;
+    dir.write("s.orogen", issue_spec);
+    const RunResult r = run_orogen("run s.orogen --out out", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const GrayImage cut = read_gray_png(dir / "out/cut.png");
+    const GrayImage base = read_gray_png(dir / "out/base.png");
+    EXPECT_EQ(cut.bits, 16);
+    EXPECT_EQ(base.bits, 8);
+    EXPECT_EQ(cut.width, 513);
+    EXPECT_EQ(cut.height, 513);
+    // Min–max normalised: the full range is used, the top is white (the thesis's wrap-around is gone).
+    EXPECT_EQ(*std::min_element(cut.samples.begin(), cut.samples.end()), 0);
+    EXPECT_EQ(*std::max_element(cut.samples.begin(), cut.samples.end()), 65535);
+    EXPECT_EQ(*std::max_element(base.samples.begin(), base.samples.end()), 255);
+    const std::string manifest = slurp(dir / "out/manifest.json");
+    EXPECT_NE(manifest.find("\"sha256\": \"" + sha256_file(dir / "out/cut.png") + "\""), std::string::npos);
+    EXPECT_NE(manifest.find("\"sha256\": \"" + sha256_file(dir / "out/base.png") + "\""), std::string::npos);
+    EXPECT_NE(manifest.find("\"seed\": 7,"), std::string::npos);
+    EXPECT_NE(manifest.find("\"name\": \"diamond-square\""), std::string::npos);
+    // The per-node timing table.
+    EXPECT_NE(r.out.find("cut              generate:fault                 6"), std::string::npos) << r.out;
+}
+
+TEST(Outputs, SameSpecAndSeedGiveIdenticalBytesWhateverTheThreadCount) {
+    TempDir dir;
+    dir.write("s.orogen", issue_spec);
+    ASSERT_EQ(run_orogen("run s.orogen --out t1 --threads 1 --quiet", "", dir.path()).exit_code, 0);
+    ASSERT_EQ(run_orogen("run s.orogen --out t2 --threads 2 --quiet", "", dir.path()).exit_code, 0);
+    ASSERT_EQ(run_orogen("run s.orogen --out t2b --threads 2 --quiet", "", dir.path()).exit_code, 0);
+    ASSERT_EQ(run_orogen("run s.orogen --out s8 --seed 8 --quiet", "", dir.path()).exit_code, 0);
+    for (const char* f : {"cut.png", "base.png"}) {
+        EXPECT_EQ(sha256_file(dir / "t1" / f), sha256_file(dir / "t2" / f)) << f;
+        EXPECT_EQ(sha256_file(dir / "t2" / f), sha256_file(dir / "t2b" / f)) << f;
+        EXPECT_NE(sha256_file(dir / "t1" / f), sha256_file(dir / "s8" / f)) << f;
+    }
+}
+
+TEST(Outputs, AddingANodeDoesNotChangeTheOthers) {
+    TempDir dir;
+    dir.write("a.orogen", issue_spec);
+    dir.write("b.orogen", std::string(issue_spec) + "extra = generate:fault(iterations=9)\n"
+                                                    "export:png(extra, path=\"extra.png\")\n");
+    ASSERT_EQ(run_orogen("run a.orogen --out a --quiet", "", dir.path()).exit_code, 0);
+    ASSERT_EQ(run_orogen("run b.orogen --out b --quiet", "", dir.path()).exit_code, 0);
+    EXPECT_EQ(slurp(dir / "a/cut.png"), slurp(dir / "b/cut.png"));
+}
+
+TEST(Outputs, A16BitPngRoundTripsThroughImport) {
+    TempDir dir;
+    dir.write("make.orogen", "orogen 1\nseed 3\ngrid 65x40 cell=5\nt = generate:diamond-square(amplitude=50)\n"
+                             "export:png(t, path=\"t.png\", bits=16)\n");
+    ASSERT_EQ(run_orogen("run make.orogen --out . --quiet", "", dir.path()).exit_code, 0);
+    dir.write("again.orogen", "orogen 1\nt = import:png(path=\"t.png\", low=-20, high=80)\n"
+                              "export:png(t, path=\"again.png\", bits=16)\n");
+    const RunResult r = run_orogen("run again.orogen --out . --quiet", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(read_gray_png(dir / "t.png").samples, read_gray_png(dir / "again.png").samples);
+}
+
+TEST(Outputs, BadPngInputsAreRefusedWithExitTwo) {
+    TempDir dir;
+    dir.write("text.png", "hello");
+    {
+        std::vector<std::uint8_t> rgba(8 * 8 * 4, 9);
+        AtomicFile f(dir / "colour.png");
+        write_rgba_png(f.stream(), 8, 8, rgba);
+        f.commit();
+        std::vector<std::uint16_t> gray(128 * 128);
+        for (std::size_t i = 0; i < gray.size(); ++i) gray[i] = std::uint16_t(i * 40503u);
+        AtomicFile g(dir / "whole.png");
+        write_gray_png(g.stream(), 128, 128, 16, gray);
+        g.commit();
+        const auto bytes = read_file(dir / "whole.png");
+        std::ofstream(dir / "truncated.png", std::ios::binary)
+            .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size() / 3));
+    }
+    auto import = [&](const std::string& file) {
+        dir.write("i.orogen", "orogen 1\nt = import:png(path=\"" + file + "\")\nexport:png(t, path=\"o.png\")\n");
+        return run_orogen("run i.orogen --out out --quiet", "", dir.path());
+    };
+    RunResult r = import("text.png");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("i.orogen:2:21: error: import:png: cannot read text.png"
+                         ": not a PNG file (it does not start with the PNG signature)"),
+              std::string::npos)
+        << r.err;
+    r = import("colour.png");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("it is an RGBA colour image, but a heightmap must be a grayscale PNG (8 or 16 bits)"),
+              std::string::npos)
+        << r.err;
+    r = import("truncated.png");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("i.orogen:2:5: error: node 't' (import:png) failed: cannot read truncated.png: damaged PNG ("),
+              std::string::npos)
+        << r.err;
+    r = import("missing.png");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("error: no such file: missing.png (looked for"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out/o.png"));
+}

@@ -1,0 +1,174 @@
+// The kernel's support code: random numbers, hashing, atomic files, PNG codec.
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+#include <orogen/parallel.hpp>
+#include <orogen/random.hpp>
+#include <orogen/values.hpp>
+
+#include <gtest/gtest.h>
+
+#include "orogen_test.hpp"
+
+#include <cmath>
+#include <set>
+
+using namespace orogen;
+using orogen::test::TempDir;
+
+TEST(Random, IsAPureFunctionOfSeedAndCounters) {
+    EXPECT_EQ(random::hash(1, 2, 3), random::hash(1, 2, 3));
+    EXPECT_NE(random::hash(1, 2, 3), random::hash(1, 3, 2));  // counter order matters
+    EXPECT_NE(random::hash(1, 2, 3), random::hash(2, 2, 3));
+    EXPECT_NE(random::hash(0, 0), random::hash(0, 1));
+}
+
+TEST(Random, UniformIsInRangeAndRoughlyUniform) {
+    int buckets[10] = {0};
+    for (int i = 0; i < 100000; ++i) {
+        const double u = random::uniform(42, i);
+        ASSERT_GE(u, 0.0);
+        ASSERT_LT(u, 1.0);
+        ++buckets[int(u * 10)];
+    }
+    for (int b : buckets) EXPECT_NEAR(b, 10000, 400);  // ~4 sigma
+    for (int i = 0; i < 1000; ++i) EXPECT_LT(random::below(7, 3, i), 7u);
+}
+
+TEST(Sha256, MatchesTheStandardTestVectors) {
+    const std::string abc = "abc";
+    EXPECT_EQ(sha256_hex({reinterpret_cast<const std::uint8_t*>(abc.data()), abc.size()}),
+              "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+    EXPECT_EQ(sha256_hex({}), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+    const std::string two_blocks = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq";
+    EXPECT_EQ(sha256_hex({reinterpret_cast<const std::uint8_t*>(two_blocks.data()), two_blocks.size()}),
+              "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+}
+
+TEST(ParallelSum, IsTheSameForEveryThreadCount) {
+    auto body = [](std::int64_t a, std::int64_t b) {
+        double s = 0;
+        for (std::int64_t i = a; i < b; ++i) s += 1.0 / double(i + 1);
+        return s;
+    };
+    const double one = parallel_sum(0, 1000000, 4096, body);
+    EXPECT_EQ(one, parallel_sum(0, 1000000, 4096, body));
+    EXPECT_NEAR(one, std::log(1000000.0) + 0.5772156649, 1e-6);
+}
+
+TEST(AtomicFile, CommitReplacesTheTargetAtOnce) {
+    TempDir dir;
+    const auto target = dir / "a.bin";
+    dir.write("a.bin", "old");
+    {
+        AtomicFile f(target);
+        f.stream() << "new contents";
+        EXPECT_EQ(orogen::test::slurp(target), "old");  // not visible before commit
+        f.commit();
+    }
+    EXPECT_EQ(orogen::test::slurp(target), "new contents");
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1);  // no temporary left
+}
+
+TEST(AtomicFile, AnAbandonedWriteLeavesTheOldFileAndNoTemporary) {
+    TempDir dir;
+    dir.write("good.png", "good");
+    try {
+        AtomicFile f(dir / "good.png");
+        f.stream() << "half";
+        throw std::runtime_error("the node failed half way");
+    } catch (const std::runtime_error&) {
+    }
+    EXPECT_EQ(orogen::test::slurp(dir / "good.png"), "good");
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1);
+}
+
+TEST(AtomicFile, AMissingFolderIsAClearError) {
+    TempDir dir;
+    try {
+        AtomicFile f(dir / "no-such-folder" / "x.png");
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "no-such-folder" / "x.png").string() + ": folder " +
+                                             (dir / "no-such-folder").string() + " does not exist");
+    }
+}
+
+namespace {
+void write_png(const std::filesystem::path& p, int w, int h, int bits, const std::vector<std::uint16_t>& s) {
+    AtomicFile f(p);
+    write_gray_png(f.stream(), w, h, bits, s);
+    f.commit();
+}
+}  // namespace
+
+TEST(Png, SixteenAndEightBitRoundTripsAreExact) {
+    TempDir dir;
+    std::vector<std::uint16_t> samples(37 * 23);
+    for (std::size_t i = 0; i < samples.size(); ++i) samples[i] = std::uint16_t((i * 2654435761u) & 0xFFFF);
+    write_png(dir / "16.png", 37, 23, 16, samples);
+    GrayImage back = read_gray_png(dir / "16.png");
+    EXPECT_EQ(back.width, 37);
+    EXPECT_EQ(back.height, 23);
+    EXPECT_EQ(back.bits, 16);
+    EXPECT_EQ(back.samples, samples);
+
+    for (auto& s : samples) s &= 0xFF;
+    write_png(dir / "8.png", 37, 23, 8, samples);
+    back = read_gray_png(dir / "8.png");
+    EXPECT_EQ(back.bits, 8);
+    EXPECT_EQ(back.samples, samples);
+}
+
+TEST(Png, BadFilesAreRefusedWithTheirName) {
+    TempDir dir;
+    dir.write("text.png", "this is not an image at all");
+    try {
+        read_gray_png(dir / "text.png");
+        FAIL();
+    } catch (const BadInput& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot read " + (dir / "text.png").string() +
+                                             ": not a PNG file (it does not start with the PNG signature)");
+    }
+
+    std::vector<std::uint8_t> rgba(16 * 16 * 4, 200);
+    {
+        AtomicFile f(dir / "rgba.png");
+        write_rgba_png(f.stream(), 16, 16, rgba);
+        f.commit();
+    }
+    try {
+        read_gray_png(dir / "rgba.png");
+        FAIL();
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("it is an RGBA colour image, but a heightmap must be a grayscale PNG"),
+                  std::string::npos)
+            << e.what();
+    }
+
+    std::vector<std::uint16_t> samples(64 * 64);
+    for (std::size_t i = 0; i < samples.size(); ++i) samples[i] = std::uint16_t(i * 7919);
+    write_png(dir / "whole.png", 64, 64, 16, samples);
+    const auto bytes = read_file(dir / "whole.png");
+    std::ofstream(dir / "cut.png", std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size() / 2));
+    EXPECT_EQ(read_gray_png_header(dir / "cut.png").width, 64);  // the header is intact...
+    try {
+        read_gray_png(dir / "cut.png");  // ...the data is not
+        FAIL();
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("damaged PNG"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Heightmap, MissingLayerNamesTheOnesThatExist) {
+    Heightmap hm(4, 3, 10.0);
+    hm.layer("water", 0.5f);
+    EXPECT_TRUE(hm.has_layer("water"));
+    EXPECT_EQ(hm.layer("water").at(3, 2), 0.5f);
+    try {
+        std::as_const(hm).layer("sediment");
+        FAIL();
+    } catch (const BadInput& e) {
+        EXPECT_STREQ(e.what(), "the heightmap has no layer 'sediment' (it has water)");
+    }
+}
