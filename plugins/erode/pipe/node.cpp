@@ -1,0 +1,177 @@
+// erode:pipe — registers the Mei et al. pipe model (pipe.hpp) with the kernel.
+#include "pipe.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/plugin.hpp>
+
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using namespace orogen;
+
+// The pipe fluxes are state too (the water's momentum): kept as layers so a
+// following erode:pipe continues exactly where this one stopped.
+constexpr const char* kFluxLayers[] = {"flux_west", "flux_east", "flux_north", "flux_south"};
+
+std::string known_layers(const ValueInfo& info) {
+    if (info.layers.empty()) return "the input has no layers";
+    std::string s = "the input's layers are: ";
+    bool first = true;
+    for (const auto& l : info.layers) {
+        s += (first ? "" : ", ") + l;
+        first = false;
+    }
+    return s;
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    auto hm = ctx.take_heightmap(0);
+    pipe::Settings s;
+    s.rain = ctx.real("rain");
+    s.evaporation = ctx.real("evaporation");
+    s.capacity = ctx.real("capacity");
+    s.dissolve = ctx.real("dissolve");
+    s.deposit = ctx.real("deposit");
+    s.gravity = ctx.real("gravity");
+    s.pipe_area = ctx.real("pipe_area");
+    s.min_slope = ctx.real("min_slope");
+    s.boundary = ctx.text("boundary") == "open" ? pipe::Boundary::open : pipe::Boundary::closed;
+
+    // Rain mask: a layer of the input, or a second heightmap of the same size.
+    std::vector<float> mask;
+    const std::string& mask_layer = ctx.text("rain_mask");
+    if (!mask_layer.empty()) {
+        if (!hm->has_layer(mask_layer)) throw BadInput("rain_mask: the input has no layer '" + mask_layer + "'");
+        const ConstGridView m = std::as_const(*hm).layer(mask_layer);
+        mask.assign(m.data, m.data + m.size());
+    } else if (ctx.has_input(1)) {
+        const auto& m = *ctx.input(1).heightmap();
+        if (m.width() != hm->width() || m.height() != hm->height()) {
+            std::ostringstream msg;
+            msg << "the rain mask is " << m.width() << "x" << m.height() << " but the terrain is " << hm->width()
+                << "x" << hm->height() << "; give a mask of the terrain's size";
+            throw BadInput(msg.str());
+        }
+        mask = m.heights();
+    }
+    for (float& v : mask)
+        if (!(v >= 0.0f)) throw BadInput("rain_mask: the mask holds a negative or NaN value; rain factors must be >= 0");
+
+    // State: continue from water/sediment/flux layers when the input has them.
+    pipe::State st;
+    st.height = hm->view();
+    st.water = hm->layer("water", 0.0f);
+    st.sediment = hm->layer("sediment", 0.0f);
+    st.flux_west = hm->layer(kFluxLayers[0], 0.0f);
+    st.flux_east = hm->layer(kFluxLayers[1], 0.0f);
+    st.flux_north = hm->layer(kFluxLayers[2], 0.0f);
+    st.flux_south = hm->layer(kFluxLayers[3], 0.0f);
+    st.speed = hm->layer("flow", 0.0f);
+    GridView eroded = hm->layer("eroded", 0.0f);
+    const std::vector<float> before = hm->heights();
+
+    const std::int64_t steps = ctx.integer("steps");
+    const double dt = ctx.real("dt");
+    {
+        pipe::Solver solver(st, s, mask.empty() ? nullptr : mask.data());
+        for (std::int64_t i = 1; i <= steps; ++i) {
+            ctx.check_cancelled();
+            solver.advance(dt, i);
+            if (i % 16 == 0 || i == steps) ctx.progress(double(i) / double(steps));
+        }
+        solver.finish();
+        std::ostringstream msg;
+        msg << steps << " steps of " << dt << " s in " << solver.substeps() << " sub-steps";
+        ctx.info(msg.str());
+    }
+    ctx.check_finite(hm->heights(), "height", steps);
+    ctx.check_finite(st.water.span(), "water", steps);
+    ctx.check_finite(st.sediment.span(), "sediment", steps);
+    const std::vector<float>& after = hm->heights();
+    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
+    return hm;
+}
+
+void check(CheckContext& ctx) {
+    const std::string& mask_layer = ctx.text("rain_mask");
+    const ValueInfo* in = ctx.input(0);
+    const ValueInfo* mask = ctx.input(1);
+    if (!mask_layer.empty()) {
+        if (mask) ctx.error("rain_mask", "give the rain mask either as a layer name or as a second input, not both");
+        if (in && in->layers_known && !in->layers.contains(mask_layer))
+            ctx.error("rain_mask", "no layer '" + mask_layer + "' on the input (" + known_layers(*in) + ")");
+    }
+    if (mask && in && mask->width > 0 && in->width > 0 &&
+        (mask->width != in->width || mask->height != in->height)) {
+        std::ostringstream msg;
+        msg << "the rain mask is " << mask->width << "x" << mask->height << " but the terrain is " << in->width << "x"
+            << in->height << "; give a mask of the terrain's size";
+        ctx.error("", msg.str());
+    }
+    for (const char* l : {"water", "sediment", "flow", "eroded"}) ctx.output().layers.insert(l);
+    for (const char* l : kFluxLayers) ctx.output().layers.insert(l);
+}
+
+}  // namespace
+
+OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
+    registry.add({
+        .kind = "erode",
+        .name = "pipe",
+        .summary = "Mei et al.'s virtual-pipe hydraulic erosion, sub-stepped so it is stable at any time step",
+        .description =
+            "The shallow-water 'virtual pipe' model of Mei, Decaudin & Hu (2007): water flows through pipes to "
+            "the 4 neighbours, accelerated by the surface drop and limited so no cell goes negative; its "
+            "velocity sets a sediment capacity (capacity * sin(tilt) * speed); the terrain erodes where the "
+            "water carries less than that and receives deposits where it carries more; sediment moves with the "
+            "water (semi-Lagrangian); water evaporates. Each step of dt seconds is split into sub-steps under "
+            "a CFL limit, so any dt runs without blowing up. Walls are closed unless boundary=open. Terrain + "
+            "sediment (and, without rain and evaporation, water) is conserved. State layers: water (m), "
+            "sediment (m), flow (speed, m/s), flux_west/east/north/south (m^3/s), eroded (net change, m); an "
+            "input that carries them continues the simulation.",
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"},
+                   {"rain_mask", ValueType::heightmap, Need::optional,
+                    "rain factor per cell (its heights, >= 0), same size as the terrain"}},
+        .output = ValueType::heightmap,
+        .params =
+            {
+                Param::integer("steps", 200).min(0).max(100'000'000).help("number of time steps"),
+                Param::real("dt", 0.25)
+                    .min(0.0, true)
+                    .max(3600.0)
+                    .unit("s")
+                    .help("time step; split internally into sub-steps under a CFL limit"),
+                Param::real("rain", 0.001).min(0.0).unit("m/s").help("rain rate on every cell (times the mask)"),
+                Param::string("rain_mask", "")
+                    .help("name of a layer of the input holding a rain factor (>= 0) per cell; \"\" = none"),
+                Param::real("evaporation", 0.01)
+                    .min(0.0)
+                    .unit("1/s")
+                    .help("fraction of water evaporating per second (exponential decay)"),
+                Param::real("capacity", 1.0)
+                    .min(0.0)
+                    .unit("s")
+                    .help("sediment capacity Kc: metres carried per unit sin(tilt) and m/s of speed"),
+                Param::real("dissolve", 0.5).min(0.0).unit("1/s").help("rate Ks of taking up the capacity deficit"),
+                Param::real("deposit", 1.0).min(0.0).unit("1/s").help("rate Kd of dropping the capacity excess"),
+                Param::real("gravity", 9.81).min(0.0, true).max(1000.0).unit("m/s²").help("gravity"),
+                Param::real("pipe_area", 1.0)
+                    .min(0.0, true)
+                    .unit("m²")
+                    .help("cross-section A of each virtual pipe: flux gains dt*g*A*drop/cell per step"),
+                Param::real("min_slope", 0.05)
+                    .min(0.0)
+                    .max(1.0)
+                    .help("lower bound of sin(tilt) in the capacity, so water on flat ground still carries"),
+                Param::choice("boundary", {"closed", "open"}, "closed")
+                    .help("closed: walls keep the water in; open: water flows off the edges"),
+            },
+        .adds_layers = {"water", "sediment", "flow", "eroded", "flux_west", "flux_east", "flux_north", "flux_south"},
+        .check = check,
+        .run = run,
+    });
+}
