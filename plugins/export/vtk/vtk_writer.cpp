@@ -1,0 +1,345 @@
+// The only translation unit of export:vtk that includes VTK.
+#include "vtk_writer.hpp"
+
+#include "terrain_mesh.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkErrorCode.h>
+#include <vtkFloatArray.h>
+#include <vtkImageData.h>
+#include <vtkIntArray.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkTypeInt32Array.h>
+#include <vtkTypeInt64Array.h>
+#include <vtkXMLImageDataWriter.h>
+#include <vtkXMLPolyDataWriter.h>
+
+#include <cstdio>
+#include <iomanip>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace orogen::vtk {
+
+namespace {
+
+/// VTK prints its own error blocks to stderr; ours (an orogen::Error) says it
+/// better, so warnings are muted while a writer runs.
+class QuietVtk {
+public:
+    QuietVtk() : was_(vtkObject::GetGlobalWarningDisplay()) { vtkObject::GlobalWarningDisplayOff(); }
+    ~QuietVtk() { vtkObject::SetGlobalWarningDisplay(was_); }
+
+private:
+    int was_;
+};
+
+/// A float array over memory VTK must not free (the heightmap's own samples: no copy).
+vtkSmartPointer<vtkFloatArray> wrap(const std::string& name, const float* data, std::size_t tuples, int components) {
+    auto a = vtkSmartPointer<vtkFloatArray>::New();
+    a->SetName(name.c_str());
+    a->SetNumberOfComponents(components);
+    a->SetArray(const_cast<float*>(data), vtkIdType(tuples) * components, 1);  // 1: VTK does not own it; read only
+    return a;
+}
+
+template <typename Writer>
+void write_with(vtkDataObject* data, AtomicFile& file, const Options& o) {
+    vtkNew<Writer> w;
+    w->SetInputData(data);
+    w->SetFileName(file.temporary().c_str());
+    w->SetDataModeToAppended();
+    w->EncodeAppendedDataOff();  // raw binary, not base64
+    w->SetHeaderTypeToUInt64();  // arrays over 4 GiB
+    if (o.compress)
+        w->SetCompressorTypeToZLib();
+    else
+        w->SetCompressorTypeToNone();
+    file.stream().close();  // VTK writes the temporary file by name
+    QuietVtk quiet;
+    const int ok = w->Write();
+    const unsigned long code = w->GetErrorCode();
+    if (ok != 1 || code != 0)
+        throw Error("cannot write " + file.target().string() + ": VTK's writer failed (" +
+                    (code == vtkErrorCode::OutOfDiskSpaceError       ? std::string("out of disk space")
+                     : code == vtkErrorCode::CannotOpenFileError     ? std::string("cannot open the file")
+                     : code != 0                                     ? "VTK error code " + std::to_string(code)
+                                                                     : std::string("unknown error")) +
+                    "; disk full or folder not writable?); the existing file, if any, is unchanged");
+}
+
+std::string number(double v) {
+    std::ostringstream s;
+    s << std::setprecision(std::numeric_limits<double>::max_digits10) << v;
+    return s.str();
+}
+
+std::string frame_name(const fs::path& target, const std::string& what, std::size_t i) {
+    char digits[32];
+    std::snprintf(digits, sizeof digits, "%06zu", i);
+    return target.stem().string() + what + "_" + digits + ".vtp";
+}
+
+void commit_series(std::vector<std::unique_ptr<AtomicFile>>& files) {
+    std::vector<AtomicFile*> list;
+    for (auto& f : files) list.push_back(f.get());
+    commit_all(list);
+}
+
+void check_layers(ConstGridView heights, std::span<const NamedGrid> layers) {
+    for (const auto& l : layers)
+        if (l.grid.width != heights.width || l.grid.height != heights.height)
+            throw Error("internal error: layer '" + l.name + "' is " + std::to_string(l.grid.width) + " x " +
+                        std::to_string(l.grid.height) + ", the heightmap " + std::to_string(heights.width) + " x " +
+                        std::to_string(heights.height));
+}
+
+}  // namespace
+
+std::string pvd_text(std::span<const PvdEntry> entries) {
+    std::ostringstream s;
+    s << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "  <Collection>\n";
+    for (const auto& e : entries)
+        s << "    <DataSet timestep=\"" << number(e.time) << "\" group=\"\" part=\"" << e.part << "\" file=\"" << e.file
+          << "\"/>\n";
+    s << "  </Collection>\n"
+      << "</VTKFile>\n";
+    return s.str();
+}
+
+// ---------------------------------------------------------------- heightmap
+
+void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, const fs::path& target,
+                     const Options& o) {
+    const std::string ext = target.extension().string();
+    if (ext != ".vti" && ext != ".vtp")
+        throw BadInput("export:vtk writes a heightmap as .vti or .vtp; '" + target.filename().string() +
+                       "' has another extension");
+    check_layers(heights, layers);
+    AtomicFile file(target);
+    if (ext == ".vti") {
+        if (o.decimate != 1) throw BadInput("decimate applies to .vtp meshes only; .vti keeps every sample");
+        vtkNew<vtkImageData> image;
+        image->SetDimensions(heights.width, 1, heights.height);  // X east, Z south: sample order as stored
+        image->SetSpacing(heights.cell, 1.0, heights.cell);
+        image->SetOrigin(0, 0, 0);
+        image->GetPointData()->AddArray(wrap("height", heights.data, heights.size(), 1));
+        image->GetPointData()->SetActiveScalars("height");
+        for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
+        write_with<vtkXMLImageDataWriter>(image, file, o);
+        file.commit();
+        return;
+    }
+
+    const terrain::TerrainMesh mesh = terrain::plan_mesh(heights, o.decimate, 1, o.vertical_scale);
+    const terrain::MeshChunk& chunk = mesh.chunks.at(0);
+    const std::size_t n = chunk.vertex_count(), triangles = chunk.triangle_count();
+    if (triangles * 3 > std::size_t(std::numeric_limits<std::int32_t>::max()))
+        throw BadInput("the mesh has " + std::to_string(triangles) + " triangles, too many for one .vtp; use decimate=2");
+    vtkNew<vtkFloatArray> xyz;
+    xyz->SetNumberOfComponents(3);
+    xyz->SetNumberOfTuples(vtkIdType(n));
+    terrain::chunk_positions(mesh, chunk, {xyz->GetPointer(0), n * 3});
+    vtkNew<vtkPoints> points;
+    points->SetData(xyz);
+    vtkNew<vtkFloatArray> normals;
+    normals->SetName("Normals");
+    normals->SetNumberOfComponents(3);
+    normals->SetNumberOfTuples(vtkIdType(n));
+    terrain::chunk_normals(mesh, chunk, {normals->GetPointer(0), n * 3});
+    vtkNew<vtkTypeInt32Array> offsets, connectivity;
+    offsets->SetNumberOfTuples(vtkIdType(triangles + 1));
+    for (std::size_t t = 0; t <= triangles; ++t) offsets->SetValue(vtkIdType(t), std::int32_t(3 * t));
+    connectivity->SetNumberOfTuples(vtkIdType(triangles * 3));
+    terrain::chunk_indices(chunk, {reinterpret_cast<std::uint32_t*>(connectivity->GetPointer(0)), triangles * 3});
+    vtkNew<vtkCellArray> polys;
+    polys->SetData(offsets, connectivity);
+    vtkNew<vtkPolyData> poly;
+    poly->SetPoints(points);
+    poly->SetPolys(polys);
+    poly->GetPointData()->SetNormals(normals);
+
+    auto add = [&](const std::string& name, ConstGridView g) {
+        if (o.decimate == 1) {
+            poly->GetPointData()->AddArray(wrap(name, g.data, g.size(), 1));
+            return;
+        }
+        vtkNew<vtkFloatArray> a;
+        a->SetName(name.c_str());
+        a->SetNumberOfTuples(vtkIdType(n));
+        std::size_t i = 0;
+        for (int y : mesh.rows)
+            for (int x : mesh.columns) a->SetValue(vtkIdType(i++), g.at(x, y));
+        poly->GetPointData()->AddArray(a);
+    };
+    add("height", heights);
+    for (const auto& l : layers) add(l.name, l.grid);
+    poly->GetPointData()->SetActiveScalars("height");
+    write_with<vtkXMLPolyDataWriter>(poly, file, o);
+    file.commit();
+}
+
+// ---------------------------------------------------------------- particles
+
+namespace {
+
+vtkSmartPointer<vtkPolyData> particle_poly(const ParticleFrame& frame, std::size_t index) {
+    const auto pos = frame.attributes.find("position");
+    if (pos == frame.attributes.end() || pos->second.components != 3)
+        throw Error("particle frame " + std::to_string(index) + " has no 3-component 'position' attribute");
+    const std::size_t n = frame.count();
+    auto poly = vtkSmartPointer<vtkPolyData>::New();
+    vtkNew<vtkPoints> points;
+    points->SetData(wrap("position", pos->second.data.data(), n, 3));
+    poly->SetPoints(points);
+    vtkNew<vtkTypeInt64Array> connectivity;
+    connectivity->SetNumberOfTuples(vtkIdType(n));
+    std::iota(connectivity->GetPointer(0), connectivity->GetPointer(0) + n, std::int64_t(0));
+    vtkNew<vtkCellArray> verts;  // one vertex cell per particle, so ParaView draws them as points
+    verts->SetData(1, connectivity);
+    poly->SetVerts(verts);
+    for (const auto& [name, attr] : frame.attributes) {
+        if (name == "position") continue;
+        if (attr.components < 1 || attr.data.size() != n * std::size_t(attr.components))
+            throw Error("particle frame " + std::to_string(index) + ": attribute '" + name + "' holds " +
+                        std::to_string(attr.data.size()) + " values for " + std::to_string(n) + " particles of " +
+                        std::to_string(attr.components) + " components");
+        poly->GetPointData()->AddArray(wrap(name, attr.data.data(), n, attr.components));
+    }
+    return poly;
+}
+
+}  // namespace
+
+std::size_t write_particles(const ParticleSeries& series, const fs::path& target, const Options& o) {
+    const std::string ext = target.extension().string();
+    if (ext == ".vtp") {
+        if (series.frames.size() != 1)
+            throw BadInput("the particles have " + std::to_string(series.frames.size()) +
+                           " frames; write a time series as .pvd (one .vtp per frame), or a single frame as .vtp");
+        AtomicFile file(target);
+        auto poly = particle_poly(series.frames[0], 0);
+        write_with<vtkXMLPolyDataWriter>(poly, file, o);
+        file.commit();
+        return 1;
+    }
+    if (ext != ".pvd")
+        throw BadInput("export:vtk-particles writes .pvd (a time series) or .vtp (one frame); '" +
+                       target.filename().string() + "' has another extension");
+    std::vector<std::unique_ptr<AtomicFile>> files;
+    std::vector<PvdEntry> entries;
+    for (std::size_t i = 0; i < series.frames.size(); ++i) {
+        const std::string name = frame_name(target, "", i);
+        files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
+        auto poly = particle_poly(series.frames[i], i);
+        write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
+        entries.push_back({series.frames[i].time, 0, name});
+    }
+    files.push_back(std::make_unique<AtomicFile>(target));  // the collection last: it names the others
+    const std::string pvd = pvd_text(entries);
+    files.back()->write({reinterpret_cast<const std::uint8_t*>(pvd.data()), pvd.size()});
+    commit_series(files);
+    return files.size();
+}
+
+// ------------------------------------------------------------------- plates
+
+std::size_t write_plates(const PlateHistory& history, const fs::path& target, const Options& o) {
+    if (target.extension() != ".pvd")
+        throw BadInput("export:vtk-plates writes a .pvd time series; '" + target.filename().string() +
+                       "' has another extension");
+    std::vector<std::unique_ptr<AtomicFile>> files;
+    std::vector<PvdEntry> entries;
+    std::int64_t previous_step = std::numeric_limits<std::int64_t>::min();
+    for (std::size_t s = 0; s < history.snapshots.size(); ++s) {
+        const PlateSnapshot& snap = history.snapshots[s];
+        // Plates: one polygon cell each; heightmap (x, y) → (X, 0, Z).
+        {
+            vtkNew<vtkPoints> points;
+            points->SetDataTypeToFloat();
+            vtkNew<vtkCellArray> polys;
+            vtkNew<vtkIntArray> id;
+            id->SetName("plate");
+            vtkNew<vtkFloatArray> velocity;
+            velocity->SetName("velocity");
+            velocity->SetNumberOfComponents(3);
+            vtkNew<vtkFloatArray> density;
+            density->SetName("density");
+            for (const PlateState& p : snap.plates) {
+                polys->InsertNextCell(vtkIdType(p.polygon.size()));
+                for (const Point2& v : p.polygon) polys->InsertCellPoint(points->InsertNextPoint(v.x, 0.0, v.y));
+                id->InsertNextValue(p.id);
+                velocity->InsertNextTuple3(p.velocity.x, 0.0, p.velocity.y);
+                density->InsertNextValue(float(p.density));
+            }
+            vtkNew<vtkPolyData> poly;
+            poly->SetPoints(points);
+            poly->SetPolys(polys);
+            poly->GetCellData()->AddArray(id);
+            poly->GetCellData()->AddArray(velocity);
+            poly->GetCellData()->AddArray(density);
+            const std::string name = frame_name(target, "_plates", s);
+            files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
+            write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
+            entries.push_back({snap.time, 0, name});
+        }
+        // Collisions since the previous snapshot: one line cell a–b each.
+        {
+            vtkNew<vtkPoints> points;
+            points->SetDataTypeToFloat();
+            vtkNew<vtkCellArray> lines;
+            vtkNew<vtkIntArray> a, b, kind;
+            a->SetName("plate_a");
+            b->SetName("plate_b");
+            kind->SetName("kind");
+            vtkNew<vtkFloatArray> impulse;
+            impulse->SetName("impulse");
+            vtkNew<vtkTypeInt64Array> step;
+            step->SetName("step");
+            for (const CollisionEvent& e : history.collisions) {
+                if (e.step <= previous_step || e.step > snap.step) continue;
+                lines->InsertNextCell(2);
+                lines->InsertCellPoint(points->InsertNextPoint(e.a.x, 0.0, e.a.y));
+                lines->InsertCellPoint(points->InsertNextPoint(e.b.x, 0.0, e.b.y));
+                a->InsertNextValue(e.plate_a);
+                b->InsertNextValue(e.plate_b);
+                kind->InsertNextValue(int(e.kind));
+                impulse->InsertNextValue(float(e.impulse));
+                step->InsertNextValue(e.step);
+            }
+            vtkNew<vtkPolyData> poly;
+            poly->SetPoints(points);
+            poly->SetLines(lines);
+            for (vtkDataArray* arr : {static_cast<vtkDataArray*>(a), static_cast<vtkDataArray*>(b),
+                                      static_cast<vtkDataArray*>(kind), static_cast<vtkDataArray*>(impulse),
+                                      static_cast<vtkDataArray*>(step)})
+                poly->GetCellData()->AddArray(arr);
+            const std::string name = frame_name(target, "_collisions", s);
+            files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
+            write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
+            entries.push_back({snap.time, 1, name});
+        }
+        previous_step = snap.step;
+    }
+    files.push_back(std::make_unique<AtomicFile>(target));
+    const std::string pvd = pvd_text(entries);
+    files.back()->write({reinterpret_cast<const std::uint8_t*>(pvd.data()), pvd.size()});
+    commit_series(files);
+    return files.size();
+}
+
+}  // namespace orogen::vtk

@@ -1,0 +1,66 @@
+// vtk_writer.hpp — VTK XML files for ParaView: heightmaps, particles, plates.
+//
+// Plain interface; VTK's headers are included only by vtk_writer.cpp.
+//
+// One frame of reference for everything, the same as glTF's and the particle
+// values': X east, Y up, Z south, metres, origin at heightmap sample (0, 0).
+// In ParaView click "Set view direction to −Y" to look down on the terrain.
+//   heightmap .vti  image data of width × 1 × height points (the XZ plane),
+//                   spacing (cell, 1, cell); point arrays "height" and every
+//                   layer by its name. "Warp By Scalar" (height, normal 0 1 0)
+//                   raises it into a surface.
+//   heightmap .vtp  the triangle mesh (as export:gltf lays it out: two CCW
+//                   triangles per tile, Y = height·scale), "Normals", and the
+//                   same point arrays.
+//   particles       one .vtp per frame (points + vertex cells, every attribute
+//                   as a point array), listed with their times in a .pvd.
+//   plates          per snapshot: a .vtp of plate polygons (cell arrays
+//                   plate, velocity, density) and a .vtp of the collisions
+//                   since the previous snapshot (lines a–b with plate_a,
+//                   plate_b, kind, impulse, step), parts 0 and 1 of a .pvd.
+// Every file is written through orogen::AtomicFile; a series is committed
+// together, after every file of it has been written.
+#pragma once
+
+#include <orogen/grid.hpp>
+#include <orogen/values.hpp>
+
+#include <filesystem>
+#include <span>
+#include <string>
+
+namespace orogen::vtk {
+
+struct NamedGrid {
+    std::string name;
+    ConstGridView grid;
+};
+
+struct Options {
+    bool compress = false;        ///< zlib-compress the arrays (smaller, slower)
+    double vertical_scale = 1.0;  ///< .vtp heightmap mesh only
+    int decimate = 1;             ///< .vtp heightmap mesh only: keep every k-th vertex
+};
+
+/// Heightmap (+ named layers of the same size) as .vti or .vtp, by `target`'s extension.
+void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, const std::filesystem::path& target,
+                     const Options& options = {});
+
+/// Particle frames: `target` .pvd (one <stem>_NNNNNN.vtp per frame beside it) or
+/// .vtp (a single frame). Returns the number of files written.
+std::size_t write_particles(const ParticleSeries& series, const std::filesystem::path& target,
+                            const Options& options = {});
+
+/// Plate history: `target` .pvd with <stem>_plates_NNNNNN.vtp and
+/// <stem>_collisions_NNNNNN.vtp per snapshot. Returns the number of files written.
+std::size_t write_plates(const PlateHistory& history, const std::filesystem::path& target, const Options& options = {});
+
+/// The .pvd text for (time, file, part) entries.
+struct PvdEntry {
+    double time = 0.0;
+    int part = 0;
+    std::string file;  ///< relative to the .pvd
+};
+std::string pvd_text(std::span<const PvdEntry> entries);
+
+}  // namespace orogen::vtk
