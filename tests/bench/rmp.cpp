@@ -4,6 +4,7 @@
 // Each benchmark runs one whole RMP (100 iterations) per benchmark iteration.
 #include "cones.hpp"
 #include "range.hpp"
+#include "voronoi.hpp"
 #include "rmp.hpp"
 
 #include <benchmark/benchmark.h>
@@ -62,3 +63,20 @@ BENCHMARK(BM_RmpCones)->Arg(7)->Arg(11)->Arg(16)->Arg(100)->Arg(1000)->Arg(10000
     ->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_RmpGraph)->Arg(3)->Arg(4)->Arg(5)->Arg(50)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Range)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond)->UseRealTime();
+
+namespace {
+
+// The cone method's parts: drawing + read-back alone, for one diagram.
+void BM_ConeDraw(benchmark::State& state) {
+    rmp::ConeRenderer renderer(kSize, kSize);
+    const auto sites = rmp::random_sites(int(state.range(0)), kSize, kSize, 5);
+    auto radii = rmp::SiteIndex(sites, kSize, kSize).cell_radius_bounds();
+    double area = 0;
+    for (double& r : radii) area += 3.2154 * (r + 1) * (r + 1);  // 12-gon footprint
+    for (auto _ : state) benchmark::DoNotOptimize(renderer.render(sites, radii).data());
+    state.counters["overdraw"] = area / (double(kSize) * kSize);
+}
+
+}  // namespace
+
+BENCHMARK(BM_ConeDraw)->Arg(7)->Arg(100)->Arg(1000)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();

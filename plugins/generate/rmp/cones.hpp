@@ -7,10 +7,11 @@
 //
 // Each cone's depth is its exact distance to its apex, written per fragment,
 // so the diagram is exact up to float rounding on cell borders (the thesis's
-// 64-segment cones bent every border by up to 0.1 %). Cones are sized to the
-// covering radius of the sites (every vertex lies within it of its nearest
-// site, see SiteIndex::covering_radius), so every vertex is covered: the
-// thesis's radius-1 cones left the map's corners bare.
+// 64-segment cones bent every border by up to 0.1 %). Each cone is as wide as
+// a bound of its own cell's reach (SiteIndex::cell_radius_bounds, from the
+// bucket grid, not from the cells), so every vertex is covered by its own
+// site's cone — the thesis's radius-1 cones left the map's corners bare —
+// while the overdraw stays a few times the grid, not sites × grid.
 //
 // Library orogen_core_rmp_gl; the OSMesa headers stay in cones_gl.cpp.
 #pragma once
@@ -41,6 +42,8 @@ public:
     /// index of the site on top plus one (0: no cone reached the vertex).
     /// Valid until the next call.
     const std::vector<std::uint32_t>& render(std::span<const Point2> sites, double radius);
+    /// The same with one radius per site (see SiteIndex::cell_radius_bounds).
+    const std::vector<std::uint32_t>& render(std::span<const Point2> sites, std::span<const double> radii);
 
     /// render() then labels: site index per vertex, -1 where no cone reached.
     std::vector<std::int32_t> labels(std::span<const Point2> sites, double radius);

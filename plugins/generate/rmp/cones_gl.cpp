@@ -28,13 +28,16 @@ constexpr int kSegments = 12;
 
 const char* kVertexShader = R"(#version 330 core
 layout(location = 0) in vec2 corner;  // fan vertex of a unit cone footprint
-layout(location = 1) in vec2 site;    // per instance: the apex, sample coordinates
+layout(location = 1) in vec3 cone;    // per instance: apex x, y and radius, samples
 uniform vec2 grid;                    // width, height in vertices (= pixels)
-uniform float radius;                 // cone radius, samples
 flat out vec2 v_site;
+flat out float v_radius;
 flat out int v_id;
 void main() {
+    vec2 site = cone.xy;
+    float radius = cone.z;
     v_site = site;
+    v_radius = radius;
     v_id = gl_InstanceID;
     // Pixel i covers [i, i+1) in window coordinates, so its centre i + 0.5
     // is vertex i: sample x maps to window x + 0.5.
@@ -45,13 +48,13 @@ void main() {
 
 const char* kFragmentShader = R"(#version 330 core
 flat in vec2 v_site;
+flat in float v_radius;
 flat in int v_id;
-uniform float radius;
 uniform float depth_scale;  // a distance every cone's depth fits under
 out vec4 colour;
 void main() {
     float d = distance(gl_FragCoord.xy - 0.5, v_site);
-    if (d > radius) discard;
+    if (d > v_radius) discard;
     gl_FragDepth = d / depth_scale;  // a cone: deeper away from its apex
     int k = v_id + 1;                // 0 stays "no cone"
     colour = vec4(float(k & 255), float((k >> 8) & 255), float((k >> 16) & 255), 255.0) / 255.0;
@@ -79,9 +82,10 @@ struct ConeRenderer::Impl {
     std::vector<std::uint8_t> dummy = std::vector<std::uint8_t>(4 * 4 * 4);  // the default framebuffer, unused
     int width = 0, height = 0;
     GLuint program = 0, vao = 0, fan = 0, instances = 0, fbo = 0, colour_rb = 0, depth_rb = 0;
-    GLint u_grid = -1, u_radius = -1, u_radius_fs = -1, u_depth_scale = -1;
+    GLint u_grid = -1, u_depth_scale = -1;
     std::vector<std::uint32_t> pixels;
     std::vector<float> site_data;
+    std::vector<double> radii;
 
     ~Impl() {
         if (!context) return;
@@ -132,7 +136,6 @@ ConeRenderer::ConeRenderer(int width, int height) : impl_(std::make_unique<Impl>
     glGetProgramiv(m.program, GL_LINK_STATUS, &ok);
     if (!ok) throw Error("cones: the OSMesa shader program did not link");
     m.u_grid = glGetUniformLocation(m.program, "grid");
-    m.u_radius = glGetUniformLocation(m.program, "radius");
     m.u_depth_scale = glGetUniformLocation(m.program, "depth_scale");
 
     // A fan whose edges are tangent to the unit circle: it covers the disc.
@@ -153,7 +156,7 @@ ConeRenderer::ConeRenderer(int width, int height) : impl_(std::make_unique<Impl>
     glGenBuffers(1, &m.instances);
     glBindBuffer(GL_ARRAY_BUFFER, m.instances);
     glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
     glVertexAttribDivisor(1, 1);
 
     // Offscreen target: 8-bit RGBA ids and a 32-bit float depth.
@@ -183,7 +186,16 @@ std::string ConeRenderer::renderer_name() const {
 }
 
 const std::vector<std::uint32_t>& ConeRenderer::render(std::span<const Point2> sites, double radius) {
+    impl_->radii.assign(sites.size(), radius);
+    const std::vector<double> radii = std::move(impl_->radii);
+    return render(sites, radii);
+}
+
+const std::vector<std::uint32_t>& ConeRenderer::render(std::span<const Point2> sites, std::span<const double> radii) {
     Impl& m = *impl_;
+    if (radii.size() != sites.size()) throw Error("cones: one radius per site is needed");
+    double max_radius = 0;
+    for (double r : radii) max_radius = std::max(max_radius, r);
     if (sites.size() >= (1u << 24) - 1) throw BadInput("cones: at most 16777214 cones fit in a 24-bit colour id");
     OSMesaMakeCurrent(m.context, m.dummy.data(), GL_UNSIGNED_BYTE, 4, 4);
     glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
@@ -194,15 +206,15 @@ const std::vector<std::uint32_t>& ConeRenderer::render(std::span<const Point2> s
     glClearDepth(1.0);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
-    m.site_data.resize(sites.size() * 2);
+    m.site_data.resize(sites.size() * 3);
     for (std::size_t i = 0; i < sites.size(); ++i) {
-        m.site_data[2 * i] = float(sites[i].x);
-        m.site_data[2 * i + 1] = float(sites[i].y);
+        m.site_data[3 * i] = float(sites[i].x);
+        m.site_data[3 * i + 1] = float(sites[i].y);
+        m.site_data[3 * i + 2] = float(radii[i]);
     }
     glUseProgram(m.program);
     glUniform2f(m.u_grid, float(m.width), float(m.height));
-    glUniform1f(m.u_radius, float(radius));
-    glUniform1f(m.u_depth_scale, float(std::hypot(m.width, m.height) + radius + 1.0));
+    glUniform1f(m.u_depth_scale, float(std::hypot(m.width, m.height) + max_radius + 1.0));
     glBindVertexArray(m.vao);
     glBindBuffer(GL_ARRAY_BUFFER, m.instances);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.site_data.size() * sizeof(float)), m.site_data.data(),
@@ -237,8 +249,10 @@ void rmp_cones(GridView terrain, const RmpParams& p, std::uint64_t seed, const I
     for (int k = 0; k < p.iterations; ++k) {
         const std::uint64_t s = iteration_seed(seed, k);
         const std::vector<Point2> sites = random_sites(p.cones, terrain.width, terrain.height, s);
-        const double radius = SiteIndex(sites, terrain.width, terrain.height).covering_radius() + 1.0;
-        const std::vector<std::uint32_t>& ids = renderer.render(sites, radius);
+        // Each cone as wide as a bound of its cell (+1 sample for float rounding).
+        std::vector<double> radii = SiteIndex(sites, terrain.width, terrain.height).cell_radius_bounds();
+        for (double& r : radii) r += 1.0;
+        const std::vector<std::uint32_t>& ids = renderer.render(sites, radii);
         // The colours under the peaks, each raised once.
         std::vector<std::uint32_t> picked;
         for (std::size_t v : peaks)

@@ -261,21 +261,76 @@ void SiteIndex::spans_of(int s, const CellPolygon& polygon, std::vector<Span>& o
     }
 }
 
-double SiteIndex::covering_radius() const {
-    // The distance to the nearest site is 1-Lipschitz: within a bucket it is
-    // at most its value at the bucket's centre plus the half diagonal.
-    double r = 0;
-    for (int j = 0; j < buckets_y_; ++j) {
-        const double y0 = j * bucket_size_, y1 = std::min((j + 1) * bucket_size_, extent_y_);
-        for (int i = 0; i < buckets_x_; ++i) {
-            const double x0 = i * bucket_size_, x1 = std::min((i + 1) * bucket_size_, extent_x_);
-            const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
-            const int n = nearest(cx, cy);
-            const double d = std::sqrt(dist2(cx, cy, sites_[std::size_t(n)]));
-            r = std::max(r, d + 0.5 * std::hypot(x1 - x0, y1 - y0));
+namespace {
+
+// A grid of tiles over the grid rectangle and, per tile, a bound of the
+// distance to the nearest site over the tile. That distance is 1-Lipschitz:
+// within a tile it is at most its value at the centre plus the half diagonal.
+// Tiles are finer than the buckets (half a bucket, and at most 1/32 of the
+// map) so the bound stays tight when there are few sites.
+struct TileBounds {
+    int nx = 0, ny = 0;
+    double size = 1;
+    std::vector<double> bound;
+    int tile_x(double x) const { return std::clamp(int(std::floor(x / size)), 0, nx - 1); }
+    int tile_y(double y) const { return std::clamp(int(std::floor(y / size)), 0, ny - 1); }
+};
+
+TileBounds tile_bounds(const SiteIndex& index, double bucket_size, double ex, double ey) {
+    TileBounds t;
+    t.size = std::max(std::min(bucket_size / 2, std::max(ex, ey) / 32), 0.25);
+    t.nx = std::max(1, int(std::ceil(ex / t.size)));
+    t.ny = std::max(1, int(std::ceil(ey / t.size)));
+    t.bound.resize(std::size_t(t.nx) * std::size_t(t.ny));
+    parallel_for(0, t.ny, 4, [&](std::int64_t j0, std::int64_t j1) {
+        for (std::int64_t j = j0; j < j1; ++j) {
+            const double y0 = double(j) * t.size, y1 = std::min(double(j + 1) * t.size, ey);
+            for (int i = 0; i < t.nx; ++i) {
+                const double x0 = i * t.size, x1 = std::min((i + 1) * t.size, ex);
+                const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+                const Point2& s = index.sites()[std::size_t(index.nearest(cx, cy))];
+                t.bound[std::size_t(j) * std::size_t(t.nx) + std::size_t(i)] =
+                    std::sqrt(dist2(cx, cy, s)) + 0.5 * std::hypot(x1 - x0, y1 - y0);
+            }
         }
-    }
-    return std::min(r, std::hypot(extent_x_, extent_y_));
+    });
+    return t;
+}
+
+}  // namespace
+
+double SiteIndex::covering_radius() const {
+    const TileBounds t = tile_bounds(*this, bucket_size_, extent_x_, extent_y_);
+    return std::min(*std::max_element(t.bound.begin(), t.bound.end()), std::hypot(extent_x_, extent_y_));
+}
+
+std::vector<double> SiteIndex::cell_radius_bounds() const {
+    const TileBounds t = tile_bounds(*this, bucket_size_, extent_x_, extent_y_);
+    const double cap = std::hypot(extent_x_, extent_y_);
+    std::vector<double> radius(sites_.size());
+    parallel_for(0, std::int64_t(sites_.size()), 1024, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t k = b; k < e; ++k) {
+            const Point2 s = sites_[std::size_t(k)];
+            double r = t.bound[std::size_t(t.tile_y(s.y)) * std::size_t(t.nx) + std::size_t(t.tile_x(s.x))];
+            while (r < cap) {  // grow to the least fixed point
+                const int i0 = t.tile_x(s.x - r), i1 = t.tile_x(s.x + r);
+                const int j0 = t.tile_y(s.y - r), j1 = t.tile_y(s.y + r);
+                double next = r;
+                for (int j = j0; j <= j1; ++j) {
+                    const double dy = std::max({0.0, j * t.size - s.y, s.y - (j + 1) * t.size});
+                    for (int i = i0; i <= i1; ++i) {
+                        const double dx = std::max({0.0, i * t.size - s.x, s.x - (i + 1) * t.size});
+                        if (dx * dx + dy * dy > r * r) continue;  // tile beyond the disc
+                        next = std::max(next, t.bound[std::size_t(j) * std::size_t(t.nx) + std::size_t(i)]);
+                    }
+                }
+                if (next <= r) break;
+                r = next;
+            }
+            radius[std::size_t(k)] = std::min(r, cap);
+        }
+    });
+    return radius;
 }
 
 std::vector<std::int32_t> label_grid(const SiteIndex& index) {

@@ -68,6 +68,15 @@ public:
     /// (an upper bound, from the bucket grid): cones this wide cover the map.
     double covering_radius() const;
 
+    /// For each site, a radius its whole cell lies within (an upper bound from
+    /// a grid of tiles, not the cells themselves): the least r with r ≥ B(t)
+    /// for every tile t within r of the site, where B(t) bounds the
+    /// nearest-site distance over tile t. A point p of s's cell has
+    /// |p − s| = (distance to its nearest site) ≤ B(tile of p), and walking
+    /// out from s along the (convex) cell shows no point passes r. Cones this
+    /// wide cover their cells, with far less overdraw than one covering radius.
+    std::vector<double> cell_radius_bounds() const;
+
     struct Span {
         int y, x0, x1;
     };

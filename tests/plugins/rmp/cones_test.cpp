@@ -20,7 +20,14 @@ TEST(RmpCones, ConesDrawTheExactVoronoiDiagram) {
         const auto sites = random_sites(count, w, h, 500 + count);
         const SiteIndex index(sites, w, h);
         const auto exact = label_grid(index);
-        const auto drawn = renderer.labels(sites, index.covering_radius() + 1.0);
+        // As rmp_cones draws them: each cone as wide as its cell's bound; and
+        // the thesis's way, every cone one radius (covering the whole map).
+        auto radii = index.cell_radius_bounds();
+        for (double& r : radii) r += 1.0;
+        const auto ids = renderer.render(sites, radii);
+        std::vector<std::int32_t> drawn(ids.size());
+        for (std::size_t i = 0; i < ids.size(); ++i) drawn[i] = std::int32_t(ids[i]) - 1;
+        EXPECT_EQ(drawn, renderer.labels(sites, index.covering_radius() + 1.0));
         std::size_t same = 0;
         for (std::size_t i = 0; i < exact.size(); ++i) {
             ASSERT_GE(drawn[i], 0) << "vertex " << i << " not covered by any cone";

@@ -134,3 +134,18 @@ TEST(RmpVoronoi, CoveringRadiusBoundsEveryVertex) {
         EXPECT_LE(r, std::hypot(w - 1, h - 1) + 1e-9);
     }
 }
+
+TEST(RmpVoronoi, CellRadiusBoundsHoldEveryCell) {
+    for (int count : {1, 7, 100, 3000}) {
+        const int w = 120, h = 90;
+        const auto sites = random_sites(count, w, h, 31 + count);
+        const SiteIndex index(sites, w, h);
+        const auto bounds = index.cell_radius_bounds();
+        ASSERT_EQ(bounds.size(), sites.size());
+        std::vector<double> reach(sites.size(), 0.0);
+        for (int s = 0; s < count; ++s)
+            for (const Point2& p : index.cell(s).vertices)  // the cell's farthest point is a corner
+                reach[std::size_t(s)] = std::max(reach[std::size_t(s)], std::hypot(p.x - sites[s].x, p.y - sites[s].y));
+        for (int s = 0; s < count; ++s) EXPECT_GE(bounds[std::size_t(s)], reach[std::size_t(s)] - 1e-9) << s;
+    }
+}
