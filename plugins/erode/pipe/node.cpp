@@ -39,6 +39,7 @@ NodeOutputs run(NodeContext& ctx) {
     s.gravity = ctx.real("gravity");
     s.pipe_area = ctx.real("pipe_area");
     s.min_slope = ctx.real("min_slope");
+    s.erosion_depth = ctx.real("erosion_depth");
     s.boundary = ctx.text("boundary") == "open" ? pipe::Boundary::open : pipe::Boundary::closed;
 
     // Rain mask: a layer of the input, or a second heightmap of the same size.
@@ -126,7 +127,7 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
         .description =
             "The shallow-water 'virtual pipe' model of Mei, Decaudin & Hu (2007): water flows through pipes to "
             "the 4 neighbours, accelerated by the surface drop and limited so no cell goes negative; its "
-            "velocity sets a sediment capacity (capacity * sin(tilt) * speed); the terrain erodes where the "
+            "velocity sets a sediment capacity (capacity * sin(tilt) * speed, ramped down in water shallower than erosion_depth); the terrain erodes where the "
             "water carries less than that and receives deposits where it carries more; sediment moves with the "
             "water (semi-Lagrangian); water evaporates. Each step of dt seconds is split into sub-steps under "
             "a CFL limit, so any dt runs without blowing up. Walls are closed unless boundary=open. Terrain + "
@@ -167,6 +168,11 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
                     .min(0.0)
                     .max(1.0)
                     .help("lower bound of sin(tilt) in the capacity, so water on flat ground still carries"),
+                Param::real("erosion_depth", 0.05)
+                    .min(0.0)
+                    .unit("m")
+                    .help("water shallower than this carries in proportion to its depth, so films of rain do not "
+                          "scour like rivers (0 = Mei's original capacity)"),
                 Param::choice("boundary", {"closed", "open"}, "closed")
                     .help("closed: walls keep the water in; open: water flows off the edges"),
             },

@@ -38,6 +38,197 @@ struct Sub {
 
 inline float speed_of(float u, float v) { return std::sqrt(u * u + v * v); }
 
+/// The arrays of one sub-step.
+struct Arrays {
+    const float* b;  ///< terrain now
+    float* b_next;   ///< terrain after erosion/deposition
+    float* d;        ///< water (updated in place by pass 2: no one reads a neighbour's depth there)
+    float* s;        ///< sediment (stored; pass 3 writes it)
+    float* s1;       ///< sediment after erosion/deposition, before transport
+    float* u;        ///< velocity east, m/s
+    float* v;        ///< velocity south, m/s
+    float *fw, *fe, *fn, *fs;  ///< outflow fluxes, m³/s (pass 1 updates each cell's own in place)
+    const float* mask;
+    int w, h;
+};
+
+struct RowSums {
+    double s1 = 0.0, water = 0.0, check = 0.0;
+    float vmax = 0.0f, dmax = 0.0f;
+};
+
+inline float rain_factor(const Arrays& a, std::size_t i) { return a.mask ? a.mask[i] : 1.0f; }
+
+/// Pass 1 for one cell. The flags say which neighbours exist; the interior
+/// loop passes constants so the compiler drops the tests and vectorises.
+inline void flux_cell(const Arrays& a, const Sub& k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
+                      float mw, float me, float mn, float ms, float mc) {
+    const float* __restrict b = a.b;
+    const float* __restrict d = a.d;
+    const float d1 = d[i] + k.rain_dt * mc;
+    const float surface = b[i] + d1;
+    // Drop to each neighbour's water surface; off the grid: closed → no pipe,
+    // open → onto dry ground at this cell's height (drop = d1).
+    const float dw = hw ? surface - (b[i - 1] + (d[i - 1] + k.rain_dt * mw)) : d1;
+    const float de = he ? surface - (b[i + 1] + (d[i + 1] + k.rain_dt * me)) : d1;
+    const float dn = hn ? surface - (b[i - W] + (d[i - W] + k.rain_dt * mn)) : d1;
+    const float ds = hs ? surface - (b[i + W] + (d[i + W] + k.rain_dt * ms)) : d1;
+    const float edge = k.open ? 1.0f : 0.0f;
+    const float fw = std::max(0.0f, a.fw[i] + k.flux_gain * dw) * (hw ? 1.0f : edge);
+    const float fe = std::max(0.0f, a.fe[i] + k.flux_gain * de) * (he ? 1.0f : edge);
+    const float fn = std::max(0.0f, a.fn[i] + k.flux_gain * dn) * (hn ? 1.0f : edge);
+    const float fs = std::max(0.0f, a.fs[i] + k.flux_gain * ds) * (hs ? 1.0f : edge);
+    // K: never send more than the cell holds (a hair less, so that round-off
+    // cannot leave a negative depth to clamp).
+    const float out = ((fw + fe) + (fn + fs)) * k.dt;
+    const float volume = d1 * k.area;
+    const float ratio = volume / std::max(out, 1e-30f) * 0.99999f;
+    const float scale = out > volume ? ratio : 1.0f;
+    a.fw[i] = fw * scale;
+    a.fe[i] = fe * scale;
+    a.fn[i] = fn * scale;
+    a.fs[i] = fs * scale;
+}
+
+template <bool HasMask>
+OROGEN_PIPE_CLONES void flux_row_impl(const Arrays& a, const Sub& k, int y) {
+    const int W = a.w;
+    const std::size_t Ws = std::size_t(W), row = std::size_t(y) * Ws;
+    const bool hn = y > 0, hs = y + 1 < a.h;
+    auto m = [&](std::size_t i) { return HasMask ? a.mask[i] : 1.0f; };
+    auto edge = [&](int x) {
+        const std::size_t i = row + std::size_t(x);
+        const bool hw = x > 0, he = x + 1 < W;
+        flux_cell(a, k, i, Ws, hw, he, hn, hs, hw ? m(i - 1) : 0.0f, he ? m(i + 1) : 0.0f, hn ? m(i - Ws) : 0.0f,
+                  hs ? m(i + Ws) : 0.0f, m(i));
+    };
+    if (!hn || !hs || W < 3) {
+        for (int x = 0; x < W; ++x) edge(x);
+        return;
+    }
+    edge(0);
+    edge(W - 1);
+#pragma GCC ivdep
+    for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
+        flux_cell(a, k, i, Ws, true, true, true, true, m(i - 1), m(i + 1), m(i - Ws), m(i + Ws), m(i));
+}
+
+void flux_row(const Arrays& a, const Sub& k, int y) {
+    if (a.mask) flux_row_impl<true>(a, k, y);
+    else flux_row_impl<false>(a, k, y);
+}
+
+/// Pass 2 for one cell; returns its speed, adds to the row sums.
+inline void water_cell(const Arrays& a, const Sub& k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
+                       float gx_scale, float gy_scale, float mc, bool rescale, double scale, RowSums& sums) {
+    const float* __restrict b = a.b;
+    const float d1 = a.d[i] + k.rain_dt * mc;
+    const float from_w = hw ? a.fe[i - 1] : 0.0f;
+    const float from_e = he ? a.fw[i + 1] : 0.0f;
+    const float from_n = hn ? a.fs[i - W] : 0.0f;
+    const float from_s = hs ? a.fn[i + W] : 0.0f;
+    const float fw = a.fw[i], fe = a.fe[i], fn = a.fn[i], fs = a.fs[i];
+    const float inflow = (from_w + from_e) + (from_n + from_s);
+    const float outflow = (fw + fe) + (fn + fs);
+    const float d2 = std::max(0.0f, d1 + k.dt * (inflow - outflow) * k.inv_area);
+    const float mean_depth = 0.5f * (d1 + d2);
+    // Water passing through the cell per second along x and y (m³/s), over
+    // the wetted cross-section: Mei's velocity.
+    const float pass_x = 0.5f * ((from_w - fw) + (fe - from_e));
+    const float pass_y = 0.5f * ((from_n - fn) + (fs - from_s));
+    const float inv_raw = 1.0f / (std::max(mean_depth, 1e-6f) * k.l);
+    const float inv = mean_depth > 1e-6f ? inv_raw : 0.0f;
+    const float uu = pass_x * inv, vv = pass_y * inv;
+    // Local tilt of the terrain (central differences, one-sided at edges).
+    const float gx = (b[he ? i + 1 : i] - b[hw ? i - 1 : i]) * gx_scale;
+    const float gy = (b[hs ? i + W : i] - b[hn ? i - W : i]) * gy_scale;
+    const float t2 = gx * gx + gy * gy;
+    const float sin_tilt = std::sqrt(t2 / (1.0f + t2));
+    const float speed = speed_of(uu, vv);
+    // Mei's capacity, times a depth ramp (after Št'ava et al. 2008): a film
+    // of rain shallower than erosion_depth carries in proportion to its
+    // depth, so sheets do not scour like rivers and the flow gathers into
+    // channels. Speeds above the wave speed c only occur in films draining
+    // within one sub-step; they are capped as in the CFL limit.
+    const float ramp = std::min(mean_depth * k.inv_erosion_depth, 1.0f);
+    const float cap = k.capacity * std::max(sin_tilt, k.min_slope) * std::min(speed, k.speed_cap) * ramp;
+    const float s0 = rescale ? float(double(a.s[i]) * scale) : a.s[i];
+    const float deficit = cap - s0;
+    const float want = (deficit > 0.0f ? k.take : k.drop) * deficit;  // > 0 erode, < 0 deposit
+    // Exchange exactly what the terrain's float can represent, so terrain +
+    // sediment is conserved even when `want` is below the height's resolution.
+    const float b2 = b[i] - want;
+    const float moved = b[i] - b2;
+    const float s1 = s0 + moved;
+    const float d3 = d2 * k.keep;
+    a.b_next[i] = b2;
+    a.s1[i] = s1;
+    a.d[i] = d3;
+    a.u[i] = uu;
+    a.v[i] = vv;
+    sums.s1 += double(s1);
+    sums.water += double(d3);
+    sums.check += double(b2) + double(d3);
+    sums.vmax = std::max(sums.vmax, speed);
+    sums.dmax = std::max(sums.dmax, d3);
+}
+
+template <bool HasMask, bool Rescale>
+OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays& a, const Sub& k, int y, double scale) {
+    const int W = a.w;
+    const std::size_t Ws = std::size_t(W), row = std::size_t(y) * Ws;
+    const bool hn = y > 0, hs = y + 1 < a.h;
+    const float gy_scale = (hn && hs) ? 0.5f * k.inv_l : ((hn || hs) ? k.inv_l : 0.0f);
+    auto m = [&](std::size_t i) { return HasMask ? a.mask[i] : 1.0f; };
+    RowSums sums;
+    auto edge = [&](int x) {
+        const bool hw = x > 0, he = x + 1 < W;
+        const float gx_scale = (hw && he) ? 0.5f * k.inv_l : ((hw || he) ? k.inv_l : 0.0f);
+        const std::size_t i = row + std::size_t(x);
+        water_cell(a, k, i, Ws, hw, he, hn, hs, gx_scale, gy_scale, m(i), Rescale, scale, sums);
+    };
+    if (!hn || !hs || W < 3) {
+        for (int x = 0; x < W; ++x) edge(x);
+        return sums;
+    }
+    edge(0);
+    const float gx_scale = 0.5f * k.inv_l;
+    for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
+        water_cell(a, k, i, Ws, true, true, true, true, gx_scale, gy_scale, m(i), Rescale, scale, sums);
+    edge(W - 1);
+    return sums;
+}
+
+RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale) {
+    if (a.mask) return rescale ? water_row_impl<true, true>(a, k, y, scale) : water_row_impl<true, false>(a, k, y, scale);
+    return rescale ? water_row_impl<false, true>(a, k, y, scale) : water_row_impl<false, false>(a, k, y, scale);
+}
+
+/// Pass 3: sediment at each cell = s1 back-traced along the velocity (bilinear).
+OROGEN_PIPE_CLONES double transport_row(const Arrays& a, const Sub& k, int y) {
+    const int W = a.w, H = a.h;
+    const float xmax = float(W - 1), ymax = float(H - 1);
+    const float step = k.dt * k.inv_l;  // cells per (m/s)
+    const std::size_t row = std::size_t(y) * std::size_t(W);
+    double sum = 0.0;
+    for (int x = 0; x < W; ++x) {
+        const std::size_t i = row + std::size_t(x);
+        const float px = std::min(std::max(float(x) - a.u[i] * step, 0.0f), xmax);
+        const float py = std::min(std::max(float(y) - a.v[i] * step, 0.0f), ymax);
+        const int x0 = std::min(int(px), W - 1), y0 = std::min(int(py), H - 1);
+        const int x1 = std::min(x0 + 1, W - 1), y1 = std::min(y0 + 1, H - 1);
+        const float fx = px - float(x0), fy = py - float(y0);
+        const float* r0 = a.s1 + std::size_t(y0) * std::size_t(W);
+        const float* r1 = a.s1 + std::size_t(y1) * std::size_t(W);
+        const float top = r0[x0] + (r0[x1] - r0[x0]) * fx;
+        const float bottom = r1[x0] + (r1[x1] - r1[x0]) * fx;
+        const float value = top + (bottom - top) * fy;
+        a.s[i] = value;
+        sum += double(value);
+    }
+    return sum;
+}
+
 }  // namespace
 
 struct Solver::Impl {
@@ -150,147 +341,31 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     k.open = cfg.boundary == Boundary::open;
 
     const int W = w, H = h;
-    const float* b = b_cur;
-    float* d = st.water.data;
-    float* fw = st.flux_west.data;
-    float* fe = st.flux_east.data;
-    float* fn = st.flux_north.data;
-    float* fs = st.flux_south.data;
-    const float* msk = mask;
+
+    Arrays ar{b_cur, b_next, st.water.data, st.sediment.data, s1.data(), u.data(), v.data(), st.flux_west.data,
+              st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H};
     const std::int64_t grain = std::max<std::int64_t>(8, H / 64);
 
     // ---- pass 1: rain, outflow flux, limiter K (each cell writes only its own four fluxes)
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
-        auto d1_at = [&](std::size_t i) { return d[i] + k.rain_dt * (msk ? msk[i] : 1.0f); };
-        auto cell = [&](std::size_t i, bool hw, bool he, bool hn, bool hs) {
-            const float d1 = d1_at(i);
-            const float surface = b[i] + d1;
-            // Drop to each neighbour's surface; off the grid: closed → none,
-            // open → onto dry ground at this cell's height (drop = d1).
-            auto drop = [&](bool has, std::size_t j) { return has ? surface - (b[j] + d1_at(j)) : d1; };
-            const float edge = k.open ? 1.0f : 0.0f;
-            float a = std::max(0.0f, fw[i] + k.flux_gain * drop(hw, hw ? i - 1 : i)) * (hw ? 1.0f : edge);
-            float e = std::max(0.0f, fe[i] + k.flux_gain * drop(he, he ? i + 1 : i)) * (he ? 1.0f : edge);
-            float no = std::max(0.0f, fn[i] + k.flux_gain * drop(hn, hn ? i - W : i)) * (hn ? 1.0f : edge);
-            float so = std::max(0.0f, fs[i] + k.flux_gain * drop(hs, hs ? i + W : i)) * (hs ? 1.0f : edge);
-            // K: never send more than the cell holds (slightly less, so that
-            // round-off cannot leave a negative depth to clamp).
-            const float out = (a + e + no + so) * k.dt;
-            const float volume = d1 * k.area;
-            const float scale = out > volume ? volume / out * 0.99999f : 1.0f;
-            fw[i] = a * scale;
-            fe[i] = e * scale;
-            fn[i] = no * scale;
-            fs[i] = so * scale;
-        };
-        for (std::int64_t y = y0; y < y1; ++y) {
-            const std::size_t row = std::size_t(y) * std::size_t(W);
-            const bool hn = y > 0, hs = y + 1 < H;
-            for (int x = 0; x < W; ++x) cell(row + std::size_t(x), x > 0, x + 1 < W, hn, hs);
-        }
+        for (std::int64_t y = y0; y < y1; ++y) flux_row(ar, k, int(y));
     });
-
     // ---- pass 2: water, velocity, erosion/deposition, evaporation
     const bool rescale = sediment_scale != 1.0;
     const double sed_scale_d = sediment_scale;
-    float* bn = b_next;
-    float* s = st.sediment.data;
-    float* s1p = s1.data();
-    float* up = u.data();
-    float* vp = v.data();
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
         for (std::int64_t y = y0; y < y1; ++y) {
-            const std::size_t row = std::size_t(y) * std::size_t(W);
-            const bool hn = y > 0, hs = y + 1 < H;
-            const std::size_t yn = hn ? row - std::size_t(W) : row, ys = hs ? row + std::size_t(W) : row;
-            const float gy_scale = (hn && hs) ? 0.5f * k.inv_l : ((hn || hs) ? k.inv_l : 0.0f);
-            double sum_s1 = 0.0, check = 0.0, water = 0.0;
-            float vm = 0.0f, dm = 0.0f;
-            for (int x = 0; x < W; ++x) {
-                const std::size_t i = row + std::size_t(x);
-                const bool hw = x > 0, he = x + 1 < W;
-                const float d1 = d[i] + k.rain_dt * (msk ? msk[i] : 1.0f);
-                const float from_w = hw ? fe[i - 1] : 0.0f;
-                const float from_e = he ? fw[i + 1] : 0.0f;
-                const float from_n = hn ? fs[i - std::size_t(W)] : 0.0f;
-                const float from_s = hs ? fn[i + std::size_t(W)] : 0.0f;
-                const float inflow = (from_w + from_e) + (from_n + from_s);
-                const float outflow = (fw[i] + fe[i]) + (fn[i] + fs[i]);
-                const float d2 = std::max(0.0f, d1 + k.dt * (inflow - outflow) * k.inv_area);
-                const float mean_depth = 0.5f * (d1 + d2);
-                // Water passing through the cell per second, x and y (m³/s).
-                const float pass_x = 0.5f * ((from_w - fw[i]) + (fe[i] - from_e));
-                const float pass_y = 0.5f * ((from_n - fn[i]) + (fs[i] - from_s));
-                const float inv = mean_depth > 1e-6f ? 1.0f / (mean_depth * k.l) : 0.0f;
-                const float uu = pass_x * inv, vv = pass_y * inv;
-                // Local tilt from the terrain (central differences, one-sided at edges).
-                const std::size_t xl = hw ? i - 1 : i, xr = he ? i + 1 : i;
-                const float gx_scale = (hw && he) ? 0.5f * k.inv_l : ((hw || he) ? k.inv_l : 0.0f);
-                const float gx = (b[xr] - b[xl]) * gx_scale;
-                const float gy = (b[ys + std::size_t(x)] - b[yn + std::size_t(x)]) * gy_scale;
-                const float t2 = gx * gx + gy * gy;
-                const float sin_tilt = std::sqrt(t2 / (1.0f + t2));
-                const float speed = speed_of(uu, vv);
-                // Mei's capacity, times a depth ramp (after Št'ava et al. 2008): a
-                // film of rain shallower than erosion_depth carries in
-                // proportion to its depth, so sheets do not scour like rivers
-                // and the flow gathers into channels.
-                const float ramp = std::min(mean_depth * k.inv_erosion_depth, 1.0f);
-                const float cap =
-                    k.capacity * std::max(sin_tilt, k.min_slope) * std::min(speed, k.speed_cap) * ramp;
-                const float s0 = rescale ? float(double(s[i]) * sed_scale_d) : s[i];
-                const float deficit = cap - s0;
-                const float want = (deficit > 0.0f ? k.take : k.drop) * deficit;  // + erode, − deposit
-                // Exchange exactly what the terrain's float can represent, so
-                // terrain + sediment is conserved even when `want` is below
-                // the resolution of the height.
-                const float b2 = b[i] - want;
-                const float moved = b[i] - b2;
-                const float s1v = s0 + moved;
-                const float d3 = d2 * k.keep;
-                bn[i] = b2;
-                s1p[i] = s1v;
-                d[i] = d3;
-                up[i] = uu;
-                vp[i] = vv;
-                sum_s1 += double(s1v);
-                water += double(d3);
-                check += double(b2) + double(d3);
-                vm = std::max(vm, speed);
-                dm = std::max(dm, d3);
-            }
-            row_s1[std::size_t(y)] = sum_s1;
-            row_water[std::size_t(y)] = water;
-            row_check[std::size_t(y)] = check;
-            row_vmax[std::size_t(y)] = vm;
-            row_dmax[std::size_t(y)] = dm;
+            RowSums r = water_row(ar, k, int(y), rescale, sed_scale_d);
+            row_s1[std::size_t(y)] = r.s1;
+            row_water[std::size_t(y)] = r.water;
+            row_check[std::size_t(y)] = r.check;
+            row_vmax[std::size_t(y)] = r.vmax;
+            row_dmax[std::size_t(y)] = r.dmax;
         }
     });
-
     // ---- pass 3: semi-Lagrangian sediment transport (bilinear back-trace)
-    const float* s1c = s1p;
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
-        const float xmax = float(W - 1), ymax = float(H - 1);
-        for (std::int64_t y = y0; y < y1; ++y) {
-            const std::size_t row = std::size_t(y) * std::size_t(W);
-            double sum = 0.0;
-            for (int x = 0; x < W; ++x) {
-                const std::size_t i = row + std::size_t(x);
-                const float px = std::min(std::max(float(x) - up[i] * k.dt * k.inv_l, 0.0f), xmax);
-                const float py = std::min(std::max(float(y) - vp[i] * k.dt * k.inv_l, 0.0f), ymax);
-                const int x0 = std::min(int(px), W - 1), y0i = std::min(int(py), H - 1);
-                const int x1 = std::min(x0 + 1, W - 1), y1i = std::min(y0i + 1, H - 1);
-                const float fx = px - float(x0), fy = py - float(y0i);
-                const float* r0 = s1c + std::size_t(y0i) * std::size_t(W);
-                const float* r1 = s1c + std::size_t(y1i) * std::size_t(W);
-                const float top = r0[x0] + (r0[x1] - r0[x0]) * fx;
-                const float bottom = r1[x0] + (r1[x1] - r1[x0]) * fx;
-                const float value = top + (bottom - top) * fy;
-                s[i] = value;
-                sum += double(value);
-            }
-            row_snew[std::size_t(y)] = sum;
-        }
+        for (std::int64_t y = y0; y < y1; ++y) row_snew[std::size_t(y)] = transport_row(ar, k, int(y));
     });
 
     // ---- reductions, in row order
