@@ -4,6 +4,7 @@
 #include "rmp.hpp"
 
 #include <orogen/plugin.hpp>
+#include <orogen/random.hpp>
 
 #include <cmath>
 #include <sstream>
@@ -25,6 +26,11 @@ std::string point_text(Point2 p) {
 
 // Polygons n cuts can make at most (the lazy caterer's sequence, thesis eq. 4.1).
 std::int64_t max_polygons(std::int64_t cuts) { return (cuts * cuts + cuts + 2) / 2; }
+
+std::uint64_t node_seed(NodeContext& ctx) {
+    const std::int64_t s = ctx.integer("seed");
+    return s < 0 ? ctx.seed() : orogen::random::hash(std::uint64_t(s));
+}
 
 }  // namespace
 
@@ -70,6 +76,11 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
                     .max(1)
                     .help("0: every region by the same amount; >0: each by height*(1 + jitter*u), u in [-1, 1) "
                           "(the thesis's dynamic areal height, 4.2)"),
+                Param::integer("seed", -1)
+                    .min(-1)
+                    .max(9.0e18)
+                    .help("-1: the node's own seed (from the spec's seed and the node's name); otherwise this "
+                          "seed, so variants of a node can share their random regions"),
                 Param::integer("cuts", 5).min(1).max(5000).help("random lines per iteration (graph)"),
                 Param::integer("regions", 2)
                     .min(1)
@@ -112,9 +123,10 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
                 ctx.progress(double(k + 1) / p.iterations);
             };
             const std::string& method = ctx.text("method");
-            if (method == "voronoi") rmp::rmp_voronoi(hm->view(), p, ctx.seed(), hook);
-            else if (method == "cones") rmp::rmp_cones(hm->view(), p, ctx.seed(), hook);
-            else rmp::rmp_graph(hm->view(), p, ctx.seed(), hook);
+            const std::uint64_t seed = node_seed(ctx);
+            if (method == "voronoi") rmp::rmp_voronoi(hm->view(), p, seed, hook);
+            else if (method == "cones") rmp::rmp_cones(hm->view(), p, seed, hook);
+            else rmp::rmp_graph(hm->view(), p, seed, hook);
             ctx.check_finite(hm->heights(), "height", p.iterations);
             return hm;
         },
@@ -146,6 +158,11 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
                     .min(0)
                     .max(1)
                     .help("0: every crossed cell by `height`; >0: each by height*(1 + jitter*u), u in [-1, 1)"),
+                Param::integer("seed", -1)
+                    .min(-1)
+                    .max(9.0e18)
+                    .help("-1: the node's own seed (from the spec's seed and the node's name); otherwise this "
+                          "seed, so variants of a node can share their random regions"),
                 Param::boolean("uplift", false).help("also add the raise to the heightmap's 'uplift' layer (m)"),
             },
         .check =
@@ -167,8 +184,9 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
             const int iterations = int(ctx.integer("iterations"));
             GridView uplift;
             if (ctx.flag("uplift")) uplift = hm->layer("uplift");
+            const std::uint64_t seed = node_seed(ctx);
             for (int k = 0; k < iterations; ++k) {
-                rmp::raise_range(hm->view(), a, b, p, rmp::iteration_seed(ctx.seed(), k),
+                rmp::raise_range(hm->view(), a, b, p, rmp::iteration_seed(seed, k),
                                  ctx.flag("uplift") ? &uplift : nullptr);
                 ctx.check_cancelled();
                 ctx.progress(double(k + 1) / iterations);
