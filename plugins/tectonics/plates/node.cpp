@@ -1,0 +1,143 @@
+// tectonics:plates — registers the plate simulation (plates.hpp) with the kernel.
+#include "plates.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/plugin.hpp>
+
+#include <algorithm>
+#include <memory>
+#include <string>
+#include <utility>
+
+namespace {
+
+using namespace orogen;
+
+plates::Params params_from(NodeContext& ctx) {
+    plates::Params p;
+    p.steps = int(ctx.integer("steps"));
+    p.dt = ctx.real("dt");
+    p.drive = *plates::parse_drive(ctx.text("drive"));  // Param::choice has checked the name
+    p.speed = ctx.real("speed");
+    p.restitution = ctx.real("restitution");
+    p.cones = int(ctx.integer("cones"));
+    p.height = ctx.real("height");
+    p.jitter = ctx.real("jitter");
+    p.rift_depth = ctx.real("rift_depth");
+    p.ridge_height = ctx.real("ridge_height");
+    p.trench_depth = ctx.real("trench_depth");
+    p.arc_height = ctx.real("arc_height");
+    p.rift_threshold = ctx.real("rift_threshold");
+    p.record_every = int(ctx.integer("record_every"));
+    return p;
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    auto hm = ctx.take_heightmap(0);
+    const plates::Params params = params_from(ctx);
+    plates::Params bounded = params;
+    bounded.max_plates = plates::max_plates(hm->width(), hm->height());
+
+    const auto start = plates::random_plates(plates::area_size(hm->width(), hm->height()),
+                                             int(ctx.integer("plates")), ctx.real("oceanic_fraction"),
+                                             params.speed, ctx.seed());
+    plates::Layers layers;
+    layers.uplift = hm->layer("uplift", 0.0f);  // added to an earlier tectonics node's uplift
+    layers.boundary = hm->layer("boundary", 0.0f);
+    layers.plate = hm->layer("plate", -1.0f);
+    layers.terrain = hm->view();
+
+    auto result = plates::simulate(start, bounded, ctx.seed(), layers, [&](std::int64_t step) {
+        ctx.check_cancelled();
+        if (step % 32 == 0) ctx.progress(double(step) / double(params.steps));
+    });
+    ctx.check_finite(hm->heights(), "height", params.steps);
+    const auto& s = result.stats;
+    ctx.info(std::to_string(s.events[1]) + " convergent (" + std::to_string(s.subductions) + " subducting), " +
+             std::to_string(s.events[2]) + " divergent, " + std::to_string(s.events[3]) + " transform contacts; " +
+             std::to_string(s.rifts) + " rifts; " + std::to_string(result.final_plates.size()) + " plates at the end");
+
+    NodeOutputs out(hm);
+    out.side["plates"] = Value(std::make_shared<PlateHistory>(std::move(result.history)));
+    return out;
+}
+
+void check(CheckContext& ctx) {
+    const ValueInfo* in = ctx.input(0);
+    const int w = in && in->width > 0 ? in->width : ctx.grid().width;
+    const int h = in && in->height > 0 ? in->height : ctx.grid().height;
+    const int most = plates::max_plates(w, h);
+    const std::int64_t n = ctx.integer("plates");
+    if (n > most)
+        ctx.error("plates", "a " + std::to_string(w) + " × " + std::to_string(h) + " heightmap holds at most " +
+                                std::to_string(most) + " plates (each needs 16 × 16 samples); ask for fewer plates "
+                                "or a larger grid");
+    for (const char* layer : {"uplift", "boundary", "plate"}) ctx.output().layers.insert(layer);
+}
+
+}  // namespace
+
+OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
+    std::vector<std::string> drives(plates::drive_names.begin(), plates::drive_names.end());
+    registry.add({
+        .kind = "tectonics",
+        .name = "plates",
+        .summary = "Box2D plate tectonics: colliding plates raise ranges; diverging plates rift, dense plates subduct",
+        .description =
+            "The thesis's plate simulation (section 3.6) and its future work. The area is cut into `plates` convex "
+            "plates (at most 8 vertices, Box2D's limit) that move in a 2-D Box2D world, kept inside and in motion "
+            "by four kinematic beams (`drive`). Each new two-point contact between two plates is classified by "
+            "their relative velocity: approaching → a mountain range raised along the contact with the RMP range "
+            "core (`cones`, `height`), or, if one plate is clearly denser (oceanic under continental), a trench on "
+            "its side and a volcanic arc on the other; separating → a rift valley with a ridge; sliding past → "
+            "no change. A plate whose collision impulse passes `rift_threshold` splits in two and the parts move "
+            "apart. The simulation area (36 units on the longer side) covers the heightmap. Adds the layers "
+            "uplift (m), boundary (1 convergent, 2 divergent, 3 transform) and plate (id of the plate over each "
+            "sample at the end, -1 none), and the side value `plates` (polygons every `record_every` steps and "
+            "every contact event).",
+        .inputs = {{"crust", ValueType::heightmap, Need::required, "the heightmap before tectonics"}},
+        .output = ValueType::heightmap,
+        .side_outputs = {{"plates", ValueType::plates, "plate polygons over time and the boundary events"}},
+        .params =
+            {
+                Param::integer("plates", 12).min(2).max(256).help("number of plates cut from the area at the start"),
+                Param::integer("steps", 1000).min(1).max(10'000'000).help("Box2D steps to simulate"),
+                Param::real("dt", 0.1).min(0.0, true).max(10.0).unit("s").help("simulated time per step"),
+                Param::choice("drive", drives, "converge")
+                    .help("how the beams move: converge (opposite beams push inward together, one axis after the "
+                          "other), rotate (faces convey round the box), shear (north and south faces convey in "
+                          "opposite directions), thesis (all beams in phase: the box shakes), still (no beams "
+                          "moving: plates keep their start velocities)"),
+                Param::real("speed", 1.0)
+                    .min(0.0, true)
+                    .max(20.0)
+                    .unit("u/s")
+                    .help("beam speed and the plates' largest start speed, in simulation units (the area is 36 u "
+                          "across, as in the thesis)"),
+                Param::real("restitution", 0.5).min(0.0).max(1.0).help("bounciness of plate contacts (thesis 0.5)"),
+                Param::integer("cones", 100)
+                    .min(1)
+                    .max(100'000)
+                    .help("Voronoi sites over the grid for each range; also sets the width of rifts and trenches "
+                          "(the cell size sqrt(area / cones))"),
+                Param::real("height", 40.0).unit("m").help("raise of a mountain range per convergent contact"),
+                Param::real("jitter", 0.5).min(0.0).max(1.0).help("per-cell variation of a range's raise (thesis 4.2)"),
+                Param::real("rift_depth", 30.0).min(0.0).unit("m").help("depth of a rift valley per divergent contact"),
+                Param::real("ridge_height", 15.0).min(0.0).unit("m").help("height of the ridge along a rift's axis"),
+                Param::real("trench_depth", 60.0).min(0.0).unit("m").help("depth of a subduction trench per contact"),
+                Param::real("arc_height", 40.0).min(0.0).unit("m").help("height of the volcanic arc per contact"),
+                Param::real("oceanic_fraction", 0.5)
+                    .min(0.0)
+                    .max(1.0)
+                    .help("share of oceanic (dense) plates; where oceanic meets continental, the oceanic subducts"),
+                Param::real("rift_threshold", 20000.0)
+                    .min(0.0)
+                    .unit("N·s")
+                    .help("collision impulse (simulation units) a plate takes before it splits in two; 0 = never"),
+                Param::integer("record_every", 10).min(1).help("record the plate polygons every this many steps"),
+            },
+        .adds_layers = {"uplift", "boundary", "plate"},
+        .check = check,
+        .run = run,
+    });
+}

@@ -1,0 +1,155 @@
+// plates.hpp — the thesis's tectonic plate simulation (section 3.6) and what
+// its chapter 5 left as future work.
+//
+// Rigid convex plates move in a 2-D Box2D world, kept in motion and inside
+// the area by four kinematic beams. Where two plates touch along a two-point
+// contact, the boundary is classified by the plates' relative velocity at
+// the contact: approaching → convergent (a mountain range raised with the
+// RMP range core, or a trench and volcanic arc where a denser plate dives
+// under a lighter one), separating → divergent (a rift valley with a ridge),
+// sliding past → transform (height unchanged). A plate that has taken more
+// than `rift_threshold` of collision impulse splits along a line through its
+// stress point, and the two parts move apart.
+//
+// The simulation frame: the plate area is [0, size.x] × [0, size.y]
+// simulation units ("u"), size = 36 u on the heightmap's longer side (the
+// thesis's 36 × 36 plate), x east and y south like the heightmap; one unit is
+// samples_per_unit() samples. The beams' rest positions leave a free margin
+// of 2 u around the area (the thesis's 40 × 40 world).
+//
+// Deterministic: Box2D steps single-threaded, events are applied in the order
+// Box2D reports them, every random number comes from orogen::random keyed by
+// (seed, purpose, index). Box2D headers stay in plates.cpp.
+#pragma once
+
+#include "polygon.hpp"
+
+#include <orogen/grid.hpp>
+#include <orogen/values.hpp>
+
+#include <array>
+#include <functional>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string_view>
+#include <vector>
+
+namespace orogen::plates {
+
+/// How the four beams move.
+enum class Drive {
+    still,     ///< beams stay put: the plates keep their initial velocities (scripted scenarios)
+    converge,  ///< opposite beams push inward together, the two axes half a period apart: squeezes the plates
+    rotate,    ///< beams convey their surfaces round the box (friction) and squeeze gently: plates circulate
+    shear,     ///< north beam conveys east, south beam west: plates slide past each other
+    thesis,    ///< the thesis's beams: all moving in phase, so the box shakes the plates back and forth
+};
+inline constexpr std::array<std::string_view, 5> drive_names = {"still", "converge", "rotate", "shear", "thesis"};
+std::optional<Drive> parse_drive(std::string_view name);
+
+inline constexpr double area_units = 36.0;   ///< u, the plate area's longer side
+inline constexpr double margin_units = 2.0;  ///< u, free space between the area and the beams at rest
+inline constexpr int max_plate_vertices = 8;  ///< b2_maxPolygonVertices
+
+/// Size of the plate area in simulation units for a width × height grid.
+Point2 area_size(int width, int height);
+/// Heightmap samples per simulation unit.
+double samples_per_unit(int width, int height);
+/// The most plates a width × height grid can hold: each plate must cover at
+/// least 16 × 16 samples (smaller ones cannot carry a range), at most 256.
+int max_plates(int width, int height);
+
+/// A plate to start from, in simulation units.
+struct PlateSpec {
+    Polygon polygon;                ///< convex, counter-clockwise in (x east, y south), ≤ 8 vertices
+    Point2 velocity;                ///< u/s
+    double angular_velocity = 0.0;  ///< rad/s
+    double density = 1.0;           ///< relative; the denser plate of a convergent pair subducts
+};
+
+/// Plate densities: oceanic crust is denser than continental.
+inline constexpr double oceanic_density = 3.0;
+inline constexpr double continental_density = 2.7;
+
+/// Split the area (size from area_size) into `count` convex plates by random
+/// straight cuts: each cut goes through a random point of the largest plate
+/// at a random angle; a cut that would give a part more than 8 vertices, a
+/// part under a quarter of the plate, or a sliver edge is drawn again. A
+/// fraction `oceanic_fraction` of the plates is oceanic. Every plate starts
+/// with a random velocity up to `speed` u/s. Throws orogen::Error if a plate
+/// cannot be cut after many tries (count far above max_plates).
+std::vector<PlateSpec> random_plates(Point2 size, int count, double oceanic_fraction, double speed,
+                                     std::uint64_t seed);
+
+struct Params {
+    int steps = 1000;
+    double dt = 0.1;  ///< s per step (the thesis stepped 1.0; see docs/tectonics.md)
+    int velocity_iterations = 10;
+    int position_iterations = 8;
+    double restitution = 0.5;
+    double friction = 0.6;
+    Drive drive = Drive::converge;
+    double speed = 1.0;   ///< u/s, beam speed (the thesis's 1)
+    double stroke = 1.0;  ///< u, how far a beam moves inward from rest (≤ margin_units)
+    /// u/s: below this relative speed at a contact the plates are resting on
+    /// each other and the contact makes no boundary event.
+    double min_speed = 0.05;
+
+    // Relief, per event. Widths are the RMP's Voronoi cell size sqrt(area / cones).
+    int cones = 100;              ///< Voronoi sites over the grid for each range
+    double height = 40.0;         ///< m raised per convergent collision
+    double jitter = 0.5;          ///< per-cell height variation of a range (thesis 4.2)
+    double rift_depth = 30.0;     ///< m
+    double ridge_height = 15.0;   ///< m
+    double trench_depth = 60.0;   ///< m
+    double arc_height = 40.0;     ///< m
+    double subduction_contrast = 0.1;  ///< density difference above which the denser plate subducts
+
+    double rift_threshold = 20000.0;  ///< accumulated plate–plate impulse (N·s, sim units) that splits a plate; 0 = never
+    double rift_speed = 0.5;      ///< u/s, how fast the two parts of a rifted plate move apart
+    int max_plates = 256;         ///< rifting stops at this many plates
+
+    int record_every = 10;  ///< record plate polygons every this many steps (and the first and last)
+};
+
+/// Where the simulation writes. `terrain` is required; `uplift` (m, added
+/// to), `boundary` (kind of the last event drawn over a sample, 0 none) and
+/// `plate` (id of the plate covering the sample at the end, -1 none) are
+/// skipped when their data is null. All the same size.
+struct Layers {
+    GridView terrain;
+    GridView uplift;
+    GridView boundary;
+    GridView plate;
+};
+
+struct Stats {
+    std::int64_t events[4] = {0, 0, 0, 0};  ///< by BoundaryKind (index 0: resting contacts skipped)
+    std::int64_t subductions = 0;           ///< convergent events shaped as trench and arc
+    std::int64_t rifts = 0;                 ///< plates split during the run
+    double box2d_seconds = 0.0;             ///< wall time inside b2World::Step
+    double relief_seconds = 0.0;            ///< wall time raising ranges, rifts, trenches
+};
+
+struct Result {
+    PlateHistory history;  ///< metres, heightmap coordinates (sample × cell)
+    Stats stats;
+    std::vector<PlateSpec> final_plates;  ///< simulation units, world polygons at the end
+    std::vector<int> final_ids;
+};
+
+/// Run the simulation from `plates` (simulation units, see area_size).
+/// Throws orogen::Error naming the step if Box2D produces a non-finite
+/// position, orogen::BadInput for unusable parameters or plates.
+/// `on_step(step)` is called after every step (progress, cancellation).
+Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
+                const std::function<void(std::int64_t)>& on_step = {});
+
+/// Draw segment a–b (sample coordinates) into `layer` with `value`, `radius`
+/// samples thick on each side (Bresenham walk, clipped to the grid).
+void draw_segment(GridView layer, Point2 a, Point2 b, float value, int radius);
+/// Fill every sample inside the convex polygon (sample coordinates) with `value`.
+void fill_polygon(GridView layer, std::span<const Point2> polygon, float value);
+
+}  // namespace orogen::plates
