@@ -120,7 +120,8 @@ public:
         size_ = area_size(w, h);
         spu_ = samples_per_unit(w, h);
         cell_ = layers.terrain.cell;
-        relief_width_ = std::sqrt(double(w) * double(h) / double(std::max(1, params.cones)));
+        // Rifts and trenches half a Voronoi cell wide: about as wide as a range's core.
+        relief_width_ = 0.5 * std::sqrt(double(w) * double(h) / double(std::max(1, params.cones)));
         world_.SetAllowSleeping(false);  // a resting plate must still feel the beams
         world_.SetContactListener(this);
         result_.history.width = (w - 1) * cell_;
