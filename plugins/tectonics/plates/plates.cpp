@@ -130,6 +130,11 @@ public:
 
     void add_plate(const PlateSpec& spec, int id) { plates_.push_back(create_plate(spec, id)); }
 
+    // Rifting never makes a plate smaller than half the mean start plate, so
+    // splits cannot cascade into slivers (small plates are light and take
+    // impulse as readily as big ones).
+    void set_min_rift_part(double area) { min_rift_part_ = area; }
+
     void add_beams() {
         const double thick = 4.0;  // u: thick enough that no plate tunnels through
         const double m = margin_units;
@@ -405,7 +410,7 @@ private:
                 auto& [left, right] = *parts;
                 const double al = signed_area(left), ar = signed_area(right);
                 if (left.size() > max_plate_vertices || right.size() > max_plate_vertices) continue;
-                if (std::min(al, ar) < 0.2 * area) continue;
+                if (std::min(al, ar) < std::max(0.2 * area, min_rift_part_)) continue;
                 split_body(i, left, right, dk, al >= ar);
                 ++result_.stats.rifts;
                 (void)step;
@@ -486,7 +491,7 @@ private:
     Layers layers_;
     b2World world_;
     Point2 size_;
-    double spu_ = 1.0, cell_ = 1.0, relief_width_ = 1.0;
+    double spu_ = 1.0, cell_ = 1.0, relief_width_ = 1.0, min_rift_part_ = 0.0;
     std::vector<std::unique_ptr<PlateBody>> owned_;  // stable addresses for Box2D user data
     std::vector<PlateBody*> plates_;  // alive plates, in creation order
     std::array<Beam, 4> beams_{};
@@ -586,6 +591,9 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
     sim.add_beams();
     for (std::size_t i = 0; i < plates.size(); ++i) sim.add_plate(plates[i], int(i));
     sim.next_id_ = int(plates.size());
+    double total_area = 0.0;
+    for (const PlateSpec& p : plates) total_area += signed_area(p.polygon);
+    sim.set_min_rift_part(0.5 * total_area / double(plates.size()));
     return sim.run(on_step);
 }
 

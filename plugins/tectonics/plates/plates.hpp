@@ -106,7 +106,9 @@ struct Params {
     double arc_height = 40.0;     ///< m
     double subduction_contrast = 0.1;  ///< density difference above which the denser plate subducts
 
-    double rift_threshold = 20000.0;  ///< accumulated plate–plate impulse (N·s, sim units) that splits a plate; 0 = never
+    /// Accumulated plate–plate impulse (N·s, sim units) that splits a plate; 0 = never. Neither part of a
+    /// rift may be smaller than half the mean start plate (or a fifth of the plate).
+    double rift_threshold = 20000.0;
     double rift_speed = 0.5;      ///< u/s, how fast the two parts of a rifted plate move apart
     int max_plates = 256;         ///< rifting stops at this many plates
 
