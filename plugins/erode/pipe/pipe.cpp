@@ -3,6 +3,10 @@
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>
 
+#if defined(__x86_64__) || defined(__SSE__)
+#include <xmmintrin.h>
+#endif
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -19,6 +23,18 @@
 
 namespace orogen::pipe {
 namespace {
+
+/// Flush denormals to zero inside a parallel body (restored on exit). Water
+/// evaporating and sediment thinning out decay towards 1e-38 and below,
+/// where every float operation costs ~100 cycles. Set on every thread for
+/// every row, so results are the same whatever the thread count.
+struct FlushDenormals {
+#if defined(__x86_64__) || defined(__SSE__)
+    unsigned saved = _mm_getcsr();
+    FlushDenormals() { _mm_setcsr(saved | 0x8040u); }  // FTZ | DAZ
+    ~FlushDenormals() { _mm_setcsr(saved); }
+#endif
+};
 
 /// Constants of one sub-step, in float for the row loops.
 struct Sub {
@@ -61,7 +77,7 @@ inline float rain_factor(const Arrays& a, std::size_t i) { return a.mask ? a.mas
 
 /// Pass 1 for one cell. The flags say which neighbours exist; the interior
 /// loop passes constants so the compiler drops the tests and vectorises.
-inline void flux_cell(const Arrays& a, const Sub& k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
+inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
                       float mw, float me, float mn, float ms, float mc) {
     const float* __restrict b = a.b;
     const float* __restrict d = a.d;
@@ -91,7 +107,7 @@ inline void flux_cell(const Arrays& a, const Sub& k, std::size_t i, std::size_t 
 }
 
 template <bool HasMask>
-OROGEN_PIPE_CLONES void flux_row_impl(const Arrays& a, const Sub& k, int y) {
+OROGEN_PIPE_CLONES void flux_row_impl(const Arrays a, const Sub k, int y) {
     const int W = a.w;
     const std::size_t Ws = std::size_t(W), row = std::size_t(y) * Ws;
     const bool hn = y > 0, hs = y + 1 < a.h;
@@ -119,8 +135,8 @@ void flux_row(const Arrays& a, const Sub& k, int y) {
 }
 
 /// Pass 2 for one cell; returns its speed, adds to the row sums.
-inline void water_cell(const Arrays& a, const Sub& k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
-                       float gx_scale, float gy_scale, float mc, bool rescale, double scale, RowSums& sums) {
+inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
+                       float gx_scale, float gy_scale, float mc, bool rescale, double scale) {
     const float* __restrict b = a.b;
     const float d1 = a.d[i] + k.rain_dt * mc;
     const float from_w = hw ? a.fe[i - 1] : 0.0f;
@@ -166,37 +182,54 @@ inline void water_cell(const Arrays& a, const Sub& k, std::size_t i, std::size_t
     a.d[i] = d3;
     a.u[i] = uu;
     a.v[i] = vv;
-    sums.s1 += double(s1);
-    sums.water += double(d3);
-    sums.check += double(b2) + double(d3);
-    sums.vmax = std::max(sums.vmax, speed);
-    sums.dmax = std::max(sums.dmax, d3);
+}
+
+/// The row's sums and maxima, from what pass 2 wrote (a separate loop, so
+/// the cell loop has no serial double accumulations and vectorises).
+OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row) {
+    RowSums sums;
+    const std::size_t W = std::size_t(a.w);
+    double s1 = 0.0, water = 0.0, check = 0.0;
+    float vmax = 0.0f, dmax = 0.0f;
+    for (std::size_t i = row; i < row + W; ++i) {
+        s1 += double(a.s1[i]);
+        water += double(a.d[i]);
+        check += double(a.b_next[i]);
+        vmax = std::max(vmax, speed_of(a.u[i], a.v[i]));
+        dmax = std::max(dmax, a.d[i]);
+    }
+    sums.s1 = s1;
+    sums.water = water;
+    sums.check = check + water;  // NaN or infinity in terrain or water shows here
+    sums.vmax = vmax;
+    sums.dmax = dmax;
+    return sums;
 }
 
 template <bool HasMask, bool Rescale>
-OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays& a, const Sub& k, int y, double scale) {
+OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, double scale) {
     const int W = a.w;
     const std::size_t Ws = std::size_t(W), row = std::size_t(y) * Ws;
     const bool hn = y > 0, hs = y + 1 < a.h;
     const float gy_scale = (hn && hs) ? 0.5f * k.inv_l : ((hn || hs) ? k.inv_l : 0.0f);
     auto m = [&](std::size_t i) { return HasMask ? a.mask[i] : 1.0f; };
-    RowSums sums;
     auto edge = [&](int x) {
         const bool hw = x > 0, he = x + 1 < W;
         const float gx_scale = (hw && he) ? 0.5f * k.inv_l : ((hw || he) ? k.inv_l : 0.0f);
         const std::size_t i = row + std::size_t(x);
-        water_cell(a, k, i, Ws, hw, he, hn, hs, gx_scale, gy_scale, m(i), Rescale, scale, sums);
+        water_cell(a, k, i, Ws, hw, he, hn, hs, gx_scale, gy_scale, m(i), Rescale, scale);
     };
     if (!hn || !hs || W < 3) {
         for (int x = 0; x < W; ++x) edge(x);
-        return sums;
+        return row_sums(a, row);
     }
     edge(0);
     const float gx_scale = 0.5f * k.inv_l;
+#pragma GCC ivdep
     for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
-        water_cell(a, k, i, Ws, true, true, true, true, gx_scale, gy_scale, m(i), Rescale, scale, sums);
+        water_cell(a, k, i, Ws, true, true, true, true, gx_scale, gy_scale, m(i), Rescale, scale);
     edge(W - 1);
-    return sums;
+    return row_sums(a, row);
 }
 
 RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale) {
@@ -278,6 +311,7 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
     // the previous run's last sub-step), so a continued run schedules its
     // sub-steps exactly as one longer run would.
     parallel_for(0, m.h, 16, [&](std::int64_t y0, std::int64_t y1) {
+        FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y) {
             float vm = 0.0f, dm = 0.0f;
             const float* sp = state.speed.row(int(y));
@@ -348,12 +382,14 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
 
     // ---- pass 1: rain, outflow flux, limiter K (each cell writes only its own four fluxes)
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
+        FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y) flux_row(ar, k, int(y));
     });
     // ---- pass 2: water, velocity, erosion/deposition, evaporation
     const bool rescale = sediment_scale != 1.0;
     const double sed_scale_d = sediment_scale;
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
+        FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y) {
             RowSums r = water_row(ar, k, int(y), rescale, sed_scale_d);
             row_s1[std::size_t(y)] = r.s1;
@@ -365,6 +401,7 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     });
     // ---- pass 3: semi-Lagrangian sediment transport (bilinear back-trace)
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
+        FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y) row_snew[std::size_t(y)] = transport_row(ar, k, int(y));
     });
 
@@ -402,6 +439,7 @@ void Solver::finish() {
     const float* up = m.u.data();
     const float* vp = m.v.data();
     parallel_for(0, std::int64_t(m.n), 1 << 16, [&](std::int64_t i0, std::int64_t i1) {
+        FlushDenormals ftz;
         for (std::int64_t i = i0; i < i1; ++i) {
             if (scale != 1.0) s[i] = float(double(s[i]) * scale);
             speed[i] = speed_of(up[i], vp[i]);
