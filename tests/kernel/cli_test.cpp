@@ -7,6 +7,7 @@
 #include "orogen_test.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <regex>
 
 using namespace orogen;
@@ -220,6 +221,26 @@ TEST(Runner, ExitCodesFollowTheKindOfFailure) {
     r = run_failing(dir, "wrong-type");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("failed: internal error: it returned a nothing but declares a heightmap"), std::string::npos);
+}
+
+TEST(Runner, CtrlCStopsTheRunAtTheNextCheckWithExit130) {
+    TempDir dir;
+    dir.write("s.orogen", "orogen 1\ngrid 9\nok = generate:fault()\nexport:png(ok, path=\"ok.png\")\n"
+                          "s = generate:slow()\nexport:png(s, path=\"slow.png\")\n");
+    dir.write("interrupt.sh", "cd '" + dir.path().string() + "'\n"
+                              "OROGEN_PLUGIN_PATH=" + fake_plugins + " " + OROGEN_CLI +
+                              " run s.orogen --out out --quiet 2>err.txt &\n"
+                              "pid=$!\nsleep 1\nkill -INT $pid\nwait $pid\necho $? > rc.txt\n");
+    const auto start = std::chrono::steady_clock::now();
+    ASSERT_EQ(std::system(("bash '" + (dir / "interrupt.sh").string() + "'").c_str()), 0);
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
+    EXPECT_EQ(slurp(dir / "rc.txt"), "130\n");
+    EXPECT_NE(slurp(dir / "err.txt").find("error: node 's' (generate:slow) failed: cancelled by the user"),
+              std::string::npos)
+        << slurp(dir / "err.txt");
+    EXPECT_TRUE(fs::exists(dir / "out/ok.png"));
+    EXPECT_FALSE(fs::exists(dir / "out/slow.png"));
+    EXPECT_FALSE(fs::exists(dir / "out/manifest.json"));
 }
 
 TEST(Runner, AnOutputFolderThatCannotBeMadeFailsWithExitOne) {

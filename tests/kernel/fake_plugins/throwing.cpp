@@ -3,7 +3,9 @@
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
 
+#include <chrono>
 #include <cmath>
+#include <thread>
 #include <stdexcept>
 
 using namespace orogen;
@@ -30,4 +32,14 @@ OROGEN_PLUGIN("test-throwing", "0.0.1", registry) {
     registry.add({.kind = "generate", .name = "wrong-type", .summary = "returns nothing though it declares a heightmap",
                   .output = ValueType::heightmap,
                   .run = [](NodeContext&) -> NodeOutputs { return {}; }});
+    registry.add({.kind = "generate", .name = "slow", .summary = "runs for up to 60 s, checking for cancellation",
+                  .output = ValueType::heightmap,
+                  .run = [](NodeContext& ctx) -> NodeOutputs {
+                      for (int i = 0; i < 6000; ++i) {
+                          std::this_thread::sleep_for(std::chrono::milliseconds(10));
+                          ctx.check_cancelled();
+                          ctx.progress(i / 6000.0);
+                      }
+                      return std::make_shared<Heightmap>(2, 2, 1.0);
+                  }});
 }
