@@ -586,6 +586,12 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
         if (p.size() > std::size_t(max_plate_vertices) || !is_convex_ccw(p))
             throw BadInput("plate " + std::to_string(i) + " must be a convex counter-clockwise polygon of 3 to " +
                            std::to_string(max_plate_vertices) + " vertices");
+        for (std::size_t k = 0; k < p.size(); ++k) {
+            const Point2 e = p[(k + 1) % p.size()] - p[k];
+            if (std::hypot(e.x, e.y) < min_gap_units)
+                throw BadInput("plate " + std::to_string(i) + " has an edge shorter than " +
+                               std::to_string(min_gap_units).substr(0, 4) + " u, which Box2D would weld away");
+        }
     }
     Simulation sim(params, seed, layers);
     sim.add_beams();

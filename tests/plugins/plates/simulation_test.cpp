@@ -42,6 +42,8 @@ PlateSpec plate(Polygon p, Point2 v, double density = continental_density) {
     return s;
 }
 
+PlateSpec plate_at(Polygon p) { return plate(std::move(p), {0, 0}); }
+
 Params scripted(int steps) {
     Params p;
     p.drive = Drive::still;
@@ -312,6 +314,28 @@ TEST(PlatesSimulation, PlateLayerNamesThePlateOverEachSample) {
     EXPECT_EQ(g.plate[0], -1.0f);  // outside every plate
 }
 
+TEST(PlatesSimulation, AWideGridGetsAWideAreaCoveringItExactly) {
+    const int w = 129, h = 65;
+    std::vector<float> height(std::size_t(w) * h), plate(height.size());
+    const Point2 size = area_size(w, h);
+    EXPECT_DOUBLE_EQ(size.x, 36.0);
+    EXPECT_DOUBLE_EQ(size.y, 18.0);
+    const std::vector<PlateSpec> plates = {plate_at(rect(0, 0, 18, 18)), plate_at(rect(18, 0, 36, 18))};
+    Layers layers;
+    layers.terrain = {height.data(), w, h, 10.0};
+    layers.plate = {plate.data(), w, h, 10.0};
+    const Result r = simulate(plates, scripted(1), 1, layers);
+    EXPECT_DOUBLE_EQ(r.history.width, 1280.0);
+    EXPECT_DOUBLE_EQ(r.history.height, 640.0);
+    // Samples well inside each half belong to its plate: the area maps onto the whole grid.
+    for (int y = 2; y < h - 2; ++y) {
+        EXPECT_EQ(plate[std::size_t(y) * w + 2], 0.0f) << y;
+        EXPECT_EQ(plate[std::size_t(y) * w + 61], 0.0f) << y;
+        EXPECT_EQ(plate[std::size_t(y) * w + 67], 1.0f) << y;
+        EXPECT_EQ(plate[std::size_t(y) * w + w - 3], 1.0f) << y;
+    }
+}
+
 TEST(PlatesSimulation, BadParametersAreRefused) {
     Grid g(33);
     const std::vector<PlateSpec> plates = {plate(rect(2, 2, 17, 34), {0, 0}), plate(rect(19, 2, 34, 34), {0, 0})};
@@ -328,6 +352,13 @@ TEST(PlatesSimulation, BadParametersAreRefused) {
         FAIL();
     } catch (const BadInput& e) {
         EXPECT_STREQ(e.what(), "plate 0 must be a convex counter-clockwise polygon of 3 to 8 vertices");
+    }
+    const std::vector<PlateSpec> sliver = {plate({{0, 0}, {5, 0}, {5, 4.99}, {4.99, 5}, {0, 5}}, {0, 0})};
+    try {
+        simulate(sliver, p, 1, g.layers());
+        FAIL();
+    } catch (const BadInput& e) {
+        EXPECT_STREQ(e.what(), "plate 0 has an edge shorter than 0.05 u, which Box2D would weld away");
     }
     EXPECT_EQ(parse_drive("converge"), Drive::converge);
     EXPECT_FALSE(parse_drive("sideways"));
