@@ -172,6 +172,24 @@ TEST(PlatesSimulation, DensePlateUnderLightGivesTrenchAndArc) {
     }
 }
 
+// Two plates sliding past each other along their shared edge: a transform
+// boundary, recorded, with the height left as it was.
+TEST(PlatesSimulation, TransformBoundaryLeavesTheHeightUnchanged) {
+    Grid g(129);
+    for (std::size_t i = 0; i < g.height.size(); ++i) g.height[i] = float(i % 13);
+    const std::vector<float> before = g.height;
+    const std::vector<PlateSpec> plates = {plate(rect(6, 6, 18, 30), {0, -1}), plate(rect(18, 6, 30, 30), {0, 1})};
+    const Result r = simulate(plates, scripted(30), 11, g.layers());
+    EXPECT_EQ(r.stats.events[int(BoundaryKind::transform)], 1);
+    EXPECT_EQ(r.stats.events[int(BoundaryKind::convergent)] + r.stats.events[int(BoundaryKind::divergent)], 0);
+    EXPECT_EQ(g.height, before);
+    for (float u : g.uplift) EXPECT_EQ(u, 0.0f);
+    ASSERT_EQ(r.history.collisions.size(), 1u);
+    EXPECT_EQ(r.history.collisions[0].kind, BoundaryKind::transform);
+    const int axis = int(std::lround(18 * g.spu()));
+    EXPECT_EQ(g.boundary[std::size_t(axis) * g.n + axis], 3.0f);
+}
+
 TEST(PlatesSimulation, RiftingKeepsPlatesConvexWithAtMostEightVerticesAndConservesArea) {
     Grid g(129);
     const auto start = random_plates(area_size(g.n, g.n), 8, 0.5, 1.0, 3);
