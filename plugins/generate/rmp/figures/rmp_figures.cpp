@@ -208,8 +208,8 @@ int shade(const std::string& in, int w, int h, const std::string& out) {
     std::memcpy(z.data(), bytes.data(), bytes.size());
     const auto [lo, hi] = std::minmax_element(z.begin(), z.end());
     const double range = std::max(double(*hi - *lo), 1e-6);
-    // Light from the north-west, 45° up; heights exaggerated so 1/4 of the map's width is the relief.
-    const double scale = 0.25 * w / range;
+    // Light from the north-west, 45° up; the relief drawn as 6 % of the map's width.
+    const double scale = 0.06 * w / range;
     const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
     Canvas c(w, h, {0, 0, 0});
     for (int y = 0; y < h; ++y)
@@ -222,7 +222,7 @@ int shade(const std::string& in, int w, int h, const std::string& out) {
             const double lambert = std::max(0.0, (-gx * lx - gy * ly + lz) / n);
             const double t = (z[std::size_t(y) * w + x] - *lo) / range;  // green lowlands to pale peaks
             const Rgb base{std::uint8_t(90 + 150 * t), std::uint8_t(130 + 110 * t), std::uint8_t(80 + 160 * t)};
-            const double k = 0.25 + 0.75 * lambert;
+            const double k = 0.35 + 0.65 * lambert;
             c.set(x, y, {std::uint8_t(base.r * k), std::uint8_t(base.g * k), std::uint8_t(base.b * k)});
         }
     c.save(out);
