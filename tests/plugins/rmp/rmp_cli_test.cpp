@@ -118,3 +118,28 @@ TEST(RmpCli, OsmesaContextFailureIsAClearRunError) {
     EXPECT_NE(r.err.find("use method=voronoi"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out" / "m.r32"));
 }
+
+// Golden hashes of the shipped pipelines' outputs (seed fixed in each spec).
+// A change here means the terrain changed: update on purpose, never silently.
+TEST(RmpCli, ShippedPipelinesKeepTheirGoldenOutputs) {
+    struct Golden {
+        const char* spec;
+        const char* file;
+        const char* sha256;
+    };
+    const Golden goldens[] = {
+        {"rmp-jitter.orogen", "rmp-jitter-static.png", "a9bf76d15db5d1ee3dd4bb38de62370fa57ac1ed798228dc01d20716fb4ad5f8"},
+        {"rmp-jitter.orogen", "rmp-jitter-dynamic.png", "fbdfa4722e6cf56f82d2e03953eb6635c3f90cd73eb9695f9245d9ea37921b4f"},
+        {"rmp-mountains.orogen", "rmp-mountains.png", "85ca3513a1ba2413e828091d1ef8e53ed69cc8de25a76259cc5ac34ecce194b6"},
+    };
+    for (const Golden& g : goldens) {
+        TempDir dir;
+        const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / g.spec;
+        const auto r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()));
+        ASSERT_EQ(r.exit_code, 0) << g.spec << ": " << r.err;
+        EXPECT_EQ(orogen::sha256_file(dir / g.file), g.sha256) << g.spec << " → " << g.file;
+    }
+    // The timing pipeline is too slow for the suite (about 20 s); it must still check.
+    const auto c = run_orogen("check " + q(fs::path(OROGEN_SOURCE_DIR) / "pipelines" / "rmp-timings.orogen"));
+    EXPECT_EQ(c.exit_code, 0) << c.err;
+}
