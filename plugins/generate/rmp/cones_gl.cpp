@@ -243,8 +243,8 @@ void rmp_cones(GridView terrain, const RmpParams& p, std::uint64_t seed, const I
     ConeRenderer renderer(terrain.width, terrain.height);
     std::vector<std::size_t> peaks;  // vertex under each peak
     for (const Point2& q : p.peaks) {
-        const Point2 s = to_samples(q, terrain.width, terrain.height);
-        peaks.push_back(std::size_t(std::lround(s.y)) * std::size_t(terrain.width) + std::size_t(std::lround(s.x)));
+        const Point2 s = peak_vertex(q, terrain.width, terrain.height);
+        peaks.push_back(std::size_t(s.y) * std::size_t(terrain.width) + std::size_t(s.x));
     }
     for (int k = 0; k < p.iterations; ++k) {
         const std::uint64_t s = iteration_seed(seed, k);

@@ -103,6 +103,16 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
                               "cuts and regions apply to method=graph only; this node uses method=" + method);
                 if (method == "graph" && ctx.given("cones"))
                     ctx.error("cones", "cones applies to method=voronoi and method=cones; method=graph uses cuts");
+                if (method == "cones") {
+                    // llvmpipe draws at most 16384 × 16384 pixels, one per vertex.
+                    const ValueInfo* base = ctx.input(0);
+                    const int w = base && base->width > 0 ? base->width : ctx.grid().width;
+                    const int h = base && base->height > 0 ? base->height : ctx.grid().height;
+                    if (w > 16384 || h > 16384)
+                        ctx.error("method", "method=cones draws one pixel per vertex and OSMesa draws at most "
+                                            "16384 × 16384; this grid is " + std::to_string(w) + " × " +
+                                            std::to_string(h) + ": use method=voronoi (the same diagram)");
+                }
                 if (method == "cones" && ctx.integer("cones") > 16'777'214)
                     ctx.error("cones", "method=cones encodes a cone's index in a 24-bit colour: at most 16777214 "
                                        "cones; use method=voronoi for more");

@@ -29,6 +29,11 @@ void validate(const RmpParams& p) {
 
 Point2 to_samples(Point2 r, int width, int height) { return {r.x * (width - 1), r.y * (height - 1)}; }
 
+Point2 peak_vertex(Point2 r, int width, int height) {
+    const Point2 s = to_samples(r, width, height);
+    return {double(std::lround(s.x)), double(std::lround(s.y))};
+}
+
 std::uint64_t iteration_seed(std::uint64_t seed, int iteration) {
     return random::hash(seed, std::uint64_t(iteration), 0x524d50ull /* "RMP" */);
 }
@@ -38,7 +43,7 @@ double iteration_height(const RmpParams& p, int iteration) { return p.height * s
 void rmp_voronoi(GridView terrain, const RmpParams& p, std::uint64_t seed, const IterationHook& hook) {
     validate(p);
     std::vector<Point2> peaks;
-    for (const Point2& q : p.peaks) peaks.push_back(to_samples(q, terrain.width, terrain.height));
+    for (const Point2& q : p.peaks) peaks.push_back(peak_vertex(q, terrain.width, terrain.height));
     std::vector<SiteIndex::Span> spans;
     for (int k = 0; k < p.iterations; ++k) {
         const std::uint64_t s = iteration_seed(seed, k);
@@ -67,7 +72,7 @@ void rmp_graph(GridView terrain, const RmpParams& p, std::uint64_t seed, const I
     const double w = terrain.width - 1, h = terrain.height - 1;
     if (!(w > 0 && h > 0)) throw BadInput("rmp: the graph method needs a grid of at least 2 × 2 vertices");
     std::vector<Point2> peaks;
-    for (const Point2& q : p.peaks) peaks.push_back(to_samples(q, terrain.width, terrain.height));
+    for (const Point2& q : p.peaks) peaks.push_back(peak_vertex(q, terrain.width, terrain.height));
     // Stamp of the last iteration that raised a vertex: a vertex on the border
     // of two raised faces rises once, by the first face's amount.
     std::vector<int> stamp(terrain.size(), -1);

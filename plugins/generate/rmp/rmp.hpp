@@ -38,6 +38,10 @@ void validate(const RmpParams& params);
 /// A grid-relative point in sample coordinates.
 Point2 to_samples(Point2 relative, int width, int height);
 
+/// The grid vertex nearest a grid-relative peak, in sample coordinates. Every
+/// method raises the region holding this vertex, so they agree on the peak.
+Point2 peak_vertex(Point2 relative, int width, int height);
+
 /// The seed of iteration `k`'s diagram (sites, cuts, jitter).
 std::uint64_t iteration_seed(std::uint64_t seed, int iteration);
 
