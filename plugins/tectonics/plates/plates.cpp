@@ -81,7 +81,7 @@ struct PlateBody {
     int id = 0;
     double density = 1.0;
     double impulse = 0.0;           // accumulated plate–plate normal impulse since the last rift attempt
-    double stress_x = 0.0, stress_y = 0.0;  // impulse-weighted sum of contact points (u·N·s)
+    double stress_x = 0.0, stress_y = 0.0;  // impulse-weighted sum of contact points, plate frame (u·N·s)
 };
 
 struct Beam {
@@ -265,8 +265,11 @@ public:
             const double j = std::max(0.0f, impulse->normalImpulses[i]);
             total += j;
             for (PlateBody* p : {pa, pb}) {
-                p->stress_x += j * double(wm.points[i].x);
-                p->stress_y += j * double(wm.points[i].y);
+                // In the plate's own frame: the plate moves and turns between
+                // the contacts that load it.
+                const b2Vec2 local = p->body->GetLocalPoint(wm.points[i]);
+                p->stress_x += j * double(local.x);
+                p->stress_y += j * double(local.y);
             }
         }
         pa->impulse += total;
@@ -395,7 +398,8 @@ private:
         for (std::size_t i = 0; i < plates_.size(); ++i) {
             PlateBody& p = *plates_[i];
             if (p.impulse < params_.rift_threshold) continue;
-            const Point2 stress{p.stress_x / p.impulse, p.stress_y / p.impulse};
+            const Point2 stress = to_point(p.body->GetWorldPoint(
+                b2Vec2(float(p.stress_x / p.impulse), float(p.stress_y / p.impulse))));
             p.impulse = p.stress_x = p.stress_y = 0.0;
             const Polygon poly = world_polygon(p.body);
             const double area = signed_area(poly);
