@@ -1,0 +1,51 @@
+// export:gltf on a 4097² terrain (20 m cells): .glb with the default automatic
+// chunks (16-bit indices) and 2048² texture, written to disk (fsync included).
+#include "export_common.hpp"
+#include "gltf_writer.hpp"
+#include "terrain_mesh.hpp"
+
+#include <benchmark/benchmark.h>
+
+#include <vector>
+
+using namespace orogen;
+
+static void BM_GltfGlb(benchmark::State& state) {
+    const int n = int(state.range(0));
+    const auto& h = bench::terrain(n);
+    gltf::Options o;
+    o.decimate = int(state.range(1));
+    std::size_t bytes = 0;
+    for (auto _ : state) bytes = gltf::write_gltf(ConstGridView(h.data(), n, n, 20.0), o, bench::scratch() / "t.glb").bytes;
+    state.counters["MB"] = double(bytes) / 1e6;
+    std::filesystem::remove(bench::scratch() / "t.glb");
+}
+BENCHMARK(BM_GltfGlb)->Args({4097, 1})->Args({4097, 4})->Args({1025, 1})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+
+// The parts, in memory: splat texture bake and its PNG, and one pass of mesh data.
+static void BM_SplatTexture(benchmark::State& state) {
+    const auto& h = bench::terrain(4097);
+    const int t = int(state.range(0));
+    for (auto _ : state) {
+        auto rgba = terrain::bake_splat_texture(ConstGridView(h.data(), 4097, 4097, 20.0), t, t);
+        benchmark::DoNotOptimize(terrain::encode_png_fast(rgba, t, t));
+    }
+}
+BENCHMARK(BM_SplatTexture)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+static void BM_MeshData(benchmark::State& state) {
+    const auto& h = bench::terrain(4097);
+    const auto mesh = terrain::plan_mesh(ConstGridView(h.data(), 4097, 4097, 20.0), 1, 0, 1.0);
+    std::vector<float> f;
+    std::vector<std::uint16_t> u;
+    for (auto _ : state)
+        for (const auto& c : mesh.chunks) {
+            f.resize(c.vertex_count() * 3);
+            terrain::chunk_positions(mesh, c, f);
+            terrain::chunk_normals(mesh, c, f);
+            u.resize(c.triangle_count() * 3);
+            terrain::chunk_indices(c, std::span<std::uint16_t>(u));
+            benchmark::DoNotOptimize(f.data());
+        }
+}
+BENCHMARK(BM_MeshData)->Unit(benchmark::kMillisecond)->UseRealTime();
