@@ -93,6 +93,26 @@ const Param* NodeDescriptor::find_param(std::string_view n) const {
     return nullptr;
 }
 
+std::string describe_layers(const ValueInfo& info) {
+    if (info.layers.empty()) return "the input has no layers";
+    std::string s = "the input's layers are: ";
+    bool first = true;
+    for (const auto& l : info.layers) {
+        s += (first ? "" : ", ") + l;
+        first = false;
+    }
+    return s;
+}
+
+bool CheckContext::require_layer(std::size_t i, std::string_view param, std::string_view name, std::string_view hint) {
+    const ValueInfo* in = input(i);
+    if (!in || !in->layers_known || in->layers.count(name)) return true;
+    std::string message = "no layer '" + std::string(name) + "' on the input (" + describe_layers(*in) + ")";
+    if (!hint.empty()) message += "; " + std::string(hint);
+    error(param, std::move(message));
+    return false;
+}
+
 void NodeContext::check_finite(std::span<const float> data, std::string_view what, std::int64_t step) const {
     for (std::size_t i = 0; i < data.size(); ++i) {
         if (!std::isfinite(data[i])) {

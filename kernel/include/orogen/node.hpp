@@ -146,7 +146,15 @@ public:
     virtual void error(std::string_view param, std::string message) = 0;
     /// What the node outputs; starts as the kernel's default guess (see NodeDescriptor::adds_layers).
     virtual ValueInfo& output() = 0;
+
+    /// True if heightmap input `i` has layer `name` (or may have it: its layers
+    /// are not known before the run). Otherwise reports at `param`
+    /// "no layer 'NAME' on the input (the input's layers are: a, b); HINT" and returns false.
+    bool require_layer(std::size_t i, std::string_view param, std::string_view name, std::string_view hint = {});
 };
+
+/// "the input has no layers" or "the input's layers are: a, b, c".
+std::string describe_layers(const ValueInfo& info);
 
 // -------------------------------------------------------------- run context
 
