@@ -22,4 +22,12 @@ Range range_of(ConstGridView grid);
 /// Min–max normalise to 0..2^bits−1 (bits 8 or 16). A flat grid maps to 0.
 std::vector<std::uint16_t> quantise(ConstGridView grid, int bits, Range range);
 
+/// Lambertian hillshade of the heights (metres, `cell` apart): the cosine
+/// between each vertex's surface normal (central differences, one-sided at
+/// the edges) and the direction to a light at `azimuth` degrees clockwise
+/// from north and `elevation` degrees above the horizon, clamped at 0 and
+/// scaled to 0..2^bits−1. A flat terrain reads sin(elevation) everywhere.
+std::vector<std::uint16_t> hillshade(ConstGridView heights, int bits, double azimuth_degrees, double elevation_degrees,
+                                     double vertical_scale = 1.0);
+
 }  // namespace orogen::png_export

@@ -1,4 +1,4 @@
-// export:png — a heightmap as an 8- or 16-bit grayscale PNG.
+// export:png — a heightmap (or one of its layers, or its hillshade) as an 8- or 16-bit grayscale PNG.
 #include "heightmap_png.hpp"
 
 #include <orogen/io.hpp>
@@ -6,33 +6,71 @@
 
 using namespace orogen;
 
+namespace {
+
+std::string layer_list(const ValueInfo& info) {
+    std::string s;
+    for (const auto& l : info.layers) s += (s.empty() ? "" : ", ") + l;
+    return s.empty() ? "it has no layers" : "it has: " + s;
+}
+
+void check(CheckContext& ctx) {
+    const auto bits = ctx.integer("bits");
+    if (bits != 8 && bits != 16) ctx.error("bits", "bits must be 8 or 16, got " + std::to_string(bits));
+    const std::string& layer = ctx.text("layer");
+    if (ctx.flag("hillshade") && !layer.empty()) {
+        ctx.error("layer", "hillshade shades the terrain's heights; give either layer= or hillshade=true, not both");
+        return;
+    }
+    if (!ctx.flag("hillshade") && (ctx.given("azimuth") || ctx.given("elevation")))
+        ctx.error(ctx.given("azimuth") ? "azimuth" : "elevation", "azimuth and elevation place the light of hillshade=true");
+    const ValueInfo* in = ctx.input(0);
+    if (!layer.empty() && layer != "height" && in && in->layers_known && in->layers.count(layer) == 0)
+        ctx.error("layer", "the input has no layer '" + layer + "' (" + layer_list(*in) + ")");
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    const Heightmap& hm = *ctx.input(0).heightmap();
+    const int bits = int(ctx.integer("bits"));
+    const std::string& layer = ctx.text("layer");
+    std::vector<std::uint16_t> samples;
+    if (ctx.flag("hillshade")) {
+        samples = png_export::hillshade(hm.view(), bits, ctx.real("azimuth"), ctx.real("elevation"));
+    } else {
+        const ConstGridView grid = layer.empty() || layer == "height" ? hm.view() : hm.layer(layer);
+        samples = png_export::quantise(grid, bits, png_export::range_of(grid));
+    }
+    AtomicFile file(ctx.output_path(ctx.text("path")));
+    write_gray_png(file.stream(), hm.width(), hm.height(), bits, samples);
+    file.commit();
+    return {};
+}
+
+}  // namespace
+
 OROGEN_PLUGIN("png-export", "0.1.0", registry) {
     registry.add({
         .kind = "export",
         .name = "png",
-        .summary = "write a heightmap as a grayscale PNG (8 or 16 bits, min-max normalised)",
+        .summary = "write a heightmap, one of its layers, or its hillshade as a grayscale PNG (8 or 16 bits)",
         .description =
             "The lowest vertex becomes black and the highest white; 16 bits keep 65536 levels,\n"
-            "which a 1025² terrain needs (8 bits band visibly beyond about 512²).",
+            "which a 1025² terrain needs (8 bits band visibly beyond about 512²). layer= writes a layer\n"
+            "(water, sediment, eroded...) min-max normalised the same way; hillshade=true writes the\n"
+            "terrain lit from azimuth/elevation instead (Lambert: black = facing away, white = facing the light).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to write"}},
         .output = ValueType::none,
         .params =
             {
                 Param::path("path", PathRole::output, {".png"}).help("output file, relative to --out"),
                 Param::integer("bits", 8).min(8).max(16).help("bits per sample: 8 or 16"),
+                Param::string("layer", "").help("write this layer instead of the heights (\"\" or \"height\": the heights)"),
+                Param::boolean("hillshade", false).help("write the hillshade of the heights instead"),
+                Param::real("azimuth", 315.0).min(0).max(360).unit("°").help(
+                    "hillshade light direction, clockwise from north (315 = north-west, the cartographers' default)"),
+                Param::real("elevation", 45.0).min(0).max(90).unit("°").help("hillshade light height above the horizon"),
             },
-        .check = [](CheckContext& ctx) {
-            const auto bits = ctx.integer("bits");
-            if (bits != 8 && bits != 16) ctx.error("bits", "bits must be 8 or 16, got " + std::to_string(bits));
-        },
-        .run = [](NodeContext& ctx) -> NodeOutputs {
-            const Heightmap& hm = *ctx.input(0).heightmap();
-            const int bits = int(ctx.integer("bits"));
-            const auto samples = png_export::quantise(hm.view(), bits, png_export::range_of(hm.view()));
-            AtomicFile file(ctx.output_path(ctx.text("path")));
-            write_gray_png(file.stream(), hm.width(), hm.height(), bits, samples);
-            file.commit();
-            return {};
-        },
+        .check = check,
+        .run = run,
     });
 }

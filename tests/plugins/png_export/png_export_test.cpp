@@ -1,0 +1,102 @@
+// export:png's layer= and hillshade=: the core, and 16-bit round trips through the binary.
+#include "heightmap_png.hpp"
+
+#include "../raw/export_test_support.hpp"
+#include "orogen_test.hpp"
+
+#include <orogen/io.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+using namespace orogen;
+using namespace orogen::test;
+namespace fs = std::filesystem;
+
+TEST(Hillshade, FlatTerrainReadsTheSineOfTheElevation) {
+    std::vector<float> flat(9 * 9, 120.0f);
+    const auto s8 = png_export::hillshade({flat.data(), 9, 9, 10.0}, 8, 315, 45);
+    const auto s16 = png_export::hillshade({flat.data(), 9, 9, 10.0}, 16, 315, 30);
+    for (auto v : s8) EXPECT_EQ(v, 180);  // round(sin 45° · 255)
+    const long expected16 = std::lround(std::sin(30.0 * 3.14159265358979323846 / 180.0) * 65535.0);
+    EXPECT_EQ(expected16, 32767);  // sin 30° is 0.49999999999999994 in doubles
+    for (auto v : s16) EXPECT_EQ(v, expected16);
+}
+
+TEST(Hillshade, SlopesFacingTheLightAreBrighterAndAFaceTowardsItIsWhite) {
+    // Light from the west (azimuth 270°) at 45°: a plane rising to the east by 1 m/m faces it squarely.
+    const int n = 7;
+    std::vector<float> east(n * n), west(n * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            east[std::size_t(y * n + x)] = float(x * 2.0);    // 2 m cells: rises 1 m per m to the east
+            west[std::size_t(y * n + x)] = float(-x * 2.0);
+        }
+    const auto lit = png_export::hillshade({east.data(), n, n, 2.0}, 8, 270, 45);
+    const auto dark = png_export::hillshade({west.data(), n, n, 2.0}, 8, 270, 45);
+    // Facing the light: normal (−1, 0, 1)/√2 · light (−cos45, 0, sin45) = 1.
+    EXPECT_EQ(lit[3 * n + 3], 255);
+    // Facing away at 45° with the light at 45°: grazing, 0.
+    EXPECT_EQ(dark[3 * n + 3], 0);
+    // North-south slopes are unaffected by a west light: (0, ±1, 1)/√2 · (−cos45, 0, sin45) = 1/2.
+    std::vector<float> south(n * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) south[std::size_t(y * n + x)] = float(y * 2.0);
+    EXPECT_NEAR(png_export::hillshade({south.data(), n, n, 2.0}, 8, 270, 45)[3 * n + 3], 127.5, 0.5);  // 0.5 · 255
+}
+
+TEST(PngExportCli, SixteenBitHeightsLayersAndHillshadeRoundTrip) {
+    TempDir dir;
+    const auto spec = dir.write("png.orogen",
+                                "orogen 1\nseed 3\ngrid 97 cell=15\n"
+                                "base = generate:fault(iterations=80, displacement=4)\n"
+                                "worn = erode:thermal(base, iterations=10)\n"
+                                "export:png(worn, path=\"h.png\", bits=16)\n"
+                                "export:png(worn, path=\"height.png\", bits=16, layer=\"height\")\n"
+                                "export:png(worn, path=\"eroded.png\", bits=16, layer=\"eroded\")\n"
+                                "export:png(worn, path=\"shade.png\", hillshade=true, azimuth=135, elevation=35)\n"
+                                "export:raw(worn, path=\"h.r32\")\n");
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    // The 16-bit PNG gives back the heights within half a quantisation step.
+    const GrayImage png = read_gray_png(dir / "out" / "h.png");
+    ASSERT_EQ(png.bits, 16);
+    ASSERT_EQ(png.width, 97);
+    const std::string raw = file_text(dir / "out" / "h.r32");
+    std::vector<float> h(97 * 97);
+    ASSERT_EQ(raw.size(), h.size() * 4);
+    std::memcpy(h.data(), raw.data(), raw.size());
+    const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
+    const double step = (double(*hi) - *lo) / 65535.0;
+    for (std::size_t i = 0; i < h.size(); ++i)
+        ASSERT_NEAR(*lo + step * png.samples[i], h[i], 0.5 * step + 1e-6) << i;
+    EXPECT_EQ(read_gray_png(dir / "out" / "height.png").samples, png.samples);  // layer="height" = the heights
+    // The eroded layer is its own picture, spread over the full 16-bit range.
+    const GrayImage eroded = read_gray_png(dir / "out" / "eroded.png");
+    EXPECT_NE(eroded.samples, png.samples);
+    EXPECT_EQ(*std::min_element(eroded.samples.begin(), eroded.samples.end()), 0);
+    EXPECT_EQ(*std::max_element(eroded.samples.begin(), eroded.samples.end()), 65535);
+    // The hillshade is the core's, written as 8-bit.
+    const GrayImage shade = read_gray_png(dir / "out" / "shade.png");
+    EXPECT_EQ(shade.bits, 8);
+    EXPECT_EQ(shade.samples, png_export::hillshade({h.data(), 97, 97, 15.0}, 8, 135, 35));
+}
+
+TEST(PngExportCli, LayerAndHillshadeMistakesFailAtCheckTime) {
+    TempDir dir;
+    const auto spec = dir.write("bad.orogen",
+                                "orogen 1\ngrid 33\nbase = generate:fault()\n"
+                                "export:png(base, path=\"a.png\", layer=\"sediment\")\n"
+                                "export:png(base, path=\"b.png\", layer=\"eroded\", hillshade=true)\n"
+                                "export:png(base, path=\"c.png\", azimuth=90)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want :
+         {"bad.orogen:4:38: error: export:png: the input has no layer 'sediment' (it has no layers)",
+          "bad.orogen:5:38: error: export:png: hillshade shades the terrain's heights; give either layer= or "
+          "hillshade=true, not both",
+          "bad.orogen:6:40: error: export:png: azimuth and elevation place the light of hillshade=true"})
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+}
