@@ -40,6 +40,7 @@ NodeOutputs run(NodeContext& ctx) {
     s.pipe_area = ctx.real("pipe_area");
     s.min_slope = ctx.real("min_slope");
     s.erosion_depth = ctx.real("erosion_depth");
+    s.creep = ctx.real("creep");
     s.boundary = ctx.text("boundary") == "open" ? pipe::Boundary::open : pipe::Boundary::closed;
 
     // Rain mask: a layer of the input, or a second heightmap of the same size.
@@ -173,6 +174,11 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
                     .unit("m")
                     .help("water shallower than this carries in proportion to its depth, so films of rain do not "
                           "scour like rivers (0 = Mei's original capacity)"),
+                Param::real("creep", 0.05)
+                    .min(0.0)
+                    .unit("m²/s")
+                    .help("soil creep: a linear diffusion of the terrain that damps the cell-sized ripples erosion "
+                          "alone amplifies (0 = Mei's original; at most 0.2*cell²/dt per sub-step)"),
                 Param::choice("boundary", {"closed", "open"}, "closed")
                     .help("closed: walls keep the water in; open: water flows off the edges"),
             },

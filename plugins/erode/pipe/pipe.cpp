@@ -49,10 +49,18 @@ struct Sub {
     float keep;        ///< e^(−Ke·dt)
     float speed_cap;   ///< m/s: capacity uses min(|v|, c)
     float inv_erosion_depth;  ///< 1/m
+    float gravity;  ///< m/s²
+    float kappa;    ///< creep·dt/l², dimensionless, at most 0.2 (stable)
     bool open;
 };
 
 inline float speed_of(float u, float v) { return std::sqrt(u * u + v * v); }
+
+/// The speed kept in the `flow` layer and used by the CFL limit: |v| capped
+/// at the wave speed √(g·d) of the cell's water (see water_cell).
+inline float flow_speed(float u, float v, float d, float gravity) {
+    return std::sqrt(std::min(u * u + v * v, gravity * d));
+}
 
 /// The arrays of one sub-step.
 struct Arrays {
@@ -155,26 +163,41 @@ inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W
     const float inv_raw = 1.0f / (std::max(mean_depth, 1e-6f) * k.l);
     const float inv = mean_depth > 1e-6f ? inv_raw : 0.0f;
     const float uu = pass_x * inv, vv = pass_y * inv;
+    // The 4 axis neighbours' terrain (the cell itself past an edge).
+    const float bc = b[i];
+    const float bw = b[hw ? i - 1 : i], be = b[he ? i + 1 : i], bn = b[hn ? i - W : i], bs = b[hs ? i + W : i];
     // Local tilt of the terrain (central differences, one-sided at edges).
-    const float gx = (b[he ? i + 1 : i] - b[hw ? i - 1 : i]) * gx_scale;
-    const float gy = (b[hs ? i + W : i] - b[hn ? i - W : i]) * gy_scale;
+    const float gx = (be - bw) * gx_scale;
+    const float gy = (bs - bn) * gy_scale;
     const float t2 = gx * gx + gy * gy;
     const float sin_tilt = std::sqrt(t2 / (1.0f + t2));
-    const float speed = speed_of(uu, vv);
-    // Mei's capacity, times a depth ramp (after Št'ava et al. 2008): a film
-    // of rain shallower than erosion_depth carries in proportion to its
-    // depth, so sheets do not scour like rivers and the flow gathers into
-    // channels. Speeds above the wave speed c only occur in films draining
-    // within one sub-step; they are capped as in the CFL limit.
+    // The speed that carries sediment: at most the shallow-water wave speed
+    // √(g·d) (Froude number ≤ 1). The frictionless pipes let a film of rain
+    // on a slope move about one cell per sub-step whatever its depth; counted
+    // in full it would scour like a river. Capped, deep fast water carries and
+    // thin films hardly do, so the flow gathers into channels.
+    const float wave2 = std::min(k.speed_cap * k.speed_cap, k.gravity * mean_depth);
+    const float speed = std::sqrt(std::min(uu * uu + vv * vv, wave2));
     const float ramp = std::min(mean_depth * k.inv_erosion_depth, 1.0f);
-    const float cap = k.capacity * std::max(sin_tilt, k.min_slope) * std::min(speed, k.speed_cap) * ramp;
+    const float cap = k.capacity * std::max(sin_tilt, k.min_slope) * speed * ramp;
     const float s0 = rescale ? float(double(a.s[i]) * scale) : a.s[i];
     const float deficit = cap - s0;
-    const float want = (deficit > 0.0f ? k.take : k.drop) * deficit;  // > 0 erode, < 0 deposit
+    float want = (deficit > 0.0f ? k.take : k.drop) * deficit;  // > 0 erode, < 0 deposit
+    // Limiters against pits and mounds: erosion never takes a cell more than
+    // half way down to its lowest neighbour, deposition never more than half
+    // way up to its highest one. (Each cell eroding on its own otherwise digs
+    // one-cell pits that trap water and deepen further: speckle.)
+    const float lowest = std::min(std::min(bw, be), std::min(bn, bs));
+    const float highest = std::max(std::max(bw, be), std::max(bn, bs));
+    want = std::min(want, std::max(0.0f, 0.5f * (bc - lowest)));
+    want = std::max(want, std::min(0.0f, 0.5f * (bc - highest)));
+    // Creep (linear diffusion, κ = creep·dt/l²): damps the grid-scale ripples
+    // that erosion alone amplifies. Pair terms κ·(b_j − b_i) cancel in the sum.
+    const float crept = bc + k.kappa * (((bw + be) + (bn + bs)) - 4.0f * bc);
     // Exchange exactly what the terrain's float can represent, so terrain +
     // sediment is conserved even when `want` is below the height's resolution.
-    const float b2 = b[i] - want;
-    const float moved = b[i] - b2;
+    const float b2 = crept - want;
+    const float moved = crept - b2;
     const float s1 = s0 + moved;
     const float d3 = d2 * k.keep;
     a.b_next[i] = b2;
@@ -186,7 +209,7 @@ inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W
 
 /// The row's sums and maxima, from what pass 2 wrote (a separate loop, so
 /// the cell loop has no serial double accumulations and vectorises).
-OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row) {
+OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row, float gravity) {
     RowSums sums;
     const std::size_t W = std::size_t(a.w);
     double s1 = 0.0, water = 0.0, check = 0.0;
@@ -195,7 +218,7 @@ OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row) {
         s1 += double(a.s1[i]);
         water += double(a.d[i]);
         check += double(a.b_next[i]);
-        vmax = std::max(vmax, speed_of(a.u[i], a.v[i]));
+        vmax = std::max(vmax, flow_speed(a.u[i], a.v[i], a.d[i], gravity));
         dmax = std::max(dmax, a.d[i]);
     }
     sums.s1 = s1;
@@ -221,7 +244,7 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
     };
     if (!hn || !hs || W < 3) {
         for (int x = 0; x < W; ++x) edge(x);
-        return row_sums(a, row);
+        return row_sums(a, row, k.gravity);
     }
     edge(0);
     const float gx_scale = 0.5f * k.inv_l;
@@ -229,7 +252,7 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
     for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
         water_cell(a, k, i, Ws, true, true, true, true, gx_scale, gy_scale, m(i), Rescale, scale);
     edge(W - 1);
-    return row_sums(a, row);
+    return row_sums(a, row, k.gravity);
 }
 
 RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale) {
@@ -373,6 +396,8 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     k.speed_cap = float(c);
     k.inv_erosion_depth = cfg.erosion_depth > 0.0 ? float(1.0 / cfg.erosion_depth) : 3.0e38f;
     k.open = cfg.boundary == Boundary::open;
+    k.gravity = float(cfg.gravity);
+    k.kappa = float(std::min(0.2, cfg.creep * dt / (l * l)));
 
     const int W = w, H = h;
 
@@ -438,11 +463,13 @@ void Solver::finish() {
     float* speed = m.st.speed.data;
     const float* up = m.u.data();
     const float* vp = m.v.data();
+    const float* dp = m.st.water.data;
+    const float gravity = float(m.cfg.gravity);
     parallel_for(0, std::int64_t(m.n), 1 << 16, [&](std::int64_t i0, std::int64_t i1) {
         FlushDenormals ftz;
         for (std::int64_t i = i0; i < i1; ++i) {
             if (scale != 1.0) s[i] = float(double(s[i]) * scale);
-            speed[i] = speed_of(up[i], vp[i]);
+            speed[i] = flow_speed(up[i], vp[i], dp[i], gravity);
         }
     });
     m.sediment_scale = 1.0;

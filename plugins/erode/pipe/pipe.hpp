@@ -62,6 +62,9 @@ struct Settings {
     /// m: water shallower than this carries in proportion to its depth (0 = Mei's
     /// original capacity, independent of depth).
     double erosion_depth = 0.05;
+    /// m²/s: creep, a linear diffusion of the terrain that damps grid-scale
+    /// ripples (0 = none, Mei's original). Limited to κ = creep·dt/l² ≤ 0.2 per sub-step.
+    double creep = 0.0;
     double cfl = 0.5;           ///< Courant number of the sub-steps (≤ 0.7 for the pipe model)
     Boundary boundary = Boundary::closed;
 };

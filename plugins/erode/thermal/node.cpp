@@ -118,9 +118,10 @@ OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
                     .min(0.0, true)
                     .max(1.0)
                     .help("fraction of the excess above the threshold moved per step (Olsen 0.5, the thesis 0.01)"),
-                Param::choice("neighbourhood", {"von-neumann", "rotated", "moore"}, "rotated")
+                Param::choice("neighbourhood", {"von-neumann", "rotated", "moore"}, "moore")
                     .help("neighbours considered: the 4 axis ones, the 4 diagonals (the thesis's rotated von "
-                          "Neumann), or all 8"),
+                          "Neumann: never exchanges material between the two checkerboard sub-lattices, so it "
+                          "leaves a diagonal hatching), or all 8"),
                 Param::string("hardness", "constant")
                     .help("constant; height (the thesis's height-aware hardness: high ground is hard, "
                           "softness ((max - h)/(max - min))^2); or the name of a layer holding hardness 0..1"),

@@ -25,7 +25,9 @@ namespace orogen::thermal {
 
 enum class Neighbourhood {
     von_neumann,  ///< 4 axis neighbours, distance = cell
-    rotated,      ///< the thesis's rotated von Neumann: the 4 diagonals, distance = cell·√2
+    rotated,      ///< the thesis's rotated von Neumann: the 4 diagonals, distance = cell·√2.
+                  ///< Never moves material between the sub-lattices x+y even / odd, which
+                  ///< then drift apart: a diagonal hatching. Kept for the thesis's experiments.
     moore,        ///< all 8
 };
 
@@ -36,7 +38,7 @@ enum class Hardness {
 };
 
 struct Settings {
-    Neighbourhood neighbourhood = Neighbourhood::rotated;
+    Neighbourhood neighbourhood = Neighbourhood::moore;
     /// Critical slope tan(talus angle), metres of drop per metre of horizontal
     /// distance. Used when talus_height < 0.
     double talus_slope = 0.7002075382097097;  // tan 35°
