@@ -233,7 +233,7 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
     height->setName("height");
     height->setGridClass(openvdb::GRID_UNKNOWN);
     height->setTransform(transform->copy());
-    height->setSaveFloatAsHalf(o.half_float);
+    height->setSaveFloatAsHalf(false);  // metres of elevation need 32 bits (half has 11)
     height->insertMeta("units", openvdb::StringMetadata("m"));
 
     openvdb::GridCPtrVec grids{surface, height};

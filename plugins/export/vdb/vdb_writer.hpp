@@ -30,7 +30,9 @@ struct TerrainOptions {
     double voxel_size = 0.0;  ///< metres; 0 = the heightmap's cell size
     double half_width = 3.0;  ///< narrow band half-width, voxels (OpenVDB's usual 3)
     double water_min = 1e-3;  ///< metres of water for a column to count as wet
-    bool half_float = false;  ///< store values as 16-bit floats (half the file)
+    /// Store the level sets' distances as 16-bit floats: half the file, an error
+    /// under 1/1000 of a voxel (|d| ≤ half_width voxels). The height grid stays 32-bit.
+    bool half_float = true;
 };
 
 struct TerrainSummary {

@@ -43,8 +43,11 @@ TEST(Vdb, PlaneGivesExactSignedDistancesInTheBand) {
     std::vector<float> heights(std::size_t(w * h));
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) heights[std::size_t(y * w + x)] = float(slope * x * cell + 100.0);
-    const auto s = vdb::write_terrain({heights.data(), w, h, cell}, nullptr, dir / "t.vdb");
+    vdb::TerrainOptions exact;
+    exact.half_float = false;
+    const auto s = vdb::write_terrain({heights.data(), w, h, cell}, nullptr, dir / "t.vdb", exact);
     EXPECT_GT(s.surface_voxels, std::size_t(w * h * 5));
+    vdb::write_terrain({heights.data(), w, h, cell}, nullptr, dir / "half.vdb");  // default: 16-bit level set
 
     const auto grids = read_all(dir / "t.vdb");
     ASSERT_EQ(grids->size(), 2u);
@@ -66,6 +69,14 @@ TEST(Vdb, PlaneGivesExactSignedDistancesInTheBand) {
             EXPECT_FLOAT_EQ(acc.getValue({i, jg - 40, k}), -6.0f);  // deep ground: inside
             EXPECT_FLOAT_EQ(acc.getValue({i, jg + 40, k}), 6.0f);   // sky: outside
         }
+    // The default half floats stay within 1/1000 of a voxel; the height grid stays exact.
+    auto half = float_grid(read_all(dir / "half.vdb"), "surface");
+    ASSERT_TRUE(half);
+    openvdb::Index64 compared = 0;
+    for (auto it = surface->cbeginValueOn(); it; ++it, ++compared)
+        ASSERT_NEAR(half->tree().getValue(it.getCoord()), *it, cell / 1000) << it.getCoord();
+    EXPECT_EQ(compared, surface->activeVoxelCount());
+    EXPECT_EQ(float_grid(read_all(dir / "half.vdb"), "height")->tree().getValue({17, 0, 23}), heights[23 * w + 17]);
     auto height = float_grid(grids, "height");
     ASSERT_TRUE(height);
     EXPECT_EQ(height->getGridClass(), openvdb::GRID_UNKNOWN);
