@@ -174,7 +174,7 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
                     .unit("m")
                     .help("water shallower than this carries in proportion to its depth, so films of rain do not "
                           "scour like rivers (0 = Mei's original capacity)"),
-                Param::real("creep", 0.05)
+                Param::real("creep", 0.2)
                     .min(0.0)
                     .unit("m²/s")
                     .help("soil creep: a linear diffusion of the terrain that damps the cell-sized ripples erosion "

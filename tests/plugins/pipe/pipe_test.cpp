@@ -245,7 +245,7 @@ TEST(Pipe, RainOnRoughTerrainGivesANetworkNotSpeckle) {
     s.rain = 0.0005;
     s.evaporation = 0.001;
     s.capacity = 1.0;
-    s.creep = 0.05;
+    s.creep = 0.2;
     s.boundary = pipe::Boundary::open;
     sim.run(s, 1500, 1.0);
     const auto [pits, mounds] = pits_and_mounds(sim.height, n);
