@@ -8,12 +8,6 @@ using namespace orogen;
 
 namespace {
 
-std::string layer_list(const ValueInfo& info) {
-    std::string s;
-    for (const auto& l : info.layers) s += (s.empty() ? "" : ", ") + l;
-    return s.empty() ? "it has no layers" : "it has: " + s;
-}
-
 void check(CheckContext& ctx) {
     const auto bits = ctx.integer("bits");
     if (bits != 8 && bits != 16) ctx.error("bits", "bits must be 8 or 16, got " + std::to_string(bits));
@@ -24,9 +18,8 @@ void check(CheckContext& ctx) {
     }
     if (!ctx.flag("hillshade") && (ctx.given("azimuth") || ctx.given("elevation")))
         ctx.error(ctx.given("azimuth") ? "azimuth" : "elevation", "azimuth and elevation place the light of hillshade=true");
-    const ValueInfo* in = ctx.input(0);
-    if (!layer.empty() && layer != "height" && in && in->layers_known && in->layers.count(layer) == 0)
-        ctx.error("layer", "the input has no layer '" + layer + "' (" + layer_list(*in) + ")");
+    if (!layer.empty() && layer != "height")
+        ctx.require_layer(0, "layer", layer, "use \"height\" (the default) or the name of an existing layer");
 }
 
 NodeOutputs run(NodeContext& ctx) {

@@ -94,7 +94,8 @@ TEST(PngExportCli, LayerAndHillshadeMistakesFailAtCheckTime) {
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want :
-         {"bad.orogen:4:38: error: export:png: the input has no layer 'sediment' (it has no layers)",
+         {"bad.orogen:4:38: error: export:png: no layer 'sediment' on the input (the input has no layers); use "
+          "\"height\" (the default) or the name of an existing layer",
           "bad.orogen:5:38: error: export:png: hillshade shades the terrain's heights; give either layer= or "
           "hillshade=true, not both",
           "bad.orogen:6:40: error: export:png: azimuth and elevation place the light of hillshade=true"})

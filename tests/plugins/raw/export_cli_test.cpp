@@ -53,7 +53,7 @@ TEST(ExportCli, BadExportsFailAtCheckTimeAndSayWhere) {
     for (const char* want : {
              "bad.orogen:5:24: error: export:gltf writes .glb, .gltf files; 't.obj' has another extension",
              "bad.orogen:6:42: error: 'decimate' of export:gltf is 0, out of range [1, 4096]",
-             "bad.orogen:7:38: error: export:png: the input has no layer 'water' (it has no layers)",
+             "bad.orogen:7:38: error: export:png: no layer 'water' on the input (the input has no layers)",
              "bad.orogen:8:22: error: export:vtk-particles input 1 ('particles') must be a particles, but 'base' is a "
              "heightmap",
              "bad.orogen:9:41: error: export:vtk: decimate applies to .vtp meshes only; .vti keeps every sample",
