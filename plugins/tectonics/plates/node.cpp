@@ -23,6 +23,8 @@ plates::Params params_from(NodeContext& ctx) {
     p.cones = int(ctx.integer("cones"));
     p.height = ctx.real("height");
     p.jitter = ctx.real("jitter");
+    p.ranges = *plates::parse_range_style(ctx.text("ranges"));
+    p.saturation = ctx.real("saturation");
     p.rift_depth = ctx.real("rift_depth");
     p.ridge_height = ctx.real("ridge_height");
     p.trench_depth = ctx.real("trench_depth");
@@ -79,6 +81,7 @@ void check(CheckContext& ctx) {
 
 OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
     std::vector<std::string> drives(plates::drive_names.begin(), plates::drive_names.end());
+    std::vector<std::string> range_styles(plates::range_style_names.begin(), plates::range_style_names.end());
     registry.add({
         .kind = "tectonics",
         .name = "plates",
@@ -118,14 +121,34 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
                 Param::integer("cones", 100)
                     .min(1)
                     .max(100'000)
-                    .help("Voronoi sites over the grid for each range; also sets the width of rifts and trenches "
-                          "(the cell size sqrt(area / cones))"),
-                Param::real("height", 40.0).unit("m").help("raise of a mountain range per convergent contact"),
-                Param::real("jitter", 0.5).min(0.0).max(1.0).help("per-cell variation of a range's raise (thesis 4.2)"),
-                Param::real("rift_depth", 30.0).min(0.0).unit("m").help("depth of a rift valley per divergent contact"),
-                Param::real("ridge_height", 15.0).min(0.0).unit("m").help("height of the ridge along a rift's axis"),
-                Param::real("trench_depth", 60.0).min(0.0).unit("m").help("depth of a subduction trench per contact"),
-                Param::real("arc_height", 40.0).min(0.0).unit("m").help("height of the volcanic arc per contact"),
+                    .help("sets the scale of all boundary relief: widths are multiples of the Voronoi cell size "
+                          "sqrt(area / cones) (a range reaches 0.8 cells either side of its contact); with "
+                          "ranges=cells, the Voronoi sites over the grid for each range (thesis 100)"),
+                Param::choice("ranges", range_styles, "peaks")
+                    .help("how a collision raises its range: peaks (a crest of jagged peaks along the contact, "
+                          "the same peaks every time the place is hit, saturating) or cells (the thesis: the "
+                          "Voronoi cells the contact crosses, a fresh diagram per contact, summed)"),
+                Param::real("height", 60.0).min(0.0).unit("m").help("raise of a mountain range per convergent contact"),
+                Param::real("jitter", 0.5)
+                    .min(0.0)
+                    .max(1.0)
+                    .help("per-peak, per-volcano (and with ranges=cells per-cell) height variation (thesis 4.2)"),
+                Param::real("rift_depth", 20.0)
+                    .min(0.0)
+                    .unit("m")
+                    .help("depth of a rift valley per divergent contact; its flanks step down in fault blocks "
+                          "half this high"),
+                Param::real("ridge_height", 10.0).min(0.0).unit("m").help("height of the rough ridge along a rift's axis"),
+                Param::real("trench_depth", 40.0).min(0.0).unit("m").help("depth of a subduction trench per contact"),
+                Param::real("arc_height", 30.0)
+                    .min(0.0)
+                    .unit("m")
+                    .help("height of the volcanoes of an arc per subduction contact"),
+                Param::real("saturation", 5.0)
+                    .min(1.0)
+                    .max(1000.0)
+                    .help("contacts' worth of relief one place can take: where a boundary is hit again and again, "
+                          "its relief tends to saturation × one contact's (ranges=cells ranges are not limited)"),
                 Param::real("oceanic_fraction", 0.5)
                     .min(0.0)
                     .max(1.0)

@@ -34,6 +34,7 @@ enum Purpose : std::uint64_t {
     purpose_velocity_size,
     purpose_spin,
     purpose_range,
+    purpose_relief,
 };
 
 constexpr double min_gap_units = 0.05;  // u: 10 × b2_linearSlop, so Box2D never welds a vertex away
@@ -120,8 +121,17 @@ public:
         size_ = area_size(w, h);
         spu_ = samples_per_unit(w, h);
         cell_ = layers.terrain.cell;
-        // Rifts and trenches half a Voronoi cell wide: about as wide as a range's core.
-        relief_width_ = 0.5 * std::sqrt(double(w) * double(h) / double(std::max(1, params.cones)));
+        // Every relief width scales with the Voronoi cell size (profiles.hpp).
+        ReliefShape shape;
+        shape.cell = std::sqrt(double(w) * double(h) / double(std::max(1, params.cones)));
+        shape.range_height = params.height;
+        shape.jitter = params.jitter;
+        shape.trench_depth = params.trench_depth;
+        shape.arc_height = params.arc_height;
+        shape.rift_depth = params.rift_depth;
+        shape.ridge_height = params.ridge_height;
+        shape.saturation = params.saturation;
+        relief_.emplace(w, h, shape, random::hash(seed, purpose_relief));
         world_.SetAllowSleeping(false);  // a resting plate must still feel the beams
         world_.SetContactListener(this);
         result_.history.width = (w - 1) * cell_;
@@ -206,6 +216,9 @@ public:
             if (step % std::max(1, params_.record_every) == 0 || step == params_.steps) snapshot(step);
             if (on_step) on_step(step);
         }
+        const auto t2 = Clock::now();
+        relief_->apply(layers_.terrain, uplift());  // the accumulated boundaries, saturated and textured
+        result_.stats.relief_seconds += seconds_since(t2);
         finish();
         return std::move(result_);
     }
@@ -370,7 +383,7 @@ private:
             Point2 a = spu_ * e.p0, b = spu_ * e.p1;  // samples
             if (e.kind == BoundaryKind::transform || !clip_segment(a, b, w, h)) continue;
             if (e.kind == BoundaryKind::divergent) {
-                carve_rift(layers_.terrain, a, b, {relief_width_, params_.rift_depth, params_.ridge_height}, uplift());
+                relief_->add_rift(a, b);
                 continue;
             }
             const double contrast = e.a->density - e.b->density;
@@ -378,9 +391,10 @@ private:
                 // The denser plate dives: the overriding (light) plate lies on
                 // the normal's side if a is the dense one.
                 const Point2 toward_light = contrast > 0.0 ? e.normal : -1.0 * e.normal;
-                shape_subduction(layers_.terrain, a, b, toward_light,
-                                 {relief_width_, params_.trench_depth, params_.arc_height}, uplift());
+                relief_->add_subduction(a, b, toward_light);
                 ++result_.stats.subductions;
+            } else if (params_.ranges == RangeStyle::peaks) {
+                relief_->add_range(a, b);
             } else {
                 rmp::RangeParams range{params_.cones, params_.height, params_.jitter};
                 rmp::raise_range(layers_.terrain, a, b, range, random::hash(seed_, purpose_range, index), uplift());
@@ -495,13 +509,14 @@ private:
     Layers layers_;
     b2World world_;
     Point2 size_;
-    double spu_ = 1.0, cell_ = 1.0, relief_width_ = 1.0, min_rift_part_ = 0.0;
+    double spu_ = 1.0, cell_ = 1.0, min_rift_part_ = 0.0;
     std::vector<std::unique_ptr<PlateBody>> owned_;  // stable addresses for Box2D user data
     std::vector<PlateBody*> plates_;  // alive plates, in creation order
     std::array<Beam, 4> beams_{};
     std::map<std::uint64_t, std::int64_t> last_touch_;  // plate pair → last step with a two-point contact
     std::vector<PendingEvent> pending_;
     std::int64_t step_ = 0;
+    std::optional<BoundaryRelief> relief_;
     Result result_;
 };
 
@@ -510,6 +525,12 @@ private:
 std::optional<Drive> parse_drive(std::string_view name) {
     for (std::size_t i = 0; i < drive_names.size(); ++i)
         if (drive_names[i] == name) return Drive(i);
+    return std::nullopt;
+}
+
+std::optional<RangeStyle> parse_range_style(std::string_view name) {
+    for (std::size_t i = 0; i < range_style_names.size(); ++i)
+        if (range_style_names[i] == name) return RangeStyle(i);
     return std::nullopt;
 }
 

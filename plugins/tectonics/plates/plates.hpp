@@ -48,6 +48,14 @@ enum class Drive {
 inline constexpr std::array<std::string_view, 5> drive_names = {"still", "converge", "rotate", "shear", "thesis"};
 std::optional<Drive> parse_drive(std::string_view name);
 
+/// How a convergent contact between plates of similar density raises its range.
+enum class RangeStyle {
+    peaks,  ///< a crest of peaks along the contact, saturating where contacts repeat (profiles.hpp)
+    cells,  ///< the thesis: the Voronoi cells the contact crosses, a fresh diagram per contact, summed
+};
+inline constexpr std::array<std::string_view, 2> range_style_names = {"peaks", "cells"};
+std::optional<RangeStyle> parse_range_style(std::string_view name);
+
 inline constexpr double area_units = 36.0;   ///< u, the plate area's longer side
 inline constexpr double margin_units = 2.0;  ///< u, free space between the area and the beams at rest
 inline constexpr int max_plate_vertices = 8;  ///< b2_maxPolygonVertices
@@ -96,14 +104,18 @@ struct Params {
     /// each other and the contact makes no boundary event.
     double min_speed = 0.05;
 
-    // Relief, per event. Widths are the RMP's Voronoi cell size sqrt(area / cones).
-    int cones = 100;              ///< Voronoi sites over the grid for each range
-    double height = 40.0;         ///< m raised per convergent collision
-    double jitter = 0.5;          ///< per-cell height variation of a range (thesis 4.2)
-    double rift_depth = 30.0;     ///< m
-    double ridge_height = 15.0;   ///< m
-    double trench_depth = 60.0;   ///< m
-    double arc_height = 40.0;     ///< m
+    // Relief, per event (profiles.hpp). Widths scale with the RMP's Voronoi cell size sqrt(area / cones).
+    int cones = 100;              ///< Voronoi sites over the grid (cells style: per range); sets every width
+    RangeStyle ranges = RangeStyle::peaks;
+    double height = 60.0;         ///< m raised per convergent collision
+    double jitter = 0.5;          ///< per-peak / per-cell height variation (thesis 4.2)
+    double rift_depth = 20.0;     ///< m
+    double ridge_height = 10.0;   ///< m
+    double trench_depth = 40.0;   ///< m
+    double arc_height = 30.0;     ///< m
+    /// Contacts' worth of relief a place can take at most: repeated contacts
+    /// saturate toward saturation × the per-contact amount (not for ranges=cells).
+    double saturation = 5.0;
     double subduction_contrast = 0.1;  ///< density difference above which the denser plate subducts
 
     /// Accumulated plate–plate impulse (N·s, sim units) that splits a plate; 0 = never. Neither part of a

@@ -1,51 +1,121 @@
-// profiles.hpp — the relief a plate boundary leaves where the thesis's
-// symmetric RMP range does not fit: a rift valley with its ridge where two
-// plates pull apart, and the asymmetric trench-and-arc profile where a dense
-// plate dives under a lighter one.
+// profiles.hpp — the relief plate boundaries leave: rugged collision ranges,
+// trenches with a chain of arc volcanoes, rift valleys with stepped
+// fault-block flanks and a rough axial ridge.
 //
-// Both are plain functions over a GridView, in sample coordinates, so they
-// can be tested alone. Each changes only the cells within a few `width`s of
-// the segment (cost ∝ segment length × width, never the whole grid), and
-// tapers smoothly past the segment's ends.
+// Every contact event is first *accumulated* into a per-feature activity
+// field (metres, as if each contact added its full amount), and the relief is
+// composed once at the end (apply):
+//
+//   relief = sat(range)·peaks(x, y)                       collision ranges
+//          − sat(trench) + volcanoes(sat(arc) at each vent) + ⅕·sat(arc)  subduction
+//          − sat(rift)·terrace(flank) + min(sat(ridge)·rough(x, y), that)  rifts
+//
+// with sat(a) = cap·(1 − exp(−a/cap)), cap = saturation × the per-contact
+// amount: a boundary touched once gets (almost) one contact's relief, a
+// boundary touched 200 times gets at most `saturation` contacts' worth, so no
+// region becomes a smear of summed profiles. The texture functions (peaks,
+// vents, terrace wobble) are fixed functions of position for a seed, so
+// repeated contacts at one place sharpen the same peaks instead of averaging
+// many random ones into a blur.
+//
+// Widths are multiples of the RMP's Voronoi cell size c = sqrt(area/cones)
+// (samples). Plain C++ over GridView, testable alone. Each add_* costs the
+// area of the band it touches (∝ segment length × width); apply costs one
+// pass over the grid.
 #pragma once
 
 #include <orogen/grid.hpp>
 
+#include <cstdint>
+#include <vector>
+
 namespace orogen::plates {
 
-/// A spreading boundary: a valley `depth` m deep and about `width` samples
-/// wide on each side (Gaussian), with a ridge `ridge_height` m high along its
-/// axis, a quarter as wide, so the axis stands above the valley floor on both
-/// sides — a rift valley with its volcanic ridge.
-struct RiftShape {
-    double width = 8.0;          ///< samples, the valley's half-width scale
-    double depth = 30.0;         ///< m
-    double ridge_height = 15.0;  ///< m
+struct ReliefShape {
+    double cell = 16.0;          ///< samples: the Voronoi cell size c; every width below scales with it
+    double range_height = 60.0;  ///< m per convergent contact (before the peak texture)
+    double jitter = 0.5;         ///< per-peak / per-volcano height variation: × (1 + jitter·u), u ∈ [−1, 1)
+    double trench_depth = 40.0;  ///< m per subduction contact
+    double arc_height = 30.0;    ///< m per subduction contact (volcano height before jitter)
+    double rift_depth = 20.0;    ///< m per divergent contact
+    double ridge_height = 10.0;  ///< m per divergent contact, the axial ridge
+    double saturation = 5.0;     ///< contacts' worth: no place gets more than saturation × a contact's amount
 };
 
-/// Cut a rift along a–b (sample coordinates). Adds the same change to
-/// `uplift` if it is non-null (negative where the ground subsides).
-void carve_rift(GridView terrain, Point2 a, Point2 b, const RiftShape& shape, GridView* uplift = nullptr);
-
-/// A subduction zone: the denser plate bends down into a trench just off the
-/// boundary on its own side; `width`·1.0 inland on the lighter plate a
-/// volcanic arc rises. Asymmetric by design, unlike a collision range.
-struct SubductionShape {
-    double width = 8.0;          ///< samples: trench–arc distance scale
-    double trench_depth = 60.0;  ///< m
-    double arc_height = 40.0;    ///< m
+/// Widths and offsets across a boundary, in samples, for a cell size c.
+struct ReliefWidths {
+    double range_half;       ///< 0.8 c: a range's envelope reaches this far either side of the contact
+    double peak_spacing;     ///< 0.4 c: spacing of the range's peaks (a second octave at a third of it)
+    double trench_offset;    ///< 0.12 c on the dense side: the trench's deepest line
+    double trench_outer;     ///< 0.3 c: the trench's gentle outer (oceanic) wall
+    double trench_inner;     ///< 0.12 c: its steep inner wall, toward the arc
+    double arc_offset;       ///< 0.6 c inland on the light plate: the volcanic line
+    double arc_band;         ///< 0.2 c: half-width of the band whose vents erupt
+    double vent_spacing;     ///< 0.4 c: lattice of possible vents
+    double vent_radius;      ///< 0.3 c: a volcano's base radius (± 20 %)
+    double rift_floor;       ///< 0.15 c: half-width of the flat rift floor
+    double rift_half;        ///< 0.6 c: the flanks reach the original ground here
+    double ridge_half;       ///< max(0.08 c, 1.5): the axial ridge's half-width
+    double end_reach;        ///< 0.3 c: relief fades past a segment's ends over this distance
 };
+ReliefWidths relief_widths(double cell);
 
-/// Shape a subduction zone along a–b. `toward_light` points (in sample
-/// coordinates, any length) from the subducting (dense) plate to the
-/// overriding (light) one: the trench lies on the opposite side, the arc on
-/// this side.
-void shape_subduction(GridView terrain, Point2 a, Point2 b, Point2 toward_light, const SubductionShape& shape,
-                      GridView* uplift = nullptr);
+/// cap·(1 − exp(−a/cap)): ≈ a for a ≪ cap, never above cap. cap ≤ 0 gives 0.
+double saturate(double accumulated, double cap);
 
-/// The cross-section functions themselves (m at signed distance s samples
-/// from the boundary, s > 0 toward the light plate / either side for rifts).
-double rift_profile(double s, const RiftShape& shape);
-double subduction_profile(double s, const SubductionShape& shape);
+/// Stairs: d (≥ 0) → stepped d with treads `step` apart, each tread tilted
+/// slightly (rotated fault blocks, 20 % of a step over its width) and a steep
+/// scarp (the last quarter of each step) to the next. Monotone
+/// non-decreasing and continuous; terrace(0) = 0, terrace(k·step) = k·step.
+/// A rift's flank position 0..1 (rim to floor) terraced into 3 blocks.
+double terrace(double depth, double step);
+
+/// Ridged fractal noise in [0, 1] (4 octaves, the first `spacing` samples):
+/// sharp crests and valleys that carve a range's peaks into ridges.
+double ridged_field(double x, double y, double spacing, std::uint64_t seed);
+
+/// The range texture: the maximum over a jittered lattice of cones
+/// (spacing `spacing` samples, one site per lattice cell, radius 0.95
+/// spacing, concave flanks), each cone's height 1 + jitter·u from the seed.
+/// Values in [0, 1 + jitter]: distinct peaks joined by sharp ridges and
+/// saddles — the RMP's per-cell heights (thesis 4.2) drawn as peaks.
+double peak_field(double x, double y, double spacing, double jitter, std::uint64_t seed);
+
+class BoundaryRelief {
+public:
+    BoundaryRelief(int width, int height, const ReliefShape& shape, std::uint64_t seed);
+
+    /// A convergent contact between plates of similar density, along a–b
+    /// (sample coordinates): a range straddling the contact.
+    void add_range(Point2 a, Point2 b);
+    /// A dense plate diving under a light one along a–b; `toward_light`
+    /// points (any length) from the dense plate to the light one: the trench
+    /// lies on the dense side, the volcanic line inland on the light side.
+    void add_subduction(Point2 a, Point2 b, Point2 toward_light);
+    /// Plates pulling apart along a–b: a rift valley with an axial ridge.
+    void add_rift(Point2 a, Point2 b);
+
+    /// Compose the accumulated relief and add it to `terrain` (and to
+    /// `uplift` if non-null). Same size as the constructor's. Deterministic
+    /// whatever the thread count.
+    void apply(GridView terrain, GridView* uplift = nullptr) const;
+
+    /// The composed relief alone at every sample (m), for tests and figures.
+    std::vector<float> relief() const;
+
+    const ReliefWidths& widths() const { return widths_; }
+
+private:
+    float relief_at(int x, int y) const;
+    std::vector<float>& field(std::vector<float>& f);
+
+    int width_, height_;
+    ReliefShape shape_;
+    ReliefWidths widths_;
+    std::uint64_t seed_;
+    // Activity fields (m, unsaturated), allocated on first use.
+    std::vector<float> range_, trench_, arc_, rift_, ridge_;
+    std::vector<float> flank_;  // largest flank position over rift contacts: 1 floor, 0 rim
+};
 
 }  // namespace orogen::plates

@@ -121,18 +121,22 @@ TEST(PlatesSimulation, HeadOnCollisionRaisesOneRangePerpendicularToTheMotion) {
 }
 
 // Two touching plates pulled apart: a rift valley (lower) with a ridge on its axis.
+// 25 cones: relief widths of a Voronoi cell of 26 samples, so the floor and
+// the ridge are several samples wide.
 TEST(PlatesSimulation, PullApartCutsARiftWithARidge) {
     Grid g(129);
     const std::vector<PlateSpec> plates = {plate(rect(6, 6, 18, 30), {-1, 0}), plate(rect(18, 6, 30, 30), {1, 0})};
-    const Result r = simulate(plates, scripted(30), 11, g.layers());
+    Params p = scripted(30);
+    p.cones = 25;
+    const Result r = simulate(plates, p, 11, g.layers());
     EXPECT_EQ(r.stats.events[int(BoundaryKind::divergent)], 1);
     EXPECT_EQ(r.stats.events[int(BoundaryKind::convergent)], 0);
     for (float u : g.uplift) EXPECT_LE(u, 0.0f);  // a rift only lowers
     const int axis = int(std::lround(18 * g.spu()));
     const int row = int(std::lround(18 * g.spu()));
     const float* u = &g.uplift[std::size_t(row) * g.n];
-    const float floor_w = *std::min_element(u + axis - 12, u + axis - 1);
-    const float floor_e = *std::min_element(u + axis + 2, u + axis + 13);
+    const float floor_w = *std::min_element(u + axis - 12, u + axis - 2);
+    const float floor_e = *std::min_element(u + axis + 3, u + axis + 13);
     EXPECT_LT(floor_w, -10.0f);
     EXPECT_LT(floor_e, -10.0f);
     EXPECT_GT(u[axis], floor_w + 4.0f) << "a ridge should stand on the rift's axis";
@@ -144,7 +148,9 @@ TEST(PlatesSimulation, PullApartCutsARiftWithARidge) {
 }
 
 // A dense (oceanic) plate driven into a light (continental) one: a trench on
-// the dense plate's side, a volcanic arc on the light one's.
+// the dense plate's side, a volcanic arc on the light one's. The arc is a
+// chain of separate volcanoes, so the profile across is taken as each
+// column's lowest and highest sample over the plates' rows.
 TEST(PlatesSimulation, DensePlateUnderLightGivesTrenchAndArc) {
     for (bool dense_west : {true, false}) {
         Grid g(129);
@@ -152,21 +158,30 @@ TEST(PlatesSimulation, DensePlateUnderLightGivesTrenchAndArc) {
         const double east = dense_west ? continental_density : oceanic_density;
         const std::vector<PlateSpec> plates = {plate(rect(6, 6, 16, 30), {2, 0}, west),
                                                plate(rect(20, 6, 30, 30), {-2, 0}, east)};
-        const Result r = simulate(plates, scripted(60), 11, g.layers());
+        Params p = scripted(60);
+        p.cones = 25;
+        const Result r = simulate(plates, p, 11, g.layers());
         EXPECT_GE(r.stats.subductions, 1);
-        const int row = int(std::lround(18 * g.spu()));
-        const float* u = &g.uplift[std::size_t(row) * g.n];
-        const int lo = int(std::min_element(u, u + g.n) - u);
-        const int hi = int(std::max_element(u, u + g.n) - u);
+        std::vector<float> lowest(std::size_t(g.n), 0.0f), highest(std::size_t(g.n), 0.0f);
+        for (int y = int(8 * g.spu()); y <= int(28 * g.spu()); ++y)
+            for (int x = 0; x < g.n; ++x) {
+                const float v = g.uplift[std::size_t(y) * g.n + x];
+                lowest[std::size_t(x)] = std::min(lowest[std::size_t(x)], v);
+                highest[std::size_t(x)] = std::max(highest[std::size_t(x)], v);
+            }
+        const int lo = int(std::min_element(lowest.begin(), lowest.end()) - lowest.begin());
+        const int hi = int(std::max_element(highest.begin(), highest.end()) - highest.begin());
         const double meet = 18.0 * g.spu();
-        EXPECT_LT(u[lo], -30.0f);
-        EXPECT_GT(u[hi], 20.0f);
+        EXPECT_LT(lowest[std::size_t(lo)], -30.0f);
+        EXPECT_GT(highest[std::size_t(hi)], 20.0f);
         if (dense_west) {
             EXPECT_LT(lo, meet) << "trench on the dense (west) side";
             EXPECT_GT(hi, meet) << "arc on the light (east) side";
+            for (int x = 0; x < int(meet) - 1; ++x) EXPECT_LE(highest[std::size_t(x)], 0.0f) << "no arc on the dense side";
         } else {
             EXPECT_GT(lo, meet);
             EXPECT_LT(hi, meet);
+            for (int x = int(meet) + 2; x < g.n; ++x) EXPECT_LE(highest[std::size_t(x)], 0.0f) << "no arc on the dense side";
         }
         EXPECT_GT(std::abs(hi - meet), std::abs(lo - meet)) << "the arc stands farther inland than the trench";
     }
