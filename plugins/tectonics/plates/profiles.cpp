@@ -56,10 +56,12 @@ double value_noise(double x, double y, double spacing, std::uint64_t seed) {
 double gradient_noise(double x, double y, std::uint64_t seed) {
     const double ix = std::floor(x), iy = std::floor(y);
     const double fx = x - ix, fy = y - iy;
+    // One of 16 unit gradients per lattice point (no trigonometry per sample).
+    static constexpr double gx[16] = {1, 0.92388, 0.70711, 0.38268, 0, -0.38268, -0.70711, -0.92388,
+                                      -1, -0.92388, -0.70711, -0.38268, 0, 0.38268, 0.70711, 0.92388};
     auto grad = [&](double i, double j, double dx, double dy) {
-        const double angle = 6.283185307179586 *
-                             random::uniform(seed, std::uint64_t(std::int64_t(i)), std::uint64_t(std::int64_t(j)));
-        return std::cos(angle) * dx + std::sin(angle) * dy;
+        const auto k = random::hash(seed, std::uint64_t(std::int64_t(i)), std::uint64_t(std::int64_t(j))) & 15u;
+        return gx[k] * dx + gx[(k + 12) & 15u] * dy;  // (cos, sin) = (gx[k], gx[k − 4])
     };
     const double n00 = grad(ix, iy, fx, fy), n10 = grad(ix + 1, iy, fx - 1, fy);
     const double n01 = grad(ix, iy + 1, fx, fy - 1), n11 = grad(ix + 1, iy + 1, fx - 1, fy - 1);
@@ -318,7 +320,35 @@ void BoundaryRelief::add_rift(Point2 a, Point2 b) {
     stamp(field(ridge_), width_, height_, a, b, n, w.end_reach, ridge, taper_table(w));
 }
 
-float BoundaryRelief::relief_at(int x, int y) const {
+BoundaryRelief::Vents BoundaryRelief::vents() const {
+    // Vents on a jittered lattice (one per lattice cell, in its middle 80 %);
+    // a vent erupts as much as the arc band's saturated activity at its site.
+    Vents v;
+    v.spacing = widths_.vent_spacing;
+    v.nx = int(std::ceil(width_ / v.spacing)) + 2;  // lattice cells −1 … nx − 2
+    v.ny = int(std::ceil(height_ / v.spacing)) + 2;
+    v.vents.resize(std::size_t(v.nx) * std::size_t(v.ny));
+    if (arc_.empty()) return v;
+    const std::uint64_t seed = random::hash(seed_, purpose_vents);
+    const double cap = shape_.saturation * shape_.arc_height;
+    for (int cj = -1; cj < v.ny - 1; ++cj)
+        for (int ci = -1; ci < v.nx - 1; ++ci) {
+            const Three u = three(random::hash(seed, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj))));
+            Vent& vent = v.at(ci, cj);
+            vent.x = (ci + 0.1 + 0.8 * u.a) * v.spacing;
+            vent.y = (cj + 0.1 + 0.8 * u.b) * v.spacing;
+            vent.radius = widths_.vent_radius * (0.8 + 0.4 * u.c);
+            const int px = int(std::lround(vent.x)), py = int(std::lround(vent.y));
+            if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
+            const float act = arc_[std::size_t(py) * std::size_t(width_) + std::size_t(px)];
+            if (!(act > 0.0f)) continue;
+            const double u_height = random::uniform(seed, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj)), 1u);
+            vent.height = saturate(act, cap) * (1.0 + shape_.jitter * (2.0 * u_height - 1.0));
+        }
+    return v;
+}
+
+float BoundaryRelief::relief_at(int x, int y, const Vents& vents) const {
     const std::size_t i = std::size_t(y) * std::size_t(width_) + std::size_t(x);
     const double sat = shape_.saturation;
     const double jitter = shape_.jitter;
@@ -337,30 +367,21 @@ float BoundaryRelief::relief_at(int x, int y) const {
     if (!arc_.empty()) {
         const double cap = sat * shape_.arc_height;
         dh += 0.2 * saturate(arc_[i], cap);  // the arc's low swell the volcanoes stand on
-        // Volcanoes: vents on a jittered lattice; a vent erupts as much as the
-        // arc band's activity at its site. The tallest cone over a sample wins.
-        const double L = w.vent_spacing;
-        const double fx = x / L, fy = y / L;
-        const double ix = std::floor(fx), iy = std::floor(fy);
-        const std::uint64_t vents = random::hash(seed_, purpose_vents);
+        // Volcanoes (see vents()): the tallest cone over a sample wins.
+        const double fx = x / vents.spacing, fy = y / vents.spacing;
+        const int ix = int(std::floor(fx)), iy = int(std::floor(fy));
         double best = 0.0;
-        for (int dj = -1; dj <= 1; ++dj)
-            for (int di = -1; di <= 1; ++di) {
-                const double ci = ix + di, cj = iy + dj;
-                const Three u = three(random::hash(vents, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj))));
-                const double sx = (ci + 0.1 + 0.8 * u.a) * L, sy = (cj + 0.1 + 0.8 * u.b) * L;
-                const int px = int(std::lround(sx)), py = int(std::lround(sy));
-                if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
-                const float act = arc_[std::size_t(py) * std::size_t(width_) + std::size_t(px)];
-                if (!(act > 0.0f)) continue;
-                const double radius = w.vent_radius * (0.8 + 0.4 * u.c);
-                const double d = std::hypot(x - sx, y - sy) / radius;
+        for (int cj = iy - 1; cj <= iy + 1; ++cj)
+            for (int ci = ix - 1; ci <= ix + 1; ++ci) {
+                if (ci < -1 || cj < -1 || ci > vents.nx - 2 || cj > vents.ny - 2) continue;
+                const Vent& v = vents.at(ci, cj);
+                if (!(v.height > 0.0)) continue;
+                const double d = std::hypot(x - v.x, y - v.y) / v.radius;
                 if (d >= 1.0) continue;
-                const double h = saturate(act, cap) * (1.0 + jitter * (2.0 * random::uniform(vents, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj)), 1u) - 1.0));
                 // Concave flanks steepening to the summit, and a small crater.
-                double cone = std::pow(1.0 - d, 1.8);
-                if (d < 0.12) cone -= 0.15 * (1.0 - d / 0.12) * std::pow(0.88, 1.8);
-                best = std::max(best, h * cone);
+                double cone = (1.0 - d) * (1.0 - d);
+                if (d < 0.12) cone -= 0.15 * (1.0 - d / 0.12) * 0.88 * 0.88;
+                best = std::max(best, v.height * cone);
             }
         dh += best;
     }
@@ -387,12 +408,13 @@ void BoundaryRelief::apply(GridView terrain, GridView* uplift) const {
     if (terrain.width != width_ || terrain.height != height_)
         throw BadInput("boundary relief: the terrain grid must be the size the relief was accumulated on");
     if (range_.empty() && trench_.empty() && arc_.empty() && rift_.empty()) return;
+    const Vents vent_lattice = vents();
     parallel_for(0, height_, 4, [&](std::int64_t r0, std::int64_t r1) {
         for (std::int64_t y = r0; y < r1; ++y) {
             float* row = terrain.row(int(y));
             float* urow = uplift ? uplift->row(int(y)) : nullptr;
             for (int x = 0; x < width_; ++x) {
-                const float dh = relief_at(x, int(y));
+                const float dh = relief_at(x, int(y), vent_lattice);
                 if (dh == 0.0f) continue;
                 row[x] += dh;
                 if (urow) urow[x] += dh;

@@ -106,7 +106,18 @@ public:
     const ReliefWidths& widths() const { return widths_; }
 
 private:
-    float relief_at(int x, int y) const;
+    struct Vent {
+        double x = 0, y = 0, radius = 1, height = 0;  // samples, m (0: dormant)
+    };
+    struct Vents {
+        double spacing = 1;
+        int nx = 0, ny = 0;
+        std::vector<Vent> vents;
+        const Vent& at(int i, int j) const { return vents[std::size_t(j + 1) * std::size_t(nx) + std::size_t(i + 1)]; }
+        Vent& at(int i, int j) { return vents[std::size_t(j + 1) * std::size_t(nx) + std::size_t(i + 1)]; }
+    };
+    Vents vents() const;
+    float relief_at(int x, int y, const Vents& vents) const;
     std::vector<float>& field(std::vector<float>& f);
 
     int width_, height_;

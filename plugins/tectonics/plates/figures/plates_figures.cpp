@@ -41,17 +41,13 @@ struct Image {
     }
 };
 
-// Hypsometric colour (m): sea blues below 0, greens to browns to pale grey above.
-void colour(double z, double& r, double& g, double& b) {
-    if (z < 0.0) {
-        const double t = std::clamp(-z / 250.0, 0.0, 1.0);
-        r = 120 - 70 * t, g = 160 - 80 * t, b = 190 - 60 * t;
-        return;
-    }
-    const double t = std::clamp(z / 500.0, 0.0, 1.0);
+// Colour by height within the picture's range: t = 0 lowest … 1 highest,
+// dark green through tan to pale grey.
+void colour(double t, double& r, double& g, double& b) {
+    t = std::clamp(t, 0.0, 1.0);
     if (t < 0.5) {
         const double u = t / 0.5;
-        r = 110 + 70 * u, g = 150 + 10 * u, b = 90 + 20 * u;
+        r = 70 + 110 * u, g = 110 + 50 * u, b = 70 + 40 * u;
     } else {
         const double u = (t - 0.5) / 0.5;
         r = 180 + 60 * u, g = 160 + 75 * u, b = 110 + 125 * u;
@@ -63,6 +59,8 @@ void shade_into(Image& img, int ox, int oy, const std::vector<float>& z, int w, 
                 int cw, int ch, int zoom) {
     auto at = [&](int x, int y) { return double(z[std::size_t(std::clamp(y, 0, h - 1)) * w + std::clamp(x, 0, w - 1)]); };
     const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
+    const auto [lo_it, hi_it] = std::minmax_element(z.begin(), z.end());
+    const double lo = *lo_it, span = std::max(double(*hi_it - *lo_it), 1e-6);
     for (int y = 0; y < ch * zoom; ++y)
         for (int x = 0; x < cw * zoom; ++x) {
             const int sx = x0 + x / zoom, sy = y0 + y / zoom;
@@ -71,7 +69,7 @@ void shade_into(Image& img, int ox, int oy, const std::vector<float>& z, int w, 
             const double n = std::sqrt(gx * gx + gy * gy + 1);
             const double lambert = std::max(0.0, (-gx * lx - gy * ly + lz) / n);
             double r, g, b;
-            colour(at(sx, sy), r, g, b);
+            colour((at(sx, sy) - lo) / span, r, g, b);
             const double k = 0.3 + 0.85 * lambert;
             img.set(ox + x, oy + y, r * k, g * k, b * k);
         }
