@@ -19,7 +19,7 @@
 // Both compute every lane with the same operations in the same order (and no
 // FMA contraction, see CMakeLists.txt), so the results are bit-identical.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define OROGEN_THERMAL_CLONES __attribute__((target_clones("avx2", "default")))
+#define OROGEN_THERMAL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define OROGEN_THERMAL_CLONES
 #endif
@@ -104,14 +104,9 @@ inline float softness(const Rule& r, float h, std::size_t i) {
     return 1.0f;
 }
 
-/// Olsen's factor F for one cell from its excess and the sum of its lower drops.
-inline float factor_from(const Rule& r, float soft, float excess, float sum) {
-    return excess > 0.0f ? r.rate * soft * excess / std::max(sum, 1e-30f) : 0.0f;
-}
-
-/// F for cell (x, y) with bounds checks (edge cells).
+/// F for cell (x, y) with bounds checks (edge cells); its outflow into `out`.
 template <Neighbourhood N>
-float factor_checked(ConstGridView in, const Rule& r, int x, int y) {
+float factor_checked(ConstGridView in, const Rule& r, int x, int y, float& out) {
     const float h = in.at(x, y);
     float excess = 0.0f, sum = 0.0f;
     for (const Offset& o : offsets<N>()) {
@@ -122,7 +117,8 @@ float factor_checked(ConstGridView in, const Rule& r, int x, int y) {
         excess = std::max(excess, d - t);
         sum += d > t ? d : 0.0f;
     }
-    return factor_from(r, softness(r, h, std::size_t(y) * std::size_t(in.width) + std::size_t(x)), excess, sum);
+    out = r.rate * softness(r, h, std::size_t(y) * std::size_t(in.width) + std::size_t(x)) * excess;
+    return out / std::max(sum, 1e-30f);
 }
 
 /// Softness of interior cells, with the hardness mode fixed at compile time
@@ -142,16 +138,20 @@ inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
     }
 }
 
-/// F for every cell of row y into f[0..width).
+/// F and the outflow O = rate·softness·max(0, excess) (metres) for every
+/// cell of row y into f[0..width) and o[0..width). A cell's outflow is
+/// Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so the update needs
+/// only O, not one product per neighbour.
 template <Neighbourhood N, Hardness H>
-OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, float* __restrict f) {
+OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, float* __restrict f,
+                                      float* __restrict o) {
     const int w = in.width;
     if (y == 0 || y == in.height - 1 || w < 3) {
-        for (int x = 0; x < w; ++x) f[x] = factor_checked<N>(in, r, x, y);
+        for (int x = 0; x < w; ++x) f[x] = factor_checked<N>(in, r, x, y, o[x]);
         return;
     }
-    f[0] = factor_checked<N>(in, r, 0, y);
-    f[w - 1] = factor_checked<N>(in, r, w - 1, y);
+    f[0] = factor_checked<N>(in, r, 0, y, o[0]);
+    f[w - 1] = factor_checked<N>(in, r, w - 1, y, o[w - 1]);
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
@@ -163,7 +163,7 @@ OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, fl
     const float* __restrict c = in.row(y);
     const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(w) : nullptr;
     const float rate = r.rate;
-    // The destination row never overlaps the sources: no alias checks needed.
+    // The destination rows never overlap the sources: no alias checks needed.
 #pragma GCC ivdep
     for (int x = 1; x < w - 1; ++x) {
         const float h = c[x];
@@ -175,41 +175,40 @@ OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, fl
             sum += d > t[k] ? d : 0.0f;
         }
         const float soft = softness_fast<H>(r, h, layer, x);
-        const float fx = rate * soft * excess / std::max(sum, 1e-30f);
-        f[x] = excess > 0.0f ? fx : 0.0f;
+        const float out = rate * soft * excess;  // excess ≥ 0: 0 when nothing is above the threshold
+        f[x] = out / std::max(sum, 1e-30f);
+        o[x] = out;
     }
 }
 
-/// New height of cell (x, y) with bounds checks. frow(dy) gives F of row y+dy.
+/// New height of cell (x, y) with bounds checks. frow(dy) gives F of row
+/// y+dy, `out` is the cell's own outflow.
 template <Neighbourhood N, typename FRow>
-float update_checked(ConstGridView in, const Rule& r, int x, int y, const FRow& frow) {
+float update_checked(ConstGridView in, const Rule& r, int x, int y, const FRow& frow, float out) {
     const float h = in.at(x, y);
-    const float fc = frow(0)[x];
-    float out = 0.0f, gain = 0.0f;
+    float gain = 0.0f;
     for (const Offset& o : offsets<N>()) {
         const int nx = x + o.dx, ny = y + o.dy;
         if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
         const float t = r.threshold(o.diagonal);
-        const float hn = in.at(nx, ny);
-        const float d = h - hn;   // drop to the neighbour
-        const float e = hn - h;   // drop from the neighbour
-        out += d > t ? fc * d : 0.0f;
+        const float e = in.at(nx, ny) - h;  // drop from the neighbour
         gain += e > t ? frow(o.dy)[nx] * e : 0.0f;
     }
-    return h - out + gain;
+    return (h - out) + gain;
 }
 
 template <Neighbourhood N>
-OROGEN_THERMAL_CLONES void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const float* const f[3]) {
+OROGEN_THERMAL_CLONES void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const float* const f[3],
+                                      const float* __restrict o) {
     const int w = in.width;
     float* __restrict dst = outv.row(y);
     auto frow = [&](int dy) { return f[1 + dy]; };
     if (y == 0 || y == in.height - 1 || w < 3) {
-        for (int x = 0; x < w; ++x) dst[x] = update_checked<N>(in, r, x, y, frow);
+        for (int x = 0; x < w; ++x) dst[x] = update_checked<N>(in, r, x, y, frow, o[x]);
         return;
     }
-    dst[0] = update_checked<N>(in, r, 0, y, frow);
-    dst[w - 1] = update_checked<N>(in, r, w - 1, y, frow);
+    dst[0] = update_checked<N>(in, r, 0, y, frow, o[0]);
+    dst[w - 1] = update_checked<N>(in, r, w - 1, y, frow, o[w - 1]);
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
@@ -221,23 +220,18 @@ OROGEN_THERMAL_CLONES void update_row(ConstGridView in, GridView outv, const Rul
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row(y);
-    const float* __restrict fc = f[1];
     // The destination row never overlaps the sources: no alias checks needed.
 #pragma GCC ivdep
     for (int x = 1; x < w - 1; ++x) {
         const float h = c[x];
-        const float fx = fc[x];
-        float out = 0.0f, gain = 0.0f;
+        float gain = 0.0f;
 #pragma GCC unroll 8
         for (int k = 0; k < K; ++k) {
-            const float hn = nb[k][x];
-            const float fn = nf[k][x];  // loaded unconditionally so the loop vectorises
-            const float d = h - hn;     // drop to the neighbour
-            const float e = hn - h;     // drop from the neighbour
-            out += d > t[k] ? fx * d : 0.0f;
+            const float e = nb[k][x] - h;  // drop from the neighbour
+            const float fn = nf[k][x];     // loaded unconditionally so the loop vectorises
             gain += e > t[k] ? fn * e : 0.0f;
         }
-        dst[x] = h - out + gain;
+        dst[x] = (h - o[x]) + gain;
     }
 }
 
@@ -250,15 +244,17 @@ void step_impl(ConstGridView in, GridView out, const Rule& r) {
     const std::int64_t grain = std::max<std::int64_t>(16, h / 32);
     parallel_for(0, h, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
-        std::vector<float> ring(std::size_t(w) * 3);
+        // Ring of 3 rows of F, and of the outflow O.
+        std::vector<float> ring(std::size_t(w) * 6);
         auto slot = [&](std::int64_t y) { return ring.data() + std::size_t(((y % 3) + 3) % 3) * std::size_t(w); };
-        if (y0 > 0) factor_row<N, H>(in, r, int(y0 - 1), slot(y0 - 1));
-        factor_row<N, H>(in, r, int(y0), slot(y0));
+        auto oslot = [&](std::int64_t y) { return slot(y) + 3 * std::size_t(w); };
+        if (y0 > 0) factor_row<N, H>(in, r, int(y0 - 1), slot(y0 - 1), oslot(y0 - 1));
+        factor_row<N, H>(in, r, int(y0), slot(y0), oslot(y0));
         for (std::int64_t y = y0; y < y1; ++y) {
-            if (y + 1 < h) factor_row<N, H>(in, r, int(y + 1), slot(y + 1));
+            if (y + 1 < h) factor_row<N, H>(in, r, int(y + 1), slot(y + 1), oslot(y + 1));
             // Rows outside the grid are never read (update_* checks bounds there).
             const float* f[3] = {slot(y - 1), slot(y), slot(y + 1)};
-            update_row<N>(in, out, r, int(y), f);
+            update_row<N>(in, out, r, int(y), f, oslot(y));
         }
     });
 }
