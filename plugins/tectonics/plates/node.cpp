@@ -128,7 +128,7 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
                     .help("how a collision raises its range: peaks (a crest of jagged peaks along the contact, "
                           "the same peaks every time the place is hit, saturating) or cells (the thesis: the "
                           "Voronoi cells the contact crosses, a fresh diagram per contact, summed)"),
-                Param::real("height", 60.0).min(0.0).unit("m").help("raise of a mountain range per convergent contact"),
+                Param::real("height", 80.0).min(0.0).unit("m").help("raise of a mountain range per convergent contact"),
                 Param::real("jitter", 0.5)
                     .min(0.0)
                     .max(1.0)
@@ -139,8 +139,8 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
                     .help("depth of a rift valley per divergent contact; its flanks step down in fault blocks "
                           "half this high"),
                 Param::real("ridge_height", 10.0).min(0.0).unit("m").help("height of the rough ridge along a rift's axis"),
-                Param::real("trench_depth", 40.0).min(0.0).unit("m").help("depth of a subduction trench per contact"),
-                Param::real("arc_height", 30.0)
+                Param::real("trench_depth", 25.0).min(0.0).unit("m").help("depth of a subduction trench per contact"),
+                Param::real("arc_height", 35.0)
                     .min(0.0)
                     .unit("m")
                     .help("height of the volcanoes of an arc per subduction contact"),

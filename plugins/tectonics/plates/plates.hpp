@@ -107,12 +107,12 @@ struct Params {
     // Relief, per event (profiles.hpp). Widths scale with the RMP's Voronoi cell size sqrt(area / cones).
     int cones = 100;              ///< Voronoi sites over the grid (cells style: per range); sets every width
     RangeStyle ranges = RangeStyle::peaks;
-    double height = 60.0;         ///< m raised per convergent collision
+    double height = 80.0;         ///< m raised per convergent collision
     double jitter = 0.5;          ///< per-peak / per-cell height variation (thesis 4.2)
     double rift_depth = 20.0;     ///< m
     double ridge_height = 10.0;   ///< m
-    double trench_depth = 40.0;   ///< m
-    double arc_height = 30.0;     ///< m
+    double trench_depth = 25.0;   ///< m
+    double arc_height = 35.0;     ///< m
     /// Contacts' worth of relief a place can take at most: repeated contacts
     /// saturate toward saturation × the per-contact amount (not for ranges=cells).
     double saturation = 5.0;

@@ -67,3 +67,27 @@ TEST(PlatesCli, SameSeedGivesTheSameBytesOnOneAndTwoThreadsAndAcrossRuns) {
         else EXPECT_EQ(bytes, first) << "differs with --threads " << threads;
     }
 }
+
+// Golden hashes of the shipped plate pipelines' outputs (seed fixed in each
+// spec). A change here means the terrain changed: update on purpose, never
+// silently (regenerate the docs/images/tectonics-*.png pictures too).
+TEST(PlatesCli, ShippedPipelinesKeepTheirGoldenOutputs) {
+    struct Golden {
+        const char* spec;
+        const char* file;
+        const char* sha256;
+    };
+    const Golden goldens[] = {
+        {"plates-relief.orogen", "plates-relief.png", "6728f3eeea7037e00fa5618dfbdac8a246d14f69b5cf733d8609fb680d82c30e"},
+        {"plates-tectonics.orogen", "plates-tectonics.png",
+         "9de43e30e523ce6e06e855986f3ad0374856c50b3232295f40e9697f8a81521f"},
+        {"plates-thesis.orogen", "plates-thesis.png", "5445ba275bde5fecd16a922a9cb77ef1eeab53fd9753e85e29b4dce424889cb3"},
+    };
+    for (const Golden& g : goldens) {
+        TempDir dir;
+        const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / g.spec;
+        const auto r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()));
+        ASSERT_EQ(r.exit_code, 0) << g.spec << ": " << r.err;
+        EXPECT_EQ(orogen::sha256_file(dir / g.file), g.sha256) << g.spec << " → " << g.file;
+    }
+}

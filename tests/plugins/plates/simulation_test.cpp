@@ -172,8 +172,8 @@ TEST(PlatesSimulation, DensePlateUnderLightGivesTrenchAndArc) {
         const int lo = int(std::min_element(lowest.begin(), lowest.end()) - lowest.begin());
         const int hi = int(std::max_element(highest.begin(), highest.end()) - highest.begin());
         const double meet = 18.0 * g.spu();
-        EXPECT_LT(lowest[std::size_t(lo)], -30.0f);
-        EXPECT_GT(highest[std::size_t(hi)], 20.0f);
+        EXPECT_LT(lowest[std::size_t(lo)], -0.8 * p.trench_depth);
+        EXPECT_GT(highest[std::size_t(hi)], 0.5 * p.arc_height);
         if (dense_west) {
             EXPECT_LT(lo, meet) << "trench on the dense (west) side";
             EXPECT_GT(hi, meet) << "arc on the light (east) side";

@@ -56,11 +56,14 @@ void colour(double t, double& r, double& g, double& b) {
 
 // Light from the north-west, 45° up, true vertical scale.
 void shade_into(Image& img, int ox, int oy, const std::vector<float>& z, int w, int h, double cell, int x0, int y0,
-                int cw, int ch, int zoom) {
+                int cw, int ch, int zoom, double lo = 0.0, double hi = -1.0) {
     auto at = [&](int x, int y) { return double(z[std::size_t(std::clamp(y, 0, h - 1)) * w + std::clamp(x, 0, w - 1)]); };
     const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
-    const auto [lo_it, hi_it] = std::minmax_element(z.begin(), z.end());
-    const double lo = *lo_it, span = std::max(double(*hi_it - *lo_it), 1e-6);
+    if (hi < lo) {  // the picture's own range
+        const auto [lo_it, hi_it] = std::minmax_element(z.begin(), z.end());
+        lo = *lo_it, hi = *hi_it;
+    }
+    const double span = std::max(hi - lo, 1e-6);
     for (int y = 0; y < ch * zoom; ++y)
         for (int x = 0; x < cw * zoom; ++x) {
             const int sx = x0 + x / zoom, sy = y0 + y / zoom;
@@ -99,6 +102,7 @@ int features(const std::string& out) {
     plates::ReliefShape shape;
     shape.cell = 120.0;  // samples: the Voronoi cell size of cones ≈ 4.6 on this grid, so the features fill it
     Image img(3 * n + 2 * gap, n);
+    std::vector<std::vector<float>> panels;
     for (int panel = 0; panel < 3; ++panel) {
         plates::BoundaryRelief relief(n, n, shape, 7);
         for (int k = 0; k < 40; ++k) {
@@ -109,9 +113,13 @@ int features(const std::string& out) {
             if (panel == 1) relief.add_subduction(a, b, {1, 0});  // dense plate west, light east
             if (panel == 2) relief.add_rift(a, b);
         }
-        const std::vector<float> z = relief.relief();
-        shade_into(img, panel * (n + gap), 0, z, n, n, cell_m, 0, 0, n, n, 1);
+        panels.push_back(relief.relief());
     }
+    double lo = 0.0, hi = 0.0;  // one colour scale for all three
+    for (const auto& z : panels)
+        for (float v : z) lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
+    for (int panel = 0; panel < 3; ++panel)
+        shade_into(img, panel * (n + gap), 0, panels[std::size_t(panel)], n, n, cell_m, 0, 0, n, n, 1, lo, hi);
     img.save(out);
     return 0;
 }
