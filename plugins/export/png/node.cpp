@@ -1,5 +1,7 @@
-// export:png — a heightmap (or one of its layers, or its hillshade) as an 8- or 16-bit grayscale PNG.
+// export:png — a heightmap (or one of its layers, or its hillshade) as an 8- or 16-bit grayscale PNG,
+// or a colour relief map (the thesis's splatting colours, hillshaded).
 #include "heightmap_png.hpp"
+#include "terrain_mesh.hpp"
 
 #include <orogen/io.hpp>
 #include <orogen/plugin.hpp>
@@ -12,18 +14,42 @@ void check(CheckContext& ctx) {
     const auto bits = ctx.integer("bits");
     if (bits != 8 && bits != 16) ctx.error("bits", "bits must be 8 or 16, got " + std::to_string(bits));
     const std::string& layer = ctx.text("layer");
+    if (ctx.flag("relief") && (ctx.flag("hillshade") || !layer.empty() || ctx.given("bits"))) {
+        ctx.error("relief", "relief=true writes an 8-bit colour map of the heights; drop hillshade=, layer= and bits=");
+        return;
+    }
     if (ctx.flag("hillshade") && !layer.empty()) {
         ctx.error("layer", "hillshade shades the terrain's heights; give either layer= or hillshade=true, not both");
         return;
     }
-    if (!ctx.flag("hillshade") && (ctx.given("azimuth") || ctx.given("elevation")))
-        ctx.error(ctx.given("azimuth") ? "azimuth" : "elevation", "azimuth and elevation place the light of hillshade=true");
+    if (!ctx.flag("hillshade") && !ctx.flag("relief") && (ctx.given("azimuth") || ctx.given("elevation")))
+        ctx.error(ctx.given("azimuth") ? "azimuth" : "elevation",
+                  "azimuth and elevation place the light of hillshade=true or relief=true");
     if (!layer.empty() && layer != "height")
         ctx.require_layer(0, "layer", layer, "use \"height\" (the default) or the name of an existing layer");
 }
 
+/// Splat colour (sand, grass, rock, snow by height and slope, as the glTF
+/// texture) times a soft hillshade: 35 % ambient light plus 65 % Lambert.
+std::vector<std::uint8_t> relief_map(ConstGridView heights, double azimuth, double elevation) {
+    std::vector<std::uint8_t> rgba = terrain::bake_splat_texture(heights, heights.width, heights.height);
+    const std::vector<std::uint16_t> shade = png_export::hillshade(heights, 16, azimuth, elevation);
+    for (std::size_t i = 0; i < shade.size(); ++i) {
+        const float light = 0.35f + 0.65f * float(shade[i]) / 65535.0f;
+        for (int c = 0; c < 3; ++c) rgba[4 * i + std::size_t(c)] = std::uint8_t(float(rgba[4 * i + std::size_t(c)]) * light + 0.5f);
+    }
+    return rgba;
+}
+
 NodeOutputs run(NodeContext& ctx) {
     const Heightmap& hm = *ctx.input(0).heightmap();
+    if (ctx.flag("relief")) {
+        const auto rgba = relief_map(hm.view(), ctx.real("azimuth"), ctx.real("elevation"));
+        AtomicFile file(ctx.output_path(ctx.text("path")));
+        write_rgba_png(file.stream(), hm.width(), hm.height(), rgba);
+        file.commit();
+        return {};
+    }
     const int bits = int(ctx.integer("bits"));
     const std::string& layer = ctx.text("layer");
     std::vector<std::uint16_t> samples;
@@ -50,7 +76,8 @@ OROGEN_PLUGIN("png-export", "0.1.0", registry) {
             "The lowest vertex becomes black and the highest white; 16 bits keep 65536 levels,\n"
             "which a 1025² terrain needs (8 bits band visibly beyond about 512²). layer= writes a layer\n"
             "(water, sediment, eroded...) min-max normalised the same way; hillshade=true writes the\n"
-            "terrain lit from azimuth/elevation instead (Lambert: black = facing away, white = facing the light).",
+            "terrain lit from azimuth/elevation instead (Lambert: black = facing away, white = facing the light);\n"
+            "relief=true writes a colour map: the thesis's splatting colours, hillshaded.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to write"}},
         .output = ValueType::none,
         .params =
@@ -59,6 +86,9 @@ OROGEN_PLUGIN("png-export", "0.1.0", registry) {
                 Param::integer("bits", 8).min(8).max(16).help("bits per sample: 8 or 16"),
                 Param::string("layer", "").help("write this layer instead of the heights (\"\" or \"height\": the heights)"),
                 Param::boolean("hillshade", false).help("write the hillshade of the heights instead"),
+                Param::boolean("relief", false).help(
+                    "write a colour relief map instead: sand, grass, rock and snow by height and slope (the thesis's "
+                    "splatting), hillshaded (8-bit RGBA)"),
                 Param::real("azimuth", 315.0).min(0).max(360).unit("°").help(
                     "hillshade light direction, clockwise from north (315 = north-west, the cartographers' default)"),
                 Param::real("elevation", 45.0).min(0).max(90).unit("°").help("hillshade light height above the horizon"),

@@ -101,3 +101,44 @@ TEST(PngExportCli, LayerAndHillshadeMistakesFailAtCheckTime) {
           "bad.orogen:6:40: error: export:png: azimuth and elevation place the light of hillshade=true"})
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
+
+// relief=true: the splat colours by height, darker on faces turned from the light.
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb/stb_image.h>
+
+TEST(PngExportCli, ReliefIsTheSplatColourShadedByTheLight) {
+    TempDir dir;
+    const auto spec = dir.write("relief.orogen",
+                                "orogen 1\ngrid 65 cell=10\nhill = generate:shape(kind=pyramid, height=300)\n"
+                                "export:png(hill, path=\"relief.png\", relief=true, azimuth=315, elevation=45)\n");
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir.path()) + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    int w = 0, h = 0, channels = 0;
+    stbi_uc* px = stbi_load((dir / "relief.png").c_str(), &w, &h, &channels, 4);
+    ASSERT_NE(px, nullptr);
+    EXPECT_EQ(w, 65);
+    EXPECT_EQ(h, 65);
+    EXPECT_EQ(channels, 4);
+    auto at = [&](int x, int y) { return px + 4 * (std::size_t(y) * 65 + std::size_t(x)); };
+    // The low corners are sand (yellow-brown: red > green > blue), the summit is snow (bright, nearly grey).
+    const stbi_uc* corner = at(2, 2);
+    EXPECT_GT(corner[0], corner[1]);
+    EXPECT_GT(corner[1], corner[2]);
+    const stbi_uc* summit = at(32, 32);
+    EXPECT_GT(int(summit[2]), 150);
+    EXPECT_LT(std::abs(int(summit[0]) - int(summit[2])), 30);
+    // The north-west face (towards the light at 315°) is brighter than the south-east face.
+    const stbi_uc* lit = at(20, 20);
+    const stbi_uc* shaded = at(44, 44);
+    EXPECT_GT(int(lit[0]) + lit[1] + lit[2], int(shaded[0]) + shaded[1] + shaded[2] + 60);
+    stbi_image_free(px);
+    // A relief map is 8-bit colour: bits= with it is a mistake.
+    const auto bad = dir.write("bad.orogen", "orogen 1\ngrid 9\nt = generate:fault()\n"
+                                             "export:png(t, path=\"r.png\", relief=true, bits=16)\n");
+    const RunResult b = run_orogen("check " + q(bad));
+    EXPECT_EQ(b.exit_code, 2);
+    EXPECT_NE(b.err.find("bad.orogen:4:36: error: export:png: relief=true writes an 8-bit colour map of the heights; "
+                         "drop hillshade=, layer= and bits="),
+              std::string::npos)
+        << b.err;
+}
