@@ -16,7 +16,7 @@
 // Row loops built for plain x86-64 and for AVX2, chosen at run time; the same
 // operations per lane in the same order (no FMA contraction), so the same bits.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define OROGEN_PIPE_CLONES __attribute__((target_clones("avx2", "default")))
+#define OROGEN_PIPE_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define OROGEN_PIPE_CLONES
 #endif
@@ -207,26 +207,74 @@ inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W
     a.v[i] = vv;
 }
 
-/// The row's sums and maxima, from what pass 2 wrote (a separate loop, so
-/// the cell loop has no serial double accumulations and vectorises).
+// Eight lanes as GCC vector types: the row reductions below run in 8
+// interleaved lanes combined in a fixed order, so they vectorise on every
+// clone and give the same bits whatever the thread count.
+typedef float F8 __attribute__((vector_size(32)));
+typedef double D8 __attribute__((vector_size(64)));
+
+inline F8 load8(const float* p) {
+    F8 r;
+    std::memcpy(&r, p, sizeof r);
+    return r;
+}
+inline D8 widen(F8 v) { return __builtin_convertvector(v, D8); }
+inline F8 max8(F8 a, F8 b) { return a < b ? b : a; }  // std::max per lane
+inline double total8(D8 t) { return ((t[0] + t[1]) + (t[2] + t[3])) + ((t[4] + t[5]) + (t[6] + t[7])); }
+inline float max_of8(F8 t) {
+    return std::max(std::max(std::max(t[0], t[1]), std::max(t[2], t[3])),
+                    std::max(std::max(t[4], t[5]), std::max(t[6], t[7])));
+}
+
+/// The row's sums and maxima, from what pass 2 wrote (a separate loop over
+/// data still in cache, so the cell loop has no reductions).
 OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row, float gravity) {
-    RowSums sums;
     const std::size_t W = std::size_t(a.w);
-    double s1 = 0.0, water = 0.0, check = 0.0;
-    float vmax = 0.0f, dmax = 0.0f;
-    for (std::size_t i = row; i < row + W; ++i) {
-        s1 += double(a.s1[i]);
-        water += double(a.d[i]);
-        check += double(a.b_next[i]);
-        vmax = std::max(vmax, flow_speed(a.u[i], a.v[i], a.d[i], gravity));
-        dmax = std::max(dmax, a.d[i]);
+    const float* __restrict s1 = a.s1 + row;
+    const float* __restrict d = a.d + row;
+    const float* __restrict b = a.b_next + row;
+    const float* __restrict u = a.u + row;
+    const float* __restrict v = a.v + row;
+    D8 ss = {}, ws = {}, cs = {};
+    F8 vm = {}, dm = {};
+    const F8 g = {gravity, gravity, gravity, gravity, gravity, gravity, gravity, gravity};
+    std::size_t i = 0;
+    for (; i + 8 <= W; i += 8) {
+        const F8 dd = load8(d + i), uu = load8(u + i), vv = load8(v + i);
+        ss += widen(load8(s1 + i));
+        ws += widen(dd);
+        cs += widen(load8(b + i));
+        const F8 sp2 = uu * uu + vv * vv, wave2 = g * dd;
+        const F8 lim = sp2 < wave2 ? sp2 : wave2;  // std::min per lane; sqrt after the max (monotonic)
+        vm = max8(vm, lim);
+        dm = max8(dm, dd);
     }
-    sums.s1 = s1;
-    sums.water = water;
-    sums.check = check + water;  // NaN or infinity in terrain or water shows here
-    sums.vmax = vmax;
-    sums.dmax = dmax;
+    RowSums sums;
+    double s_tail = 0.0, w_tail = 0.0, c_tail = 0.0;
+    float v_tail = 0.0f, d_tail = 0.0f;
+    for (; i < W; ++i) {
+        s_tail += double(s1[i]);
+        w_tail += double(d[i]);
+        c_tail += double(b[i]);
+        v_tail = std::max(v_tail, std::min(u[i] * u[i] + v[i] * v[i], gravity * d[i]));
+        d_tail = std::max(d_tail, d[i]);
+    }
+    sums.s1 = total8(ss) + s_tail;
+    sums.water = total8(ws) + w_tail;
+    sums.check = (total8(cs) + c_tail) + sums.water;  // NaN or infinity in terrain or water shows here
+    sums.vmax = std::sqrt(std::max(max_of8(vm), v_tail));
+    sums.dmax = std::max(max_of8(dm), d_tail);
     return sums;
+}
+
+/// Σ v[0..n) in double, 8 interleaved lanes combined in a fixed order.
+OROGEN_PIPE_CLONES double sum_row(const float* __restrict v, std::size_t n) {
+    D8 t = {};
+    std::size_t i = 0;
+    for (; i + 8 <= n; i += 8) t += widen(load8(v + i));
+    double tail = 0.0;
+    for (; i < n; ++i) tail += double(v[i]);
+    return total8(t) + tail;
 }
 
 template <bool HasMask, bool Rescale>
@@ -260,29 +308,46 @@ RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double sca
     return rescale ? water_row_impl<false, true>(a, k, y, scale) : water_row_impl<false, false>(a, k, y, scale);
 }
 
-/// Pass 3: sediment at each cell = s1 back-traced along the velocity (bilinear).
-OROGEN_PIPE_CLONES double transport_row(const Arrays& a, const Sub& k, int y) {
-    const int W = a.w, H = a.h;
-    const float xmax = float(W - 1), ymax = float(H - 1);
-    const float step = k.dt * k.inv_l;  // cells per (m/s)
-    const std::size_t row = std::size_t(y) * std::size_t(W);
-    double sum = 0.0;
-    for (int x = 0; x < W; ++x) {
-        const std::size_t i = row + std::size_t(x);
-        const float px = std::min(std::max(float(x) - a.u[i] * step, 0.0f), xmax);
-        const float py = std::min(std::max(float(y) - a.v[i] * step, 0.0f), ymax);
-        const int x0 = std::min(int(px), W - 1), y0 = std::min(int(py), H - 1);
-        const int x1 = std::min(x0 + 1, W - 1), y1 = std::min(y0 + 1, H - 1);
-        const float fx = px - float(x0), fy = py - float(y0);
-        const float* r0 = a.s1 + std::size_t(y0) * std::size_t(W);
-        const float* r1 = a.s1 + std::size_t(y1) * std::size_t(W);
-        const float top = r0[x0] + (r0[x1] - r0[x0]) * fx;
-        const float bottom = r1[x0] + (r1[x1] - r1[x0]) * fx;
-        const float value = top + (bottom - top) * fy;
-        a.s[i] = value;
-        sum += double(value);
+/// Pass 3 for one row: out[x] = s1 back-traced from (x, y) along (u, v) by
+/// `step` cells per m/s, bilinear. The back-trace is clamped to one cell per
+/// axis: in one sub-step water only reaches the 4 neighbours (pipes link
+/// neighbours only, and the limiter K never sends more than a cell holds), so
+/// the sediment it carries cannot come from farther. The source then lies in
+/// the 3×3 block around the cell, and bilinear interpolation is a 3×3
+/// stencil with tent weights: contiguous loads, no gathers, vectorises.
+/// `up`/`dn` are the rows above/below (the row itself at the grid's edge,
+/// whose weights are then folded onto it, as clamping the back-trace would).
+OROGEN_PIPE_CLONES void transport_cells(const float* __restrict u, const float* __restrict v,
+                                        const float* __restrict up, const float* __restrict mid,
+                                        const float* __restrict dn, float* __restrict out, int W, float step) {
+    auto cell = [&](int x, int xl, int xr) {
+        const float bx = std::min(std::max(u[x] * step, -1.0f), 1.0f);  // cells back along x
+        const float by = std::min(std::max(v[x] * step, -1.0f), 1.0f);
+        const float wl = std::max(bx, 0.0f), wr = std::max(-bx, 0.0f), wc = (1.0f - wl) - wr;
+        const float wu = std::max(by, 0.0f), wd = std::max(-by, 0.0f), wm = (1.0f - wu) - wd;
+        const float ru = (wl * up[xl] + wc * up[x]) + wr * up[xr];
+        const float rm = (wl * mid[xl] + wc * mid[x]) + wr * mid[xr];
+        const float rd = (wl * dn[xl] + wc * dn[x]) + wr * dn[xr];
+        out[x] = (wu * ru + wm * rm) + wd * rd;
+    };
+    if (W < 3) {
+        for (int x = 0; x < W; ++x) cell(x, std::max(x - 1, 0), std::min(x + 1, W - 1));
+        return;
     }
-    return sum;
+    cell(0, 0, 1);
+    for (int x = 1; x < W - 1; ++x) cell(x, x - 1, x + 1);
+    cell(W - 1, W - 2, W - 1);
+}
+
+/// Pass 3: sediment at each cell = s1 back-traced along the velocity; returns the row's sum.
+double transport_row(const Arrays& a, const Sub& k, int y) {
+    const std::size_t row = std::size_t(y) * std::size_t(a.w);
+    const std::size_t W = std::size_t(a.w);
+    const float* mid = a.s1 + row;
+    const float* up = y > 0 ? mid - W : mid;
+    const float* dn = y + 1 < a.h ? mid + W : mid;
+    transport_cells(a.u + row, a.v + row, up, mid, dn, a.s + row, a.w, k.dt * k.inv_l);
+    return sum_row(a.s + row, std::size_t(a.w));
 }
 
 }  // namespace
