@@ -4,10 +4,12 @@
 // Rigid convex plates move in a 2-D Box2D world, kept in motion and inside
 // the area by four kinematic beams. Where two plates touch along a two-point
 // contact, the boundary is classified by the plates' relative velocity at
-// the contact: approaching → convergent (a mountain range raised with the
-// RMP range core, or a trench and volcanic arc where a denser plate dives
-// under a lighter one), separating → divergent (a rift valley with a ridge),
-// sliding past → transform (height unchanged). A plate that has taken more
+// the contact: approaching → convergent (a jagged mountain range, or a
+// trench and a chain of arc volcanoes where a denser plate dives under a
+// lighter one), separating → divergent (a rift valley with fault-block
+// flanks and a ridge), sliding past → transform (height unchanged). The
+// relief is accumulated per event and composed, saturating, at the end
+// (profiles.hpp). A plate that has taken more
 // than `rift_threshold` of collision impulse splits along a line through its
 // stress point, and the two parts move apart.
 //
