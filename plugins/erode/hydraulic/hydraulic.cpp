@@ -16,7 +16,7 @@
 // Row loops built for plain x86-64 and for AVX2, chosen at run time; same
 // operations per lane in the same order (no FMA contraction), same bits.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define OROGEN_HYDRAULIC_CLONES __attribute__((target_clones("avx2", "default")))
+#define OROGEN_HYDRAULIC_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
 #define OROGEN_HYDRAULIC_CLONES
 #endif
@@ -47,9 +47,11 @@ struct Rule {
 struct PrepRow {
     float *h, *w, *s, *a;  // terrain, water, sediment, altitude a = h + w (m)
 };
-/// One row of Olsen's flow factors: water moved to a lower neighbour = F·drop, sediment = G·drop.
+/// One row of Olsen's flow factors: water moved to a lower neighbour = F·drop,
+/// sediment = G·drop; and each cell's total outflow of water (ow = F·Σdrop) and
+/// sediment (os = G·Σdrop), so the gather needs no product per giving pipe.
 struct FactorRow {
-    float *f, *g;
+    float *f, *g, *ow, *os;
 };
 
 // ---------------------------------------------------------------- step 1 + 2
@@ -109,7 +111,8 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
 
 /// Olsen's flow factors for one cell from its altitude a, water w, sediment s
 /// and its neighbours' altitudes (absent neighbours: `has` false).
-inline void factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4], float& f, float& g) {
+inline void factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4], float& f, float& g,
+                        float& ow, float& os) {
     float drop_sum = 0.0f, lower_sum = 0.0f, lower_n = 0.0f;
     for (int k = 0; k < 4; ++k) {
         const float d = a - an[k];
@@ -118,13 +121,16 @@ inline void factor_cell(float a, float w, float s, const float (&an)[4], const b
         lower_sum += lower ? an[k] : 0.0f;
         lower_n += lower ? 1.0f : 0.0f;
     }
-    const float mean = (a + lower_sum) / (1.0f + lower_n);  // ā over the cell and its lower neighbours
+    // ā over the cell and its lower neighbours.
+    const float mean = (a + lower_sum) / (1.0f + lower_n);
     // Olsen's two cases: level out (move a − ā) or drain completely (move w).
     const float moved = std::min(w, a - mean);
     const float ff = moved / std::max(drop_sum, 1e-30f);
     f = moved > 0.0f ? ff : 0.0f;
     const float gg = f * s / std::max(w, 1e-30f);
     g = w > 0.0f ? gg : 0.0f;
+    ow = f * drop_sum;
+    os = g * drop_sum;
 }
 
 OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, const PrepRow* dn, int w,
@@ -133,7 +139,7 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
         const float an[4] = {x > 0 ? c.a[x - 1] : 0.0f, x + 1 < w ? c.a[x + 1] : 0.0f, up ? up->a[x] : 0.0f,
                              dn ? dn->a[x] : 0.0f};
         const bool has[4] = {x > 0, x + 1 < w, up != nullptr, dn != nullptr};
-        factor_cell(c.a[x], c.w[x], c.s[x], an, has, out.f[x], out.g[x]);
+        factor_cell(c.a[x], c.w[x], c.s[x], an, has, out.f[x], out.g[x], out.ow[x], out.os[x]);
     };
     if (!up || !dn || w < 3) {
         for (int x = 0; x < w; ++x) edge(x);
@@ -148,36 +154,39 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
     const float* __restrict sc = c.s;
     float* __restrict f = out.f;
     float* __restrict g = out.g;
+    float* __restrict ow = out.ow;
+    float* __restrict os = out.os;
     constexpr bool all[4] = {true, true, true, true};
 #pragma GCC ivdep
     for (int x = 1; x < w - 1; ++x) {
         const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
-        float fx, gx;
-        factor_cell(a[x], wc[x], sc[x], an, all, fx, gx);
+        float fx, gx, owx, osx;
+        factor_cell(a[x], wc[x], sc[x], an, all, fx, gx, owx, osx);
         f[x] = fx;
         g[x] = gx;
+        ow[x] = owx;
+        os[x] = osx;
     }
 }
 
 // ----------------------------------------------- step 3 gather + step 4
 
-/// One cell's new state: its own outflow, its neighbours' inflow, then evaporation.
-inline void output_cell(const Rule& r, float a, float h1, float w1, float s1, float f, float g, const float (&an)[4],
+/// One cell's new state: its own outflow (ow, os), its neighbours' inflow,
+/// then evaporation.
+inline void output_cell(const Rule& r, float a, float h1, float w1, float s1, float ow, float os, const float (&an)[4],
                         const float (&fn)[4], const float (&gn)[4], const bool (&has)[4], float& h_out, float& w_out,
                         float& s_out) {
-    float w_net = 0.0f, s_net = 0.0f;
+    float w_in = 0.0f, s_in = 0.0f;
     for (int k = 0; k < 4; ++k) {
-        const float d = a - an[k];  // drop to neighbour k (giving)
-        const float e = an[k] - a;  // drop from neighbour k (receiving): the giver's own d
-        const bool give = has[k] && d > 0.0f;
+        const float e = an[k] - a;  // drop from neighbour k (receiving): the giver's own drop
         const bool take = has[k] && e > 0.0f;
-        w_net += (take ? fn[k] * e : 0.0f) - (give ? f * d : 0.0f);
-        s_net += (take ? gn[k] * e : 0.0f) - (give ? g * d : 0.0f);
+        w_in += take ? fn[k] * e : 0.0f;
+        s_in += take ? gn[k] * e : 0.0f;
     }
     // Round-off can leave a drained cell at −1e-9 m: clamp, so that capacity
     // never turns negative (the water lost is far below float resolution of the total).
-    const float w2 = std::max((w1 + w_net) * r.keep, 0.0f);
-    const float s2 = s1 + s_net;
+    const float w2 = std::max(((w1 - ow) + w_in) * r.keep, 0.0f);
+    const float s2 = (s1 - os) + s_in;
     const float excess = std::max(s2 - r.capacity * w2, 0.0f);  // deposited where water cannot hold it
     w_out = w2;
     s_out = s2 - excess;
@@ -193,7 +202,7 @@ OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const 
         const float an[4] = {c.a[xl], c.a[xr], up ? up->a[x] : 0.0f, dn ? dn->a[x] : 0.0f};
         const float fn[4] = {fc.f[xl], fc.f[xr], fup ? fup->f[x] : 0.0f, fdn ? fdn->f[x] : 0.0f};
         const float gn[4] = {fc.g[xl], fc.g[xr], fup ? fup->g[x] : 0.0f, fdn ? fdn->g[x] : 0.0f};
-        output_cell(r, c.a[x], c.h[x], c.w[x], c.s[x], fc.f[x], fc.g[x], an, fn, gn, has, ho[x], wo[x], so[x]);
+        output_cell(r, c.a[x], c.h[x], c.w[x], c.s[x], fc.ow[x], fc.os[x], an, fn, gn, has, ho[x], wo[x], so[x]);
     };
     if (!up || !dn || w < 3) {
         for (int x = 0; x < w; ++x) edge(x);
@@ -217,7 +226,7 @@ OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const 
         const float fn[4] = {f[x - 1], f[x + 1], fu[x], fd[x]};
         const float gn[4] = {g[x - 1], g[x + 1], gu[x], gd[x]};
         float hx, wx, sx;
-        output_cell(r, a[x], c.h[x], c.w[x], c.s[x], f[x], g[x], an, fn, gn, all, hx, wx, sx);
+        output_cell(r, a[x], c.h[x], c.w[x], c.s[x], fc.ow[x], fc.os[x], an, fn, gn, all, hx, wx, sx);
         ho[x] = hx;
         wo[x] = wx;
         so[x] = sx;
@@ -235,7 +244,7 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
     parallel_for(0, rows, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
         constexpr int kPrep = 5, kFactor = 3;
-        std::vector<float> buffer(std::size_t(w) * (4 * kPrep + 2 * kFactor));
+        std::vector<float> buffer(std::size_t(w) * (4 * kPrep + 4 * kFactor));
         PrepRow prep[kPrep];
         FactorRow fac[kFactor];
         float* p = buffer.data();
@@ -244,8 +253,8 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
             p += 4 * w;
         }
         for (auto& row : fac) {
-            row = {p, p + w};
-            p += 2 * w;
+            row = {p, p + w, p + 2 * w, p + 3 * w};
+            p += 4 * w;
         }
         auto prep_at = [&](std::int64_t y) -> PrepRow& { return prep[y % kPrep]; };
         auto fac_at = [&](std::int64_t y) -> FactorRow& { return fac[y % kFactor]; };
