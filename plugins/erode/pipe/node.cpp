@@ -128,12 +128,14 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
         .description =
             "The shallow-water 'virtual pipe' model of Mei, Decaudin & Hu (2007): water flows through pipes to "
             "the 4 neighbours, accelerated by the surface drop and limited so no cell goes negative; its "
-            "velocity sets a sediment capacity (capacity * sin(tilt) * speed, ramped down in water shallower than erosion_depth); the terrain erodes where the "
-            "water carries less than that and receives deposits where it carries more; sediment moves with the "
-            "water (semi-Lagrangian); water evaporates. Each step of dt seconds is split into sub-steps under "
+            "velocity sets a sediment capacity (capacity * sin(tilt) * speed, the speed capped at sqrt(g*depth) so "
+            "thin films do not scour like rivers, ramped down in water shallower than erosion_depth); the terrain "
+            "erodes where the water carries less than that (never below its lowest neighbour) and receives "
+            "deposits where it carries more (never above its highest); creep diffuses the terrain a little; "
+            "sediment moves with the water (semi-Lagrangian, at most one cell per sub-step); water evaporates. Each step of dt seconds is split into sub-steps under "
             "a CFL limit, so any dt runs without blowing up. Walls are closed unless boundary=open. Terrain + "
             "sediment (and, without rain and evaporation, water) is conserved. State layers: water (m), "
-            "sediment (m), flow (speed, m/s), flux_west/east/north/south (m^3/s), eroded (net change, m); an "
+            "sediment (m), flow (speed carrying sediment, m/s), flux_west/east/north/south (m^3/s), eroded (net change, m); an "
             "input that carries them continues the simulation.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"},
                    {"rain_mask", ValueType::heightmap, Need::optional,
