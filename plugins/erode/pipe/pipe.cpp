@@ -85,7 +85,7 @@ inline float rain_factor(const Arrays& a, std::size_t i) { return a.mask ? a.mas
 
 /// Pass 1 for one cell. The flags say which neighbours exist; the interior
 /// loop passes constants so the compiler drops the tests and vectorises.
-inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
+[[gnu::always_inline]] inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
                       float mw, float me, float mn, float ms, float mc) {
     const float* __restrict b = a.b;
     const float* __restrict d = a.d;
@@ -143,7 +143,7 @@ void flux_row(const Arrays& a, const Sub& k, int y) {
 }
 
 /// Pass 2 for one cell; returns its speed, adds to the row sums.
-inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
+[[gnu::always_inline]] inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
                        float gx_scale, float gy_scale, float mc, bool rescale, double scale) {
     const float* __restrict b = a.b;
     const float d1 = a.d[i] + k.rain_dt * mc;
@@ -365,6 +365,7 @@ struct Solver::Impl {
     double vmax = 0.0, dmax = 0.0;
     std::vector<double> row_s1, row_snew, row_check, row_water;
     std::vector<float> row_vmax, row_dmax;
+    std::vector<std::uint8_t> water_done, transport_done;  ///< rows the fused sweep did (per sub-step)
     bool finished = false;
 
     void substep(double dt, std::int64_t step, std::int64_t sub);
@@ -394,6 +395,8 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
     m.row_check.resize(std::size_t(m.h));
     m.row_water.resize(std::size_t(m.h));
     m.row_vmax.resize(std::size_t(m.h));
+    m.water_done.resize(std::size_t(m.h));
+    m.transport_done.resize(std::size_t(m.h));
     m.row_dmax.resize(std::size_t(m.h));
     // The first sub-step's CFL limit comes from the state (speed and water of
     // the previous run's last sub-step), so a continued run schedules its
@@ -468,31 +471,56 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
 
     Arrays ar{b_cur, b_next, st.water.data, st.sediment.data, s1.data(), u.data(), v.data(), st.flux_west.data,
               st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H};
-    const std::int64_t grain = std::max<std::int64_t>(8, H / 64);
-
-    // ---- pass 1: rain, outflow flux, limiter K (each cell writes only its own four fluxes)
-    parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
-        FlushDenormals ftz;
-        for (std::int64_t y = y0; y < y1; ++y) flux_row(ar, k, int(y));
-    });
-    // ---- pass 2: water, velocity, erosion/deposition, evaporation
+    // Chunks of rows: few and large, since each chunk leaves its edge rows
+    // to the clean-up passes below.
+    const std::int64_t grain = std::max<std::int64_t>(16, H / 16);
     const bool rescale = sediment_scale != 1.0;
     const double sed_scale_d = sediment_scale;
+    auto water = [&](int y) {
+        RowSums r = water_row(ar, k, y, rescale, sed_scale_d);
+        row_s1[std::size_t(y)] = r.s1;
+        row_water[std::size_t(y)] = r.water;
+        row_check[std::size_t(y)] = r.check;
+        row_vmax[std::size_t(y)] = r.vmax;
+        row_dmax[std::size_t(y)] = r.dmax;
+    };
+    // One sweep per chunk [y0, y1) does all three passes with a lag, while
+    // the rows are in cache:
+    //   1. flux(y): rain, outflow flux, limiter K (each cell writes only its own fluxes);
+    //   2. water(y − 1): depth, velocity, erosion/deposition, evaporation — once
+    //      the fluxes of rows y − 2..y are final;
+    //   3. transport(y − 2): semi-Lagrangian sediment — once s1 of rows y − 3..y − 1 is.
+    // Water of a chunk's first and last rows waits (their neighbours' fluxes
+    // belong to other chunks, and other chunks' flux passes still read their
+    // old depth), and so does transport of its first and last two rows; the
+    // clean-up passes do them. Every row is the same pure function of the
+    // sub-step's inputs whoever computes it, so the split cannot change the result.
+    std::fill(water_done.begin(), water_done.end(), std::uint8_t(0));
+    std::fill(transport_done.begin(), transport_done.end(), std::uint8_t(0));
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y) {
-            RowSums r = water_row(ar, k, int(y), rescale, sed_scale_d);
-            row_s1[std::size_t(y)] = r.s1;
-            row_water[std::size_t(y)] = r.water;
-            row_check[std::size_t(y)] = r.check;
-            row_vmax[std::size_t(y)] = r.vmax;
-            row_dmax[std::size_t(y)] = r.dmax;
+            flux_row(ar, k, int(y));
+            const std::int64_t yw = y - 1, yt = y - 2;
+            if (yw > y0 && yw < y1 - 1) {
+                water(int(yw));
+                water_done[std::size_t(yw)] = 1;
+            }
+            if (yt > y0 + 1 && yt < y1 - 2) {
+                row_snew[std::size_t(yt)] = transport_row(ar, k, int(yt));
+                transport_done[std::size_t(yt)] = 1;
+            }
         }
     });
-    // ---- pass 3: semi-Lagrangian sediment transport (bilinear back-trace)
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
-        for (std::int64_t y = y0; y < y1; ++y) row_snew[std::size_t(y)] = transport_row(ar, k, int(y));
+        for (std::int64_t y = y0; y < y1; ++y)
+            if (!water_done[std::size_t(y)]) water(int(y));
+    });
+    parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
+        FlushDenormals ftz;
+        for (std::int64_t y = y0; y < y1; ++y)
+            if (!transport_done[std::size_t(y)]) row_snew[std::size_t(y)] = transport_row(ar, k, int(y));
     });
 
     // ---- reductions, in row order
