@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -240,14 +241,15 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
     // rain/dissolve stage, one of the flow factors). Every row is the same
     // pure function of `in` wherever it is computed: chunking cannot change
     // the result.
-    const std::int64_t grain = std::max<std::int64_t>(16, rows / 32);
+    const std::int64_t grain = std::max<std::int64_t>(32, rows / 8);
     parallel_for(0, rows, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
         constexpr int kPrep = 5, kFactor = 3;
-        std::vector<float> buffer(std::size_t(w) * (4 * kPrep + 4 * kFactor));
+        // Not zero-filled: every slot is written before it is read.
+        std::unique_ptr<float[]> storage(new float[std::size_t(w) * (4 * kPrep + 4 * kFactor)]);
         PrepRow prep[kPrep];
         FactorRow fac[kFactor];
-        float* p = buffer.data();
+        float* p = storage.get();
         for (auto& row : prep) {
             row = {p, p + w, p + 2 * w, p + 3 * w};
             p += 4 * w;
