@@ -2,7 +2,7 @@
 # The minimum real and CPU time per benchmark over several repetitions (the
 # fairest figure on a shared machine). Used for the ## Erosion figures in
 # docs/benchmarks.md.
-# usage: minb.py BENCH FILTER [reps]  -> min real and cpu time per benchmark name
+# usage: bench_min.py BENCH FILTER [reps]  -> min real and cpu time per benchmark name
 import json, subprocess, sys
 b, f = sys.argv[1], sys.argv[2]
 reps = sys.argv[3] if len(sys.argv) > 3 else "5"
