@@ -14,10 +14,11 @@
 //   4. evaporate: water shrinks by the factor (1 − evaporation); sediment above
 //      capacity · water is deposited.
 // Water and sediment are state that carries from step to step (the thesis's
-// code reset them every iteration). Moves are pair terms F_a·(a_a − a_b)
-// computed bit-identically by giver and receiver, so terrain + sediment and
-// water are conserved to round-off and each step is independent of the order
-// of visiting cells (hence of the thread count).
+// code reset them every iteration). A receiver gains the pair term
+// F_a·(a_a − a_b) from each giver a; the giver loses its total F_a·Σ drops
+// (equal to the sum of its pair terms up to round-off), so terrain +
+// sediment and water are conserved to round-off and each step is
+// independent of the order of visiting cells (hence of the thread count).
 #pragma once
 
 #include <orogen/grid.hpp>

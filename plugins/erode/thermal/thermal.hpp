@@ -7,11 +7,12 @@
 //     total = rate · softness · (d_max − T)        (metres)
 // out of a cell, shared among the neighbours i with d_i > T in proportion to
 // d_i. Written as outflow_i = F · d_i with one per-cell factor
-// F = rate · softness · (d_max − T) / Σ d_i, every pair term F_a·(h_a − h_b)
-// is computed bit-identically by the giver (as outflow) and the receiver (as
-// inflow), so material is conserved to float round-off and each step is a
-// gather: the result does not depend on the order cells are visited, hence
-// not on the thread count. (The thesis's code updated heights in place, so
+// F = rate · softness · (d_max − T) / Σ d_i, the receiver gains F_a·(h_a − h_b)
+// from each giver a, and the giver loses its total rate · softness · excess
+// (= F·Σ d_i, one product instead of one per neighbour; equal to the sum of
+// its pair terms up to float round-off), so material is conserved to float
+// round-off and each step is a gather: the result does not depend on the
+// order cells are visited, hence not on the thread count. (The thesis's code updated heights in place, so
 // its result depended on the visiting order.)
 #pragma once
 
