@@ -97,6 +97,34 @@ TEST(Pipe, ConservesWaterAndMaterialOver10000Steps) {
     EXPECT_GT(total(sim.sediment), 1e-3);
 }
 
+// The same with the node's default creep (diffusion of the terrain, pair
+// terms): terrain + sediment still conserved, and the terrain does smooth.
+TEST(Pipe, ConservesMaterialWithCreep) {
+    Sim sim = bowl(41, 3.0f);
+    for (int y = 0; y < sim.h; ++y)
+        for (int x = 0; x < sim.w; ++x) sim.at(sim.height, x, y) += 0.2f * float(random::uniform(3, x, y));
+    const auto height0 = sim.height;
+    const double water0 = total(sim.water);
+    const double material0 = total(sim.height) + total(sim.sediment);
+    pipe::Settings s = closed_no_sources();
+    s.capacity = 0.5;
+    s.creep = 0.2;
+    sim.run(s, 3000, 0.05);
+    EXPECT_NEAR(total(sim.water), water0, 1e-5 * water0);
+    EXPECT_NEAR(total(sim.height) + total(sim.sediment), material0, 1e-5 * material0);
+    // Creep smoothed the noise: the mean |laplacian| dropped.
+    auto roughness = [&](const std::vector<float>& v) {
+        double r = 0.0;
+        for (int y = 1; y < sim.h - 1; ++y)
+            for (int x = 1; x < sim.w - 1; ++x) {
+                const std::size_t i = std::size_t(y) * sim.w + x;
+                r += std::fabs(4.0 * v[i] - v[i - 1] - v[i + 1] - v[i - sim.w] - v[i + sim.w]);
+            }
+        return r;
+    };
+    EXPECT_LT(roughness(sim.height), 0.5 * roughness(height0));
+}
+
 TEST(Pipe, AnyTimeStepStaysFiniteAndNonNegative) {
     for (double dt : {1e-4, 0.5, 5.0, 60.0}) {
         Sim sim(40, 33, 2.0);
