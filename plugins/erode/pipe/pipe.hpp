@@ -12,18 +12,23 @@
 //      than it holds (never negative);
 //   3. water: d2 = d1 + Δt·(Σ inflow − Σ outflow)/l²;
 //   4. velocity from the flux through the cell over the mean depth;
-//   5. capacity C = Kc · max(sin α, min_slope) · min(|v|, c) · min(d/d_e, 1)
-//      (α the local tilt; the depth ramp d/d_e, after Št'ava et al. 2008,
-//      keeps thin films of rain from scouring like rivers);
-//      erode (1 − e^(−Ks·Δt))·(C − s) where s < C, deposit
-//      (1 − e^(−Kd·Δt))·(s − C) where s > C;
-//   6. sediment moves semi-Lagrangian (bilinear back-trace); with closed walls
-//      the total is restored by a global fix-up factor, so terrain + sediment
-//      is conserved;
+//   5. capacity C = Kc · max(sin α, min_slope) · min(|v|, √(g·d), c) · min(d/d_e, 1)
+//      (α the local tilt from central differences; the speed capped at the
+//      wave speed √(g·d) and the depth ramp d/d_e, after Št'ava et al. 2008,
+//      keep thin films of rain from scouring like rivers);
+//      erode (1 − e^(−Ks·Δt))·(C − s) where s < C — at most half the drop to
+//      the lowest axis neighbour (no pits) — and deposit (1 − e^(−Kd·Δt))·(s − C)
+//      where s > C — at most half the rise to the highest one (no mounds);
+//      creep: b += κ·∇²b, κ = creep·Δt/l² ≤ 0.2 (damps one-cell ripples);
+//   6. sediment moves semi-Lagrangian (bilinear back-trace, clamped to one
+//      cell: water reaches only the 4 neighbours in a sub-step); with closed
+//      walls the total is restored by a global fix-up factor, so terrain +
+//      sediment is conserved;
 //   7. evaporation: d ← d2 · e^(−Ke·Δt).
 // Stability: the thesis abandoned this model because it blew up at usable
 // time steps. Here the requested step is split into sub-steps with
-//     Δt_sub ≤ cfl · l / (min(|v|max, c) + c),  c = √(g · max(d_max, A/l)),
+//     Δt_sub ≤ cfl · l / (v_max + c),  c = √(g · max(d_max, A/l)),
+// (v_max the largest carrying speed min(|v|, √(g·d)), the `speed` layer)
 // (c bounds the speed of the model's gravity waves: √(g·A/l) is the pipe
 // model's own wave speed, √(g·d) the shallow-water one); the flux limiter K
 // keeps depths non-negative, and the semi-Lagrangian transport and the
@@ -32,9 +37,10 @@
 // displacement to about one cell; counting it in full would shrink the
 // sub-step without bound.)
 //
-// Every pass writes each cell from one loop iteration and reads only the
-// previous pass's arrays, so the result is the same for any thread count;
-// every reduction is summed per row, then over rows in order.
+// Each chunk of rows runs the three passes in one sweep with a lag of one row
+// (edge rows in clean-up passes); every row is the same pure function of the
+// sub-step's inputs whoever computes it, so the result is the same for any
+// thread count; every reduction is summed per row, then over rows in order.
 #pragma once
 
 #include <orogen/grid.hpp>
