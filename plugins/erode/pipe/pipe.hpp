@@ -82,7 +82,7 @@ struct State {
     GridView water;     ///< water depth d, m
     GridView sediment;  ///< suspended sediment s, m of terrain
     GridView flux_west, flux_east, flux_north, flux_south;  ///< outflow through each pipe, m³/s
-    GridView speed;     ///< |v| of the last sub-step, m/s (also read at start: the first sub-step's CFL)
+    GridView speed;     ///< carrying speed min(|v|, √(g·d)) of the last sub-step, m/s (also read at start: the first sub-step's CFL)
 };
 
 class Solver {
