@@ -12,17 +12,6 @@ namespace {
 
 using namespace orogen;
 
-std::string known_layers(const ValueInfo& info) {
-    if (info.layers.empty()) return "the input has no layers";
-    std::string s = "the input's layers are: ";
-    bool first = true;
-    for (const auto& l : info.layers) {
-        s += (first ? "" : ", ") + l;
-        first = false;
-    }
-    return s;
-}
-
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
     hydraulic::Settings s;
@@ -66,10 +55,7 @@ NodeOutputs run(NodeContext& ctx) {
 void check(CheckContext& ctx) {
     const std::string& hardness = ctx.text("hardness");
     if (hardness != "steepness" && hardness != "constant") {
-        const ValueInfo* in = ctx.input(0);
-        if (in && in->layers_known && !in->layers.contains(hardness))
-            ctx.error("hardness", "no layer '" + hardness + "' on the input (" + known_layers(*in) +
-                                      "); use steepness, constant or the name of an existing layer");
+        ctx.require_layer(0, "hardness", hardness, "use steepness, constant or the name of an existing layer");
     }
     for (const char* l : {"water", "sediment", "eroded"}) ctx.output().layers.insert(l);
 }

@@ -17,17 +17,6 @@ using namespace orogen;
 // following erode:pipe continues exactly where this one stopped.
 constexpr const char* kFluxLayers[] = {"flux_west", "flux_east", "flux_north", "flux_south"};
 
-std::string known_layers(const ValueInfo& info) {
-    if (info.layers.empty()) return "the input has no layers";
-    std::string s = "the input's layers are: ";
-    bool first = true;
-    for (const auto& l : info.layers) {
-        s += (first ? "" : ", ") + l;
-        first = false;
-    }
-    return s;
-}
-
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
     pipe::Settings s;
@@ -104,8 +93,7 @@ void check(CheckContext& ctx) {
     const ValueInfo* mask = ctx.input(1);
     if (!mask_layer.empty()) {
         if (mask) ctx.error("rain_mask", "give the rain mask either as a layer name or as a second input, not both");
-        if (in && in->layers_known && !in->layers.contains(mask_layer))
-            ctx.error("rain_mask", "no layer '" + mask_layer + "' on the input (" + known_layers(*in) + ")");
+        ctx.require_layer(0, "rain_mask", mask_layer);
     }
     if (mask && in && mask->width > 0 && in->width > 0 &&
         (mask->width != in->width || mask->height != in->height)) {

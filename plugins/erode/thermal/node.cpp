@@ -15,17 +15,6 @@ namespace {
 
 using namespace orogen;
 
-std::string known_layers(const ValueInfo& info) {
-    if (info.layers.empty()) return "the input has no layers";
-    std::string s = "the input's layers are: ";
-    bool first = true;
-    for (const auto& l : info.layers) {
-        s += (first ? "" : ", ") + l;
-        first = false;
-    }
-    return s;
-}
-
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
     thermal::Settings s;
@@ -78,10 +67,7 @@ void check(CheckContext& ctx) {
     if (hardness == "height") {
         ctx.output().layers.insert("hardness");
     } else if (hardness != "constant") {
-        const ValueInfo* in = ctx.input(0);
-        if (in && in->layers_known && !in->layers.contains(hardness))
-            ctx.error("hardness", "no layer '" + hardness + "' on the input (" + known_layers(*in) +
-                                      "); use constant, height or the name of an existing layer");
+        ctx.require_layer(0, "hardness", hardness, "use constant, height or the name of an existing layer");
     }
     ctx.output().layers.insert("eroded");
 }
