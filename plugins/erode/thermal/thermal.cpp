@@ -164,16 +164,24 @@ OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, fl
     const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(w) : nullptr;
     const float rate = r.rate;
     // The destination rows never overlap the sources: no alias checks needed.
+    // The largest drop per threshold class (axis, diagonal), minus its
+    // threshold once: rounding is monotone, so max_k(d_k − t) = max_k(d_k) − t
+    // bit for bit, and this saves one subtraction per neighbour.
+    const float t_axis = r.t_axis, t_diag = r.t_diag;
 #pragma GCC ivdep
     for (int x = 1; x < w - 1; ++x) {
         const float h = c[x];
-        float excess = 0.0f, sum = 0.0f;
+        float max_axis = -INFINITY, max_diag = -INFINITY, sum = 0.0f;
 #pragma GCC unroll 8
         for (int k = 0; k < K; ++k) {
             const float d = h - nb[k][x];
-            excess = std::max(excess, d - t[k]);
-            sum += d > t[k] ? d : 0.0f;
+            if (offs[k].diagonal) max_diag = std::max(max_diag, d);
+            else max_axis = std::max(max_axis, d);
+            sum = d > t[k] ? sum + d : sum;  // the same bits as sum + (d > t ? d : 0): sum ≥ +0
         }
+        float excess = 0.0f;
+        if constexpr (N != Neighbourhood::rotated) excess = std::max(excess, max_axis - t_axis);
+        if constexpr (N != Neighbourhood::von_neumann) excess = std::max(excess, max_diag - t_diag);
         const float soft = softness_fast<H>(r, h, layer, x);
         const float out = rate * soft * excess;  // excess ≥ 0: 0 when nothing is above the threshold
         f[x] = out / std::max(sum, 1e-30f);
