@@ -216,6 +216,7 @@ int cmd_list(const Args& args, const PluginSet& plugins) {
 
 std::string value_text(const ParamValue& v, const Param& p) {
     std::ostringstream s;
+    s.precision(15);
     std::visit(
         [&](const auto& x) {
             using T = std::decay_t<decltype(x)>;
@@ -271,11 +272,7 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
                     s.help.empty() ? "" : (" — " + s.help).c_str());
     std::printf("\nparameters:%s\n", n->params.empty() ? " none" : "");
     for (const auto& p : n->params) {
-        std::string type = std::string(to_string(p.type));
-        if (p.type == ParamType::choice) {
-            type = "";
-            for (const auto& c : p.choices) type += (type.empty() ? "" : "|") + c;
-        }
+        const std::string type = std::string(to_string(p.type));
         std::string range;
         if (p.minimum || p.maximum) {
             range = std::string(p.minimum ? (p.minimum_exclusive ? "(" : "[") : "(") +
@@ -284,6 +281,11 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
         }
         std::printf("  %-16s %-12s default %-12s%s%s\n", p.name.c_str(), type.c_str(), value_text(p.default_value, p).c_str(),
                     range.empty() ? "" : ("  range " + range).c_str(), p.unit_text.empty() ? "" : ("  unit " + p.unit_text).c_str());
+        if (p.type == ParamType::choice) {
+            std::string options;
+            for (const auto& c : p.choices) options += (options.empty() ? "" : ", ") + c;
+            std::printf("      one of: %s\n", options.c_str());
+        }
         if (!p.help_text.empty()) std::printf("      %s\n", p.help_text.c_str());
     }
     std::printf("\nprovided by %s\n", plugins.registry().provider(n->qualified_name()).c_str());

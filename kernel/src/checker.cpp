@@ -32,6 +32,7 @@ using spec::Location;
 
 std::string number_text(double v) {
     std::ostringstream s;
+    s.precision(15);  // 1000000, not 1e+06; 0.1, not 0.10000000000000001
     s << v;
     return s.str();
 }

@@ -83,7 +83,7 @@ TEST(Cli, OverridesAreCheckedLikeTheSpec) {
                              "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err,
-              "--set cut.iterations=-5:1:16: error: 'iterations' of generate:fault is -5, out of range [1, 1e+06]\n"
+              "--set cut.iterations=-5:1:16: error: 'iterations' of generate:fault is -5, out of range [1, 1000000]\n"
               "  cut.iterations=-5\n"
               "                 ^~\n"
               "--set cut.displacment=3:1:5: error: generate:fault ('cut') has no parameter 'displacment'; did you mean 'displacement'?\n"
@@ -120,7 +120,7 @@ TEST(Cli, ListHelpAndVersionDescribeThePlugins) {
 
     r = run_orogen("help generate:fault");
     ASSERT_EQ(r.exit_code, 0);
-    EXPECT_NE(r.out.find("  iterations       integer      default 200           range [1, 1e+06]\n"
+    EXPECT_NE(r.out.find("  iterations       integer      default 200           range [1, 1000000]\n"
                          "      number of fault lines\n"),
               std::string::npos)
         << r.out;

@@ -37,7 +37,7 @@ TEST(PlatesCli, BadStepsDtPlatesAndDriveAreCheckErrors) {
         const char* message;
     } cases[] = {
         {"tectonics:plates(crust, plates=1)", "error: 'plates' of tectonics:plates is 1, out of range [2, 256]"},
-        {"tectonics:plates(crust, steps=0)", "error: 'steps' of tectonics:plates is 0, out of range [1, 1e+07]"},
+        {"tectonics:plates(crust, steps=0)", "error: 'steps' of tectonics:plates is 0, out of range [1, 10000000]"},
         {"tectonics:plates(crust, dt=0)", "error: 'dt' of tectonics:plates is 0, out of range (0, 10] s"},
         {"tectonics:plates(crust, dt=-0.5)", "error: 'dt' of tectonics:plates is -0.5, out of range (0, 10] s"},
         {"tectonics:plates(crust, drive=sideways)",
