@@ -103,17 +103,23 @@ inline float softness(const Rule& r, float h, std::size_t i) {
     }
     return 1.0f;
 }
+/// Rows y−1, y, y+1 of one height field around row y (pointers; those
+/// outside the grid are never read) and the grid's size.
+struct Rows3 {
+    const float* row[3];
+    int width, height;
+};
 
 /// F for cell (x, y) with bounds checks (edge cells); its outflow into `out`.
 template <Neighbourhood N>
-float factor_checked(ConstGridView in, const Rule& r, int x, int y, float& out) {
-    const float h = in.at(x, y);
+float factor_checked(const Rows3& in, const Rule& r, int x, int y, float& out) {
+    const float h = in.row[1][x];
     float excess = 0.0f, sum = 0.0f;
     for (const Offset& o : offsets<N>()) {
         const int nx = x + o.dx, ny = y + o.dy;
         if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
         const float t = r.threshold(o.diagonal);
-        const float d = h - in.at(nx, ny);
+        const float d = h - in.row[1 + o.dy][nx];
         excess = std::max(excess, d - t);
         sum += d > t ? d : 0.0f;
     }
@@ -142,34 +148,39 @@ inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
 /// cell of row y into f[0..width) and o[0..width). A cell's outflow is
 /// Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so the update needs
 /// only O, not one product per neighbour.
+
+/// F and the outflow O = rate·softness·max(0, excess) (metres) for every
+/// cell of row y into f[0..width) and o[0..width). A cell's outflow is
+/// Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so the update needs
+/// only O, not one product per neighbour.
 template <Neighbourhood N, Hardness H>
-OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, float* __restrict f,
+OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int xa, int xb, float* __restrict f,
                                       float* __restrict o) {
     const int w = in.width;
     if (y == 0 || y == in.height - 1 || w < 3) {
-        for (int x = 0; x < w; ++x) f[x] = factor_checked<N>(in, r, x, y, o[x]);
+        for (int x = xa; x < xb; ++x) f[x] = factor_checked<N>(in, r, x, y, o[x]);
         return;
     }
-    f[0] = factor_checked<N>(in, r, 0, y, o[0]);
-    f[w - 1] = factor_checked<N>(in, r, w - 1, y, o[w - 1]);
+    if (xa == 0) f[0] = factor_checked<N>(in, r, 0, y, o[0]), xa = 1;
+    if (xb == w) f[w - 1] = factor_checked<N>(in, r, w - 1, y, o[w - 1]), xb = w - 1;
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        nb[k] = in.row(y + offs[k].dy) + offs[k].dx;
+        nb[k] = in.row[1 + offs[k].dy] + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
-    const float* __restrict c = in.row(y);
+    const float* __restrict c = in.row[1];
     const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(w) : nullptr;
     const float rate = r.rate;
-    // The destination rows never overlap the sources: no alias checks needed.
     // The largest drop per threshold class (axis, diagonal), minus its
     // threshold once: rounding is monotone, so max_k(d_k − t) = max_k(d_k) − t
     // bit for bit, and this saves one subtraction per neighbour.
     const float t_axis = r.t_axis, t_diag = r.t_diag;
+    // The destination rows never overlap the sources: no alias checks needed.
 #pragma GCC ivdep
-    for (int x = 1; x < w - 1; ++x) {
+    for (int x = xa; x < xb; ++x) {
         const float h = c[x];
         float max_axis = -INFINITY, max_diag = -INFINITY, sum = 0.0f;
 #pragma GCC unroll 8
@@ -189,48 +200,48 @@ OROGEN_THERMAL_CLONES void factor_row(ConstGridView in, const Rule& r, int y, fl
     }
 }
 
-/// New height of cell (x, y) with bounds checks. frow(dy) gives F of row
-/// y+dy, `out` is the cell's own outflow.
-template <Neighbourhood N, typename FRow>
-float update_checked(ConstGridView in, const Rule& r, int x, int y, const FRow& frow, float out) {
-    const float h = in.at(x, y);
+/// New height of cell (x, y) with bounds checks. f[1 + dy] is F of row
+/// y + dy, `out` the cell's own outflow.
+template <Neighbourhood N>
+float update_checked(const Rows3& in, const Rule& r, int x, int y, const float* const f[3], float out) {
+    const float h = in.row[1][x];
     float gain = 0.0f;
     for (const Offset& o : offsets<N>()) {
         const int nx = x + o.dx, ny = y + o.dy;
         if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
         const float t = r.threshold(o.diagonal);
-        const float e = in.at(nx, ny) - h;  // drop from the neighbour
-        gain += e > t ? frow(o.dy)[nx] * e : 0.0f;
+        const float e = in.row[1 + o.dy][nx] - h;  // drop from the neighbour
+        gain += e > t ? f[1 + o.dy][nx] * e : 0.0f;
     }
     return (h - out) + gain;
 }
 
+/// Row y of the next step into dst, from rows y−1..y+1 of the heights, F of
+/// rows y−1..y+1 and the outflow of row y.
 template <Neighbourhood N>
-OROGEN_THERMAL_CLONES void update_row(ConstGridView in, GridView outv, const Rule& r, int y, const float* const f[3],
-                                      const float* __restrict o) {
+OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int y, int xa, int xb, const float* const f[3],
+                                      const float* __restrict o, float* __restrict dst) {
     const int w = in.width;
-    float* __restrict dst = outv.row(y);
-    auto frow = [&](int dy) { return f[1 + dy]; };
     if (y == 0 || y == in.height - 1 || w < 3) {
-        for (int x = 0; x < w; ++x) dst[x] = update_checked<N>(in, r, x, y, frow, o[x]);
+        for (int x = xa; x < xb; ++x) dst[x] = update_checked<N>(in, r, x, y, f, o[x]);
         return;
     }
-    dst[0] = update_checked<N>(in, r, 0, y, frow, o[0]);
-    dst[w - 1] = update_checked<N>(in, r, w - 1, y, frow, o[w - 1]);
+    if (xa == 0) dst[0] = update_checked<N>(in, r, 0, y, f, o[0]), xa = 1;
+    if (xb == w) dst[w - 1] = update_checked<N>(in, r, w - 1, y, f, o[w - 1]), xb = w - 1;
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
     const float* __restrict nf[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        nb[k] = in.row(y + offs[k].dy) + offs[k].dx;
+        nb[k] = in.row[1 + offs[k].dy] + offs[k].dx;
         nf[k] = f[1 + offs[k].dy] + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
-    const float* __restrict c = in.row(y);
+    const float* __restrict c = in.row[1];
     // The destination row never overlaps the sources: no alias checks needed.
 #pragma GCC ivdep
-    for (int x = 1; x < w - 1; ++x) {
+    for (int x = xa; x < xb; ++x) {
         const float h = c[x];
         float gain = 0.0f;
 #pragma GCC unroll 8
@@ -243,44 +254,109 @@ OROGEN_THERMAL_CLONES void update_row(ConstGridView in, GridView outv, const Rul
     }
 }
 
+/// Most steps done in one sweep over the grid (temporal blocking).
+constexpr int kMaxStepsPerSweep = kStepsPerSweep;
+
+/// `steps` (1..kMaxStepsPerSweep) steps from `in` to `out` in one sweep.
+///
+/// Row y of step s+1 depends on rows y−2..y+2 of step s (the gain from a
+/// neighbour uses its F, which looks one row further). Each band of output
+/// rows [y0, y1) is computed as a pipeline: step s keeps a ring of 4 rows of
+/// heights and 3 rows of F and O, and produces its rows on demand from
+/// step s−1 (rows [y0 − 2(steps−s), y1 + 2(steps−s)), recomputed by both
+/// neighbouring bands). So the grid is read and written once per `steps`
+/// steps, and the intermediate rows stay in L1/L2. Every row of every step
+/// is the same pure function of the previous step as in a single step, with
+/// the same operations in the same order: the result is bit-identical to
+/// `steps` single steps, whatever the bands or the thread count.
 template <Neighbourhood N, Hardness H>
-void step_impl(ConstGridView in, GridView out, const Rule& r) {
-    const int w = in.width, h = in.height;
-    // Rows in parallel. Each chunk recomputes F for its one-row halo; F of a
-    // row is the same pure function of `in` wherever it is computed, so the
-    // result does not depend on the chunking.
-    const std::int64_t grain = std::max<std::int64_t>(16, h / 32);
-    parallel_for(0, h, grain, [&](std::int64_t y0, std::int64_t y1) {
+void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
+    const int w = in.width, hgt = in.height;
+    // Fixed bands of rows (not per thread): few enough that the recomputed
+    // halos (2·steps·(steps−1) rows per band) cost little. Strips of columns
+    // (with halos likewise) are supported by the pipeline but were slower
+    // than whole rows here (per-row overhead, short vector loops), so a strip
+    // is the whole width.
+    const std::int64_t band = std::max<std::int64_t>(16, (hgt + 7) / 8);
+    const std::int64_t bands = (hgt + band - 1) / band;
+    const int strip = w;
+    parallel_for(0, bands, 1, [&](std::int64_t b0, std::int64_t b1) {
         FlushDenormals ftz;
-        // Ring of 3 rows of F, and of the outflow O.
-        std::vector<float> ring(std::size_t(w) * 6);
-        auto slot = [&](std::int64_t y) { return ring.data() + std::size_t(((y % 3) + 3) % 3) * std::size_t(w); };
-        auto oslot = [&](std::int64_t y) { return slot(y) + 3 * std::size_t(w); };
-        if (y0 > 0) factor_row<N, H>(in, r, int(y0 - 1), slot(y0 - 1), oslot(y0 - 1));
-        factor_row<N, H>(in, r, int(y0), slot(y0), oslot(y0));
-        for (std::int64_t y = y0; y < y1; ++y) {
-            if (y + 1 < h) factor_row<N, H>(in, r, int(y + 1), slot(y + 1), oslot(y + 1));
-            // Rows outside the grid are never read (update_* checks bounds there).
-            const float* f[3] = {slot(y - 1), slot(y), slot(y + 1)};
-            update_row<N>(in, out, r, int(y), f, oslot(y));
+        // Local rows cover the strip plus its widest halo, padded so rows
+        // do not all map to the same cache sets.
+        const std::size_t stride = std::size_t(std::min(w, strip) + 4 * steps + 16);
+        // Per step s ≥ 1: 4 rows of heights; per step s ≥ 0: 3 rows of F, 3 of O.
+        thread_local std::vector<float> store;
+        store.resize(stride * std::size_t(kMaxStepsPerSweep * 4 + (kMaxStepsPerSweep + 1) * 6));
+        for (std::int64_t b = b0; b < b1; ++b) {
+            const int y0 = int(b * band), y1 = int(std::min<std::int64_t>(hgt, (b + 1) * band));
+            for (int x0 = 0; x0 < w; x0 += strip) {
+            const int x1 = std::min(w, x0 + strip);
+            // Local row pointers are shifted so that p[x] addresses column x.
+            const std::ptrdiff_t xbase = std::ptrdiff_t(x0) - 2 * steps;
+            int next_h[kMaxStepsPerSweep + 1];  // next row of heights to produce, per step
+            int next_f[kMaxStepsPerSweep + 1];  // next row of F/O to compute, per step
+            int hx0[kMaxStepsPerSweep + 1], hx1[kMaxStepsPerSweep + 1];  // columns of heights, per step
+            for (int s = 0; s <= steps; ++s) {
+                next_h[s] = std::max(0, y0 - 2 * (steps - s));
+                next_f[s] = std::max(0, y0 - 2 * (steps - s - 1) - 1);
+                hx0[s] = std::max(0, x0 - 2 * (steps - s));
+                hx1[s] = std::min(w, x1 + 2 * (steps - s));
+            }
+            auto hrow = [&](int s, int y) -> float* {  // step s ≥ 1
+                return store.data() + stride * std::size_t((s - 1) * 4 + (y & 3)) - xbase;
+            };
+            auto frow = [&](int s, int y) -> float* {
+                return store.data() + stride * std::size_t(kMaxStepsPerSweep * 4 + s * 6 + (y % 3)) - xbase;
+            };
+            auto orow = [&](int s, int y) { return frow(s, y) + 3 * stride; };
+            auto rows3 = [&](int s, int y) {
+                Rows3 rs{{nullptr, nullptr, nullptr}, w, hgt};
+                for (int dy = -1; dy <= 1; ++dy) {
+                    const int yy = y + dy;
+                    if (yy < 0 || yy >= hgt) continue;
+                    rs.row[1 + dy] = s == 0 ? in.row(yy) : hrow(s, yy);
+                }
+                return rs;
+            };
+            // Demand-driven: producing heights of step s, row y, first makes
+            // sure F of step s−1 exists up to row y+1, which makes sure the
+            // heights of step s−1 exist up to row y+2. F of step s is needed
+            // one column less wide than its heights on each side.
+            auto ensure_f = [&](auto& self_h, int s, int upto) -> void {
+                upto = std::min(upto, hgt - 1);
+                const int fx0 = std::max(0, x0 - 2 * (steps - s) + 1), fx1 = std::min(w, x1 + 2 * (steps - s) - 1);
+                for (; next_f[s] <= upto; ++next_f[s]) {
+                    const int y = next_f[s];
+                    if (s > 0) self_h(self_h, s, std::min(y + 1, hgt - 1));
+                    factor_row<N, H>(rows3(s, y), r, y, fx0, fx1, frow(s, y), orow(s, y));
+                }
+            };
+            auto ensure_h = [&](auto& self, int s, int upto) -> void {
+                for (; next_h[s] <= upto; ++next_h[s]) {
+                    const int y = next_h[s];
+                    ensure_f(self, s - 1, y + 1);
+                    const float* f[3] = {y > 0 ? frow(s - 1, y - 1) : nullptr, frow(s - 1, y),
+                                         y + 1 < hgt ? frow(s - 1, y + 1) : nullptr};
+                    float* dst = s == steps ? out.row(y) : hrow(s, y);
+                    update_row<N>(rows3(s - 1, y), r, y, hx0[s], hx1[s], f, orow(s - 1, y), dst);
+                }
+            };
+            ensure_h(ensure_h, steps, y1 - 1);
+            }
         }
     });
 }
 
-}  // namespace
-
-void step(ConstGridView in, GridView out, const Settings& settings, const float* hardness) {
-    if (in.width != out.width || in.height != out.height)
-        throw Error("thermal::step: input and output grids differ in size");
-    if (settings.hardness == Hardness::layer && hardness == nullptr)
-        throw Error("thermal::step: hardness layer mode needs a hardness layer");
+/// `steps` (1..kMaxStepsPerSweep) steps from `in` to `out`, which must not overlap.
+void steps_into(ConstGridView in, GridView out, const Settings& settings, const float* hardness, int steps) {
     Rule r = make_rule(settings, in.cell);
     r.hardness_layer = hardness;
     auto with_hardness = [&]<Neighbourhood N>() {
         switch (settings.hardness) {
-            case Hardness::constant: step_impl<N, Hardness::constant>(in, out, r); break;
-            case Hardness::height: step_impl<N, Hardness::height>(in, out, r); break;
-            case Hardness::layer: step_impl<N, Hardness::layer>(in, out, r); break;
+            case Hardness::constant: sweep<N, Hardness::constant>(in, out, r, steps); break;
+            case Hardness::height: sweep<N, Hardness::height>(in, out, r, steps); break;
+            case Hardness::layer: sweep<N, Hardness::layer>(in, out, r, steps); break;
         }
     };
     switch (settings.neighbourhood) {
@@ -290,15 +366,43 @@ void step(ConstGridView in, GridView out, const Settings& settings, const float*
     }
 }
 
+}  // namespace
+
+void step(ConstGridView in, GridView out, const Settings& settings, const float* hardness) {
+    if (in.width != out.width || in.height != out.height)
+        throw Error("thermal::step: input and output grids differ in size");
+    if (settings.hardness == Hardness::layer && hardness == nullptr)
+        throw Error("thermal::step: hardness layer mode needs a hardness layer");
+    steps_into(in, out, settings, hardness, 1);
+}
+
+void steps(ConstGridView in, GridView out, int count, const Settings& settings, const float* hardness) {
+    if (in.width != out.width || in.height != out.height)
+        throw Error("thermal::steps: input and output grids differ in size");
+    if (count < 1 || count > kStepsPerSweep)
+        throw Error("thermal::steps: count must be 1.." + std::to_string(kStepsPerSweep));
+    if (settings.hardness == Hardness::layer && hardness == nullptr)
+        throw Error("thermal::steps: hardness layer mode needs a hardness layer");
+    steps_into(in, out, settings, hardness, count);
+}
+
 void erode(GridView heights, std::int64_t iterations, const Settings& settings, const float* hardness,
            const std::function<void(std::int64_t, ConstGridView)>& on_step) {
     if (iterations <= 0) return;
+    if (settings.hardness == Hardness::layer && hardness == nullptr)
+        throw Error("thermal::erode: hardness layer mode needs a hardness layer");
     std::vector<float> scratch(heights.size());
     GridView a = heights;
     GridView b{scratch.data(), heights.width, heights.height, heights.cell};
-    for (std::int64_t i = 1; i <= iterations; ++i) {
-        step(a, b, settings, hardness);
+    // Several steps per sweep only pay when the grid streams from DRAM; when
+    // it stays in the caches (1025²: 8 MB for both buffers) the pipeline's
+    // larger working set (L2 instead of L1) costs more than it saves.
+    const int per_sweep = heights.size() * 2 * sizeof(float) > (std::size_t(32) << 20) ? kStepsPerSweep : 1;
+    for (std::int64_t i = 0; i < iterations;) {
+        const int k = int(std::min<std::int64_t>(per_sweep, iterations - i));
+        steps_into(a, b, settings, hardness, k);
         std::swap(a, b);
+        i += k;
         if (on_step) on_step(i, a);
     }
     if (a.data != heights.data) std::memcpy(heights.data, a.data, heights.size() * sizeof(float));

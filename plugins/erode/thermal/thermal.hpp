@@ -62,9 +62,22 @@ Neighbourhood parse_neighbourhood(std::string_view name);
 /// same size. `hardness` (Hardness::layer only) holds in.size() values 0..1.
 void step(ConstGridView in, GridView out, const Settings& settings, const float* hardness = nullptr);
 
-/// `iterations` steps on `heights` in place (double-buffered internally).
-/// `on_step(i, current)` is called after step i (1-based) with the current
-/// heights, for progress, cancellation and finiteness checks.
+/// `count` (1..kStepsPerSweep) steps from `in` to `out` in one sweep over the
+/// grid, bit-identical to `count` calls of step(). `in` and `out` must not
+/// overlap and have the same size.
+void steps(ConstGridView in, GridView out, int count, const Settings& settings, const float* hardness = nullptr);
+
+/// Steps erode() does per sweep over a large grid (temporal blocking: each
+/// row is read from and written to memory once per kStepsPerSweep steps).
+/// Grids whose two buffers fit in 32 MB take one step per sweep.
+inline constexpr int kStepsPerSweep = 4;
+
+/// `iterations` steps on `heights` in place (double-buffered internally),
+/// done up to kStepsPerSweep at a time; the result is bit-identical to
+/// `iterations` calls of step(). `on_step(i, current)` is called with the
+/// current heights after step i for every i that ends a sweep — every
+/// step on small grids, every kStepsPerSweep-th step and the last on large
+/// ones — for progress, cancellation and finiteness checks.
 void erode(GridView heights, std::int64_t iterations, const Settings& settings, const float* hardness = nullptr,
            const std::function<void(std::int64_t, ConstGridView)>& on_step = {});
 

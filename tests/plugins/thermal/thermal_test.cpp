@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -164,6 +165,47 @@ TEST(Thermal, SameBytesOnOneAndTwoThreads) {
     }
     ASSERT_EQ(a.size(), b.size());
     EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
+}
+
+// Several steps in one sweep (temporal blocking, what erode() does on large
+// grids) give the same bytes as as many single steps, for every rule,
+// hardness mode, odd and tiny sizes (bands of rows and their halos clipped
+// at the edges), on 1 and 2 threads.
+TEST(Thermal, StepsInOneSweepEqualSingleSteps) {
+    const std::pair<int, int> sizes[] = {{1, 9}, {9, 1}, {3, 3}, {5, 40}, {40, 5}, {67, 72}, {130, 211}};
+    for (const auto [w, h] : sizes) {
+        const auto start = noise_terrain(w, h, 21, 40.0f);
+        std::vector<float> hard(start.size());
+        for (std::size_t i = 0; i < hard.size(); ++i) hard[i] = float(random::uniform(22, i)) * 1.2f - 0.1f;
+        for (auto nb : {thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated,
+                        thermal::Neighbourhood::moore}) {
+            for (auto hm : {thermal::Hardness::constant, thermal::Hardness::height, thermal::Hardness::layer}) {
+                thermal::Settings s;
+                s.neighbourhood = nb;
+                s.hardness = hm;
+                s.talus_slope = 0.3;
+                s.height_max = 40.0f;
+                for (int count = 1; count <= thermal::kStepsPerSweep; ++count) {
+                    // Reference: `count` single steps.
+                    std::vector<float> a = start, b(start.size());
+                    for (int i = 0; i < count; ++i) {
+                        thermal::step(ConstGridView{a.data(), w, h, 1.0}, GridView{b.data(), w, h, 1.0}, s,
+                                      hard.data());
+                        std::swap(a, b);
+                    }
+                    for (std::size_t threads : {1u, 2u}) {
+                        tbb::global_control c(tbb::global_control::max_allowed_parallelism, threads);
+                        std::vector<float> out(start.size(), -1.0f);
+                        thermal::steps(ConstGridView{start.data(), w, h, 1.0}, GridView{out.data(), w, h, 1.0}, count,
+                                       s, hard.data());
+                        ASSERT_EQ(std::memcmp(out.data(), a.data(), a.size() * sizeof(float)), 0)
+                            << w << "x" << h << " rule " << int(nb) << " hardness " << int(hm) << " count " << count
+                            << " threads " << threads;
+                    }
+                }
+            }
+        }
+    }
 }
 
 TEST(Thermal, UnknownNeighbourhoodIsBadInput) {
