@@ -114,18 +114,18 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
 /// and its neighbours' altitudes (absent neighbours: `has` false).
 inline void factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4], float& f, float& g,
                         float& ow, float& os) {
-    float drop_sum = 0.0f, lower_sum = 0.0f, lower_n = 0.0f;
+    float drop_sum = 0.0f, lower_n = 0.0f;
     for (int k = 0; k < 4; ++k) {
         const float d = a - an[k];
         const bool lower = has[k] && d > 0.0f;
         drop_sum += lower ? d : 0.0f;
-        lower_sum += lower ? an[k] : 0.0f;
         lower_n += lower ? 1.0f : 0.0f;
     }
-    // ā over the cell and its lower neighbours.
-    const float mean = (a + lower_sum) / (1.0f + lower_n);
-    // Olsen's two cases: level out (move a − ā) or drain completely (move w).
-    const float moved = std::min(w, a - mean);
+    // Olsen's two cases: level out (move a − ā, ā the mean altitude of the
+    // cell and its n lower neighbours) or drain completely (move w). Since
+    // a − ā = (n·a − Σ a_k)/(1 + n) = Σ (a − a_k)/(1 + n) = drop_sum/(1 + n),
+    // no sum of altitudes is needed (and no cancellation between them).
+    const float moved = std::min(w, drop_sum / (1.0f + lower_n));
     const float ff = moved / std::max(drop_sum, 1e-30f);
     f = moved > 0.0f ? ff : 0.0f;
     const float gg = f * s / std::max(w, 1e-30f);
