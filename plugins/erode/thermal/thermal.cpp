@@ -272,12 +272,13 @@ constexpr int kMaxStepsPerSweep = kStepsPerSweep;
 template <Neighbourhood N, Hardness H>
 void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     const int w = in.width, hgt = in.height;
-    // Fixed bands of rows (not per thread): few enough that the recomputed
-    // halos (2·steps·(steps−1) rows per band) cost little. Strips of columns
+    // Fixed bands of rows (not per thread): for one step 32 (its halo is one
+    // row of F), for several 16, so that the recomputed halos
+    // (2·steps·(steps−1) rows per band) cost little. Strips of columns
     // (with halos likewise) are supported by the pipeline but were slower
     // than whole rows here (per-row overhead, short vector loops), so a strip
     // is the whole width.
-    const std::int64_t band = std::max<std::int64_t>(16, (hgt + 7) / 8);
+    const std::int64_t band = std::max<std::int64_t>(16, steps == 1 ? hgt / 32 : (hgt + 15) / 16);
     const std::int64_t bands = (hgt + band - 1) / band;
     const int strip = w;
     parallel_for(0, bands, 1, [&](std::int64_t b0, std::int64_t b1) {
