@@ -11,6 +11,8 @@
 // Coordinates: sample coordinates, the rectangle [0, width] × [0, height].
 #pragma once
 
+#include "convex_fill.hpp"
+
 #include <orogen/grid.hpp>
 
 #include <cstdint>
@@ -56,11 +58,5 @@ int face_containing(const Arrangement& arrangement, Point2 p);
 /// neighbours taken in ascending index order, as the thesis's DFS.
 std::vector<int> depth_first_order(const Arrangement& arrangement, int start);
 
-/// For a convex polygon (sample coordinates): call fn(y, x0, x1) for each grid
-/// row holding vertices inside it or on its border, x0..x1 inclusive.
-struct RowSpan {
-    int y, x0, x1;
-};
-void convex_row_spans(std::span<const Point2> polygon, int width, int height, std::vector<RowSpan>& out);
 
 }  // namespace orogen::rmp

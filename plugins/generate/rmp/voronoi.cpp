@@ -12,11 +12,6 @@ namespace orogen::rmp {
 
 namespace {
 
-// Tolerance when rounding polygon coordinates to vertex indices, samples.
-// The exact nearest-site queries at each run's ends make the result exact;
-// this only keeps a vertex lying on the polygon's border from being missed.
-constexpr double kRoundEps = 1e-7;
-
 double dist2(double ax, double ay, const Point2& b) {
     const double dx = ax - b.x, dy = ay - b.y;
     return dx * dx + dy * dy;
@@ -220,38 +215,11 @@ CellPolygon SiteIndex::cell(int s) const {
 }
 
 void SiteIndex::spans_of(int s, const CellPolygon& polygon, std::vector<Span>& out) const {
+    // The polygon's spans, then both ends settled with exact queries (ties and rounding on the border).
+    thread_local std::vector<RowSpan> rough;
+    convex_row_spans(polygon.vertices, width_, height_, rough);
     out.clear();
-    const auto& v = polygon.vertices;
-    if (v.empty()) return;
-    double ymin = v[0].y, ymax = v[0].y;
-    for (const Point2& p : v) {
-        ymin = std::min(ymin, p.y);
-        ymax = std::max(ymax, p.y);
-    }
-    const int y0 = std::max(0, int(std::ceil(ymin - kRoundEps)));
-    const int y1 = std::min(height_ - 1, int(std::floor(ymax + kRoundEps)));
-    const std::size_t n = v.size();
-    for (int y = y0; y <= y1; ++y) {
-        double xl = std::numeric_limits<double>::infinity(), xr = -xl;
-        for (std::size_t k = 0; k < n; ++k) {
-            const Point2& a = v[k];
-            const Point2& b = v[(k + 1) % n];
-            const double lo = std::min(a.y, b.y), hi = std::max(a.y, b.y);
-            if (y < lo - kRoundEps || y > hi + kRoundEps) continue;
-            if (hi - lo < 1e-12) {
-                xl = std::min({xl, a.x, b.x});
-                xr = std::max({xr, a.x, b.x});
-                continue;
-            }
-            const double u = std::clamp((double(y) - a.y) / (b.y - a.y), 0.0, 1.0);
-            const double x = a.x + u * (b.x - a.x);
-            xl = std::min(xl, x);
-            xr = std::max(xr, x);
-        }
-        if (xl > xr) continue;
-        int x0 = std::max(0, int(std::ceil(xl - kRoundEps)));
-        int x1 = std::min(width_ - 1, int(std::floor(xr + kRoundEps)));
-        // Settle both ends with exact queries (ties and rounding on the border).
+    for (auto [y, x0, x1] : rough) {
         while (x0 <= x1 && nearest(x0, y) != s) ++x0;
         while (x1 >= x0 && nearest(x1, y) != s) --x1;
         if (x0 > x1) continue;

@@ -13,6 +13,8 @@
 // covers [0, width-1] × [0, height-1].
 #pragma once
 
+#include "convex_fill.hpp"
+
 #include <orogen/grid.hpp>
 
 #include <cstdint>
@@ -77,9 +79,7 @@ public:
     /// wide cover their cells, with far less overdraw than one covering radius.
     std::vector<double> cell_radius_bounds() const;
 
-    struct Span {
-        int y, x0, x1;
-    };
+    using Span = RowSpan;
     void spans_of(int s, const CellPolygon& polygon, std::vector<Span>& out) const;
 
 private:
