@@ -3,10 +3,6 @@
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>
 
-#if defined(__x86_64__) || defined(__SSE__)
-#include <xmmintrin.h>
-#endif
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -23,18 +19,6 @@
 
 namespace orogen::pipe {
 namespace {
-
-/// Flush denormals to zero inside a parallel body (restored on exit). Water
-/// evaporating and sediment thinning out decay towards 1e-38 and below,
-/// where every float operation costs ~100 cycles. Set on every thread for
-/// every row, so results are the same whatever the thread count.
-struct FlushDenormals {
-#if defined(__x86_64__) || defined(__SSE__)
-    unsigned saved = _mm_getcsr();
-    FlushDenormals() { _mm_setcsr(saved | 0x8040u); }  // FTZ | DAZ
-    ~FlushDenormals() { _mm_setcsr(saved); }
-#endif
-};
 
 /// Constants of one sub-step, in float for the row loops.
 struct Sub {
