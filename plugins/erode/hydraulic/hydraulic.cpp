@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <utility>
@@ -33,19 +34,31 @@ struct PrepRow {
     float *h, *w, *s, *a;  // terrain, water, sediment, altitude a = h + w (m)
 };
 /// One row of Olsen's flow factors: water moved to a lower neighbour = F·drop,
-/// sediment = G·drop; and each cell's total outflow of water (ow = F·Σdrop) and
-/// sediment (os = G·Σdrop), so the gather needs no product per giving pipe.
+/// sediment = G·drop; and what each cell keeps after its total outflow of
+/// water (wr = w − F·Σdrop) and sediment (sr = s − G·Σdrop), so the gather
+/// needs no product per giving pipe.
 struct FactorRow {
-    float *f, *g, *ow, *os;
+    float *f, *g, *wr, *sr;
 };
+
+/// The flow and output loops over a row's inner cells x = 1 … w − 2 run on to
+/// a multiple of 16 cells (no scalar remainder loop in any clone); the cells
+/// past w − 2 are junk in the rows' padding, never read for a real cell, and
+/// x = w − 1 is recomputed after the loop. Rows hold at least padded_end(w) + 1
+/// floats, the tails initialised.
+constexpr int padded_end(int w) { return 1 + (w - 2 + 15) / 16 * 16; }
 
 // ---------------------------------------------------------------- step 1 + 2
 
 template <Hardness H>
 inline float softness(float gx, float gy, const float* layer, int x) {
     if constexpr (H == Hardness::steepness) {
-        const float ny = 1.0f / std::sqrt(1.0f + gx * gx + gy * gy);  // |n_y| of the unit normal
-        const float t = 1.0f - ny;
+        // 1 − |n_y| of the unit normal, |n_y| = 1/√q, q = 1 + g²; written as
+        // g²/(q + √q) (multiply 1 − 1/√q by √q(√q + 1)/(√q(√q + 1))): no
+        // cancellation on gentle slopes, and still one root and one division.
+        const float g2 = gx * gx + gy * gy;
+        const float q = 1.0f + g2;
+        const float t = g2 / (q + std::sqrt(q));
         return t * t * t;
     } else if constexpr (H == Hardness::constant) {
         return 1.0f;
@@ -84,12 +97,16 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
         const float sx = xr > xl ? r.inv_cell / float(xr - xl) : 0.0f;
         prep_cell<H>(r, hc[x], wc[x], sc[x], (hc[xr] - hc[xl]) * sx, (hd[x] - hu[x]) * sy, layer, x, out);
     };
-    edge(0);
-    if (w > 1) edge(w - 1);
+    // Whole vectors (padded_end) where the grids hold that many floats past
+    // the row start (they run on into the next row: junk in the padding);
+    // the edges after the loop.
+    const int xe = std::size_t(padded_end(w)) < std::size_t(rows - yd) * std::size_t(w) ? padded_end(w) : w - 1;
     const float sx = 0.5f * r.inv_cell;
 #pragma GCC ivdep
-    for (int x = 1; x < w - 1; ++x)
+    for (int x = 1; x < xe; ++x)
         prep_cell<H>(r, hc[x], wc[x], sc[x], (hc[x + 1] - hc[x - 1]) * sx, (hd[x] - hu[x]) * sy, layer, x, out);
+    edge(0);
+    if (w > 1) edge(w - 1);
 }
 
 // -------------------------------------------------------------- step 3 flow
@@ -97,7 +114,7 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
 /// Olsen's flow factors for one cell from its altitude a, water w, sediment s
 /// and its neighbours' altitudes (absent neighbours: `has` false).
 inline void factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4], float& f, float& g,
-                        float& ow, float& os) {
+                        float& wr, float& sr) {
     float drop_sum = 0.0f, lower_n = 0.0f;
     for (int k = 0; k < 4; ++k) {
         const float d = a - an[k];
@@ -107,15 +124,18 @@ inline void factor_cell(float a, float w, float s, const float (&an)[4], const b
     }
     // Olsen's two cases: level out (move a − ā, ā the mean altitude of the
     // cell and its n lower neighbours) or drain completely (move w). Since
-    // a − ā = (n·a − Σ a_k)/(1 + n) = Σ (a − a_k)/(1 + n) = drop_sum/(1 + n),
-    // no sum of altitudes is needed (and no cancellation between them).
-    const float moved = std::min(w, drop_sum / (1.0f + lower_n));
-    const float ff = moved / std::max(drop_sum, 1e-30f);
-    f = moved > 0.0f ? ff : 0.0f;
-    const float gg = f * s / std::max(w, 1e-30f);
-    g = w > 0.0f ? gg : 0.0f;
-    ow = f * drop_sum;
-    os = g * drop_sum;
+    // a − ā = (n·a − Σ a_k)/(1 + n) = Σ (a − a_k)/(1 + n) = D/(1 + n)
+    // (D = drop_sum), no sum of altitudes is needed. The water moved per
+    // metre of drop is F = min(w, D/(1 + n))/D = w/max(D, w·(1 + n)) and the
+    // sediment G = F·s/w = s/max(D, w·(1 + n)): one division per cell. Where
+    // nothing flows (D = 0 or w = 0) F = G = 0.
+    const float m = std::max(drop_sum, w * (1.0f + lower_n));
+    const float inv = 1.0f / std::max(m, 1e-30f);
+    const bool flows = drop_sum > 0.0f && w > 0.0f;
+    f = flows ? w * inv : 0.0f;
+    g = flows ? s * inv : 0.0f;
+    wr = w - f * drop_sum;
+    sr = s - g * drop_sum;
 }
 
 OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, const PrepRow* dn, int w,
@@ -124,14 +144,12 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
         const float an[4] = {x > 0 ? c.a[x - 1] : 0.0f, x + 1 < w ? c.a[x + 1] : 0.0f, up ? up->a[x] : 0.0f,
                              dn ? dn->a[x] : 0.0f};
         const bool has[4] = {x > 0, x + 1 < w, up != nullptr, dn != nullptr};
-        factor_cell(c.a[x], c.w[x], c.s[x], an, has, out.f[x], out.g[x], out.ow[x], out.os[x]);
+        factor_cell(c.a[x], c.w[x], c.s[x], an, has, out.f[x], out.g[x], out.wr[x], out.sr[x]);
     };
     if (!up || !dn || w < 3) {
         for (int x = 0; x < w; ++x) edge(x);
         return;
     }
-    edge(0);
-    edge(w - 1);
     const float* __restrict a = c.a;
     const float* __restrict au = up->a;
     const float* __restrict ad = dn->a;
@@ -139,26 +157,30 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
     const float* __restrict sc = c.s;
     float* __restrict f = out.f;
     float* __restrict g = out.g;
-    float* __restrict ow = out.ow;
-    float* __restrict os = out.os;
+    float* __restrict wr = out.wr;
+    float* __restrict sr = out.sr;
     constexpr bool all[4] = {true, true, true, true};
+    // Whole vectors only (see padded_end); the edges after, over the junk.
+    const int xe = padded_end(w);
 #pragma GCC ivdep
-    for (int x = 1; x < w - 1; ++x) {
+    for (int x = 1; x < xe; ++x) {
         const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
-        float fx, gx, owx, osx;
-        factor_cell(a[x], wc[x], sc[x], an, all, fx, gx, owx, osx);
+        float fx, gx, wrx, srx;
+        factor_cell(a[x], wc[x], sc[x], an, all, fx, gx, wrx, srx);
         f[x] = fx;
         g[x] = gx;
-        ow[x] = owx;
-        os[x] = osx;
+        wr[x] = wrx;
+        sr[x] = srx;
     }
+    edge(0);
+    edge(w - 1);
 }
 
 // ----------------------------------------------- step 3 gather + step 4
 
-/// One cell's new state: its own outflow (ow, os), its neighbours' inflow,
-/// then evaporation.
-inline void output_cell(const Rule& r, float a, float h1, float w1, float s1, float ow, float os, const float (&an)[4],
+/// One cell's new state: what it kept after its own outflow (wr, sr), its
+/// neighbours' inflow, then evaporation.
+inline void output_cell(const Rule& r, float a, float h1, float wr, float sr, const float (&an)[4],
                         const float (&fn)[4], const float (&gn)[4], const bool (&has)[4], float& h_out, float& w_out,
                         float& s_out) {
     float w_in = 0.0f, s_in = 0.0f;
@@ -170,8 +192,8 @@ inline void output_cell(const Rule& r, float a, float h1, float w1, float s1, fl
     }
     // Round-off can leave a drained cell at −1e-9 m: clamp, so that capacity
     // never turns negative (the water lost is far below float resolution of the total).
-    const float w2 = std::max(((w1 - ow) + w_in) * r.keep, 0.0f);
-    const float s2 = (s1 - os) + s_in;
+    const float w2 = std::max((wr + w_in) * r.keep, 0.0f);
+    const float s2 = sr + s_in;
     const float excess = std::max(s2 - r.capacity * w2, 0.0f);  // deposited where water cannot hold it
     w_out = w2;
     s_out = s2 - excess;
@@ -187,14 +209,12 @@ OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const 
         const float an[4] = {c.a[xl], c.a[xr], up ? up->a[x] : 0.0f, dn ? dn->a[x] : 0.0f};
         const float fn[4] = {fc.f[xl], fc.f[xr], fup ? fup->f[x] : 0.0f, fdn ? fdn->f[x] : 0.0f};
         const float gn[4] = {fc.g[xl], fc.g[xr], fup ? fup->g[x] : 0.0f, fdn ? fdn->g[x] : 0.0f};
-        output_cell(r, c.a[x], c.h[x], c.w[x], c.s[x], fc.ow[x], fc.os[x], an, fn, gn, has, ho[x], wo[x], so[x]);
+        output_cell(r, c.a[x], c.h[x], fc.wr[x], fc.sr[x], an, fn, gn, has, ho[x], wo[x], so[x]);
     };
     if (!up || !dn || w < 3) {
         for (int x = 0; x < w; ++x) edge(x);
         return;
     }
-    edge(0);
-    edge(w - 1);
     const float* __restrict a = c.a;
     const float* __restrict au = up->a;
     const float* __restrict ad = dn->a;
@@ -205,17 +225,20 @@ OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const 
     const float* __restrict gu = fup->g;
     const float* __restrict gd = fdn->g;
     constexpr bool all[4] = {true, true, true, true};
+    const int xe = padded_end(w);
 #pragma GCC ivdep
-    for (int x = 1; x < w - 1; ++x) {
+    for (int x = 1; x < xe; ++x) {
         const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
         const float fn[4] = {f[x - 1], f[x + 1], fu[x], fd[x]};
         const float gn[4] = {g[x - 1], g[x + 1], gu[x], gd[x]};
         float hx, wx, sx;
-        output_cell(r, a[x], c.h[x], c.w[x], c.s[x], fc.ow[x], fc.os[x], an, fn, gn, all, hx, wx, sx);
+        output_cell(r, a[x], c.h[x], fc.wr[x], fc.sr[x], an, fn, gn, all, hx, wx, sx);
         ho[x] = hx;
         wo[x] = wx;
         so[x] = sx;
     }
+    edge(0);
+    edge(w - 1);
 }
 
 template <Hardness H>
@@ -228,36 +251,66 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
     const std::int64_t grain = std::max<std::int64_t>(32, rows / 8);
     parallel_for(0, rows, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
-        constexpr int kPrep = 5, kFactor = 3;
-        // Not zero-filled: every slot is written before it is read.
-        std::unique_ptr<float[]> storage(new float[std::size_t(w) * (4 * kPrep + 4 * kFactor)]);
+        // Rings of rows: 4 of the rain/dissolve stage (output row y needs
+        // y − 1 … y + 1 while the factors of y + 1 need y … y + 2) and 3 of
+        // the factors; plus one row of output, copied to the grids whole (the
+        // output loop then stores only to cache-resident, 4K-spaced rows; the
+        // three grids are usually n floats apart and alias each other and the
+        // input rows read next; memcpy also streams the copy fastest).
+        constexpr int kPrep = 4, kFactor = 3, kArrays = 4 * kPrep + 4 * kFactor + 3;
+        // Every slot is written before it is read, but for the padding past
+        // w (zeroed once, then junk; see padded_end). Each row
+        // array starts one float before a 64-byte boundary (the vector loops
+        // run from x = 1, so their loads at x and their stores are aligned),
+        // and the arrays are 128 bytes apart modulo 4 KiB, so no two of them
+        // alias in the low 12 address bits (a load stalls behind an unrelated
+        // store whose address matches there: "4K aliasing").
+        std::size_t stride = (std::size_t(padded_end(w)) + 16) / 16 * 16;
+        stride += (32 + 1024 - stride % 1024) % 1024;
+        std::unique_ptr<float[]> storage(new float[stride * kArrays + 16]);
+        float* p = storage.get();
+        p += (64 - (reinterpret_cast<std::uintptr_t>(p + 1) & 63)) / sizeof(float) % 16;
+        for (int k = 0; k < kArrays; ++k) std::fill(p + k * stride + w, p + (k + 1) * stride, 0.0f);
         PrepRow prep[kPrep];
         FactorRow fac[kFactor];
-        float* p = storage.get();
         for (auto& row : prep) {
-            row = {p, p + w, p + 2 * w, p + 3 * w};
-            p += 4 * w;
+            row = {p, p + stride, p + 2 * stride, p + 3 * stride};
+            p += 4 * stride;
         }
         for (auto& row : fac) {
-            row = {p, p + w, p + 2 * w, p + 3 * w};
-            p += 4 * w;
+            row = {p, p + stride, p + 2 * stride, p + 3 * stride};
+            p += 4 * stride;
         }
+        float* const ho = p;
+        float* const wo = p + stride;
+        float* const so = p + 2 * stride;
         auto prep_at = [&](std::int64_t y) -> PrepRow& { return prep[y % kPrep]; };
         auto fac_at = [&](std::int64_t y) -> FactorRow& { return fac[y % kFactor]; };
         std::int64_t next_prep = std::max<std::int64_t>(0, y0 - 2);
         std::int64_t next_factor = std::max<std::int64_t>(0, y0 - 1);
+        const std::size_t bytes = std::size_t(w) * sizeof(float);
         for (std::int64_t y = y0; y < y1; ++y) {
-            for (; next_prep <= std::min<std::int64_t>(rows - 1, y + 2); ++next_prep)
-                prep_row<H>(in, r, int(next_prep), prep_at(next_prep));
-            for (; next_factor <= std::min<std::int64_t>(rows - 1, y + 1); ++next_factor) {
+            const std::int64_t last_prep = std::min<std::int64_t>(rows - 1, y + 2);
+            const std::int64_t last_factor = std::min<std::int64_t>(rows - 1, y + 1);
+            while (next_prep <= last_prep || next_factor <= last_factor) {
+                // The factors of row fy as soon as rows fy − 1 … fy + 1 are
+                // ready (so that 4 rows of the first stage suffice).
                 const std::int64_t fy = next_factor;
-                factor_row(fy > 0 ? &prep_at(fy - 1) : nullptr, prep_at(fy), fy + 1 < rows ? &prep_at(fy + 1) : nullptr,
-                           w, fac_at(fy));
+                if (fy <= last_factor && next_prep > std::min<std::int64_t>(rows - 1, fy + 1)) {
+                    factor_row(fy > 0 ? &prep_at(fy - 1) : nullptr, prep_at(fy),
+                               fy + 1 < rows ? &prep_at(fy + 1) : nullptr, w, fac_at(fy));
+                    ++next_factor;
+                } else {
+                    prep_row<H>(in, r, int(next_prep), prep_at(next_prep));
+                    ++next_prep;
+                }
             }
             const bool has_up = y > 0, has_dn = y + 1 < rows;
             output_row(r, has_up ? &prep_at(y - 1) : nullptr, has_up ? &fac_at(y - 1) : nullptr, prep_at(y), fac_at(y),
-                       has_dn ? &prep_at(y + 1) : nullptr, has_dn ? &fac_at(y + 1) : nullptr, w, out.height.row(int(y)),
-                       out.water.row(int(y)), out.sediment.row(int(y)));
+                       has_dn ? &prep_at(y + 1) : nullptr, has_dn ? &fac_at(y + 1) : nullptr, w, ho, wo, so);
+            std::memcpy(out.height.row(int(y)), ho, bytes);
+            std::memcpy(out.water.row(int(y)), wo, bytes);
+            std::memcpy(out.sediment.row(int(y)), so, bytes);
         }
     });
 }
