@@ -315,7 +315,79 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
     });
 }
 
+Rule make_rule(const Settings& settings, const float* hardness, double cell) {
+    return Rule{float(settings.rain),
+                float(settings.solubility),
+                float(1.0 - settings.evaporation),
+                float(settings.capacity),
+                settings.hardness,
+                hardness,
+                float(1.0 / cell)};
+}
+
+template <Hardness H>
+void outflow_impl(const ConstState& in, const Rule& r, GridView flow) {
+    const int w = in.height.width, rows = in.height.height;
+    parallel_for(0, rows, std::max<std::int64_t>(32, rows / 8), [&](std::int64_t y0, std::int64_t y1) {
+        FlushDenormals ftz;
+        // Rows as step_impl's (padded, tails zeroed): 3 of the first stage, 1 of factors.
+        const std::size_t stride = (std::size_t(padded_end(w)) + 16) / 16 * 16 + 32;
+        std::vector<float> storage(stride * (4 * 3 + 4), 0.0f);
+        float* p = storage.data();
+        PrepRow prep[3];
+        for (auto& row : prep) {
+            row = {p, p + stride, p + 2 * stride, p + 3 * stride};
+            p += 4 * stride;
+        }
+        const FactorRow fac{p, p + stride, p + 2 * stride, p + 3 * stride};
+        auto prep_at = [&](std::int64_t y) -> PrepRow& { return prep[y % 3]; };
+        // Water leaving row c: what a cell has after rain and dissolving
+        // minus what it keeps after its own outflow.
+        auto emit = [&](std::int64_t c) {
+            factor_row(c > 0 ? &prep_at(c - 1) : nullptr, prep_at(c), c + 1 < rows ? &prep_at(c + 1) : nullptr, w, fac);
+            float* out = flow.row(int(c));
+            for (int x = 0; x < w; ++x) out[x] = prep_at(c).w[x] - fac.wr[x];
+        };
+        for (std::int64_t y = std::max<std::int64_t>(0, y0 - 1); y < std::min<std::int64_t>(rows, y1 + 1); ++y) {
+            prep_row<H>(in, r, int(y), prep_at(y));
+            if (y - 1 >= y0 && y - 1 < y1) emit(y - 1);  // row y − 1 has both neighbours now
+        }
+        if (y1 == rows) emit(rows - 1);  // the last row has no lower neighbour
+    });
+}
+
 }  // namespace
+
+void outflow(const ConstState& in, const Settings& settings, const float* hardness, GridView flow) {
+    const int w = in.height.width, h = in.height.height;
+    for (ConstGridView v : {in.water, in.sediment, ConstGridView(flow)})
+        if (v.width != w || v.height != h) throw Error("hydraulic::outflow: grids differ in size");
+    if (settings.hardness == Hardness::layer && hardness == nullptr)
+        throw Error("hydraulic::outflow: hardness layer mode needs a hardness layer");
+    const Rule r = make_rule(settings, hardness, in.height.cell);
+    switch (settings.hardness) {
+        case Hardness::steepness: outflow_impl<Hardness::steepness>(in, r, flow); break;
+        case Hardness::constant: outflow_impl<Hardness::constant>(in, r, flow); break;
+        case Hardness::layer: outflow_impl<Hardness::layer>(in, r, flow); break;
+    }
+}
+
+void steepness_hardness(ConstGridView height, GridView out) {
+    const int w = height.width, rows = height.height;
+    const float inv_cell = float(1.0 / height.cell);
+    for (int y = 0; y < rows; ++y) {
+        // The same differences as the rain/dissolve stage: central inside, one-sided at the edges.
+        const int yu = std::max(y - 1, 0), yd = std::min(y + 1, rows - 1);
+        const float sy = yd > yu ? inv_cell / float(yd - yu) : 0.0f;
+        for (int x = 0; x < w; ++x) {
+            const int xl = std::max(x - 1, 0), xr = std::min(x + 1, w - 1);
+            const float sx = xr > xl ? inv_cell / float(xr - xl) : 0.0f;
+            const float gx = (height.row(y)[xr] - height.row(y)[xl]) * sx;
+            const float gy = (height.row(yd)[x] - height.row(yu)[x]) * sy;
+            out.row(y)[x] = 1.0f - softness<Hardness::steepness>(gx, gy, nullptr, x);
+        }
+    }
+}
 
 void step(const ConstState& in, const State& out, const Settings& settings, const float* hardness) {
     const int w = in.height.width, h = in.height.height;
@@ -324,13 +396,7 @@ void step(const ConstState& in, const State& out, const Settings& settings, cons
         if (v.width != w || v.height != h) throw Error("hydraulic::step: state grids differ in size");
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("hydraulic::step: hardness layer mode needs a hardness layer");
-    const Rule r{float(settings.rain),
-                 float(settings.solubility),
-                 float(1.0 - settings.evaporation),
-                 float(settings.capacity),
-                 settings.hardness,
-                 hardness,
-                 float(1.0 / in.height.cell)};
+    const Rule r = make_rule(settings, hardness, in.height.cell);
     switch (settings.hardness) {
         case Hardness::steepness: step_impl<Hardness::steepness>(in, out, r); break;
         case Hardness::constant: step_impl<Hardness::constant>(in, out, r); break;

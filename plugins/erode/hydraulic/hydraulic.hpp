@@ -61,4 +61,14 @@ void step(const ConstState& in, const State& out, const Settings& settings, cons
 void erode(const State& state, std::int64_t iterations, const Settings& settings, const float* hardness = nullptr,
            const std::function<void(std::int64_t, const ConstState&)>& on_step = {});
 
+/// The water (m) each cell of `in` sends to its lower neighbours in the next
+/// step (after rain and dissolving; before evaporation): where the water
+/// runs, for the node's `flow` layer. Same rules as step().
+void outflow(const ConstState& in, const Settings& settings, const float* hardness, GridView flow);
+
+/// The thesis's steepness hardness 1 − (1 − |n_y|)³ (1 on flat ground, which does
+/// not dissolve, falling toward 0 on cliffs)
+/// of each cell, from the same slopes step() uses: the node's `hardness` layer.
+void steepness_hardness(ConstGridView height, GridView out);
+
 }  // namespace orogen::hydraulic

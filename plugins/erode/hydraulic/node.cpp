@@ -49,6 +49,10 @@ NodeOutputs run(NodeContext& ctx) {
                      });
     const std::vector<float>& after = hm->heights();
     for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
+    // Where the water runs: what each cell would send downhill next step.
+    GridView flow = hm->layer("flow", 0.0f);
+    hydraulic::outflow({hm->view(), water, sediment}, s, layer, flow);
+    if (s.hardness == hydraulic::Hardness::steepness) hydraulic::steepness_hardness(hm->view(), hm->layer("hardness", 0.0f));
     return hm;
 }
 
@@ -57,7 +61,8 @@ void check(CheckContext& ctx) {
     if (hardness != "steepness" && hardness != "constant") {
         ctx.require_layer(0, "hardness", hardness, "use steepness, constant or the name of an existing layer");
     }
-    for (const char* l : {"water", "sediment", "eroded"}) ctx.output().layers.insert(l);
+    for (const char* l : {"water", "sediment", "eroded", "flow"}) ctx.output().layers.insert(l);
+    if (hardness == "steepness") ctx.output().layers.insert("hardness");
 }
 
 }  // namespace
@@ -74,7 +79,9 @@ OROGEN_PLUGIN("erode-hydraulic", "0.1.0", registry) {
             "Olsen's two cases (level out, or drain completely); a fraction of the water evaporates and sediment "
             "above capacity * water is deposited. Water and sediment persist between steps and between nodes: "
             "an input carrying water and sediment layers continues from them. Terrain + sediment is conserved. "
-            "Adds the layers water (m), sediment (m) and eroded (net terrain change, m).",
+            "Adds the layers water (m), sediment (m), eroded (net terrain change, m), flow (water each cell "
+            "sends downhill per step at the end, m) and, with hardness=steepness, hardness (1 on flat ground, "
+            "falling toward 0 on cliffs).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"}},
         .output = ValueType::heightmap,
         .params =
@@ -96,7 +103,7 @@ OROGEN_PLUGIN("erode-hydraulic", "0.1.0", registry) {
                     .help("steepness (the thesis's (1 - |n_y|)^3: flat ground resists), constant, or the name of a "
                           "layer holding hardness 0..1"),
             },
-        .adds_layers = {"water", "sediment", "eroded"},
+        .adds_layers = {"water", "sediment", "eroded", "flow"},
         .check = check,
         .run = run,
     });
