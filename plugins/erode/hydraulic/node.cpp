@@ -49,7 +49,11 @@ NodeOutputs run(NodeContext& ctx) {
                      });
     const std::vector<float>& after = hm->heights();
     for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
-    // Where the water runs: what each cell would send downhill next step.
+    // Where the water runs: what each cell would send downhill next step. This
+    // automaton moved the water itself, so a pipe model's flux state from an
+    // earlier node no longer describes it (and erode:pipe reads `flow` as its
+    // speed only together with its fluxes): drop them.
+    for (const char* l : {"flux_west", "flux_east", "flux_north", "flux_south"}) hm->remove_layer(l);
     GridView flow = hm->layer("flow", 0.0f);
     hydraulic::outflow({hm->view(), water, sediment}, s, layer, flow);
     if (s.hardness == hydraulic::Hardness::steepness) hydraulic::steepness_hardness(hm->view(), hm->layer("hardness", 0.0f));

@@ -4,6 +4,8 @@
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
 
+#include <algorithm>
+
 #include <sstream>
 #include <string>
 #include <utility>
@@ -53,6 +55,12 @@ NodeOutputs run(NodeContext& ctx) {
         if (!(v >= 0.0f)) throw BadInput("rain_mask: the mask holds a negative or NaN value; rain factors must be >= 0");
 
     // State: continue from water/sediment/flux layers when the input has them.
+    // `flow` is this model's speed only in a pipe state (one with the flux
+    // layers); erode:hydraulic writes its own `flow` (water per step, m) and
+    // drops the fluxes, and its `flow` must not set the first sub-step's CFL limit.
+    bool pipe_state = true;
+    for (const char* l : kFluxLayers) pipe_state = pipe_state && hm->has_layer(l);
+    if (!pipe_state) hm->remove_layer("flow");
     pipe::State st;
     st.height = hm->view();
     st.water = hm->layer("water", 0.0f);
