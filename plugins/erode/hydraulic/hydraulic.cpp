@@ -325,6 +325,16 @@ Rule make_rule(const Settings& settings, const float* hardness, double cell) {
                 float(1.0 / cell)};
 }
 
+/// Calls f.template operator()<H>() with the hardness mode H fixed at compile time.
+template <class F>
+void with_hardness(Hardness hardness, F&& f) {
+    switch (hardness) {
+        case Hardness::steepness: f.template operator()<Hardness::steepness>(); break;
+        case Hardness::constant: f.template operator()<Hardness::constant>(); break;
+        case Hardness::layer: f.template operator()<Hardness::layer>(); break;
+    }
+}
+
 template <Hardness H>
 void outflow_impl(const ConstState& in, const Rule& r, GridView flow) {
     const int w = in.height.width, rows = in.height.height;
@@ -365,11 +375,7 @@ void outflow(const ConstState& in, const Settings& settings, const float* hardne
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("hydraulic::outflow: hardness layer mode needs a hardness layer");
     const Rule r = make_rule(settings, hardness, in.height.cell);
-    switch (settings.hardness) {
-        case Hardness::steepness: outflow_impl<Hardness::steepness>(in, r, flow); break;
-        case Hardness::constant: outflow_impl<Hardness::constant>(in, r, flow); break;
-        case Hardness::layer: outflow_impl<Hardness::layer>(in, r, flow); break;
-    }
+    with_hardness(settings.hardness, [&]<Hardness H>() { outflow_impl<H>(in, r, flow); });
 }
 
 void steepness_hardness(ConstGridView height, GridView out) {
@@ -397,11 +403,7 @@ void step(const ConstState& in, const State& out, const Settings& settings, cons
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("hydraulic::step: hardness layer mode needs a hardness layer");
     const Rule r = make_rule(settings, hardness, in.height.cell);
-    switch (settings.hardness) {
-        case Hardness::steepness: step_impl<Hardness::steepness>(in, out, r); break;
-        case Hardness::constant: step_impl<Hardness::constant>(in, out, r); break;
-        case Hardness::layer: step_impl<Hardness::layer>(in, out, r); break;
-    }
+    with_hardness(settings.hardness, [&]<Hardness H>() { step_impl<H>(in, out, r); });
 }
 
 void erode(const State& state, std::int64_t iterations, const Settings& settings, const float* hardness,
