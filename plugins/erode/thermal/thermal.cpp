@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -75,44 +76,8 @@ Rule make_rule(const Settings& s, double cell) {
     return r;
 }
 
-/// Softness (0..1) of the cell at index i with height h: scales what it gives.
-inline float softness(const Rule& r, float h, std::size_t i) {
-    switch (r.hardness) {
-        case Hardness::constant: return 1.0f;
-        case Hardness::height: return 1.0f - height_hardness(h, r.h_min, r.h_max);
-        case Hardness::layer: {
-            const float k = r.hardness_layer[i];
-            return 1.0f - (k < 0.0f ? 0.0f : (k > 1.0f ? 1.0f : k));
-        }
-    }
-    return 1.0f;
-}
-/// Rows y−1, y, y+1 of one height field around row y (pointers; those
-/// outside the grid are never read) and the grid's size.
-struct Rows3 {
-    const float* row[3];
-    int width, height;
-};
-
-/// F for cell (x, y) with bounds checks (edge cells); its outflow into `out`.
-template <Neighbourhood N>
-float factor_checked(const Rows3& in, const Rule& r, int x, int y, float& out) {
-    const float h = in.row[1][x];
-    float excess = 0.0f, sum = 0.0f;
-    for (const Offset& o : offsets<N>()) {
-        const int nx = x + o.dx, ny = y + o.dy;
-        if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
-        const float t = r.threshold(o.diagonal);
-        const float d = h - in.row[1 + o.dy][nx];
-        excess = std::max(excess, d - t);
-        sum += d > t ? d : 0.0f;
-    }
-    out = r.rate * softness(r, h, std::size_t(y) * std::size_t(in.width) + std::size_t(x)) * excess;
-    return out / std::max(sum, 1e-30f);
-}
-
-/// Softness of interior cells, with the hardness mode fixed at compile time
-/// so the row loops vectorise.
+/// Softness of a cell with the hardness mode fixed at compile time (so the
+/// row loops vectorise); `layer` is the cell's row of the hardness layer.
 template <Hardness H>
 inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
     if constexpr (H == Hardness::constant) {
@@ -128,6 +93,46 @@ inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
     }
 }
 
+/// Softness (0..1) of the cell (x, y) with height h: scales what it gives.
+/// The same values as softness_fast, for the edge cells.
+inline float softness(const Rule& r, float h, int x, int y, int width) {
+    const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(width) : nullptr;
+    switch (r.hardness) {
+        case Hardness::constant: return softness_fast<Hardness::constant>(r, h, layer, x);
+        case Hardness::height: return softness_fast<Hardness::height>(r, h, layer, x);
+        case Hardness::layer: return softness_fast<Hardness::layer>(r, h, layer, x);
+    }
+    return 1.0f;
+}
+
+/// Rows y−1, y, y+1 of one height field around row y and the grid's size.
+/// A row outside the grid may be given as `nan_row` (NaN from column −1 to
+/// width): a NaN neighbour is never lower or higher by more than the
+/// threshold and never the largest drop, so it drops out of every sum and
+/// maximum — the vector loops then serve the first and last rows too.
+struct Rows3 {
+    const float* row[3];
+    int width, height;
+    const float* nan_row = nullptr;
+};
+
+/// F for cell (x, y) with bounds checks (edge cells); its outflow into `out`.
+template <Neighbourhood N>
+float factor_checked(const Rows3& in, const Rule& r, int x, int y, float& out) {
+    const float h = in.row[1][x];
+    float excess = 0.0f, sum = 0.0f;
+    for (const Offset& o : offsets<N>()) {
+        const int nx = x + o.dx, ny = y + o.dy;
+        if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
+        const float t = r.threshold(o.diagonal);
+        const float d = h - in.row[1 + o.dy][nx];
+        excess = std::max(excess, d - t);
+        sum += d > t ? d : 0.0f;
+    }
+    out = r.rate * softness(r, h, x, y, in.width) * excess;
+    return out / std::max(sum, 1e-30f);
+}
+
 /// F and the outflow O = rate·softness·max(0, excess) (metres) for every
 /// cell of row y into f[0..width) and o[0..width). A cell's outflow is
 /// Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so the update needs
@@ -141,7 +146,8 @@ template <Neighbourhood N, Hardness H>
 OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int xa, int xb, float* __restrict f,
                                       float* __restrict o) {
     const int w = in.width;
-    if (y == 0 || y == in.height - 1 || w < 3) {
+    const bool edge_row = y == 0 || y == in.height - 1;
+    if (w < 3 || (edge_row && !in.nan_row)) {
         for (int x = xa; x < xb; ++x) f[x] = factor_checked<N>(in, r, x, y, o[x]);
         return;
     }
@@ -152,7 +158,8 @@ OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int
     const float* __restrict nb[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        nb[k] = in.row[1 + offs[k].dy] + offs[k].dx;
+        const float* row = in.row[1 + offs[k].dy];
+        nb[k] = (row ? row : in.nan_row) + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row[1];
@@ -206,7 +213,8 @@ template <Neighbourhood N>
 OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int y, int xa, int xb, const float* const f[3],
                                       const float* __restrict o, float* __restrict dst) {
     const int w = in.width;
-    if (y == 0 || y == in.height - 1 || w < 3) {
+    const bool edge_row = y == 0 || y == in.height - 1;
+    if (w < 3 || (edge_row && !in.nan_row)) {
         for (int x = xa; x < xb; ++x) dst[x] = update_checked<N>(in, r, x, y, f, o[x]);
         return;
     }
@@ -218,8 +226,12 @@ OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int y, int
     const float* __restrict nf[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        nb[k] = in.row[1 + offs[k].dy] + offs[k].dx;
-        nf[k] = f[1 + offs[k].dy] + offs[k].dx;
+        // A missing row: NaN heights (never higher by more than the
+        // threshold, so its F, read from the same row, is never used).
+        const float* row = in.row[1 + offs[k].dy];
+        const float* frow = f[1 + offs[k].dy];
+        nb[k] = (row ? row : in.nan_row) + offs[k].dx;
+        nf[k] = (frow ? frow : in.nan_row) + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row[1];
@@ -271,7 +283,8 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
         // do not all map to the same cache sets.
         const std::size_t stride = std::size_t(std::min(w, strip) + 4 * steps + 16);
         // Per step s ≥ 1: 4 rows of heights; per step s ≥ 0: 3 rows of F, 3 of O.
-        thread_local std::vector<float> store;
+        thread_local std::vector<float> store, nan_row;
+        nan_row.assign(std::size_t(w) + 2, std::numeric_limits<float>::quiet_NaN());
         store.resize(stride * std::size_t(kMaxStepsPerSweep * 4 + (kMaxStepsPerSweep + 1) * 6));
         for (std::int64_t b = b0; b < b1; ++b) {
             const int y0 = int(b * band), y1 = int(std::min<std::int64_t>(hgt, (b + 1) * band));
@@ -296,7 +309,7 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
             };
             auto orow = [&](int s, int y) { return frow(s, y) + 3 * stride; };
             auto rows3 = [&](int s, int y) {
-                Rows3 rs{{nullptr, nullptr, nullptr}, w, hgt};
+                Rows3 rs{{nullptr, nullptr, nullptr}, w, hgt, nan_row.data() + 1};
                 for (int dy = -1; dy <= 1; ++dy) {
                     const int yy = y + dy;
                     if (yy < 0 || yy >= hgt) continue;

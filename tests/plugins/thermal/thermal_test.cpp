@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <numbers>
@@ -203,6 +204,74 @@ TEST(Thermal, StepsInOneSweepEqualSingleSteps) {
                             << " threads " << threads;
                     }
                 }
+            }
+        }
+    }
+}
+
+// One step against a plain reference of Olsen's rule, written here in double
+// from the documented formulas, on every cell — edges and corners included —
+// for every rule and hardness mode: O = rate·softness·max(0, max_i(d_i − T_i))
+// leaves a cell, shared in proportion to d_i among the neighbours with d_i > T_i.
+TEST(Thermal, StepMatchesAPlainReferenceOnEveryCell) {
+    for (const auto [w, h] : {std::pair{23, 17}, std::pair{3, 40}, std::pair{64, 2}}) {
+        const auto v = noise_terrain(w, h, 51, 30.0f);
+        std::vector<float> hard(v.size());
+        for (std::size_t i = 0; i < hard.size(); ++i) hard[i] = float(random::uniform(52, i)) * 1.2f - 0.1f;
+        const float lo = *std::min_element(v.begin(), v.end()), hi = *std::max_element(v.begin(), v.end());
+        for (auto nb : {thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated,
+                        thermal::Neighbourhood::moore}) {
+            for (auto hm : {thermal::Hardness::constant, thermal::Hardness::height, thermal::Hardness::layer}) {
+                thermal::Settings s;
+                s.neighbourhood = nb;
+                s.hardness = hm;
+                s.talus_slope = 0.6;
+                s.rate = 0.4;
+                s.height_min = lo;
+                s.height_max = hi;
+                std::vector<float> out(v.size());
+                thermal::step(ConstGridView{v.data(), w, h, 1.5}, GridView{out.data(), w, h, 1.5}, s, hard.data());
+
+                const bool axis = nb != thermal::Neighbourhood::rotated;
+                const bool diag = nb != thermal::Neighbourhood::von_neumann;
+                auto at = [&](int x, int y) { return double(v[std::size_t(y) * w + x]); };
+                std::vector<double> factor(v.size()), loss(v.size());
+                auto neighbours = [&](int x, int y, auto&& f) {
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) {
+                            const bool diagonal = dx != 0 && dy != 0;
+                            if ((dx == 0 && dy == 0) || (diagonal ? !diag : !axis)) continue;
+                            if (x + dx < 0 || y + dy < 0 || x + dx >= w || y + dy >= h) continue;
+                            f(x + dx, y + dy, 0.6 * 1.5 * (diagonal ? std::sqrt(2.0) : 1.0));
+                        }
+                };
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) {
+                        double excess = 0.0, sum = 0.0;
+                        neighbours(x, y, [&](int nx, int ny, double t) {
+                            const double d = at(x, y) - at(nx, ny);
+                            excess = std::max(excess, d - t);
+                            if (d > t) sum += d;
+                        });
+                        const std::size_t i = std::size_t(y) * w + x;
+                        double soft = 1.0;
+                        if (hm == thermal::Hardness::height) soft = std::pow((hi - at(x, y)) / (hi - lo), 2.0);
+                        if (hm == thermal::Hardness::layer) soft = 1.0 - std::clamp(double(hard[i]), 0.0, 1.0);
+                        loss[i] = s.rate * soft * excess;
+                        factor[i] = sum > 0.0 ? loss[i] / sum : 0.0;
+                    }
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) {
+                        double gain = 0.0;
+                        neighbours(x, y, [&](int nx, int ny, double t) {
+                            const double e = at(nx, ny) - at(x, y);
+                            if (e > t) gain += factor[std::size_t(ny) * w + nx] * e;
+                        });
+                        const std::size_t i = std::size_t(y) * w + x;
+                        ASSERT_NEAR(out[i], at(x, y) - loss[i] + gain, 1e-4)
+                            << w << "x" << h << " cell " << x << "," << y << " rule " << int(nb) << " hardness "
+                            << int(hm);
+                    }
             }
         }
     }
