@@ -4,7 +4,9 @@
 #include <orogen/parallel.hpp>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <iterator>
 #include <limits>
@@ -93,43 +95,48 @@ inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
     }
 }
 
-/// Softness (0..1) of the cell (x, y) with height h: scales what it gives.
-/// The same values as softness_fast, for the edge cells.
-inline float softness(const Rule& r, float h, int x, int y, int width) {
-    const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(width) : nullptr;
-    switch (r.hardness) {
-        case Hardness::constant: return softness_fast<Hardness::constant>(r, h, layer, x);
-        case Hardness::height: return softness_fast<Hardness::height>(r, h, layer, x);
-        case Hardness::layer: return softness_fast<Hardness::layer>(r, h, layer, x);
-    }
-    return 1.0f;
-}
-
-/// Rows y−1, y, y+1 of one height field around row y and the grid's size.
-/// A row outside the grid may be given as `nan_row` (NaN from column −1 to
-/// width): a NaN neighbour is never lower or higher by more than the
-/// threshold and never the largest drop, so it drops out of every sum and
-/// maximum — the vector loops then serve the first and last rows too.
+/// Rows y−1, y, y+1 of one height field around row y (null outside the
+/// grid) and the grid's size. A missing row reads as `nan_row` (NaN from
+/// column −1 to width), as do columns outside the grid on the edge cells: a
+/// NaN neighbour is never lower or higher by more than the threshold and
+/// never the largest drop, so it drops out of every sum and maximum, and the
+/// first and last rows run through the vector loops.
 struct Rows3 {
     const float* row[3];
     int width, height;
-    const float* nan_row = nullptr;
+    const float* nan_row;
 };
 
-/// F for cell (x, y) with bounds checks (edge cells); its outflow into `out`.
-template <Neighbourhood N>
-float factor_checked(const Rows3& in, const Rule& r, int x, int y, float& out) {
+/// Row y + dy of `in`, or the NaN row where it lies outside the grid.
+inline const float* row_or_nan(const Rows3& in, const float* row) { return row ? row : in.nan_row; }
+
+/// Element x of `row`, or NaN where x lies outside the grid — without a
+/// branch: on the edge cells the comparisons follow the terrain.
+inline float at_or_nan(const float* row, int x, int width) {
+    const bool outside = x < 0 || x >= width;
+    const float v = row[std::clamp(x, 0, width - 1)];
+    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(v) | (std::uint32_t(outside) * 0x7fc00000u));
+}
+
+/// F for the edge cell (x, y) (first or last column, or any cell of a grid
+/// narrower than 3) and its outflow into `out`: the vector loop's operations
+/// in the same order, with NaN for the neighbours outside the grid, so the
+/// same bits as an inner cell would get.
+template <Neighbourhood N, Hardness H>
+float factor_edge(const Rows3& in, const Rule& r, int x, int y, float& out) {
     const float h = in.row[1][x];
-    float excess = 0.0f, sum = 0.0f;
+    float max_axis = -INFINITY, max_diag = -INFINITY, sum = 0.0f;
     for (const Offset& o : offsets<N>()) {
-        const int nx = x + o.dx, ny = y + o.dy;
-        if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
-        const float t = r.threshold(o.diagonal);
-        const float d = h - in.row[1 + o.dy][nx];
-        excess = std::max(excess, d - t);
-        sum += d > t ? d : 0.0f;
+        const float d = h - at_or_nan(row_or_nan(in, in.row[1 + o.dy]), x + o.dx, in.width);
+        if (o.diagonal) max_diag = std::max(max_diag, d);
+        else max_axis = std::max(max_axis, d);
+        sum = d > r.threshold(o.diagonal) ? sum + d : sum;
     }
-    out = r.rate * softness(r, h, x, y, in.width) * excess;
+    float excess = 0.0f;
+    if constexpr (N != Neighbourhood::rotated) excess = std::max(excess, max_axis - r.t_axis);
+    if constexpr (N != Neighbourhood::von_neumann) excess = std::max(excess, max_diag - r.t_diag);
+    const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(in.width) : nullptr;
+    out = r.rate * softness_fast<H>(r, h, layer, x) * excess;
     return out / std::max(sum, 1e-30f);
 }
 
@@ -146,20 +153,18 @@ template <Neighbourhood N, Hardness H>
 OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int xa, int xb, float* __restrict f,
                                       float* __restrict o) {
     const int w = in.width;
-    const bool edge_row = y == 0 || y == in.height - 1;
-    if (w < 3 || (edge_row && !in.nan_row)) {
-        for (int x = xa; x < xb; ++x) f[x] = factor_checked<N>(in, r, x, y, o[x]);
+    if (w < 3) {
+        for (int x = xa; x < xb; ++x) f[x] = factor_edge<N, H>(in, r, x, y, o[x]);
         return;
     }
-    if (xa == 0) f[0] = factor_checked<N>(in, r, 0, y, o[0]), xa = 1;
-    if (xb == w) f[w - 1] = factor_checked<N>(in, r, w - 1, y, o[w - 1]), xb = w - 1;
+    if (xa == 0) f[0] = factor_edge<N, H>(in, r, 0, y, o[0]), xa = 1;
+    if (xb == w) f[w - 1] = factor_edge<N, H>(in, r, w - 1, y, o[w - 1]), xb = w - 1;
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        const float* row = in.row[1 + offs[k].dy];
-        nb[k] = (row ? row : in.nan_row) + offs[k].dx;
+        nb[k] = row_or_nan(in, in.row[1 + offs[k].dy]) + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row[1];
@@ -191,35 +196,34 @@ OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int
     }
 }
 
-/// New height of cell (x, y) with bounds checks. f[1 + dy] is F of row
-/// y + dy, `out` the cell's own outflow.
+/// New height of the edge cell x of row y (see factor_edge). f[1 + dy] is F
+/// of row y + dy, `out` the cell's own outflow.
 template <Neighbourhood N>
-float update_checked(const Rows3& in, const Rule& r, int x, int y, const float* const f[3], float out) {
+float update_edge(const Rows3& in, const Rule& r, int x, const float* const f[3], float out) {
     const float h = in.row[1][x];
     float gain = 0.0f;
     for (const Offset& o : offsets<N>()) {
-        const int nx = x + o.dx, ny = y + o.dy;
-        if (nx < 0 || ny < 0 || nx >= in.width || ny >= in.height) continue;
-        const float t = r.threshold(o.diagonal);
-        const float e = in.row[1 + o.dy][nx] - h;  // drop from the neighbour
-        gain += e > t ? f[1 + o.dy][nx] * e : 0.0f;
+        // A neighbour outside the grid is NaN: never higher by more than the
+        // threshold, so its F (read from the NaN row) is never used.
+        const float e = at_or_nan(row_or_nan(in, in.row[1 + o.dy]), x + o.dx, in.width) - h;
+        const float fn = at_or_nan(row_or_nan(in, f[1 + o.dy]), x + o.dx, in.width);
+        gain += e > r.threshold(o.diagonal) ? fn * e : 0.0f;
     }
     return (h - out) + gain;
 }
 
-/// Row y of the next step into dst, from rows y−1..y+1 of the heights, F of
-/// rows y−1..y+1 and the outflow of row y.
+/// The next step of the row y that `in` is centred on, into dst, from rows
+/// y−1..y+1 of the heights, F of rows y−1..y+1 (f) and the outflow of row y (o).
 template <Neighbourhood N>
-OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int y, int xa, int xb, const float* const f[3],
+OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int xa, int xb, const float* const f[3],
                                       const float* __restrict o, float* __restrict dst) {
     const int w = in.width;
-    const bool edge_row = y == 0 || y == in.height - 1;
-    if (w < 3 || (edge_row && !in.nan_row)) {
-        for (int x = xa; x < xb; ++x) dst[x] = update_checked<N>(in, r, x, y, f, o[x]);
+    if (w < 3) {
+        for (int x = xa; x < xb; ++x) dst[x] = update_edge<N>(in, r, x, f, o[x]);
         return;
     }
-    if (xa == 0) dst[0] = update_checked<N>(in, r, 0, y, f, o[0]), xa = 1;
-    if (xb == w) dst[w - 1] = update_checked<N>(in, r, w - 1, y, f, o[w - 1]), xb = w - 1;
+    if (xa == 0) dst[0] = update_edge<N>(in, r, 0, f, o[0]), xa = 1;
+    if (xb == w) dst[w - 1] = update_edge<N>(in, r, w - 1, f, o[w - 1]), xb = w - 1;
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
@@ -228,10 +232,8 @@ OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int y, int
     for (int k = 0; k < K; ++k) {
         // A missing row: NaN heights (never higher by more than the
         // threshold, so its F, read from the same row, is never used).
-        const float* row = in.row[1 + offs[k].dy];
-        const float* frow = f[1 + offs[k].dy];
-        nb[k] = (row ? row : in.nan_row) + offs[k].dx;
-        nf[k] = (frow ? frow : in.nan_row) + offs[k].dx;
+        nb[k] = row_or_nan(in, in.row[1 + offs[k].dy]) + offs[k].dx;
+        nf[k] = row_or_nan(in, f[1 + offs[k].dy]) + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row[1];
@@ -337,7 +339,7 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
                     const float* f[3] = {y > 0 ? frow(s - 1, y - 1) : nullptr, frow(s - 1, y),
                                          y + 1 < hgt ? frow(s - 1, y + 1) : nullptr};
                     float* dst = s == steps ? out.row(y) : hrow(s, y);
-                    update_row<N>(rows3(s - 1, y), r, y, hx0[s], hx1[s], f, orow(s - 1, y), dst);
+                    update_row<N>(rows3(s - 1, y), r, hx0[s], hx1[s], f, orow(s - 1, y), dst);
                 }
             };
             ensure_h(ensure_h, steps, y1 - 1);
