@@ -67,6 +67,19 @@ inline float softness(float gx, float gy, const float* layer, int x) {
     }
 }
 
+/// The slope (metres per metre) at (x, y): central differences inside,
+/// one-sided on the edges. The rain/dissolve stage's edge cells and the
+/// `hardness` layer use it; the inner loop inlines the central case.
+inline void slope_at(ConstGridView height, float inv_cell, int x, int y, float& gx, float& gy) {
+    const int w = height.width, rows = height.height;
+    const int xl = std::max(x - 1, 0), xr = std::min(x + 1, w - 1);
+    const int yu = std::max(y - 1, 0), yd = std::min(y + 1, rows - 1);
+    const float sx = xr > xl ? inv_cell / float(xr - xl) : 0.0f;
+    const float sy = yd > yu ? inv_cell / float(yd - yu) : 0.0f;
+    gx = (height.row(y)[xr] - height.row(y)[xl]) * sx;
+    gy = (height.row(yd)[x] - height.row(yu)[x]) * sy;
+}
+
 template <Hardness H>
 inline void prep_cell(const Rule& r, float h, float w, float s, float gx, float gy, const float* layer, int x,
                       const PrepRow& out) {
@@ -93,9 +106,9 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
     const float* __restrict sc = in.sediment.data + base;
     const float* layer = r.hardness_layer ? r.hardness_layer + base : nullptr;
     auto edge = [&](int x) {
-        const int xl = std::max(x - 1, 0), xr = std::min(x + 1, w - 1);
-        const float sx = xr > xl ? r.inv_cell / float(xr - xl) : 0.0f;
-        prep_cell<H>(r, hc[x], wc[x], sc[x], (hc[xr] - hc[xl]) * sx, (hd[x] - hu[x]) * sy, layer, x, out);
+        float gx, gy;
+        slope_at(in.height, r.inv_cell, x, y, gx, gy);
+        prep_cell<H>(r, hc[x], wc[x], sc[x], gx, gy, layer, x, out);
     };
     // Whole vectors (padded_end) where the grids hold that many floats past
     // the row start (they run on into the next row: junk in the padding);
@@ -379,20 +392,13 @@ void outflow(const ConstState& in, const Settings& settings, const float* hardne
 }
 
 void steepness_hardness(ConstGridView height, GridView out) {
-    const int w = height.width, rows = height.height;
     const float inv_cell = float(1.0 / height.cell);
-    for (int y = 0; y < rows; ++y) {
-        // The same differences as the rain/dissolve stage: central inside, one-sided at the edges.
-        const int yu = std::max(y - 1, 0), yd = std::min(y + 1, rows - 1);
-        const float sy = yd > yu ? inv_cell / float(yd - yu) : 0.0f;
-        for (int x = 0; x < w; ++x) {
-            const int xl = std::max(x - 1, 0), xr = std::min(x + 1, w - 1);
-            const float sx = xr > xl ? inv_cell / float(xr - xl) : 0.0f;
-            const float gx = (height.row(y)[xr] - height.row(y)[xl]) * sx;
-            const float gy = (height.row(yd)[x] - height.row(yu)[x]) * sy;
+    for (int y = 0; y < height.height; ++y)
+        for (int x = 0; x < height.width; ++x) {
+            float gx, gy;
+            slope_at(height, inv_cell, x, y, gx, gy);
             out.row(y)[x] = 1.0f - softness<Hardness::steepness>(gx, gy, nullptr, x);
         }
-    }
 }
 
 void step(const ConstState& in, const State& out, const Settings& settings, const float* hardness) {
