@@ -4,19 +4,21 @@
 #include <orogen/parallel.hpp>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <iterator>
 #include <limits>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-// The row loops are built for plain x86-64 and for AVX2, picked at run time.
-// Both compute every lane with the same operations in the same order (and no
-// FMA contraction, see CMakeLists.txt), so the results are bit-identical.
+// The row loops are built for plain x86-64, AVX2 and AVX-512, picked at run
+// time. All compute every lane with the same operations in the same order
+// (and no FMA contraction, see CMakeLists.txt), so the results are
+// bit-identical. (Fused multiply-adds for the gains were measured: no faster
+// here, and the plain x86-64 clone would have to call fmaf.)
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define OROGEN_THERMAL_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
@@ -95,88 +97,42 @@ inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
     }
 }
 
-/// Rows y−1, y, y+1 of one height field around row y (null outside the
-/// grid) and the grid's size. A missing row reads as `nan_row` (NaN from
-/// column −1 to width), as do columns outside the grid on the edge cells: a
-/// NaN neighbour is never lower or higher by more than the threshold and
-/// never the largest drop, so it drops out of every sum and maximum, and the
-/// first and last rows run through the vector loops.
+/// Rows y−1, y, y+1 of one height field around row y. Every row has a NaN
+/// column at −1 and at `width`, and a row outside the grid is all NaN: a NaN
+/// neighbour is never lower or higher by more than the threshold and never
+/// the largest drop, so it drops out of every sum and maximum, and the edge
+/// cells run through the same loops as the others.
 struct Rows3 {
     const float* row[3];
-    int width, height;
-    const float* nan_row;
+    int width;
 };
 
-/// Row y + dy of `in`, or the NaN row where it lies outside the grid.
-inline const float* row_or_nan(const Rows3& in, const float* row) { return row ? row : in.nan_row; }
-
-/// Element x of `row`, or NaN where x lies outside the grid — without a
-/// branch: on the edge cells the comparisons follow the terrain.
-inline float at_or_nan(const float* row, int x, int width) {
-    const bool outside = x < 0 || x >= width;
-    const float v = row[std::clamp(x, 0, width - 1)];
-    return std::bit_cast<float>(std::bit_cast<std::uint32_t>(v) | (std::uint32_t(outside) * 0x7fc00000u));
-}
-
-/// F for the edge cell (x, y) (first or last column, or any cell of a grid
-/// narrower than 3) and its outflow into `out`: the vector loop's operations
-/// in the same order, with NaN for the neighbours outside the grid, so the
-/// same bits as an inner cell would get.
-template <Neighbourhood N, Hardness H>
-float factor_edge(const Rows3& in, const Rule& r, int x, int y, float& out) {
-    const float h = in.row[1][x];
-    float max_axis = -INFINITY, max_diag = -INFINITY, sum = 0.0f;
-    for (const Offset& o : offsets<N>()) {
-        const float d = h - at_or_nan(row_or_nan(in, in.row[1 + o.dy]), x + o.dx, in.width);
-        if (o.diagonal) max_diag = std::max(max_diag, d);
-        else max_axis = std::max(max_axis, d);
-        sum = d > r.threshold(o.diagonal) ? sum + d : sum;
-    }
-    float excess = 0.0f;
-    if constexpr (N != Neighbourhood::rotated) excess = std::max(excess, max_axis - r.t_axis);
-    if constexpr (N != Neighbourhood::von_neumann) excess = std::max(excess, max_diag - r.t_diag);
-    const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(in.width) : nullptr;
-    out = r.rate * softness_fast<H>(r, h, layer, x) * excess;
-    return out / std::max(sum, 1e-30f);
-}
-
 /// F and the outflow O = rate·softness·max(0, excess) (metres) for every
-/// cell of row y into f[0..width) and o[0..width). A cell's outflow is
-/// Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so the update needs
-/// only O, not one product per neighbour.
-
-/// F and the outflow O = rate·softness·max(0, excess) (metres) for every
-/// cell of row y into f[0..width) and o[0..width). A cell's outflow is
-/// Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so the update needs
-/// only O, not one product per neighbour.
+/// cell of the row `in` is centred on, into f[0..width) and o[0..width). A
+/// cell's outflow is Σ_i F·d_i over its lower neighbours = F·Σ d_i = O, so
+/// the update needs only O, not one product per neighbour. `layer` is the
+/// row of the hardness layer (Hardness::layer only).
 template <Neighbourhood N, Hardness H>
-OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int xa, int xb, float* __restrict f,
+OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, const float* layer, float* __restrict f,
                                       float* __restrict o) {
-    const int w = in.width;
-    if (w < 3) {
-        for (int x = xa; x < xb; ++x) f[x] = factor_edge<N, H>(in, r, x, y, o[x]);
-        return;
-    }
-    if (xa == 0) f[0] = factor_edge<N, H>(in, r, 0, y, o[0]), xa = 1;
-    if (xb == w) f[w - 1] = factor_edge<N, H>(in, r, w - 1, y, o[w - 1]), xb = w - 1;
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        nb[k] = row_or_nan(in, in.row[1 + offs[k].dy]) + offs[k].dx;
+        nb[k] = in.row[1 + offs[k].dy] + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row[1];
-    const float* layer = r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(w) : nullptr;
     const float rate = r.rate;
     // The largest drop per threshold class (axis, diagonal), minus its
     // threshold once: rounding is monotone, so max_k(d_k − t) = max_k(d_k) − t
     // bit for bit, and this saves one subtraction per neighbour.
     const float t_axis = r.t_axis, t_diag = r.t_diag;
+    const int w = in.width;
     // The destination rows never overlap the sources: no alias checks needed.
 #pragma GCC ivdep
-    for (int x = xa; x < xb; ++x) {
+    for (int x = 0; x < w; ++x) {
         const float h = c[x];
         float max_axis = -INFINITY, max_diag = -INFINITY, sum = 0.0f;
 #pragma GCC unroll 8
@@ -196,55 +152,31 @@ OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, int y, int
     }
 }
 
-/// New height of the edge cell x of row y (see factor_edge). f[1 + dy] is F
-/// of row y + dy, `out` the cell's own outflow.
+/// The next step of the row `in` is centred on, into dst[0..width), from F
+/// of the rows above, at and below (f) and the row's own outflow (o).
 template <Neighbourhood N>
-float update_edge(const Rows3& in, const Rule& r, int x, const float* const f[3], float out) {
-    const float h = in.row[1][x];
-    float gain = 0.0f;
-    for (const Offset& o : offsets<N>()) {
-        // A neighbour outside the grid is NaN: never higher by more than the
-        // threshold, so its F (read from the NaN row) is never used.
-        const float e = at_or_nan(row_or_nan(in, in.row[1 + o.dy]), x + o.dx, in.width) - h;
-        const float fn = at_or_nan(row_or_nan(in, f[1 + o.dy]), x + o.dx, in.width);
-        gain += e > r.threshold(o.diagonal) ? fn * e : 0.0f;
-    }
-    return (h - out) + gain;
-}
-
-/// The next step of the row y that `in` is centred on, into dst, from rows
-/// y−1..y+1 of the heights, F of rows y−1..y+1 (f) and the outflow of row y (o).
-template <Neighbourhood N>
-OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, int xa, int xb, const float* const f[3],
+OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, const float* const f[3],
                                       const float* __restrict o, float* __restrict dst) {
-    const int w = in.width;
-    if (w < 3) {
-        for (int x = xa; x < xb; ++x) dst[x] = update_edge<N>(in, r, x, f, o[x]);
-        return;
-    }
-    if (xa == 0) dst[0] = update_edge<N>(in, r, 0, f, o[0]), xa = 1;
-    if (xb == w) dst[w - 1] = update_edge<N>(in, r, w - 1, f, o[w - 1]), xb = w - 1;
     constexpr auto& offs = offsets<N>();
     constexpr int K = int(std::size(offs));
     const float* __restrict nb[K];
     const float* __restrict nf[K];
     float t[K];
     for (int k = 0; k < K; ++k) {
-        // A missing row: NaN heights (never higher by more than the
-        // threshold, so its F, read from the same row, is never used).
-        nb[k] = row_or_nan(in, in.row[1 + offs[k].dy]) + offs[k].dx;
-        nf[k] = row_or_nan(in, f[1 + offs[k].dy]) + offs[k].dx;
+        nb[k] = in.row[1 + offs[k].dy] + offs[k].dx;
+        nf[k] = f[1 + offs[k].dy] + offs[k].dx;
         t[k] = r.threshold(offs[k].diagonal);
     }
     const float* __restrict c = in.row[1];
+    const int w = in.width;
     // The destination row never overlaps the sources: no alias checks needed.
 #pragma GCC ivdep
-    for (int x = xa; x < xb; ++x) {
+    for (int x = 0; x < w; ++x) {
         const float h = c[x];
         float gain = 0.0f;
 #pragma GCC unroll 8
         for (int k = 0; k < K; ++k) {
-            const float e = nb[k][x] - h;  // drop from the neighbour
+            const float e = nb[k][x] - h;  // drop from the neighbour (NaN outside the grid: never used)
             const float fn = nf[k][x];     // loaded unconditionally so the loop vectorises
             gain += e > t[k] ? fn * e : 0.0f;
         }
@@ -260,90 +192,84 @@ constexpr int kMaxStepsPerSweep = kStepsPerSweep;
 /// Row y of step s+1 depends on rows y−2..y+2 of step s (the gain from a
 /// neighbour uses its F, which looks one row further). Each band of output
 /// rows [y0, y1) is computed as a pipeline: step s keeps a ring of 4 rows of
-/// heights and 3 rows of F and O, and produces its rows on demand from
-/// step s−1 (rows [y0 − 2(steps−s), y1 + 2(steps−s)), recomputed by both
-/// neighbouring bands). So the grid is read and written once per `steps`
-/// steps, and the intermediate rows stay in L1/L2. Every row of every step
-/// is the same pure function of the previous step as in a single step, with
-/// the same operations in the same order: the result is bit-identical to
-/// `steps` single steps, whatever the bands or the thread count.
+/// heights (step 0: copies of the input rows) and 3 rows of F and O, and
+/// produces its rows on demand from step s−1 (rows
+/// [y0 − 2(steps−s), y1 + 2(steps−s)), recomputed by both neighbouring
+/// bands). So the grid is read and written once per `steps` steps, and the
+/// intermediate rows stay in L1/L2. Every row of every step is the same pure
+/// function of the previous step as in a single step, with the same
+/// operations in the same order: the result is bit-identical to `steps`
+/// single steps, whatever the bands or the thread count.
 template <Neighbourhood N, Hardness H>
 void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     const int w = in.width, hgt = in.height;
     // Fixed bands of rows (not per thread): for one step 32 (its halo is one
-    // row of F), for several 16, so that the recomputed halos
-    // (2·steps·(steps−1) rows per band) cost little. Strips of columns
-    // (with halos likewise) are supported by the pipeline but were slower
-    // than whole rows here (per-row overhead, short vector loops), so a strip
-    // is the whole width.
-    const std::int64_t band = std::max<std::int64_t>(16, steps == 1 ? hgt / 32 : (hgt + 15) / 16);
+    // row of F), for several 8, so that the recomputed halos
+    // (2·steps·(steps−1) rows of heights per band) cost little.
+    const std::int64_t band = std::max<std::int64_t>(16, steps == 1 ? hgt / 32 : (hgt + 7) / 8);
     const std::int64_t bands = (hgt + band - 1) / band;
-    const int strip = w;
+    // Local rows: column 0 on a 64-byte boundary (the loops' centre loads and
+    // stores are whole cache lines), a NaN column on each side, and not a
+    // multiple of 1 KiB apart (which would put them all in the same cache sets).
+    std::size_t stride = (std::size_t(w) + 17 + 15) & ~std::size_t(15);
+    if (stride % 256 == 0) stride += 16;
+    const std::size_t height_rows = std::size_t(steps) * 4, rows = height_rows + std::size_t(steps) * 6 + 1;
+    constexpr float nan = std::numeric_limits<float>::quiet_NaN();
     parallel_for(0, bands, 1, [&](std::int64_t b0, std::int64_t b1) {
         FlushDenormals ftz;
-        // Local rows cover the strip plus its widest halo, padded so rows
-        // do not all map to the same cache sets.
-        const std::size_t stride = std::size_t(std::min(w, strip) + 4 * steps + 16);
-        // Per step s ≥ 1: 4 rows of heights; per step s ≥ 0: 3 rows of F, 3 of O.
-        thread_local std::vector<float> store, nan_row;
-        nan_row.assign(std::size_t(w) + 2, std::numeric_limits<float>::quiet_NaN());
-        store.resize(stride * std::size_t(kMaxStepsPerSweep * 4 + (kMaxStepsPerSweep + 1) * 6));
+        thread_local std::vector<float> store;
+        store.resize(stride * rows + 16);
+        float* const base = reinterpret_cast<float*>((reinterpret_cast<std::uintptr_t>(store.data()) + 63) &
+                                                     ~std::uintptr_t(63));
+        auto slot = [&](std::size_t i) { return base + stride * i + 16; };  // column 0 of local row i
+        float* const nan_row = slot(rows - 1);                              // stands for rows outside the grid
+        std::fill(nan_row - 1, nan_row + w + 1, nan);
+        for (std::size_t i = 0; i < height_rows; ++i) slot(i)[-1] = slot(i)[w] = nan;
+        // Heights of step s (0 ≤ s < steps), F and O of step s, row y.
+        auto hrow = [&](int s, int y) { return slot(std::size_t(s * 4 + (y & 3))); };
+        auto frow = [&](int s, int y) { return slot(height_rows + std::size_t(s * 6 + y % 3)); };
+        auto orow = [&](int s, int y) { return slot(height_rows + std::size_t(s * 6 + 3 + y % 3)); };
+        auto rows3 = [&](int s, int y) {
+            Rows3 rs{{nan_row, nan_row, nan_row}, w};
+            for (int dy = -1; dy <= 1; ++dy)
+                if (y + dy >= 0 && y + dy < hgt) rs.row[1 + dy] = hrow(s, y + dy);
+            return rs;
+        };
         for (std::int64_t b = b0; b < b1; ++b) {
             const int y0 = int(b * band), y1 = int(std::min<std::int64_t>(hgt, (b + 1) * band));
-            for (int x0 = 0; x0 < w; x0 += strip) {
-            const int x1 = std::min(w, x0 + strip);
-            // Local row pointers are shifted so that p[x] addresses column x.
-            const std::ptrdiff_t xbase = std::ptrdiff_t(x0) - 2 * steps;
             int next_h[kMaxStepsPerSweep + 1];  // next row of heights to produce, per step
             int next_f[kMaxStepsPerSweep + 1];  // next row of F/O to compute, per step
-            int hx0[kMaxStepsPerSweep + 1], hx1[kMaxStepsPerSweep + 1];  // columns of heights, per step
             for (int s = 0; s <= steps; ++s) {
                 next_h[s] = std::max(0, y0 - 2 * (steps - s));
                 next_f[s] = std::max(0, y0 - 2 * (steps - s - 1) - 1);
-                hx0[s] = std::max(0, x0 - 2 * (steps - s));
-                hx1[s] = std::min(w, x1 + 2 * (steps - s));
             }
-            auto hrow = [&](int s, int y) -> float* {  // step s ≥ 1
-                return store.data() + stride * std::size_t((s - 1) * 4 + (y & 3)) - xbase;
-            };
-            auto frow = [&](int s, int y) -> float* {
-                return store.data() + stride * std::size_t(kMaxStepsPerSweep * 4 + s * 6 + (y % 3)) - xbase;
-            };
-            auto orow = [&](int s, int y) { return frow(s, y) + 3 * stride; };
-            auto rows3 = [&](int s, int y) {
-                Rows3 rs{{nullptr, nullptr, nullptr}, w, hgt, nan_row.data() + 1};
-                for (int dy = -1; dy <= 1; ++dy) {
-                    const int yy = y + dy;
-                    if (yy < 0 || yy >= hgt) continue;
-                    rs.row[1 + dy] = s == 0 ? in.row(yy) : hrow(s, yy);
-                }
-                return rs;
-            };
             // Demand-driven: producing heights of step s, row y, first makes
             // sure F of step s−1 exists up to row y+1, which makes sure the
-            // heights of step s−1 exist up to row y+2. F of step s is needed
-            // one column less wide than its heights on each side.
+            // heights of step s−1 exist up to row y+2.
             auto ensure_f = [&](auto& self_h, int s, int upto) -> void {
                 upto = std::min(upto, hgt - 1);
-                const int fx0 = std::max(0, x0 - 2 * (steps - s) + 1), fx1 = std::min(w, x1 + 2 * (steps - s) - 1);
                 for (; next_f[s] <= upto; ++next_f[s]) {
                     const int y = next_f[s];
-                    if (s > 0) self_h(self_h, s, std::min(y + 1, hgt - 1));
-                    factor_row<N, H>(rows3(s, y), r, y, fx0, fx1, frow(s, y), orow(s, y));
+                    self_h(self_h, s, std::min(y + 1, hgt - 1));
+                    const float* layer =
+                        r.hardness_layer ? r.hardness_layer + std::size_t(y) * std::size_t(w) : nullptr;
+                    factor_row<N, H>(rows3(s, y), r, layer, frow(s, y), orow(s, y));
                 }
             };
             auto ensure_h = [&](auto& self, int s, int upto) -> void {
                 for (; next_h[s] <= upto; ++next_h[s]) {
                     const int y = next_h[s];
+                    if (s == 0) {
+                        std::memcpy(hrow(0, y), in.row(y), std::size_t(w) * sizeof(float));
+                        continue;
+                    }
                     ensure_f(self, s - 1, y + 1);
-                    const float* f[3] = {y > 0 ? frow(s - 1, y - 1) : nullptr, frow(s - 1, y),
-                                         y + 1 < hgt ? frow(s - 1, y + 1) : nullptr};
-                    float* dst = s == steps ? out.row(y) : hrow(s, y);
-                    update_row<N>(rows3(s - 1, y), r, hx0[s], hx1[s], f, orow(s - 1, y), dst);
+                    const float* f[3] = {y > 0 ? frow(s - 1, y - 1) : nan_row, frow(s - 1, y),
+                                         y + 1 < hgt ? frow(s - 1, y + 1) : nan_row};
+                    update_row<N>(rows3(s - 1, y), r, f, orow(s - 1, y), s == steps ? out.row(y) : hrow(s, y));
                 }
             };
             ensure_h(ensure_h, steps, y1 - 1);
-            }
         }
     });
 }
@@ -391,9 +317,11 @@ void erode(GridView heights, std::int64_t iterations, const Settings& settings, 
     if (iterations <= 0) return;
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("thermal::erode: hardness layer mode needs a hardness layer");
-    std::vector<float> scratch(heights.size());
+    // Not zero-filled: the first sweep writes every cell, and its two threads
+    // fault the pages in as they go instead of one memset before it.
+    const auto scratch = std::make_unique_for_overwrite<float[]>(heights.size());
     GridView a = heights;
-    GridView b{scratch.data(), heights.width, heights.height, heights.cell};
+    GridView b{scratch.get(), heights.width, heights.height, heights.cell};
     // Several steps per sweep only pay when the grid streams from DRAM; when
     // it stays in the caches (1025²: 8 MB for both buffers) the pipeline's
     // larger working set (L2 instead of L1) costs more than it saves.
