@@ -9,7 +9,6 @@
 #include <cstring>
 #include <iterator>
 #include <limits>
-#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -215,6 +214,32 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     if (stride % 256 == 0) stride += 16;
     const std::size_t height_rows = std::size_t(steps) * 4, rows = height_rows + std::size_t(steps) * 6 + 1;
     constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+    // In place (`in` and `out` the same grid): a band overwrites its output
+    // row y only after it has copied in input rows up to y + 2·steps, so its
+    // own rows are safe; but the 2·steps rows on each side of a boundary
+    // between bands are also read by the band across it, which may already
+    // have overwritten them: those come from a copy taken before the sweep.
+    const bool in_place = in.data == out.data;
+    const int halo = 2 * steps;
+    const std::size_t edge_rows = std::size_t(2 * halo);  // per boundary: rows [yb − halo, yb + halo)
+    std::vector<float> edges(in_place ? std::size_t(bands - 1) * edge_rows * std::size_t(w) : 0);
+    if (in_place)
+        parallel_for(0, bands - 1, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (std::int64_t b = b0; b < b1; ++b)
+                for (std::size_t i = 0; i < edge_rows; ++i) {
+                    const std::int64_t y = (b + 1) * band - halo + std::int64_t(i);
+                    if (y < hgt)
+                        std::memcpy(edges.data() + (std::size_t(b) * edge_rows + i) * std::size_t(w),
+                                    in.row(int(y)), std::size_t(w) * sizeof(float));
+                }
+        });
+    // Input row y for the band [y0, y1) with index b.
+    auto input_row = [&](std::int64_t b, int y0, int y1, int y) -> const float* {
+        if (!in_place || (y >= y0 && y < y1)) return in.row(y);
+        const std::int64_t boundary = y < y0 ? b - 1 : b;
+        const std::int64_t first = (boundary + 1) * band - halo;
+        return edges.data() + (std::size_t(boundary) * edge_rows + std::size_t(y - first)) * std::size_t(w);
+    };
     parallel_for(0, bands, 1, [&](std::int64_t b0, std::int64_t b1) {
         FlushDenormals ftz;
         thread_local std::vector<float> store;
@@ -260,7 +285,7 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
                 for (; next_h[s] <= upto; ++next_h[s]) {
                     const int y = next_h[s];
                     if (s == 0) {
-                        std::memcpy(hrow(0, y), in.row(y), std::size_t(w) * sizeof(float));
+                        std::memcpy(hrow(0, y), input_row(b, y0, y1, y), std::size_t(w) * sizeof(float));
                         continue;
                     }
                     ensure_f(self, s - 1, y + 1);
@@ -274,7 +299,7 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     });
 }
 
-/// `steps` (1..kMaxStepsPerSweep) steps from `in` to `out`, which must not overlap.
+/// `steps` (1..kMaxStepsPerSweep) steps from `in` to `out`: the same grid, or grids that do not overlap.
 void steps_into(ConstGridView in, GridView out, const Settings& settings, const float* hardness, int steps) {
     Rule r = make_rule(settings, in.cell);
     r.hardness_layer = hardness;
@@ -317,21 +342,27 @@ void erode(GridView heights, std::int64_t iterations, const Settings& settings, 
     if (iterations <= 0) return;
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("thermal::erode: hardness layer mode needs a hardness layer");
-    // Not zero-filled: the first sweep writes every cell, and its two threads
-    // fault the pages in as they go instead of one memset before it.
-    const auto scratch = std::make_unique_for_overwrite<float[]>(heights.size());
-    GridView a = heights;
-    GridView b{scratch.get(), heights.width, heights.height, heights.cell};
     // Several steps per sweep only pay when the grid streams from DRAM; when
     // it stays in the caches (1025²: 8 MB for both buffers) the pipeline's
-    // larger working set (L2 instead of L1) costs more than it saves.
-    const int per_sweep = heights.size() * 2 * sizeof(float) > (std::size_t(32) << 20) ? kStepsPerSweep : 1;
-    for (std::int64_t i = 0; i < iterations;) {
-        const int k = int(std::min<std::int64_t>(per_sweep, iterations - i));
-        steps_into(a, b, settings, hardness, k);
+    // larger working set (L2 instead of L1) costs more than it saves. Such
+    // large grids are also swept in place: no second buffer (64 MB at 4097²,
+    // whose page faults cost more than a step).
+    if (heights.size() * 2 * sizeof(float) > (std::size_t(32) << 20)) {
+        for (std::int64_t i = 0; i < iterations;) {
+            const int k = int(std::min<std::int64_t>(kStepsPerSweep, iterations - i));
+            steps_into(heights, heights, settings, hardness, k);
+            i += k;
+            if (on_step) on_step(i, heights);
+        }
+        return;
+    }
+    std::vector<float> scratch(heights.size());
+    GridView a = heights;
+    GridView b{scratch.data(), heights.width, heights.height, heights.cell};
+    for (std::int64_t i = 0; i < iterations; ++i) {
+        steps_into(a, b, settings, hardness, 1);
         std::swap(a, b);
-        i += k;
-        if (on_step) on_step(i, a);
+        if (on_step) on_step(i + 1, a);
     }
     if (a.data != heights.data) std::memcpy(heights.data, a.data, heights.size() * sizeof(float));
 }

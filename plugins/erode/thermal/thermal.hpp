@@ -58,13 +58,13 @@ struct Settings {
 /// Parse "von-neumann" | "rotated" | "moore"; throws orogen::BadInput otherwise.
 Neighbourhood parse_neighbourhood(std::string_view name);
 
-/// One step: out = thermal(in). `in` and `out` must not overlap and have the
-/// same size. `hardness` (Hardness::layer only) holds in.size() values 0..1.
+/// One step: out = thermal(in). `in` and `out` have the same size and are
+/// either the same grid (in place) or do not overlap. `hardness` (Hardness::layer only) holds in.size() values 0..1.
 void step(ConstGridView in, GridView out, const Settings& settings, const float* hardness = nullptr);
 
 /// `count` (1..kStepsPerSweep) steps from `in` to `out` in one sweep over the
-/// grid, bit-identical to `count` calls of step(). `in` and `out` must not
-/// overlap and have the same size.
+/// grid, bit-identical to `count` calls of step(). `in` and `out` have the
+/// same size and are either the same grid (in place) or do not overlap.
 void steps(ConstGridView in, GridView out, int count, const Settings& settings, const float* hardness = nullptr);
 
 /// Steps erode() does per sweep over a large grid (temporal blocking: each
@@ -72,7 +72,8 @@ void steps(ConstGridView in, GridView out, int count, const Settings& settings, 
 /// Grids whose two buffers fit in 32 MB take one step per sweep.
 inline constexpr int kStepsPerSweep = 4;
 
-/// `iterations` steps on `heights` in place (double-buffered internally),
+/// `iterations` steps on `heights` in place (double-buffered internally on
+/// grids whose two buffers fit in 32 MB, swept in place on larger ones),
 /// done up to kStepsPerSweep at a time; the result is bit-identical to
 /// `iterations` calls of step(). `on_step(i, current)` is called with the
 /// current heights after step i for every i that ends a sweep — every

@@ -169,11 +169,12 @@ TEST(Thermal, SameBytesOnOneAndTwoThreads) {
 }
 
 // Several steps in one sweep (temporal blocking, what erode() does on large
-// grids) give the same bytes as as many single steps, for every rule,
-// hardness mode, odd and tiny sizes (bands of rows and their halos clipped
-// at the edges), on 1 and 2 threads.
+// grids), into another grid or in place, give the same bytes as as many
+// single steps, for every rule, hardness mode, odd and tiny sizes (bands of
+// rows and their halos clipped at the edges; 23×113 ends in a band of one
+// row), on 1 and 2 threads.
 TEST(Thermal, StepsInOneSweepEqualSingleSteps) {
-    const std::pair<int, int> sizes[] = {{1, 9}, {9, 1}, {3, 3}, {5, 40}, {40, 5}, {67, 72}, {130, 211}};
+    const std::pair<int, int> sizes[] = {{1, 9}, {9, 1}, {3, 3}, {5, 40}, {40, 5}, {67, 72}, {23, 113}, {130, 211}};
     for (const auto [w, h] : sizes) {
         const auto start = noise_terrain(w, h, 21, 40.0f);
         std::vector<float> hard(start.size());
@@ -202,11 +203,40 @@ TEST(Thermal, StepsInOneSweepEqualSingleSteps) {
                         ASSERT_EQ(std::memcmp(out.data(), a.data(), a.size() * sizeof(float)), 0)
                             << w << "x" << h << " rule " << int(nb) << " hardness " << int(hm) << " count " << count
                             << " threads " << threads;
+                        // In place: the rows next to each boundary between bands
+                        // are read by both bands, one of which may have written them.
+                        std::vector<float> same = start;
+                        thermal::steps(ConstGridView{same.data(), w, h, 1.0}, GridView{same.data(), w, h, 1.0}, count,
+                                       s, hard.data());
+                        ASSERT_EQ(std::memcmp(same.data(), a.data(), a.size() * sizeof(float)), 0)
+                            << "in place " << w << "x" << h << " rule " << int(nb) << " hardness " << int(hm)
+                            << " count " << count << " threads " << threads;
                     }
                 }
             }
         }
     }
+}
+
+// erode() on a grid too large for two buffers in 32 MB sweeps it in place,
+// kStepsPerSweep steps at a time: the same bytes as single steps into a
+// second grid, including a last sweep of fewer steps.
+TEST(Thermal, ErodeOfALargeGridInPlaceEqualsSingleSteps) {
+    const int w = 2100, h = 2101, iterations = thermal::kStepsPerSweep + 1;
+    ASSERT_GT(std::size_t(w) * h * 2 * sizeof(float), std::size_t(32) << 20);
+    auto a = noise_terrain(w, h, 23, 60.0f);
+    std::vector<float> eroded = a, b(a.size());
+    thermal::Settings s;
+    s.talus_slope = 0.3;
+    for (int i = 0; i < iterations; ++i) {
+        thermal::step(ConstGridView{a.data(), w, h, 1.0}, GridView{b.data(), w, h, 1.0}, s);
+        std::swap(a, b);
+    }
+    std::vector<std::int64_t> reported;
+    thermal::erode(GridView{eroded.data(), w, h, 1.0}, iterations, s, nullptr,
+                   [&](std::int64_t i, ConstGridView) { reported.push_back(i); });
+    EXPECT_EQ(std::memcmp(eroded.data(), a.data(), a.size() * sizeof(float)), 0);
+    EXPECT_EQ(reported, (std::vector<std::int64_t>{thermal::kStepsPerSweep, iterations}));
 }
 
 // One step against a plain reference of Olsen's rule, written here in double
