@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cstring>
 #include <iterator>
-#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -50,6 +49,14 @@ constexpr auto& offsets() {
     if constexpr (N == Neighbourhood::von_neumann) return kVonNeumann;
     else if constexpr (N == Neighbourhood::rotated) return kRotated;
     else return kMoore;
+}
+
+/// Index of the first diagonal (or axis) neighbour in offsets<N>(), −1 if none.
+template <Neighbourhood N>
+constexpr int first_of(bool diagonal) {
+    for (int k = 0; k < int(std::size(offsets<N>())); ++k)
+        if (offsets<N>()[k].diagonal == diagonal) return k;
+    return -1;
 }
 
 /// Per-step constants shared by every row.
@@ -96,11 +103,16 @@ inline float softness_fast(const Rule& r, float h, const float* layer, int x) {
     }
 }
 
-/// Rows y−1, y, y+1 of one height field around row y. Every row has a NaN
-/// column at −1 and at `width`, and a row outside the grid is all NaN: a NaN
-/// neighbour is never lower or higher by more than the threshold and never
-/// the largest drop, so it drops out of every sum and maximum, and the edge
-/// cells run through the same loops as the others.
+/// Height of the wall around the grid (metres): every local row of heights
+/// has a wall column at −1 and at `width`, and a row outside the grid is all
+/// wall, with F = 0 in the matching columns and rows of F. A wall cell is
+/// never lower than a neighbour (its drop, h − 1e30 = −1e30, is below every
+/// threshold and every real drop) and gives F·e = 0 to it, so the edge cells
+/// run through the same loops as the others, with the same bits as if their
+/// missing neighbours were skipped.
+constexpr float kWall = 1e30f;
+
+/// Rows y−1, y, y+1 of one height field around row y (see kWall).
 struct Rows3 {
     const float* row[3];
     int width;
@@ -133,12 +145,14 @@ OROGEN_THERMAL_CLONES void factor_row(const Rows3& in, const Rule& r, const floa
 #pragma GCC ivdep
     for (int x = 0; x < w; ++x) {
         const float h = c[x];
-        float max_axis = -INFINITY, max_diag = -INFINITY, sum = 0.0f;
+        // Every neighbour is a number (see kWall), so each maximum starts
+        // from its class's first drop instead of −∞ (two operations less).
+        float max_axis = 0.0f, max_diag = 0.0f, sum = 0.0f;
 #pragma GCC unroll 8
         for (int k = 0; k < K; ++k) {
             const float d = h - nb[k][x];
-            if (offs[k].diagonal) max_diag = std::max(max_diag, d);
-            else max_axis = std::max(max_axis, d);
+            if (offs[k].diagonal) max_diag = k == first_of<N>(true) ? d : std::max(max_diag, d);
+            else max_axis = k == first_of<N>(false) ? d : std::max(max_axis, d);
             sum = d > t[k] ? sum + d : sum;  // the same bits as sum + (d > t ? d : 0): sum ≥ +0
         }
         float excess = 0.0f;
@@ -175,7 +189,7 @@ OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, const floa
         float gain = 0.0f;
 #pragma GCC unroll 8
         for (int k = 0; k < K; ++k) {
-            const float e = nb[k][x] - h;  // drop from the neighbour (NaN outside the grid: never used)
+            const float e = nb[k][x] - h;  // drop from the neighbour (from a wall: its F is 0)
             const float fn = nf[k][x];     // loaded unconditionally so the loop vectorises
             gain += e > t[k] ? fn * e : 0.0f;
         }
@@ -208,12 +222,11 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     const std::int64_t band = std::max<std::int64_t>(16, steps == 1 ? hgt / 32 : (hgt + 7) / 8);
     const std::int64_t bands = (hgt + band - 1) / band;
     // Local rows: column 0 on a 64-byte boundary (the loops' centre loads and
-    // stores are whole cache lines), a NaN column on each side, and not a
+    // stores are whole cache lines), a wall column on each side, and not a
     // multiple of 1 KiB apart (which would put them all in the same cache sets).
     std::size_t stride = (std::size_t(w) + 17 + 15) & ~std::size_t(15);
     if (stride % 256 == 0) stride += 16;
-    const std::size_t height_rows = std::size_t(steps) * 4, rows = height_rows + std::size_t(steps) * 6 + 1;
-    constexpr float nan = std::numeric_limits<float>::quiet_NaN();
+    const std::size_t height_rows = std::size_t(steps) * 4, rows = height_rows + std::size_t(steps) * 6 + 2;
     // In place (`in` and `out` the same grid): a band overwrites its output
     // row y only after it has copied in input rows up to y + 2·steps, so its
     // own rows are safe; but the 2·steps rows on each side of a boundary
@@ -247,15 +260,19 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
         float* const base = reinterpret_cast<float*>((reinterpret_cast<std::uintptr_t>(store.data()) + 63) &
                                                      ~std::uintptr_t(63));
         auto slot = [&](std::size_t i) { return base + stride * i + 16; };  // column 0 of local row i
-        float* const nan_row = slot(rows - 1);                              // stands for rows outside the grid
-        std::fill(nan_row - 1, nan_row + w + 1, nan);
-        for (std::size_t i = 0; i < height_rows; ++i) slot(i)[-1] = slot(i)[w] = nan;
+        // Rows outside the grid: heights (wall) and F (0).
+        float* const wall_row = slot(rows - 2);
+        float* const zero_row = slot(rows - 1);
+        std::fill(wall_row - 1, wall_row + w + 1, kWall);
+        std::fill(zero_row - 1, zero_row + w + 1, 0.0f);
+        for (std::size_t i = 0; i < height_rows; ++i) slot(i)[-1] = slot(i)[w] = kWall;
+        for (std::size_t i = height_rows; i < rows - 2; ++i) slot(i)[-1] = slot(i)[w] = 0.0f;
         // Heights of step s (0 ≤ s < steps), F and O of step s, row y.
         auto hrow = [&](int s, int y) { return slot(std::size_t(s * 4 + (y & 3))); };
         auto frow = [&](int s, int y) { return slot(height_rows + std::size_t(s * 6 + y % 3)); };
         auto orow = [&](int s, int y) { return slot(height_rows + std::size_t(s * 6 + 3 + y % 3)); };
         auto rows3 = [&](int s, int y) {
-            Rows3 rs{{nan_row, nan_row, nan_row}, w};
+            Rows3 rs{{wall_row, wall_row, wall_row}, w};
             for (int dy = -1; dy <= 1; ++dy)
                 if (y + dy >= 0 && y + dy < hgt) rs.row[1 + dy] = hrow(s, y + dy);
             return rs;
@@ -289,8 +306,8 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
                         continue;
                     }
                     ensure_f(self, s - 1, y + 1);
-                    const float* f[3] = {y > 0 ? frow(s - 1, y - 1) : nan_row, frow(s - 1, y),
-                                         y + 1 < hgt ? frow(s - 1, y + 1) : nan_row};
+                    const float* f[3] = {y > 0 ? frow(s - 1, y - 1) : zero_row, frow(s - 1, y),
+                                         y + 1 < hgt ? frow(s - 1, y + 1) : zero_row};
                     update_row<N>(rows3(s - 1, y), r, f, orow(s - 1, y), s == steps ? out.row(y) : hrow(s, y));
                 }
             };
