@@ -216,10 +216,12 @@ constexpr int kMaxStepsPerSweep = kStepsPerSweep;
 template <Neighbourhood N, Hardness H>
 void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     const int w = in.width, hgt = in.height;
-    // Fixed bands of rows (not per thread): for one step 32 (its halo is one
-    // row of F), for several 8, so that the recomputed halos
-    // (2·steps·(steps−1) rows of heights per band) cost little.
-    const std::int64_t band = std::max<std::int64_t>(16, steps == 1 ? hgt / 32 : (hgt + 7) / 8);
+    // Bands of rows: for one step 32 (its halo is one row of F); for several
+    // two per thread, so that the recomputed halos (2·steps·(steps−1) rows
+    // of heights per band) cost little. The result does not depend on them.
+    const std::int64_t per_thread_bands = 2 * std::int64_t(std::max(1, thread_count()));
+    const std::int64_t band = std::max<std::int64_t>(
+        16, steps == 1 ? hgt / 32 : (hgt + per_thread_bands - 1) / per_thread_bands);
     const std::int64_t bands = (hgt + band - 1) / band;
     // Local rows: column 0 on a 64-byte boundary (the loops' centre loads and
     // stores are whole cache lines), a wall column on each side, and not a
@@ -359,29 +361,16 @@ void erode(GridView heights, std::int64_t iterations, const Settings& settings, 
     if (iterations <= 0) return;
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("thermal::erode: hardness layer mode needs a hardness layer");
-    // Several steps per sweep only pay when the grid streams from DRAM; when
-    // it stays in the caches (1025²: 8 MB for both buffers) the pipeline's
-    // larger working set (L2 instead of L1) costs more than it saves. Such
-    // large grids are also swept in place: no second buffer (64 MB at 4097²,
-    // whose page faults cost more than a step).
-    if (heights.size() * 2 * sizeof(float) > (std::size_t(32) << 20)) {
-        for (std::int64_t i = 0; i < iterations;) {
-            const int k = int(std::min<std::int64_t>(kStepsPerSweep, iterations - i));
-            steps_into(heights, heights, settings, hardness, k);
-            i += k;
-            if (on_step) on_step(i, heights);
-        }
-        return;
+    // In place, kStepsPerSweep steps per sweep: each row is read from and
+    // written to memory once per sweep instead of once per step, and no
+    // second buffer is needed (its page faults would cost more than a step
+    // at 4097²).
+    for (std::int64_t i = 0; i < iterations;) {
+        const int k = int(std::min<std::int64_t>(kStepsPerSweep, iterations - i));
+        steps_into(heights, heights, settings, hardness, k);
+        i += k;
+        if (on_step) on_step(i, heights);
     }
-    std::vector<float> scratch(heights.size());
-    GridView a = heights;
-    GridView b{scratch.data(), heights.width, heights.height, heights.cell};
-    for (std::int64_t i = 0; i < iterations; ++i) {
-        steps_into(a, b, settings, hardness, 1);
-        std::swap(a, b);
-        if (on_step) on_step(i + 1, a);
-    }
-    if (a.data != heights.data) std::memcpy(heights.data, a.data, heights.size() * sizeof(float));
 }
 
 }  // namespace orogen::thermal

@@ -67,18 +67,16 @@ void step(ConstGridView in, GridView out, const Settings& settings, const float*
 /// same size and are either the same grid (in place) or do not overlap.
 void steps(ConstGridView in, GridView out, int count, const Settings& settings, const float* hardness = nullptr);
 
-/// Steps erode() does per sweep over a large grid (temporal blocking: each
-/// row is read from and written to memory once per kStepsPerSweep steps).
-/// Grids whose two buffers fit in 32 MB take one step per sweep.
+/// Steps erode() does per sweep over the grid (temporal blocking: each row
+/// is read from and written to memory once per kStepsPerSweep steps).
 inline constexpr int kStepsPerSweep = 4;
 
-/// `iterations` steps on `heights` in place (double-buffered internally on
-/// grids whose two buffers fit in 32 MB, swept in place on larger ones),
-/// done up to kStepsPerSweep at a time; the result is bit-identical to
+/// `iterations` steps on `heights` in place, done kStepsPerSweep at a time
+/// (the last sweep may do fewer); the result is bit-identical to
 /// `iterations` calls of step(). `on_step(i, current)` is called with the
 /// current heights after step i for every i that ends a sweep — every
-/// step on small grids, every kStepsPerSweep-th step and the last on large
-/// ones — for progress, cancellation and finiteness checks.
+/// kStepsPerSweep-th step and the last — for progress, cancellation and
+/// finiteness checks.
 void erode(GridView heights, std::int64_t iterations, const Settings& settings, const float* hardness = nullptr,
            const std::function<void(std::int64_t, ConstGridView)>& on_step = {});
 

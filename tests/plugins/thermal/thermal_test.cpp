@@ -218,25 +218,29 @@ TEST(Thermal, StepsInOneSweepEqualSingleSteps) {
     }
 }
 
-// erode() on a grid too large for two buffers in 32 MB sweeps it in place,
-// kStepsPerSweep steps at a time: the same bytes as single steps into a
-// second grid, including a last sweep of fewer steps.
-TEST(Thermal, ErodeOfALargeGridInPlaceEqualsSingleSteps) {
-    const int w = 2100, h = 2101, iterations = thermal::kStepsPerSweep + 1;
-    ASSERT_GT(std::size_t(w) * h * 2 * sizeof(float), std::size_t(32) << 20);
-    auto a = noise_terrain(w, h, 23, 60.0f);
-    std::vector<float> eroded = a, b(a.size());
+// erode() sweeps the grid in place, kStepsPerSweep steps at a time: the same
+// bytes as single steps into a second grid, including a last sweep of fewer
+// steps, on 1 and 2 threads (two bands per thread).
+TEST(Thermal, ErodeInPlaceEqualsSingleSteps) {
+    const int w = 301, h = 257, iterations = 2 * thermal::kStepsPerSweep + 1;
+    const auto start = noise_terrain(w, h, 23, 60.0f);
     thermal::Settings s;
     s.talus_slope = 0.3;
+    std::vector<float> a = start, b(a.size());
     for (int i = 0; i < iterations; ++i) {
         thermal::step(ConstGridView{a.data(), w, h, 1.0}, GridView{b.data(), w, h, 1.0}, s);
         std::swap(a, b);
     }
-    std::vector<std::int64_t> reported;
-    thermal::erode(GridView{eroded.data(), w, h, 1.0}, iterations, s, nullptr,
-                   [&](std::int64_t i, ConstGridView) { reported.push_back(i); });
-    EXPECT_EQ(std::memcmp(eroded.data(), a.data(), a.size() * sizeof(float)), 0);
-    EXPECT_EQ(reported, (std::vector<std::int64_t>{thermal::kStepsPerSweep, iterations}));
+    for (std::size_t threads : {1u, 2u}) {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, threads);
+        std::vector<float> eroded = start;
+        std::vector<std::int64_t> reported;
+        thermal::erode(GridView{eroded.data(), w, h, 1.0}, iterations, s, nullptr,
+                       [&](std::int64_t i, ConstGridView) { reported.push_back(i); });
+        EXPECT_EQ(std::memcmp(eroded.data(), a.data(), a.size() * sizeof(float)), 0) << threads << " threads";
+        EXPECT_EQ(reported, (std::vector<std::int64_t>{thermal::kStepsPerSweep, 2 * thermal::kStepsPerSweep,
+                                                       iterations}));
+    }
 }
 
 // One step against a plain reference of Olsen's rule, written here in double
