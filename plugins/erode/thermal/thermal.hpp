@@ -59,7 +59,8 @@ struct Settings {
 Neighbourhood parse_neighbourhood(std::string_view name);
 
 /// One step: out = thermal(in). `in` and `out` have the same size and are
-/// either the same grid (in place) or do not overlap. `hardness` (Hardness::layer only) holds in.size() values 0..1.
+/// either the same grid (in place) or do not overlap. `hardness`
+/// (Hardness::layer only) holds in.size() values 0..1.
 void step(ConstGridView in, GridView out, const Settings& settings, const float* hardness = nullptr);
 
 /// `count` (1..kStepsPerSweep) steps from `in` to `out` in one sweep over the

@@ -168,8 +168,8 @@ TEST(Thermal, SameBytesOnOneAndTwoThreads) {
     EXPECT_EQ(std::memcmp(a.data(), b.data(), a.size() * sizeof(float)), 0);
 }
 
-// Several steps in one sweep (temporal blocking, what erode() does on large
-// grids), into another grid or in place, give the same bytes as as many
+// Several steps in one sweep (temporal blocking, what erode() does), into
+// another grid or in place, give the same bytes as as many
 // single steps, for every rule, hardness mode, odd and tiny sizes (bands of
 // rows and their halos clipped at the edges; 23×113 ends in a band of one
 // row), on 1 and 2 threads.
