@@ -14,6 +14,7 @@
 #include <vtkCallbackCommand.h>
 #include <vtkInteractorEventRecorder.h>
 #include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkLogger.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
 #include <vtkOutputWindow.h>
@@ -526,6 +527,8 @@ private:
 int main(int argc, char** argv) {
     vtkNew<orogen::view::QuietOutputWindow> quiet;
     vtkOutputWindow::SetInstance(quiet);
+    // VTK 9 also logs errors through loguru straight to stderr.
+    if (!std::getenv("OROGEN_VIEW_VTK_LOG")) vtkLogger::SetStderrVerbosity(vtkLogger::VERBOSITY_OFF);
     try {
         orogen::view::App app(orogen::view::parse(argc, argv));
         return app.run();

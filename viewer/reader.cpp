@@ -5,6 +5,7 @@
 #include <orogen/io.hpp>
 
 #include <nlohmann/json.hpp>
+#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkImageData.h>
@@ -38,6 +39,17 @@ const float* Terrain::layer(const std::string& name) const {
 namespace {
 
 std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// Notices the errors a VTK reader raises (its error code stays 0 for many of them).
+struct ErrorFlag {
+    bool raised = false;
+    vtkNew<vtkCallbackCommand> command;
+    explicit ErrorFlag(vtkObject* watched) {
+        command->SetClientData(this);
+        command->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<ErrorFlag*>(self)->raised = true; });
+        watched->AddObserver(vtkCommand::ErrorEvent, command);
+    }
+};
 
 /// A readable regular file, or one clear error saying which it is not.
 void check_readable(const fs::path& file) {
@@ -81,20 +93,49 @@ void take_layers(vtkPointData* pd, vtkIdType count, Terrain& t) {
     }
 }
 
+/// VTK's XML readers read a truncated raw appended block without a word:
+/// check that every array's bytes are in the file (uncompressed files; a
+/// compressed one fails in VTK's decompressor, which raises an error).
+void check_appended_data(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::string head(1 << 16, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(std::size_t(in.gcount()));
+    const auto appended = head.find("<AppendedData encoding=\"raw\"");
+    if (appended == std::string::npos || head.find("compressor=") != std::string::npos) return;
+    const auto start = head.find('_', appended);
+    if (start == std::string::npos) throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    const bool wide = head.find("header_type=\"UInt64\"") != std::string::npos;
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(file, ec);
+    for (std::size_t at = head.find("offset=\""); at < appended; at = head.find("offset=\"", at + 1)) {
+        const std::uint64_t offset = std::stoull(head.substr(at + 8, 24));
+        const std::uint64_t begin = start + 1 + offset;
+        std::uint64_t bytes = 0;
+        in.clear();
+        in.seekg(std::streamoff(begin));
+        in.read(reinterpret_cast<char*>(&bytes), wide ? 8 : 4);  // little-endian, as the host
+        if (!in || begin + (wide ? 8 : 4) + bytes > size)
+            throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    }
+}
+
 Terrain read_vti(const fs::path& file) {
+    check_appended_data(file);
     vtkNew<vtkXMLImageDataReader> reader;
     if (!reader->CanReadFile(file.c_str()))
         throw BadInput("cannot read " + quoted(file) + ": not a VTK image data (.vti) file, or truncated");
     reader->SetFileName(file.c_str());
+    ErrorFlag error(reader);
     reader->Update();
     vtkImageData* image = reader->GetOutput();
     int dims[3] = {0, 0, 0};
     if (image) image->GetDimensions(dims);
     vtkDataArray* h = image ? image->GetPointData()->GetArray("height") : nullptr;
-    if (reader->GetErrorCode() != 0 || !h)
-        throw BadInput("cannot read " + quoted(file) + ": " +
-                       (h ? std::string("the file is damaged (truncated?)")
-                          : std::string("it has no 'height' point array; is it an export:vtk heightmap?")));
+    if (error.raised || reader->GetErrorCode() != 0)
+        throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    if (!h)
+        throw BadInput("cannot read " + quoted(file) + ": it has no 'height' point array; is it an export:vtk heightmap?");
     if (dims[1] != 1 || dims[0] < 2 || dims[2] < 2)
         throw BadInput("cannot show " + quoted(file) + ": expected width × 1 × height points (export:vtk's layout), got " +
                        std::to_string(dims[0]) + " × " + std::to_string(dims[1]) + " × " + std::to_string(dims[2]));
@@ -112,12 +153,14 @@ Terrain read_vti(const fs::path& file) {
 }
 
 vtkSmartPointer<vtkPolyData> read_polydata(const fs::path& file) {
+    check_appended_data(file);
     vtkNew<vtkXMLPolyDataReader> reader;
     if (!reader->CanReadFile(file.c_str()))
         throw BadInput("cannot read " + quoted(file) + ": not a VTK polygonal data (.vtp) file, or truncated");
     reader->SetFileName(file.c_str());
+    ErrorFlag error(reader);
     reader->Update();
-    if (reader->GetErrorCode() != 0 || !reader->GetOutput())
+    if (error.raised || reader->GetErrorCode() != 0 || !reader->GetOutput())
         throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
     vtkSmartPointer<vtkPolyData> poly = reader->GetOutput();
     return poly;

@@ -462,6 +462,7 @@ struct Scene::Impl {
         double b[6];
         renderer->ComputeVisiblePropBounds(b);
         if (b[0] > b[1]) return;
+        renderer->ComputeAspect();  // before the first render too: the fit depends on the window's shape
         const double centre[3] = {(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2};
         const double el = (top_view ? 90.0 : std::clamp(angles.elevation, -89.0, 90.0)) * pi / 180,
                      az = angles.azimuth * pi / 180;

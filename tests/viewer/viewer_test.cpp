@@ -227,6 +227,7 @@ PlateHistory moving_plates() {
 
 TEST_F(Viewer, PlatesSeriesFramesDifferOverTime) {
     write_vti(dir / "t.vti", plain_and_plateau(), 65, 65);
+    fs::create_directories(dir / "plates");
     vtk::write_plates(moving_plates(), dir / "plates" / "plates.pvd");
     for (int t = 0; t < 3; ++t) {
         const Result r = view("t.vti plates/plates.pvd --screenshot p" + std::to_string(t) + ".png --time " +
@@ -301,35 +302,32 @@ TEST_F(Viewer, EachKeyDoesWhatTheHelpSays) {
     };
     const std::string before = replay({});
     EXPECT_EQ(state_value(before, "layer"), "splat");
-    struct Case {
-        std::string sym;
-        char code;
-        std::string key, after;
-    };
-    const std::vector<Case> cases{
-        {"l", 'l', "layer", "height"},          {"L", 'L', "layer", "flow"},
-        {"w", 'w', "water", "off"},             {"p", 'p', "particles", "off"},
-        {"m", 'm', "plates", "off"},            {"e", 'e', "edges", "on"},
-        {"h", 'h', "help", "on"},               {"v", 'v', "view", "top"},
-        {"plus", '+', "exaggeration", "1.25"},  {"minus", '-', "exaggeration", "0.8"},
-        {"period", '.', "time_index", "1"},     {"space", ' ', "playing", "on"},
-        {"a", 'a', "particle_attribute", "1"},  {"f", 'f', "full_resolution", "on"},
-    };
-    for (const auto& c : cases) {
-        const std::string after = replay({{c.sym, c.code}});
-        EXPECT_EQ(state_value(after, c.key), c.after) << "key " << c.sym;
-        EXPECT_NE(state_value(before, c.key), c.after) << "key " << c.sym;
+    // Every toggle at once (each changes its own setting), then the keys that go back.
+    const std::string all = replay({{"l", 'l'}, {"w", 'w'}, {"p", 'p'}, {"m", 'm'}, {"e", 'e'}, {"h", 'h'}, {"v", 'v'},
+                                    {"plus", '+'}, {"period", '.'}, {"space", ' '}, {"a", 'a'}, {"f", 'f'}});
+    const std::vector<std::pair<std::string, std::string>> expected{
+        {"layer", "height"}, {"water", "off"},          {"particles", "off"}, {"plates", "off"},
+        {"edges", "on"},     {"help", "on"},            {"view", "top"},      {"exaggeration", "1.25"},
+        {"time_index", "1"}, {"playing", "on"},         {"particle_attribute", "1"},
+        {"full_resolution", "on"}};
+    for (const auto& [key, value] : expected) {
+        EXPECT_EQ(state_value(all, key), value) << key;
+        EXPECT_NE(state_value(before, key), value) << key;
     }
+    const std::string back = replay({{"L", 'L'}, {"minus", '-'}, {"comma", ','}});
+    EXPECT_EQ(state_value(back, "layer"), "flow");  // before splat: the last layer
+    EXPECT_EQ(state_value(back, "exaggeration"), "0.8");
+    EXPECT_EQ(state_value(back, "time_index"), "0");  // stays at the first time
     // r puts the camera back where it started after a drag.
     std::ofstream(dir / "events.log") << "# StreamVersion 1\n"
                                          "LeftButtonPressEvent 160 120 0 0 0 0 0\n"
                                          "MouseMoveEvent 200 150 0 0 0 0 0\n"
                                          "MouseMoveEvent 260 170 0 0 0 0 0\n"
                                          "LeftButtonReleaseEvent 260 170 0 0 0 0 0\n";
-    const std::string dragged = view("t.vti --events events.log --print-state --size 320x240").out;
+    const std::string dragged = view("t.vti plates.pvd --events events.log --print-state --size 320x240").out;
     EXPECT_NE(state_value(dragged, "camera"), state_value(before, "camera"));
     std::ofstream(dir / "events.log", std::ios::app) << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
-    const std::string reset = view("t.vti --events events.log --print-state --size 320x240").out;
+    const std::string reset = view("t.vti plates.pvd --events events.log --print-state --size 320x240").out;
     EXPECT_EQ(state_value(reset, "camera"), state_value(before, "camera"));
     // s writes a screenshot into the working folder.
     std::ofstream(dir / "events.log") << key_events({{"s", 's'}});
