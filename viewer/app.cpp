@@ -60,6 +60,7 @@ const char* const usage =
     "  --time T               show the series frame at or before time T\n"
     "  --exaggeration E       vertical exaggeration (default 1)\n"
     "  --full                 full resolution for terrains over 1025 samples a side\n"
+    "  --no-water             start with the water surface hidden (key w)\n"
     "  --orogen PATH          the orogen CLI to run specs with (default: beside orogen-view)\n"
     "  --timing               print the time to the first frame and to switch to each layer\n"
     "  -h, --help             this text; in the window, press h for the keys\n";
@@ -88,6 +89,7 @@ struct Options {
     std::optional<double> time;
     double exaggeration = 1.0;
     bool full = false;
+    bool no_water = false;
     bool watch = false;
     fs::path out;
     fs::path orogen;
@@ -146,6 +148,8 @@ Options parse(int argc, char** argv) {
         } else if (a == "--exaggeration") {
             o.exaggeration = number("--exaggeration", value());
             if (!(o.exaggeration > 0)) throw BadInput("--exaggeration must be above 0");
+        } else if (a == "--no-water") {
+            o.no_water = true;
         } else if (a == "--full") {
             o.full = true;
         } else if (a == "--watch") {
@@ -362,6 +366,7 @@ private:
             scene_->set_time(*o_.time);
         }
         if (o_.full) scene_->set_full_resolution(true);
+        if (o_.no_water) scene_->toggle_water();
         if (o_.exaggeration != 1.0) scene_->set_exaggeration(o_.exaggeration);
         if (o_.camera || o_.top) {
             if (o_.camera) scene_->set_camera(*o_.camera);
@@ -452,7 +457,7 @@ private:
             const fs::path s = o_.screenshot;
             scene_->screenshot((s.parent_path() / (s.stem().string() + "-" + std::to_string(reloads_) + ".png")).string());
         }
-        if (o_.exit_after_reloads > 0 && reloads_ >= o_.exit_after_reloads) interactor_->TerminateApp();
+        if (o_.exit_after_reloads > 0 && reloads_ >= o_.exit_after_reloads) interactor_->SetDone(true);  // not TerminateApp(): in VTK 9.1 it crashes the X event loop from a callback
     }
 
     static std::string trim_lines(const std::string& text, int max) {
@@ -496,7 +501,7 @@ private:
             scene_->screenshot(file);
             scene_->set_message("saved " + file, false);
         } else if (k == "q" || k == "Escape") {
-            interactor_->TerminateApp();
+            interactor_->SetDone(true);  // not TerminateApp(): in VTK 9.1 it crashes the X event loop from a callback
             return;
         } else {
             return;

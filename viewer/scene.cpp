@@ -121,11 +121,11 @@ vtkSmartPointer<vtkLookupTable> lut_for(const std::string& name, const float* v,
         return name == "boundary" ? categories({ids.begin(), ids.end()}, boundary_names, boundary_colours)
                                   : categories({ids.begin(), ids.end()});
     }
-    // Heavy tails (a few fast cells of flow) would wash the map out: the
-    // range ends at the 99.5th percentile of magnitudes.
+    // Heavy tails (a few fast cells of flow, a few deep gullies) would wash
+    // the map out: the range ends at the 98th percentile of magnitudes.
     std::vector<float> mags(v, v + n);
     for (float& m : mags) m = std::fabs(m);
-    const std::size_t k = std::min(n - 1, std::size_t(double(n) * 0.995));
+    const std::size_t k = std::min(n - 1, std::size_t(double(n) * 0.98));
     std::nth_element(mags.begin(), mags.begin() + std::ptrdiff_t(k), mags.end());
     const double top = std::max(double(mags[k]), 1e-9);
     if (style.kind == LayerStyle::diverging)  // blue below zero, white at zero, red above (cool to warm)
@@ -528,7 +528,7 @@ Scene::Scene(vtkRenderWindow* window) : impl_(std::make_unique<Impl>()) {
         "if (dist > 1.0) { discard; } else { float scale = 1.0 - dist; ambientColor *= scale; diffuseColor *= scale; }\n");
     m.bar->SetNumberOfLabels(5);
     m.bar->SetOrientationToHorizontal();  // bottom right, clear of long titles
-    m.bar->SetPosition(0.6, 0.015);
+    m.bar->SetPosition(0.6, 0.05);
     m.bar->SetWidth(0.38);
     m.bar->SetHeight(0.11);
     m.bar->SetMaximumHeightInPixels(90);
@@ -540,9 +540,9 @@ Scene::Scene(vtkRenderWindow* window) : impl_(std::make_unique<Impl>()) {
     m.message->GetTextProperty()->SetVerticalJustificationToTop();
     m.message->SetPosition(0.01, 0.98);
     m.help->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
-    m.help->GetTextProperty()->SetJustificationToCentered();
+    m.help->GetTextProperty()->SetJustificationToLeft();  // a table: the columns line up
     m.help->GetTextProperty()->SetVerticalJustificationToCentered();
-    m.help->SetPosition(0.5, 0.5);
+    m.help->SetPosition(0.22, 0.5);
     m.help->SetInput(help_text().c_str());
     m.help->SetVisibility(false);
     m.message->SetVisibility(false);

@@ -349,7 +349,8 @@ TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) 
     write_spec(good1);
     const std::string cmd = "cd '" + dir.string() + "' && '" OROGEN_VIEW "' w.orogen --watch --exit-after-reloads 4 "
                             "--orogen '" OROGEN_CLI "' --out out --screenshot shot.png --size 320x240 >stdout 2>stderr";
-    std::thread viewer([&] { std::system(cmd.c_str()); });
+    int status = -1;
+    std::thread viewer([&] { status = std::system(cmd.c_str()); });
     auto wait_for = [&](const std::string& text) {
         for (int i = 0; i < 600; ++i) {
             if (slurp(dir / "stdout").find(text) != std::string::npos) return true;
@@ -366,6 +367,7 @@ TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) 
     const bool fourth = third && wait_for("reload 4: ok");
     viewer.join();
     ASSERT_TRUE(fourth) << slurp(dir / "stdout") << slurp(dir / "stderr");
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;  // exits cleanly after the 4th load
     const std::string out = slurp(dir / "stdout");
     EXPECT_NE(out.find("w.orogen:4:"), std::string::npos) << out;  // file:line:col of the syntax error
     const Picture p1 = read_png(dir / "shot-1.png"), p2 = read_png(dir / "shot-2.png"), p3 = read_png(dir / "shot-3.png"),
