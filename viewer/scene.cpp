@@ -49,7 +49,7 @@ constexpr double pi = 3.14159265358979323846;
 
 /// The longest side shown by default; bigger terrains keep every k-th sample
 /// (the colour texture keeps full resolution up to `max_texture`).
-constexpr int display_samples = 1025;
+constexpr int display_samples = 513;
 constexpr int max_texture = 8192;
 
 struct LayerStyle {
@@ -590,25 +590,26 @@ void Scene::show(Content content, bool keep_camera) {
         m.terrain->SetVisibility(true);
     }
     for (const auto& file : m.content.gltf) {
-        // The importer adds its actors to a renderer of its own window; move them into ours.
-        vtkNew<vtkGLTFImporter> importer;
-        vtkNew<vtkRenderWindow> scratch;
-        scratch->SetOffScreenRendering(true);
-        importer->SetFileName(file.c_str());
-        importer->SetRenderWindow(scratch);
-        importer->Update();
-        vtkRenderer* r = scratch->GetRenderers()->GetFirstRenderer();
-        vtkActorCollection* actors = r ? r->GetActors() : nullptr;
-        if (!actors || actors->GetNumberOfItems() == 0)
-            throw BadInput("cannot read '" + file.string() + "': not a valid glTF file, or it holds no mesh");
+        // The importer adds its actors (and may add lights) to our renderer: keep the actors, drop the rest.
+        std::set<vtkActor*> before;
+        vtkActorCollection* actors = m.renderer->GetActors();
         actors->InitTraversal();
-        while (vtkActor* a = actors->GetNextActor()) {
-            m.gltf_actors.emplace_back(a);
-            m.renderer->AddActor(a);
-            double b[6];
-            a->GetBounds(b);
-            m.top = std::max(m.top, b[3]);
-        }
+        while (vtkActor* a = actors->GetNextActor()) before.insert(a);
+        vtkNew<vtkGLTFImporter> importer;
+        importer->SetFileName(file.c_str());
+        importer->SetRenderWindow(m.window);
+        importer->Update();
+        actors = m.renderer->GetActors();  // rebuilt from the renderer's props on each call
+        actors->InitTraversal();
+        while (vtkActor* a = actors->GetNextActor())
+            if (!before.count(a)) {
+                m.gltf_actors.emplace_back(a);
+                double b[6];
+                a->GetBounds(b);
+                m.top = std::max(m.top, b[3]);
+            }
+        if (m.gltf_actors.empty())
+            throw BadInput("cannot read '" + file.string() + "': not a valid glTF file, or it holds no mesh");
     }
     m.plate_series = m.particle_series = nullptr;
     std::set<double> times;
@@ -778,6 +779,7 @@ void Scene::screenshot(const std::string& file) {
     grab->SetInput(impl_->window);
     grab->SetInputBufferTypeToRGBA();
     grab->ReadFrontBufferOff();
+    grab->ShouldRerenderOff();  // just rendered
     grab->Update();
     vtkImageData* image = grab->GetOutput();
     int dims[3];
