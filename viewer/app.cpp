@@ -389,6 +389,10 @@ private:
                       << ms(t0, t1) << " ms, render " << ms(t1, t2) << " ms)\n";
         }
         scene_->set_layer(o_.layer.empty() ? "splat" : o_.layer);
+        const auto t0 = Clock::now();
+        const double c0 = cpu_ms();
+        scene_->render();
+        std::cout << "render, nothing changed: " << ms(t0, Clock::now()) << " ms wall, " << cpu_ms() - c0 << " ms CPU\n";
     }
 
     static double cpu_ms() {
