@@ -59,7 +59,7 @@ const char* const usage =
     "  --layer NAME           colour by this layer (splat, height, water, flow, plate, ...)\n"
     "  --time T               show the series frame at or before time T\n"
     "  --exaggeration E       vertical exaggeration (default 1)\n"
-    "  --full                 full mesh resolution for terrains over 513 samples a side\n"
+    "  --full                 full mesh resolution for terrains over 257 samples a side\n"
     "  --no-water             start with the water surface hidden (key w)\n"
     "  --orogen PATH          the orogen CLI to run specs with (default: beside orogen-view)\n"
     "  --timing               print the time to the first frame and to switch to each layer\n"
