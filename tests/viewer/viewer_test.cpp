@@ -192,19 +192,31 @@ TEST_F(Viewer, AnUnknownLayerNamesTheLayersThereAre) {
     EXPECT_EQ(r.err, "orogen-view: error: no layer 'flw' to colour by; this terrain has: splat, height, flow\n");
 }
 
-TEST_F(Viewer, RawPngAndVtpTerrainsShowTheSameSplat) {
+TEST_F(Viewer, VtpRawAndPngTerrainsShowTheSameSplat) {
     const auto h = plain_and_plateau();
     write_vti(dir / "t.vti", h, 65, 65);
     vtk::write_heightmap(ConstGridView(h.data(), 65, 65, 10.0), {}, dir / "t.vtp");
     raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
+    {  // a 16-bit PNG heightmap: no units, but the same bands (flat plain and plateau)
+        std::vector<std::uint16_t> grey(h.size());
+        for (std::size_t i = 0; i < h.size(); ++i) grey[i] = std::uint16_t(std::lround(h[i] / 100.0 * 65535));
+        AtomicFile png(dir / "t.png");
+        write_gray_png(png.stream(), 65, 65, 16, grey);
+        png.commit();
+    }
     ASSERT_EQ(view("t.vti --screenshot a.png " + top_view).code, 0);
     Result r = view("t.vtp --screenshot b.png " + top_view);
     ASSERT_EQ(r.code, 0) << r.err;
     r = view("t.r16 --screenshot c.png " + top_view);
     ASSERT_EQ(r.code, 0) << r.err;
-    const Picture a = read_png(dir / "a.png"), b = read_png(dir / "b.png"), c = read_png(dir / "c.png");
-    EXPECT_LT(distance(patch(a, 70, 160), patch(b, 70, 160)), 10);
-    EXPECT_LT(distance(patch(a, 250, 160), patch(c, 250, 160)), 10);
+    r = view("t.png --screenshot d.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Picture a = read_png(dir / "a.png"), b = read_png(dir / "b.png"), c = read_png(dir / "c.png"),
+                  d = read_png(dir / "d.png");
+    for (const Picture* p : {&b, &c, &d}) {
+        EXPECT_LT(distance(patch(a, 70, 160), patch(*p, 70, 160)), 10);
+        EXPECT_LT(distance(patch(a, 250, 160), patch(*p, 250, 160)), 10);
+    }
 }
 
 // --------------------------------------------------------------------- time
