@@ -309,6 +309,18 @@ Series read_pvd(const fs::path& file) {
 Content read_files(std::span<const fs::path> files) {
     Content c;
     for (const fs::path& file : files) {
+        std::error_code ec;
+        if (fs::is_directory(file, ec)) {  // an output folder: what a spec run there would show
+            const auto inside = pick_outputs(file);
+            if (inside.empty())
+                throw BadInput("cannot open " + quoted(file) + ": the folder holds nothing orogen-view shows (" +
+                               known_extensions + ")");
+            Content more = read_files(inside);
+            for (auto& t : more.terrains) c.terrains.push_back(std::move(t));
+            for (auto& s : more.series) c.series.push_back(std::move(s));
+            for (auto& g : more.gltf) c.gltf.push_back(std::move(g));
+            continue;
+        }
         const std::string ext = extension(file);
         const bool known = ext == ".vti" || ext == ".vtp" || ext == ".pvd" || ext == ".glb" || ext == ".gltf" ||
                            ext == ".png" || ext == ".r16" || ext == ".r32";

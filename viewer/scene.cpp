@@ -346,20 +346,29 @@ struct Scene::Impl {
             }
             const std::size_t texels = std::size_t(tw) * th;
             if (lut->GetIndexedLookup()) {
-                // Categories: each id its table colour (ids are whole numbers stored as floats).
-                std::map<int, std::array<std::uint8_t, 4>> colour;
-                for (int i = 0; i < lut->GetNumberOfAnnotatedValues(); ++i) {
+                // Categories: each id its table colour (ids are whole numbers stored as floats),
+                // looked up in a table indexed by id − lowest id.
+                const int count = lut->GetNumberOfAnnotatedValues();
+                int lowest = 0, highest = 0;
+                for (int i = 0; i < count; ++i) {
+                    const int id = lut->GetAnnotatedValue(i).ToInt();
+                    lowest = i ? std::min(lowest, id) : id;
+                    highest = i ? std::max(highest, id) : id;
+                }
+                std::vector<std::array<std::uint8_t, 4>> colour(std::size_t(highest - lowest + 1), {0, 0, 0, 255});
+                for (int i = 0; i < count; ++i) {
                     const double* c = lut->GetTableValue(i);
-                    colour[lut->GetAnnotatedValue(i).ToInt()] = {std::uint8_t(c[0] * 255 + 0.5),
-                                                                 std::uint8_t(c[1] * 255 + 0.5),
-                                                                 std::uint8_t(c[2] * 255 + 0.5), 255};
+                    colour[std::size_t(lut->GetAnnotatedValue(i).ToInt() - lowest)] = {
+                        std::uint8_t(c[0] * 255 + 0.5), std::uint8_t(c[1] * 255 + 0.5), std::uint8_t(c[2] * 255 + 0.5), 255};
                 }
                 std::uint8_t* out = rgba->GetPointer(0);
-                for (std::size_t i = 0; i < texels; ++i) {
-                    const auto it = colour.find(int(std::lround(v[i])));
-                    const std::array<std::uint8_t, 4> c = it != colour.end() ? it->second : std::array<std::uint8_t, 4>{0, 0, 0, 255};
-                    std::copy(c.begin(), c.end(), out + 4 * i);
-                }
+                parallel_for(0, std::int64_t(texels), 1 << 16, [&](std::int64_t a, std::int64_t b) {
+                    for (std::int64_t i = a; i < b; ++i) {
+                        const long id = std::lround(v[i]) - lowest;
+                        const auto& c = id >= 0 && id < long(colour.size()) ? colour[std::size_t(id)] : colour.front();
+                        std::copy(c.begin(), c.end(), out + 4 * i);
+                    }
+                });
                 texture->InterpolateOff();  // categories stay crisp
             } else {
                 lut->MapScalarsThroughTable2(const_cast<float*>(v), rgba->GetPointer(0), VTK_FLOAT, int(texels), 1,

@@ -246,7 +246,10 @@ TEST_F(Viewer, PlatesSeriesFramesDifferOverTime) {
                               std::to_string(t) + " " + top_view);
         ASSERT_EQ(r.code, 0) << r.err;
     }
+    // The folder opens the same: its terrain and its series.
+    ASSERT_EQ(view(". --screenshot folder.png --time 0 " + top_view).code, 0);
     const Picture p0 = read_png(dir / "p0.png"), p1 = read_png(dir / "p1.png"), p2 = read_png(dir / "p2.png");
+    EXPECT_LT(differing_pixels(p0, read_png(dir / "folder.png")), 50u);
     EXPECT_GT(differing_pixels(p0, p1), 1000u);
     EXPECT_GT(differing_pixels(p1, p2), 1000u);
     // The plates tint the terrain: without them (m toggles, here: no .pvd) the picture differs.
@@ -408,6 +411,10 @@ TEST_F(Viewer, BadInputGivesOneClearErrorAndExit2) {
     expect("notes.txt",
            "cannot open 'notes.txt': unknown file type '.txt'; orogen-view opens .vti, .vtp, .pvd, .glb, .gltf, .png "
            "(16-bit heightmap), .r16, .r32 (with their .json sidecar) and .orogen specs");
+    fs::create_directories(dir / "empty");
+    expect("empty", std::string("cannot open 'empty': the folder holds nothing orogen-view shows (") +
+                        ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar) "
+                        "and .orogen specs)");
     const auto h = plain_and_plateau();
     raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
     fs::remove(dir / "t.r16.json");
