@@ -9,7 +9,7 @@ packages=(
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
   libgdal-dev gdal-bin
   libstb-dev libpng-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
-  xvfb xauth
+  xvfb xauth libx11-dev
 )
 
 missing=()

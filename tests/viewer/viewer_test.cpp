@@ -1,0 +1,463 @@
+// orogen-view, run as users run it: a subprocess under Xvfb (tests/viewer/xvfb-run.sh),
+// on files written by the real exporters; its pictures are read back and sampled.
+#include "terrain_mesh.hpp"
+#include "raw.hpp"
+#include "vtk_writer.hpp"
+
+#include <orogen/io.hpp>
+#include <orogen/values.hpp>
+
+#include <gtest/gtest.h>
+#include <png.h>
+
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+using namespace orogen;
+
+namespace {
+
+struct Result {
+    int code = -1;
+    std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+class Viewer : public ::testing::Test {
+protected:
+    fs::path dir;
+
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir = fs::temp_directory_path() / ("orogen_view_test_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+    }
+    void TearDown() override { fs::remove_all(dir); }
+
+    /// Run `orogen-view args` (a shell command line) in `dir`; `prefix` goes before the program (e.g. "env -u DISPLAY").
+    Result view(const std::string& args, const std::string& prefix = "") {
+        const std::string cmd = "cd '" + dir.string() + "' && " + prefix + " '" OROGEN_VIEW "' " + args + " >'" +
+                                (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
+        const int status = std::system(cmd.c_str());
+        Result r;
+        r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        r.out = slurp(dir / "stdout");
+        r.err = slurp(dir / "stderr");
+        return r;
+    }
+
+    /// A width × height terrain, cell 10 m, with layers.
+    void write_vti(const fs::path& file, const std::vector<float>& h, int w, int hgt,
+                   const std::vector<std::pair<std::string, std::vector<float>>>& layers = {}) {
+        std::vector<vtk::NamedGrid> named;
+        for (const auto& [name, v] : layers) named.push_back({name, ConstGridView(v.data(), w, hgt, 10.0)});
+        vtk::write_heightmap(ConstGridView(h.data(), w, hgt, 10.0), named, file);
+    }
+};
+
+struct Picture {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgb;
+    std::array<int, 3> at(int x, int y) const {
+        const std::uint8_t* p = &rgb[(std::size_t(y) * width + x) * 3];
+        return {p[0], p[1], p[2]};
+    }
+};
+
+Picture read_png(const fs::path& file) {
+    png_image image{};
+    image.version = PNG_IMAGE_VERSION;
+    Picture p;
+    if (!png_image_begin_read_from_file(&image, file.c_str())) {
+        ADD_FAILURE() << "cannot read " << file;
+        return p;
+    }
+    image.format = PNG_FORMAT_RGB;
+    p.width = int(image.width);
+    p.height = int(image.height);
+    p.rgb.resize(PNG_IMAGE_SIZE(image));
+    png_image_finish_read(&image, nullptr, p.rgb.data(), 0, nullptr);
+    return p;
+}
+
+/// Mean colour of a 9 × 9 patch.
+std::array<double, 3> patch(const Picture& p, int cx, int cy) {
+    std::array<double, 3> m{};
+    for (int y = cy - 4; y <= cy + 4; ++y)
+        for (int x = cx - 4; x <= cx + 4; ++x)
+            for (int c = 0; c < 3; ++c) m[c] += p.at(x, y)[c] / 81.0;
+    return m;
+}
+
+double distance(const std::array<double, 3>& a, const std::array<std::uint8_t, 3>& b) {
+    return std::sqrt(std::pow(a[0] - b[0], 2) + std::pow(a[1] - b[1], 2) + std::pow(a[2] - b[2], 2));
+}
+double distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return std::sqrt(std::pow(a[0] - b[0], 2) + std::pow(a[1] - b[1], 2) + std::pow(a[2] - b[2], 2));
+}
+
+std::size_t differing_pixels(const Picture& a, const Picture& b) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i + 2 < a.rgb.size() && i + 2 < b.rgb.size(); i += 3)
+        n += std::abs(a.rgb[i] - b.rgb[i]) + std::abs(a.rgb[i + 1] - b.rgb[i + 1]) + std::abs(a.rgb[i + 2] - b.rgb[i + 2]) > 30;
+    return n;
+}
+
+/// A 65 × 65 terrain: a flat plain at 0 m (west), a slope, a flat plateau at 100 m (east).
+std::vector<float> plain_and_plateau(int n = 65) {
+    std::vector<float> h(std::size_t(n) * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) h[std::size_t(y) * n + x] = x < 28 ? 0.f : x > 36 ? 100.f : float(x - 28) * 12.5f;
+    return h;
+}
+
+const std::string top_view = "--top --camera 0,90 --size 320x320";
+
+// ------------------------------------------------------------------ pictures
+
+TEST_F(Viewer, ScreenshotShowsTheSplatColoursWhereExpected) {
+    write_vti(dir / "t.vti", plain_and_plateau(), 65, 65);
+    const Result r = view("t.vti --screenshot shot.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    const Picture p = read_png(dir / "shot.png");
+    ASSERT_EQ(p.width, 320);
+    ASSERT_EQ(p.height, 320);
+    // Looking down, north up: the plain (lowest band: sand) on the left, the
+    // plateau (highest band: snow) on the right, the steep slope rock.
+    const auto west = patch(p, 70, 160), east = patch(p, 250, 160);
+    EXPECT_LT(distance(west, terrain::sand_colour), 30) << west[0] << " " << west[1] << " " << west[2];
+    EXPECT_LT(distance(east, terrain::snow_colour), 30) << east[0] << " " << east[1] << " " << east[2];
+    for (const auto& other : {terrain::grass_colour, terrain::rock_colour, terrain::snow_colour})
+        EXPECT_GT(distance(west, other), 45);
+    // Not an empty picture: the terrain covers the middle, the background the corners differ from it.
+    EXPECT_GT(distance(patch(p, 160, 160), patch(p, 6, 6)), 20);
+}
+
+TEST_F(Viewer, ColouringByALayerChangesThePixelsAndUsesItsColourMap) {
+    const int n = 65;
+    std::vector<float> flow(n * n), plate(n * n), eroded(n * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            flow[y * n + x] = float(x) / n;
+            plate[y * n + x] = float((x < n / 2 ? 0 : 1) + (y < n / 2 ? 0 : 2) + 3);  // ids 3..6 in quadrants
+            eroded[y * n + x] = x < n / 2 ? -2.f : 2.f;                             // deposits west, erosion east
+        }
+    write_vti(dir / "t.vti", plain_and_plateau(), n, n, {{"flow", flow}, {"plate", plate}, {"eroded", eroded}});
+    ASSERT_EQ(view("t.vti --screenshot splat.png " + top_view).code, 0);
+    const Result r = view("t.vti --screenshot flow.png --layer flow " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_EQ(view("t.vti --screenshot plate.png --layer plate " + top_view).code, 0);
+    ASSERT_EQ(view("t.vti --screenshot eroded.png --layer eroded " + top_view).code, 0);
+    const Picture splat = read_png(dir / "splat.png"), fl = read_png(dir / "flow.png"), pl = read_png(dir / "plate.png"),
+                  er = read_png(dir / "eroded.png");
+    EXPECT_GT(differing_pixels(splat, fl), 20000u);
+    // Flow rises west to east: the colour map's ends differ.
+    EXPECT_GT(distance(patch(fl, 70, 160), patch(fl, 250, 160)), 80);
+    // One colour per plate: the four quadrants' colours are all different.
+    const std::array<std::array<double, 3>, 4> q{patch(pl, 90, 90), patch(pl, 230, 90), patch(pl, 90, 230),
+                                                 patch(pl, 230, 230)};
+    for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) EXPECT_GT(distance(q[i], q[j]), 40) << "quadrants " << i << " and " << j;
+    // Diverging map: negative (west) blue, positive (east) red.
+    const auto west = patch(er, 70, 160), east = patch(er, 250, 160);
+    EXPECT_GT(west[2], west[0] + 40);
+    EXPECT_GT(east[0], east[2] + 40);
+}
+
+TEST_F(Viewer, AnUnknownLayerNamesTheLayersThereAre) {
+    std::vector<float> flow(65 * 65, 1.f);
+    write_vti(dir / "t.vti", plain_and_plateau(), 65, 65, {{"flow", flow}});
+    const Result r = view("t.vti --screenshot s.png --layer flw");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_EQ(r.err, "orogen-view: error: no layer 'flw' to colour by; this terrain has: splat, height, flow\n");
+}
+
+TEST_F(Viewer, VtpRawAndPngTerrainsShowTheSameSplat) {
+    const auto h = plain_and_plateau();
+    write_vti(dir / "t.vti", h, 65, 65);
+    vtk::write_heightmap(ConstGridView(h.data(), 65, 65, 10.0), {}, dir / "t.vtp");
+    raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
+    {  // a 16-bit PNG heightmap: no units, but the same bands (flat plain and plateau)
+        std::vector<std::uint16_t> grey(h.size());
+        for (std::size_t i = 0; i < h.size(); ++i) grey[i] = std::uint16_t(std::lround(h[i] / 100.0 * 65535));
+        AtomicFile png(dir / "t.png");
+        write_gray_png(png.stream(), 65, 65, 16, grey);
+        png.commit();
+    }
+    ASSERT_EQ(view("t.vti --screenshot a.png " + top_view).code, 0);
+    Result r = view("t.vtp --screenshot b.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = view("t.r16 --screenshot c.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    r = view("t.png --screenshot d.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Picture a = read_png(dir / "a.png"), b = read_png(dir / "b.png"), c = read_png(dir / "c.png"),
+                  d = read_png(dir / "d.png");
+    for (const Picture* p : {&b, &c, &d}) {
+        EXPECT_LT(distance(patch(a, 70, 160), patch(*p, 70, 160)), 10);
+        EXPECT_LT(distance(patch(a, 250, 160), patch(*p, 250, 160)), 10);
+    }
+}
+
+// --------------------------------------------------------------------- time
+
+PlateHistory moving_plates() {
+    PlateHistory h;
+    h.width = h.height = 640;
+    for (int s = 0; s < 3; ++s) {
+        PlateSnapshot snap;
+        snap.step = s * 10;
+        snap.time = s;
+        const float shift = 150.f * s;
+        snap.plates.push_back({1, {{0, 0}, {200 + shift, 0}, {200 + shift, 640}, {0, 640}}, {1, 0}, 1.0});
+        snap.plates.push_back({2, {{200 + shift, 0}, {640, 0}, {640, 640}, {200 + shift, 640}}, {-1, 0}, 1.0});
+        h.snapshots.push_back(snap);
+        h.collisions.push_back({snap.step, 1, 2, {200 + shift, 0}, {200 + shift, 640}, BoundaryKind::convergent, 5.0});
+    }
+    return h;
+}
+
+TEST_F(Viewer, PlatesSeriesFramesDifferOverTime) {
+    write_vti(dir / "t.vti", plain_and_plateau(), 65, 65);
+    fs::create_directories(dir / "plates");
+    vtk::write_plates(moving_plates(), dir / "plates" / "plates.pvd");
+    for (int t = 0; t < 3; ++t) {
+        const Result r = view("t.vti plates/plates.pvd --screenshot p" + std::to_string(t) + ".png --time " +
+                              std::to_string(t) + " " + top_view);
+        ASSERT_EQ(r.code, 0) << r.err;
+    }
+    // The folder opens the same: its terrain and its series.
+    ASSERT_EQ(view(". --screenshot folder.png --time 0 " + top_view).code, 0);
+    const Picture p0 = read_png(dir / "p0.png"), p1 = read_png(dir / "p1.png"), p2 = read_png(dir / "p2.png");
+    EXPECT_LT(differing_pixels(p0, read_png(dir / "folder.png")), 50u);
+    EXPECT_GT(differing_pixels(p0, p1), 1000u);
+    EXPECT_GT(differing_pixels(p1, p2), 1000u);
+    // The plates tint the terrain: without them (m toggles, here: no .pvd) the picture differs.
+    ASSERT_EQ(view("t.vti --screenshot bare.png " + top_view).code, 0);
+    EXPECT_GT(differing_pixels(read_png(dir / "bare.png"), p0), 20000u);
+}
+
+TEST_F(Viewer, ParticleSeriesFramesShowMovingColouredParticles) {
+    ParticleSeries s;
+    for (int f = 0; f < 2; ++f) {
+        ParticleFrame frame;
+        frame.time = f * 0.5;
+        frame.step = f;
+        ParticleAttribute pos{3, {}}, density{1, {}};
+        for (int i = 0; i < 200; ++i) {
+            pos.data.insert(pos.data.end(), {float(i % 20) * 30 + 20 + f * 40, 120.f, float(i / 20) * 60 + 20});
+            density.data.push_back(float(i));
+        }
+        frame.attributes["position"] = pos;
+        frame.attributes["density"] = density;
+        s.frames.push_back(frame);
+    }
+    write_vti(dir / "t.vti", plain_and_plateau(), 65, 65);
+    vtk::write_particles(s, dir / "p.pvd");
+    ASSERT_EQ(view("t.vti p.pvd --screenshot a.png --time 0 " + top_view).code, 0);
+    ASSERT_EQ(view("t.vti p.pvd --screenshot b.png --time 0.5 " + top_view).code, 0);
+    ASSERT_EQ(view("t.vti --screenshot c.png " + top_view).code, 0);
+    const Picture a = read_png(dir / "a.png"), b = read_png(dir / "b.png"), c = read_png(dir / "c.png");
+    EXPECT_GT(differing_pixels(a, c), 500u);   // particles drawn
+    EXPECT_GT(differing_pixels(a, b), 500u);   // and they moved
+}
+
+// ---------------------------------------------------------------------- keys
+
+/// A VTK event log (vtkInteractorEventRecorder's format) pressing `keys` in order.
+std::string key_events(const std::vector<std::pair<std::string, char>>& keys) {
+    std::string s = "# StreamVersion 1\n";
+    for (const auto& [sym, code] : keys) {
+        const int c = static_cast<unsigned char>(code);
+        s += "KeyPressEvent 10 10 0 0 " + std::to_string(c) + " 1 " + sym + "\n";
+        s += "CharEvent 10 10 0 0 " + std::to_string(c) + " 1 " + sym + "\n";
+        s += "KeyReleaseEvent 10 10 0 0 " + std::to_string(c) + " 1 " + sym + "\n";
+    }
+    return s;
+}
+
+std::string state_value(const std::string& state, const std::string& key) {
+    std::istringstream in(state);
+    for (std::string line; std::getline(in, line);)
+        if (line.rfind(key + "=", 0) == 0) return line.substr(key.size() + 1);
+    return "?";
+}
+
+TEST_F(Viewer, EachKeyDoesWhatTheHelpSays) {
+    const int n = 65;
+    std::vector<float> water(n * n), flow(n * n, 1.f);
+    for (int i = 0; i < n * n; ++i) water[i] = (i % n) < 20 ? 0.5f : 0.f;
+    write_vti(dir / "t.vti", plain_and_plateau(), n, n, {{"water", water}, {"flow", flow}});
+    vtk::write_plates(moving_plates(), dir / "plates.pvd");
+    auto replay = [&](const std::vector<std::pair<std::string, char>>& keys) {
+        std::ofstream(dir / "events.log") << key_events(keys);
+        const Result r = view("t.vti plates.pvd --events events.log --print-state --size 320x240");
+        EXPECT_EQ(r.code, 0) << r.err;
+        return r.out;
+    };
+    const std::string before = replay({});
+    EXPECT_EQ(state_value(before, "layer"), "splat");
+    // Every toggle at once (each changes its own setting), then the keys that go back.
+    const std::string all = replay({{"l", 'l'}, {"w", 'w'}, {"p", 'p'}, {"m", 'm'}, {"e", 'e'}, {"h", 'h'}, {"v", 'v'},
+                                    {"plus", '+'}, {"period", '.'}, {"space", ' '}, {"a", 'a'}, {"f", 'f'}});
+    const std::vector<std::pair<std::string, std::string>> expected{
+        {"layer", "height"}, {"water", "off"},          {"particles", "off"}, {"plates", "off"},
+        {"edges", "on"},     {"help", "on"},            {"view", "top"},      {"exaggeration", "1.25"},
+        {"time_index", "1"}, {"playing", "on"},         {"particle_attribute", "1"},
+        {"full_resolution", "on"}};
+    for (const auto& [key, value] : expected) {
+        EXPECT_EQ(state_value(all, key), value) << key;
+        EXPECT_NE(state_value(before, key), value) << key;
+    }
+    const std::string back = replay({{"L", 'L'}, {"minus", '-'}, {"comma", ','}});
+    EXPECT_EQ(state_value(back, "layer"), "flow");  // before splat: the last layer
+    EXPECT_EQ(state_value(back, "exaggeration"), "0.8");
+    EXPECT_EQ(state_value(back, "time_index"), "0");  // stays at the first time
+    // r puts the camera back where it started after a drag.
+    std::ofstream(dir / "events.log") << "# StreamVersion 1\n"
+                                         "LeftButtonPressEvent 160 120 0 0 0 0 0\n"
+                                         "MouseMoveEvent 200 150 0 0 0 0 0\n"
+                                         "MouseMoveEvent 260 170 0 0 0 0 0\n"
+                                         "LeftButtonReleaseEvent 260 170 0 0 0 0 0\n";
+    const std::string dragged = view("t.vti plates.pvd --events events.log --print-state --size 320x240").out;
+    EXPECT_NE(state_value(dragged, "camera"), state_value(before, "camera"));
+    std::ofstream(dir / "events.log", std::ios::app) << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
+    const std::string reset = view("t.vti plates.pvd --events events.log --print-state --size 320x240").out;
+    EXPECT_EQ(state_value(reset, "camera"), state_value(before, "camera"));
+    // s writes a screenshot into the working folder.
+    std::ofstream(dir / "events.log") << key_events({{"s", 's'}});
+    ASSERT_EQ(view("t.vti --events events.log --size 320x240").code, 0);
+    EXPECT_TRUE(fs::exists(dir / "orogen-view-1.png"));
+}
+
+// --------------------------------------------------------------------- watch
+
+TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) {
+    const fs::path spec = dir / "w.orogen";
+    auto write_spec = [&](const std::string& body) {
+        std::ofstream(dir / "tmp.orogen") << "orogen 1\nseed 3\ngrid 65 cell=10\n" << body;
+        fs::rename(dir / "tmp.orogen", spec);  // as editors save: a new file in one step
+    };
+    const std::string good1 = "t = generate:diamond-square(roughness=0.5, amplitude=50)\nexport:vtk(t, path=\"t.vti\")\n";
+    const std::string good2 = "t = generate:diamond-square(roughness=0.5, amplitude=400)\nexport:vtk(t, path=\"t.vti\")\n";
+    const std::string bad = "t = generate:diamond-square(roughness=0.5, amplitude=400\nexport:vtk(t, path=\"t.vti\")\n";
+    write_spec(good1);
+    const std::string cmd = "cd '" + dir.string() + "' && '" OROGEN_VIEW "' w.orogen --watch --exit-after-reloads 4 "
+                            "--orogen '" OROGEN_CLI "' --out out --screenshot shot.png --size 320x240 >stdout 2>stderr";
+    int status = -1;
+    std::thread viewer([&] { status = std::system(cmd.c_str()); });
+    auto wait_for = [&](const std::string& text) {
+        for (int i = 0; i < 600; ++i) {
+            if (slurp(dir / "stdout").find(text) != std::string::npos) return true;
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        return false;
+    };
+    const bool first = wait_for("reload 1: ok");
+    if (first) write_spec(good2);
+    const bool second = first && wait_for("reload 2: ok");
+    if (second) write_spec(bad);
+    const bool third = second && wait_for("reload 3: error");
+    if (third) write_spec(good1);
+    const bool fourth = third && wait_for("reload 4: ok");
+    viewer.join();
+    ASSERT_TRUE(fourth) << slurp(dir / "stdout") << slurp(dir / "stderr");
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;  // exits cleanly after the 4th load
+    const std::string out = slurp(dir / "stdout");
+    EXPECT_NE(out.find("w.orogen:4:"), std::string::npos) << out;  // file:line:col of the syntax error
+    const Picture p1 = read_png(dir / "shot-1.png"), p2 = read_png(dir / "shot-2.png"), p3 = read_png(dir / "shot-3.png"),
+                  p4 = read_png(dir / "shot-4.png");
+    EXPECT_GT(differing_pixels(p1, p2), 2000u);  // the parameter change shows
+    EXPECT_GT(differing_pixels(p2, p3), 200u);   // the error text shows
+    // ... over the last good terrain: the lower right quarter is unchanged.
+    std::size_t same = 0, total = 0;
+    for (int y = 140; y < 220; ++y)
+        for (int x = 170; x < 300; ++x, ++total) same += p2.at(x, y) == p3.at(x, y);
+    EXPECT_GT(same, total * 95 / 100);
+    EXPECT_LT(differing_pixels(p1, p4), 200u);  // recovered: the first terrain again, no error text
+}
+
+// ----------------------------------------------------------------- bad input
+
+TEST_F(Viewer, BadInputGivesOneClearErrorAndExit2) {
+    auto expect = [&](const std::string& args, const std::string& message, const std::string& prefix = "") {
+        const Result r = view(args, prefix);
+        EXPECT_EQ(r.code, 2) << args;
+        EXPECT_EQ(r.err, "orogen-view: error: " + message + "\n") << args;
+        EXPECT_EQ(r.out, "") << args;
+    };
+    expect("missing.vti", "cannot open 'missing.vti': no such file");
+    std::ofstream(dir / "notes.txt") << "hello";
+    expect("notes.txt",
+           "cannot open 'notes.txt': unknown file type '.txt'; orogen-view opens .vti, .vtp, .pvd, .glb, .gltf, .png "
+           "(16-bit heightmap), .r16, .r32 (with their .json sidecar) and .orogen specs");
+    fs::create_directories(dir / "empty");
+    expect("empty", std::string("cannot open 'empty': the folder holds nothing orogen-view shows (") +
+                        ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar) "
+                        "and .orogen specs)");
+    const auto h = plain_and_plateau();
+    raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
+    fs::remove(dir / "t.r16.json");
+    expect("t.r16",
+           "cannot show 't.r16': its sidecar 't.r16.json' is missing (a RAW file has no size or height range; "
+           "export:raw writes both files: copy the .json along)");
+    vtk::write_plates(moving_plates(), dir / "plates.pvd");
+    fs::remove(dir / "plates_plates_000001.vtp");
+    fs::remove(dir / "plates_collisions_000002.vtp");
+    expect("plates.pvd",
+           "'plates.pvd' lists 2 of its 6 frame files that are missing, the first 'plates_plates_000001.vtp'; copy the "
+           "series' .vtp files along with the .pvd");
+    // A truncated .vti: VTK's reader complains loudly; the user sees one line.
+    write_vti(dir / "t.vti", h, 65, 65);
+    fs::resize_file(dir / "t.vti", fs::file_size(dir / "t.vti") / 2);
+    expect("t.vti", "cannot read 't.vti': the file is damaged (truncated?)");
+    std::ofstream(dir / "locked.vti") << "x";
+    fs::permissions(dir / "locked.vti", fs::perms::none);
+    if (geteuid() != 0)  // root reads anything
+        expect("locked.vti", "cannot read 'locked.vti': permission denied or unreadable (check its permissions)");
+    write_vti(dir / "good.vti", h, 65, 65);
+    const std::string hint =
+        "; orogen-view renders through X: on a machine without a screen, run it under a virtual display, e.g. "
+        "xvfb-run -a orogen-view FILE --screenshot out.png";
+    expect("good.vti", "no X display (DISPLAY is not set)" + hint, "env -u DISPLAY");
+    expect("good.vti", "cannot connect to the X display ':987'" + hint, "env DISPLAY=:987");
+}
+
+TEST_F(Viewer, GltfFromTheExporterOpens) {
+    const std::string spec = "orogen 1\nseed 1\ngrid 65 cell=10\nt = generate:diamond-square(amplitude=100)\n"
+                             "export:gltf(t, path=\"t.glb\")\n";
+    std::ofstream(dir / "g.orogen") << spec;
+    const std::string run = "'" OROGEN_CLI "' run '" + (dir / "g.orogen").string() + "' --out '" + dir.string() +
+                            "' --quiet >/dev/null 2>&1";
+    ASSERT_EQ(std::system(run.c_str()), 0);
+    const Result r = view("t.glb --screenshot g.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const Picture p = read_png(dir / "g.png");
+    EXPECT_GT(distance(patch(p, 160, 160), patch(p, 6, 6)), 20);
+    std::ofstream(dir / "bad.glb") << "not a glb";
+    const Result bad = view("bad.glb --screenshot b.png");
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_EQ(bad.err, "orogen-view: error: cannot read 'bad.glb': not a valid glTF file, or it holds no mesh\n");
+}
+
+}  // namespace

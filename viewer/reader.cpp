@@ -1,0 +1,398 @@
+// reader.cpp — orogen's files into grids and frames (see reader.hpp).
+#include "reader.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#include <nlohmann/json.hpp>
+#include <vtkCallbackCommand.h>
+#include <vtkCellArray.h>
+#include <vtkCellData.h>
+#include <vtkImageData.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkXMLDataElement.h>
+#include <vtkXMLDataParser.h>
+#include <vtkXMLImageDataReader.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+#include <map>
+
+namespace fs = std::filesystem;
+
+namespace orogen::view {
+
+const char* const known_extensions =
+    ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar) and .orogen specs";
+
+const float* Terrain::layer(const std::string& name) const {
+    for (const auto& l : layers)
+        if (l.name == name) return l.values->GetPointer(0);
+    return nullptr;
+}
+
+namespace {
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+/// Notices the errors a VTK reader raises (its error code stays 0 for many of them).
+struct ErrorFlag {
+    bool raised = false;
+    vtkNew<vtkCallbackCommand> command;
+    explicit ErrorFlag(vtkObject* watched) {
+        command->SetClientData(this);
+        command->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<ErrorFlag*>(self)->raised = true; });
+        watched->AddObserver(vtkCommand::ErrorEvent, command);
+    }
+};
+
+/// A readable regular file, or one clear error saying which it is not.
+void check_readable(const fs::path& file) {
+    std::error_code ec;
+    const auto status = fs::status(file, ec);
+    if (!fs::exists(status))
+        throw BadInput("cannot open " + quoted(file) + ": no such file");
+    if (fs::is_directory(status))
+        throw BadInput("cannot open " + quoted(file) + ": it is a folder; give a file inside it");
+    std::ifstream probe(file, std::ios::binary);
+    char byte;
+    if (!probe || (!probe.read(&byte, 1) && fs::file_size(file, ec) != 0))
+        throw BadInput("cannot read " + quoted(file) + ": permission denied or unreadable (check its permissions)");
+}
+
+std::string extension(const fs::path& file) {
+    std::string e = file.extension().string();
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return e;
+}
+
+vtkSmartPointer<vtkFloatArray> float_array(vtkDataArray* a, const std::string& name) {
+    auto f = vtkSmartPointer<vtkFloatArray>::New();
+    if (auto* same = vtkFloatArray::SafeDownCast(a)) {
+        f = same;  // no copy: the reader's own array
+    } else {
+        f->DeepCopy(a);
+    }
+    f->SetName(name.c_str());
+    return f;
+}
+
+/// Every 1-component point array except `height` and normals, as layers.
+void take_layers(vtkPointData* pd, vtkIdType count, Terrain& t) {
+    for (int i = 0; i < pd->GetNumberOfArrays(); ++i) {
+        vtkDataArray* a = pd->GetArray(i);
+        if (!a || !a->GetName() || a->GetNumberOfComponents() != 1 || a->GetNumberOfTuples() != count) continue;
+        const std::string name = a->GetName();
+        if (name == "height" || name == "Normals") continue;
+        t.layers.push_back({name, float_array(a, name)});
+    }
+}
+
+/// VTK's XML readers read a truncated raw appended block without a word:
+/// check that every array's bytes are in the file (uncompressed files; a
+/// compressed one fails in VTK's decompressor, which raises an error).
+void check_appended_data(const fs::path& file) {
+    std::ifstream in(file, std::ios::binary);
+    std::string head(1 << 16, '\0');
+    in.read(head.data(), std::streamsize(head.size()));
+    head.resize(std::size_t(in.gcount()));
+    const auto appended = head.find("<AppendedData encoding=\"raw\"");
+    if (appended == std::string::npos || head.find("compressor=") != std::string::npos) return;
+    const auto start = head.find('_', appended);
+    if (start == std::string::npos) throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    const bool wide = head.find("header_type=\"UInt64\"") != std::string::npos;
+    std::error_code ec;
+    const std::uintmax_t size = fs::file_size(file, ec);
+    for (std::size_t at = head.find("offset=\""); at < appended; at = head.find("offset=\"", at + 1)) {
+        const std::uint64_t offset = std::stoull(head.substr(at + 8, 24));
+        const std::uint64_t begin = start + 1 + offset;
+        std::uint64_t bytes = 0;
+        in.clear();
+        in.seekg(std::streamoff(begin));
+        in.read(reinterpret_cast<char*>(&bytes), wide ? 8 : 4);  // little-endian, as the host
+        if (!in || begin + (wide ? 8 : 4) + bytes > size)
+            throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    }
+}
+
+Terrain read_vti(const fs::path& file) {
+    check_appended_data(file);
+    vtkNew<vtkXMLImageDataReader> reader;
+    if (!reader->CanReadFile(file.c_str()))
+        throw BadInput("cannot read " + quoted(file) + ": not a VTK image data (.vti) file, or truncated");
+    reader->SetFileName(file.c_str());
+    ErrorFlag error(reader);
+    reader->Update();
+    vtkImageData* image = reader->GetOutput();
+    int dims[3] = {0, 0, 0};
+    if (image) image->GetDimensions(dims);
+    vtkDataArray* h = image ? image->GetPointData()->GetArray("height") : nullptr;
+    if (error.raised || reader->GetErrorCode() != 0)
+        throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    if (!h)
+        throw BadInput("cannot read " + quoted(file) + ": it has no 'height' point array; is it an export:vtk heightmap?");
+    if (dims[1] != 1 || dims[0] < 2 || dims[2] < 2)
+        throw BadInput("cannot show " + quoted(file) + ": expected width × 1 × height points (export:vtk's layout), got " +
+                       std::to_string(dims[0]) + " × " + std::to_string(dims[1]) + " × " + std::to_string(dims[2]));
+    Terrain t;
+    t.file = file;
+    t.width = dims[0];
+    t.height = dims[2];
+    t.cell = image->GetSpacing()[0];
+    const vtkIdType n = vtkIdType(t.width) * t.height;
+    if (h->GetNumberOfTuples() != n || h->GetNumberOfComponents() != 1)
+        throw BadInput("cannot read " + quoted(file) + ": its 'height' array does not hold one value per point");
+    t.heights = float_array(h, "height");
+    take_layers(image->GetPointData(), n, t);
+    return t;
+}
+
+vtkSmartPointer<vtkPolyData> read_polydata(const fs::path& file) {
+    check_appended_data(file);
+    vtkNew<vtkXMLPolyDataReader> reader;
+    if (!reader->CanReadFile(file.c_str()))
+        throw BadInput("cannot read " + quoted(file) + ": not a VTK polygonal data (.vtp) file, or truncated");
+    reader->SetFileName(file.c_str());
+    ErrorFlag error(reader);
+    reader->Update();
+    if (error.raised || reader->GetErrorCode() != 0 || !reader->GetOutput())
+        throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    vtkSmartPointer<vtkPolyData> poly = reader->GetOutput();
+    return poly;
+}
+
+/// export:vtk's .vtp mesh is its grid's kept rows of kept columns, row-major:
+/// the grid is recovered from the points (width = points sharing the first Z).
+Terrain terrain_from_mesh(const fs::path& file, vtkPolyData* poly) {
+    const vtkIdType n = poly->GetNumberOfPoints();
+    vtkIdType width = 1;
+    const double z0 = poly->GetPoint(0)[2];
+    while (width < n && poly->GetPoint(width)[2] == z0) ++width;
+    if (width < 2 || n % width != 0 || n / width < 2)
+        throw BadInput("cannot show " + quoted(file) + ": its points are not a grid of rows (export:vtk's .vtp mesh is)");
+    Terrain t;
+    t.file = file;
+    t.width = int(width);
+    t.height = int(n / width);
+    t.cell = poly->GetPoint(1)[0] - poly->GetPoint(0)[0];
+    t.heights = float_array(poly->GetPointData()->GetArray("height"), "height");
+    take_layers(poly->GetPointData(), n, t);
+    return t;
+}
+
+Terrain read_png(const fs::path& file) {
+    const GrayImage image = read_gray_png(file);  // BadInput names the file for colour, palette, truncated
+    if (image.width < 2 || image.height < 2)
+        throw BadInput("cannot show " + quoted(file) + ": a heightmap needs at least 2 × 2 pixels");
+    Terrain t;
+    t.file = file;
+    t.width = image.width;
+    t.height = image.height;
+    // A PNG has no units: 1 m per pixel, the full grey range spanning a
+    // quarter of the width, so a heightmap looks like a landscape.
+    t.cell = 1.0;
+    const double top = (image.bits == 16 ? 65535.0 : 255.0), relief = 0.25 * (std::max(t.width, t.height) - 1);
+    t.heights = vtkSmartPointer<vtkFloatArray>::New();
+    t.heights->SetName("height");
+    t.heights->SetNumberOfTuples(vtkIdType(image.samples.size()));
+    for (std::size_t i = 0; i < image.samples.size(); ++i)
+        t.heights->SetValue(vtkIdType(i), float(image.samples[i] / top * relief));
+    return t;
+}
+
+Terrain read_raw(const fs::path& file, bool r16) {
+    const fs::path sidecar = file.string() + ".json";
+    if (!fs::exists(sidecar))
+        throw BadInput("cannot show " + quoted(file) + ": its sidecar " + quoted(sidecar.filename()) +
+                       " is missing (a RAW file has no size or height range; export:raw writes both files: copy the "
+                       ".json along)");
+    check_readable(sidecar);
+    nlohmann::json j;
+    try {
+        std::ifstream in(sidecar);
+        j = nlohmann::json::parse(in);
+    } catch (const std::exception&) {
+        throw BadInput("cannot read " + quoted(sidecar) + ": not valid JSON");
+    }
+    auto number = [&](const char* key) -> double {
+        if (!j.contains(key) || !j[key].is_number())
+            throw BadInput(quoted(sidecar) + " has no number '" + key + "' (export:raw writes width, height, " +
+                           "cell_size, height_min, height_max)");
+        return j[key].get<double>();
+    };
+    Terrain t;
+    t.file = file;
+    t.width = int(number("width"));
+    t.height = int(number("height"));
+    t.cell = number("cell_size");
+    const double low = r16 ? number("height_min") : 0.0, high = r16 ? number("height_max") : 0.0;
+    const std::size_t count = std::size_t(t.width) * std::size_t(t.height), bytes = count * (r16 ? 2 : 4);
+    std::error_code ec;
+    if (t.width < 2 || t.height < 2 || fs::file_size(file, ec) != bytes)
+        throw BadInput("cannot show " + quoted(file) + ": it holds " + std::to_string(fs::file_size(file, ec)) +
+                       " bytes, but its sidecar says " + std::to_string(t.width) + " × " + std::to_string(t.height) +
+                       " samples of " + (r16 ? "2" : "4") + " bytes (" + std::to_string(bytes) + ")");
+    std::vector<char> data(bytes);
+    std::ifstream(file, std::ios::binary).read(data.data(), std::streamsize(bytes));
+    t.heights = vtkSmartPointer<vtkFloatArray>::New();
+    t.heights->SetName("height");
+    t.heights->SetNumberOfTuples(vtkIdType(count));
+    for (std::size_t i = 0; i < count; ++i) {
+        if (r16) {
+            const auto* b = reinterpret_cast<const unsigned char*>(data.data() + 2 * i);
+            t.heights->SetValue(vtkIdType(i), float(low + (high - low) * (b[0] | (b[1] << 8)) / 65535.0));
+        } else {
+            float v;
+            std::memcpy(&v, data.data() + 4 * i, 4);  // little-endian, as the host
+            t.heights->SetValue(vtkIdType(i), v);
+        }
+    }
+    return t;
+}
+
+/// Which part of a frame a .vtp fills, by what it holds.
+void place(Frame& frame, vtkSmartPointer<vtkPolyData> poly) {
+    if (poly->GetNumberOfPolys() > 0 || poly->GetCellData()->GetArray("plate"))
+        frame.plates = poly;
+    else if (poly->GetNumberOfLines() > 0 || poly->GetCellData()->GetArray("plate_a"))
+        frame.collisions = poly;
+    else
+        frame.particles = poly;
+}
+
+Series read_pvd(const fs::path& file) {
+    vtkNew<vtkXMLDataParser> parser;
+    parser->SetFileName(file.c_str());
+    vtkXMLDataElement* root = parser->Parse() ? parser->GetRootElement() : nullptr;
+    vtkXMLDataElement* collection = root ? root->FindNestedElementWithName("Collection") : nullptr;
+    if (!collection)
+        throw BadInput("cannot read " + quoted(file) + ": not a ParaView collection (.pvd): no <Collection> element");
+    struct Entry {
+        double time;
+        fs::path file;
+    };
+    std::vector<Entry> entries;
+    std::vector<fs::path> missing;
+    for (int i = 0; i < collection->GetNumberOfNestedElements(); ++i) {
+        vtkXMLDataElement* e = collection->GetNestedElement(i);
+        if (std::strcmp(e->GetName(), "DataSet") != 0 || !e->GetAttribute("file")) continue;
+        double time = 0.0;
+        e->GetScalarAttribute("timestep", time);
+        const fs::path frame = file.parent_path() / e->GetAttribute("file");
+        if (!fs::exists(frame)) missing.push_back(frame);
+        entries.push_back({time, frame});
+    }
+    if (!missing.empty())
+        throw BadInput(quoted(file) + " lists " + std::to_string(missing.size()) + " of its " +
+                       std::to_string(entries.size()) + " frame files that are missing, the first " +
+                       quoted(missing.front()) + "; copy the series' .vtp files along with the .pvd");
+    if (entries.empty()) throw BadInput(quoted(file) + " lists no frames");
+    std::map<double, Frame> frames;
+    for (const auto& e : entries) {
+        Frame& f = frames[e.time];
+        f.time = e.time;
+        place(f, read_polydata(e.file));
+    }
+    Series s;
+    s.file = file;
+    for (auto& [time, f] : frames) s.frames.push_back(std::move(f));
+    return s;
+}
+
+}  // namespace
+
+Content read_files(std::span<const fs::path> files) {
+    Content c;
+    for (const fs::path& file : files) {
+        std::error_code ec;
+        if (fs::is_directory(file, ec)) {  // an output folder: what a spec run there would show
+            const auto inside = pick_outputs(file);
+            if (inside.empty())
+                throw BadInput("cannot open " + quoted(file) + ": the folder holds nothing orogen-view shows (" +
+                               known_extensions + ")");
+            Content more = read_files(inside);
+            for (auto& t : more.terrains) c.terrains.push_back(std::move(t));
+            for (auto& s : more.series) c.series.push_back(std::move(s));
+            for (auto& g : more.gltf) c.gltf.push_back(std::move(g));
+            continue;
+        }
+        const std::string ext = extension(file);
+        const bool known = ext == ".vti" || ext == ".vtp" || ext == ".pvd" || ext == ".glb" || ext == ".gltf" ||
+                           ext == ".png" || ext == ".r16" || ext == ".r32";
+        if (!known)
+            throw BadInput("cannot open " + quoted(file) + ": unknown file type '" + ext + "'; orogen-view opens " +
+                           known_extensions);
+        check_readable(file);
+        if (ext == ".vti") {
+            c.terrains.push_back(read_vti(file));
+        } else if (ext == ".vtp") {
+            auto poly = read_polydata(file);
+            if (poly->GetNumberOfPolys() > 0 && poly->GetPointData()->GetArray("height")) {
+                c.terrains.push_back(terrain_from_mesh(file, poly));
+            } else {
+                Series s;
+                s.file = file;
+                s.frames.emplace_back();
+                place(s.frames.back(), poly);
+                c.series.push_back(std::move(s));
+            }
+        } else if (ext == ".pvd") {
+            c.series.push_back(read_pvd(file));
+        } else if (ext == ".glb" || ext == ".gltf") {
+            c.gltf.push_back(file);
+        } else if (ext == ".png") {
+            c.terrains.push_back(read_png(file));
+        } else {
+            c.terrains.push_back(read_raw(file, ext == ".r16"));
+        }
+    }
+    return c;
+}
+
+std::vector<fs::path> pick_outputs(const fs::path& folder) {
+    std::vector<fs::path> all;
+    std::error_code ec;
+    for (auto it = fs::recursive_directory_iterator(folder, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec))
+        if (it->is_regular_file() && it->path().filename().string()[0] != '.') all.push_back(it->path());
+    std::sort(all.begin(), all.end());
+    std::vector<fs::path> picked;
+    auto first = [&](auto&& accept) {
+        for (const auto& p : all)
+            if (accept(p)) {
+                picked.push_back(p);
+                return true;
+            }
+        return false;
+    };
+    auto ext_is = [](const char* e) { return [e](const fs::path& p) { return extension(p) == e; }; };
+    auto gray16 = [](const fs::path& p) {
+        if (extension(p) != ".png") return false;
+        try {
+            return read_gray_png_header(p).bits == 16;
+        } catch (const std::exception&) {
+            return false;  // colour pictures (relief, flow) are not heightmaps
+        }
+    };
+    auto terrain_vtp = [](const fs::path& p) {
+        if (extension(p) != ".vtp") return false;
+        try {
+            auto poly = read_polydata(p);
+            return poly->GetNumberOfPolys() > 0 && poly->GetPointData()->GetArray("height") != nullptr;
+        } catch (const std::exception&) {
+            return false;
+        }
+    };
+    first(ext_is(".vti")) || first(terrain_vtp) || first(ext_is(".r16")) || first(ext_is(".r32")) || first(gray16) ||
+        first(ext_is(".glb")) || first(ext_is(".gltf"));
+    for (const auto& p : all)
+        if (extension(p) == ".pvd") picked.push_back(p);
+    return picked;
+}
+
+}  // namespace orogen::view

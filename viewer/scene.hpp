@@ -1,0 +1,90 @@
+// scene.hpp — what orogen-view draws: the terrain (splat-coloured or coloured
+// by a layer, through a texture so switching layers re-uploads no geometry),
+// its water, plates and collisions, particles, and the text overlays.
+//
+// Frame: the exporters' — X east, Y up, Z south, metres. Vertical
+// exaggeration scales Y of every 3D actor (VTK transforms the normals too,
+// so the lighting follows). The light is a hillshade's: from the north-west,
+// 45° above the horizon.
+#pragma once
+
+#include "reader.hpp"
+
+#include <vtkSmartPointer.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+class vtkRenderWindow;
+class vtkRenderer;
+
+namespace orogen::view {
+
+/// Where the camera stands, seen from the terrain's centre: compass bearing
+/// (degrees, 0 = north, 90 = east), elevation above the horizon (degrees) and
+/// distance (metres; 0 = fit the whole scene).
+struct CameraAngles {
+    double azimuth = 200.0, elevation = 40.0, distance = 0.0;
+};
+
+class Scene {
+public:
+    explicit Scene(vtkRenderWindow* window);
+    ~Scene();
+
+    /// Replace what is shown (the camera stays where it is if `keep_camera`).
+    void show(Content content, bool keep_camera);
+    bool empty() const;
+
+    // Colour: index 0 is the splat colours, 1 height, then each layer.
+    std::vector<std::string> layer_names() const;
+    std::string layer() const;
+    void cycle_layer(int step);
+    /// false if the terrain has no such layer.
+    bool set_layer(const std::string& name);
+
+    void toggle_water();
+    void toggle_particles();
+    void toggle_plates();
+    void toggle_edges();
+    void toggle_help();
+    void cycle_particle_attribute();
+    /// Full resolution instead of the display decimation of big terrains.
+    void set_full_resolution(bool full);
+    bool full_resolution() const;
+
+    double exaggeration() const;
+    void set_exaggeration(double e);
+
+    void set_camera(const CameraAngles& angles);
+    void reset_camera();
+    void toggle_top_view();
+
+    // Time over every .pvd series: the union of their frame times.
+    const std::vector<double>& times() const;
+    std::size_t time_index() const;
+    void set_time_index(std::size_t i);
+    /// The frame at or just before `t`.
+    void set_time(double t);
+    void set_playing(bool playing);
+    bool playing() const;
+
+    /// A message over the scene (e.g. a spec error); "" hides it.
+    void set_message(const std::string& text, bool error);
+    /// The keys and what they do, as the help overlay shows them.
+    static std::string help_text();
+
+    /// One line per setting, "name=value", for tests and --print-state.
+    std::string state() const;
+
+    /// Write the current frame as PNG.
+    void screenshot(const std::string& file);
+    void render();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace orogen::view
