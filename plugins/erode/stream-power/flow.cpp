@@ -1,0 +1,286 @@
+// flow.cpp — D8 routing, pit resolution over the basin graph, stack, drainage area (see flow.hpp).
+#include "flow.hpp"
+
+#include <orogen/parallel.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace orogen::stream_power {
+
+namespace {
+
+constexpr double kSqrt2 = 1.4142135623730951;
+constexpr int kRowBlock = 16;  // rows per fixed block when links are collected (the order is the block order)
+
+struct Link {
+    double pass;        // max(h_i, h_j): the water level at which the two basins join, m
+    std::int32_t a, b;  // basin graph nodes, a < b (0 = the sea: every outlet basin)
+    std::int32_t i, j;  // the two cells (i in a's basin, j in b's)
+};
+
+bool link_before(const Link& l, const Link& r) {
+    if (l.pass != r.pass) return l.pass < r.pass;
+    if (l.a != r.a) return l.a < r.a;
+    if (l.b != r.b) return l.b < r.b;
+    if (l.i != r.i) return l.i < r.i;
+    return l.j < r.j;
+}
+
+std::int32_t find(std::vector<std::int32_t>& parent, std::int32_t v) {
+    while (parent[std::size_t(v)] != v) {
+        parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
+        v = parent[std::size_t(v)];
+    }
+    return v;
+}
+
+}  // namespace
+
+FlowRouter::FlowRouter(int width, int height, double cell, OpenSides open, std::int64_t outlet_cell)
+    : width_(width), height_(height), size_(std::size_t(width) * std::size_t(height)), cell_(cell), open_(open) {
+    if (width < 1 || height < 1 || !(cell > 0.0)) throw std::invalid_argument("FlowRouter: empty grid or cell <= 0");
+    if (size_ >= std::size_t(std::numeric_limits<std::int32_t>::max()))
+        throw std::invalid_argument("FlowRouter: more than 2^31 cells");
+    outlet_.assign(size_, 0);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const bool o = (y == 0 && open.north) || (y == height - 1 && open.south) || (x == 0 && open.west) ||
+                           (x == width - 1 && open.east);
+            outlet_[std::size_t(y) * std::size_t(width) + std::size_t(x)] = o ? 1 : 0;
+        }
+    if (!open.any()) {
+        if (outlet_cell < 0 || std::size_t(outlet_cell) >= size_) throw std::invalid_argument("FlowRouter: outlet outside the grid");
+        outlet_[std::size_t(outlet_cell)] = 1;
+    }
+    receiver_.resize(size_);
+    donors_.resize(size_);
+    stack_.resize(size_);
+    basin_.resize(size_);
+    area_.resize(size_);
+    walk_.reserve(1024);
+}
+
+double FlowRouter::distance(std::int64_t i) const {
+    const std::int64_t r = receiver_[std::size_t(i)];
+    if (r == i) return 0.0;
+    const std::int64_t d = r - i;
+    return (d == 1 || d == -1 || d == width_ || d == -width_) ? cell_ : cell_ * kSqrt2;
+}
+
+int FlowRouter::direction(std::int64_t i) const {
+    const std::int64_t r = receiver_[std::size_t(i)];
+    if (r == i) return -1;
+    const int dx = int(r % width_ - i % width_), dy = int(r / width_ - i / width_);
+    for (int k = 0; k < 8; ++k)
+        if (kDx[k] == dx && kDy[k] == dy) return k;
+    return -1;
+}
+
+void FlowRouter::receivers_from(const double* h) {
+    const int W = width_, H = height_;
+    const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y) {
+            const bool inner_row = y > 0 && y < H - 1;
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                if (outlet_[std::size_t(i)]) {
+                    receiver_[std::size_t(i)] = std::int32_t(i);
+                    continue;
+                }
+                const double hi = h[i];
+                double best = 0.0;
+                std::int64_t to = i;
+                if (inner_row && x > 0 && x < W - 1) {
+                    for (int k = 0; k < 8; ++k) {
+                        const std::int64_t j = i + kDy[k] * W + kDx[k];
+                        const double s = (hi - h[j]) * inv[k];
+                        if (s > best) best = s, to = j;
+                    }
+                } else {
+                    for (int k = 0; k < 8; ++k) {
+                        const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                        if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                        const std::int64_t j = std::int64_t(ny) * W + nx;
+                        const double s = (hi - h[j]) * inv[k];
+                        if (s > best) best = s, to = j;
+                    }
+                }
+                receiver_[std::size_t(i)] = std::int32_t(to);
+            }
+        }
+    });
+}
+
+void FlowRouter::build_stack(bool label_basins) {
+    const int W = width_, H = height_;
+    // Donor bits: neighbour k of i sends to i. Each cell's byte is written by one iteration.
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y)
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                std::uint8_t m = 0;
+                for (int k = 0; k < 8; ++k) {
+                    const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                    if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                    const std::int64_t j = std::int64_t(ny) * W + nx;
+                    if (receiver_[std::size_t(j)] == i) m = std::uint8_t(m | (1u << k));
+                }
+                donors_[std::size_t(i)] = m;
+            }
+    });
+    roots_.clear();
+    for (std::size_t i = 0; i < size_; ++i)
+        if (receiver_[i] == std::int32_t(i)) roots_.push_back(std::int32_t(i));
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
+    if (label_basins) basin_start_.assign(roots_.size() + 1, 0);
+    std::size_t pos = 0;
+    for (std::size_t b = 0; b < roots_.size(); ++b) {
+        if (label_basins) basin_start_[b] = std::int64_t(pos);
+        walk_.clear();
+        walk_.push_back(roots_[b]);
+        while (!walk_.empty()) {
+            const std::int32_t c = walk_.back();
+            walk_.pop_back();
+            stack_[pos++] = c;
+            if (label_basins) basin_[std::size_t(c)] = std::int32_t(b);
+            unsigned m = donors_[std::size_t(c)];
+            while (m) {
+                const int k = std::countr_zero(m);
+                m &= m - 1;
+                walk_.push_back(std::int32_t(c + off[k]));
+            }
+        }
+    }
+    if (label_basins) basin_start_[roots_.size()] = std::int64_t(pos);
+    if (pos != size_) throw std::logic_error("FlowRouter: the receivers hold a loop");  // cannot happen: drops are strict
+}
+
+void FlowRouter::route(double* h, Depressions mode) {
+    receivers_from(h);
+    pits_ = 0;
+    for (std::size_t i = 0; i < size_; ++i) pits_ += (receiver_[i] == std::int32_t(i) && !outlet_[i]) ? 1 : 0;
+    build_stack(pits_ > 0);
+    if (pits_ > 0) {
+        resolve_pits(h, mode);
+        build_stack(false);
+    }
+}
+
+void FlowRouter::resolve_pits(double* h, Depressions mode) {
+    const int W = width_, H = height_;
+    const std::size_t nb = roots_.size();
+    // Graph nodes: 0 = the sea (every outlet basin), 1..P = the pit basins.
+    std::vector<std::int32_t> node(nb);
+    std::int32_t nodes = 1;
+    for (std::size_t b = 0; b < nb; ++b) node[b] = outlet_[std::size_t(roots_[b])] ? 0 : nodes++;
+
+    // Links over every edge (4 forward neighbours: E, SE, S, SW) between two
+    // basins, one of them a pit basin; collected per fixed block of rows.
+    const std::int64_t blocks = (H + kRowBlock - 1) / kRowBlock;
+    std::vector<std::vector<Link>> per_block(static_cast<std::size_t>(blocks));
+    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t blk = b0; blk < b1; ++blk) {
+            auto& out = per_block[std::size_t(blk)];
+            const int y0 = int(blk) * kRowBlock, y1 = std::min(H, y0 + kRowBlock);
+            for (int y = y0; y < y1; ++y)
+                for (int x = 0; x < W; ++x) {
+                    const std::int64_t i = std::int64_t(y) * W + x;
+                    const std::int32_t ni = node[std::size_t(basin_[std::size_t(i)])];
+                    static constexpr int fwd[4] = {0, 1, 2, 3};
+                    for (int k : fwd) {
+                        const int nx = x + kDx[k], ny = y + kDy[k];
+                        if (nx < 0 || nx >= W || ny >= H) continue;
+                        const std::int64_t j = std::int64_t(ny) * W + nx;
+                        const std::int32_t nj = node[std::size_t(basin_[std::size_t(j)])];
+                        if (ni == nj) continue;
+                        const double pass = std::max(h[i], h[j]);
+                        if (ni < nj)
+                            out.push_back({pass, ni, nj, std::int32_t(i), std::int32_t(j)});
+                        else
+                            out.push_back({pass, nj, ni, std::int32_t(j), std::int32_t(i)});
+                    }
+                }
+        }
+    });
+    std::vector<Link> links;
+    std::size_t total = 0;
+    for (const auto& v : per_block) total += v.size();
+    links.reserve(total);
+    for (const auto& v : per_block) links.insert(links.end(), v.begin(), v.end());
+    per_block.clear();
+    std::sort(links.begin(), links.end(), link_before);  // a total order: the result is independent of collection order
+
+    // Kruskal: the minimum spanning tree of the basin graph.
+    std::vector<std::int32_t> parent(static_cast<std::size_t>(nodes));
+    for (std::int32_t v = 0; v < nodes; ++v) parent[std::size_t(v)] = v;
+    std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
+    std::int32_t joined = 0;
+    for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
+        const std::int32_t ra = find(parent, links[e].a), rb = find(parent, links[e].b);
+        if (ra == rb) continue;
+        parent[std::size_t(ra)] = rb;
+        ++joined;
+        adjacent[std::size_t(links[e].a)].push_back(std::int32_t(e));
+        adjacent[std::size_t(links[e].b)].push_back(std::int32_t(e));
+    }
+
+    // Orient the tree from the sea: each pit basin's way out, and its lake level.
+    std::vector<double> level(std::size_t(nodes), -std::numeric_limits<double>::infinity());
+    std::vector<std::int32_t> out_link(std::size_t(nodes), -1);
+    std::vector<std::uint8_t> seen(std::size_t(nodes), 0);
+    std::vector<std::int32_t> queue{0};
+    seen[0] = 1;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+        const std::int32_t v = queue[q];
+        for (std::int32_t e : adjacent[std::size_t(v)]) {
+            const Link& l = links[std::size_t(e)];
+            const std::int32_t u = l.a == v ? l.b : l.a;
+            if (seen[std::size_t(u)]) continue;
+            seen[std::size_t(u)] = 1;
+            out_link[std::size_t(u)] = e;
+            level[std::size_t(u)] = std::max(l.pass, level[std::size_t(v)]);
+            queue.push_back(u);
+        }
+    }
+
+    for (std::size_t b = 0; b < nb; ++b) {
+        const std::int32_t v = node[b];
+        if (v == 0) continue;
+        if (out_link[std::size_t(v)] < 0) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
+        const Link& l = links[std::size_t(out_link[std::size_t(v)])];
+        const std::int32_t inside = l.a == v ? l.i : l.j, across = l.a == v ? l.j : l.i;
+        if (mode == Depressions::fill) {
+            const double lv = level[std::size_t(v)];
+            for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
+                const std::int32_t c = stack_[std::size_t(s)];
+                if (h[c] < lv) h[c] = lv;
+            }
+        }
+        // Reverse the path pass cell → pit, and send the pass cell's water across.
+        std::int32_t prev = across, c = inside;
+        for (;;) {
+            const std::int32_t next = receiver_[std::size_t(c)];
+            receiver_[std::size_t(c)] = prev;
+            if (next == c) break;
+            prev = c;
+            c = next;
+        }
+    }
+}
+
+void FlowRouter::accumulate() {
+    const double a0 = cell_ * cell_;
+    std::fill(area_.begin(), area_.end(), a0);
+    for (std::size_t s = size_; s-- > 0;) {
+        const std::int32_t i = stack_[s], r = receiver_[std::size_t(i)];
+        if (r != i) area_[std::size_t(r)] += area_[std::size_t(i)];
+    }
+}
+
+}  // namespace orogen::stream_power
