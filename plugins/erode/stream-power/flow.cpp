@@ -4,6 +4,7 @@
 #include <orogen/parallel.hpp>
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -14,7 +15,6 @@ namespace orogen::stream_power {
 namespace {
 
 constexpr double kSqrt2 = 1.4142135623730951;
-constexpr int kRowBlock = 16;  // rows per fixed block when links are collected (the order is the block order)
 
 struct Link {
     double pass;        // max(h_i, h_j): the water level at which the two basins join, m
@@ -81,8 +81,16 @@ int FlowRouter::direction(std::int64_t i) const {
 }
 
 void FlowRouter::receivers_from(const double* h) {
+    // Receivers and donor bits in one pass. A cell's donor byte is written by
+    // the (up to 8) cells around it: inside a band of rows only this band's
+    // iterations touch it, so the OR is plain; in the two rows at each end of
+    // a band (shared with the neighbouring bands) it is atomic. OR is
+    // commutative, so the bytes do not depend on the split.
     const int W = width_, H = height_;
     const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
+    std::fill(donors_.begin(), donors_.end(), std::uint8_t(0));
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
     parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
         for (std::int64_t y = y0; y < y1; ++y) {
             const bool inner_row = y > 0 && y < H - 1;
@@ -94,60 +102,57 @@ void FlowRouter::receivers_from(const double* h) {
                 }
                 const double hi = h[i];
                 double best = 0.0;
-                std::int64_t to = i;
+                int dir = -1;
                 if (inner_row && x > 0 && x < W - 1) {
-                    for (int k = 0; k < 8; ++k) {
-                        const std::int64_t j = i + kDy[k] * W + kDx[k];
-                        const double s = (hi - h[j]) * inv[k];
-                        if (s > best) best = s, to = j;
+                    for (int k = 0; k < 8; ++k) {  // branch-free: the comparisons are unpredictable on rough ground
+                        const double s = (hi - h[i + off[k]]) * inv[k];
+                        const bool better = s > best;
+                        best = better ? s : best;
+                        dir = better ? k : dir;
                     }
                 } else {
                     for (int k = 0; k < 8; ++k) {
                         const int nx = x + kDx[k], ny = int(y) + kDy[k];
                         if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
-                        const std::int64_t j = std::int64_t(ny) * W + nx;
-                        const double s = (hi - h[j]) * inv[k];
-                        if (s > best) best = s, to = j;
+                        const double s = (hi - h[i + off[k]]) * inv[k];
+                        if (s > best) best = s, dir = k;
                     }
                 }
+                if (dir < 0) {
+                    receiver_[std::size_t(i)] = std::int32_t(i);
+                    continue;
+                }
+                const std::int64_t to = i + off[dir];
                 receiver_[std::size_t(i)] = std::int32_t(to);
+                const auto bit = std::uint8_t(1u << ((dir + 4) & 7));  // seen from `to`, i is neighbour dir+4
+                const std::int64_t ty = y + kDy[dir];
+                if (ty <= y0 || ty >= y1 - 1)
+                    std::atomic_ref<std::uint8_t>(donors_[std::size_t(to)]).fetch_or(bit, std::memory_order_relaxed);
+                else
+                    donors_[std::size_t(to)] = std::uint8_t(donors_[std::size_t(to)] | bit);
             }
         }
     });
 }
 
 void FlowRouter::build_stack(bool label_basins) {
-    const int W = width_, H = height_;
-    // Donor bits: neighbour k of i sends to i. Each cell's byte is written by one iteration.
-    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
-        for (std::int64_t y = y0; y < y1; ++y)
-            for (int x = 0; x < W; ++x) {
-                const std::int64_t i = y * W + x;
-                std::uint8_t m = 0;
-                for (int k = 0; k < 8; ++k) {
-                    const int nx = x + kDx[k], ny = int(y) + kDy[k];
-                    if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
-                    const std::int64_t j = std::int64_t(ny) * W + nx;
-                    if (receiver_[std::size_t(j)] == i) m = std::uint8_t(m | (1u << k));
-                }
-                donors_[std::size_t(i)] = m;
-            }
-    });
+    const int W = width_;
     roots_.clear();
     for (std::size_t i = 0; i < size_; ++i)
         if (receiver_[i] == std::int32_t(i)) roots_.push_back(std::int32_t(i));
     std::int64_t off[8];
     for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
-    if (label_basins) basin_start_.assign(roots_.size() + 1, 0);
+    basin_start_.assign(roots_.size() + 1, 0);
     std::size_t pos = 0;
+    std::int32_t* stack = stack_.data();
     for (std::size_t b = 0; b < roots_.size(); ++b) {
-        if (label_basins) basin_start_[b] = std::int64_t(pos);
+        basin_start_[b] = std::int64_t(pos);
         walk_.clear();
         walk_.push_back(roots_[b]);
         while (!walk_.empty()) {
             const std::int32_t c = walk_.back();
             walk_.pop_back();
-            stack_[pos++] = c;
+            stack[pos++] = c;
             if (label_basins) basin_[std::size_t(c)] = std::int32_t(b);
             unsigned m = donors_[std::size_t(c)];
             while (m) {
@@ -157,8 +162,14 @@ void FlowRouter::build_stack(bool label_basins) {
             }
         }
     }
-    if (label_basins) basin_start_[roots_.size()] = std::int64_t(pos);
+    basin_start_[roots_.size()] = std::int64_t(pos);
     if (pos != size_) throw std::logic_error("FlowRouter: the receivers hold a loop");  // cannot happen: drops are strict
+    // Groups of whole basins, about size/kChunks cells each: the work the
+    // solver can share between threads (basins do not exchange water).
+    chunks_.assign(1, 0);
+    const std::int64_t target = std::max<std::int64_t>(1, std::int64_t(size_) / kChunks);
+    for (std::size_t b = 1; b <= roots_.size(); ++b)
+        if (basin_start_[b] - chunks_.back() >= target || b == roots_.size()) chunks_.push_back(basin_start_[b]);
 }
 
 void FlowRouter::route(double* h, Depressions mode) {
@@ -166,22 +177,33 @@ void FlowRouter::route(double* h, Depressions mode) {
     pits_ = 0;
     for (std::size_t i = 0; i < size_; ++i) pits_ += (receiver_[i] == std::int32_t(i) && !outlet_[i]) ? 1 : 0;
     build_stack(pits_ > 0);
-    if (pits_ > 0) {
-        resolve_pits(h, mode);
-        build_stack(false);
-    }
+    if (pits_ > 0) resolve_pits(h, mode);
 }
 
 void FlowRouter::resolve_pits(double* h, Depressions mode) {
     const int W = width_, H = height_;
     const std::size_t nb = roots_.size();
     // Graph nodes: 0 = the sea (every outlet basin), 1..P = the pit basins.
-    std::vector<std::int32_t> node(nb);
+    std::vector<std::int32_t> node(nb), node_basin{0};
     std::int32_t nodes = 1;
-    for (std::size_t b = 0; b < nb; ++b) node[b] = outlet_[std::size_t(roots_[b])] ? 0 : nodes++;
+    for (std::size_t b = 0; b < nb; ++b) {
+        if (outlet_[std::size_t(roots_[b])]) {
+            node[b] = 0;
+        } else {
+            node[b] = nodes++;
+            node_basin.push_back(std::int32_t(b));
+        }
+    }
 
     // Links over every edge (4 forward neighbours: E, SE, S, SW) between two
-    // basins, one of them a pit basin; collected per fixed block of rows.
+    // basins, one of them a pit basin, collected per fixed block of rows;
+    // each block keeps only its lowest link per pair of nodes (by the total
+    // order the global sort uses, so the result does not depend on blocks).
+    std::vector<std::int32_t>& cell_node = basin_;  // basin → node, in place: the labels are not needed after
+    parallel_for(0, std::int64_t(size_), 1 << 15, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i) cell_node[std::size_t(i)] = node[std::size_t(basin_[std::size_t(i)])];
+    });
+    constexpr int kRowBlock = 16;
     const std::int64_t blocks = (H + kRowBlock - 1) / kRowBlock;
     std::vector<std::vector<Link>> per_block(static_cast<std::size_t>(blocks));
     parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
@@ -191,13 +213,12 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
             for (int y = y0; y < y1; ++y)
                 for (int x = 0; x < W; ++x) {
                     const std::int64_t i = std::int64_t(y) * W + x;
-                    const std::int32_t ni = node[std::size_t(basin_[std::size_t(i)])];
-                    static constexpr int fwd[4] = {0, 1, 2, 3};
-                    for (int k : fwd) {
+                    const std::int32_t ni = cell_node[std::size_t(i)];
+                    for (int k = 0; k < 4; ++k) {
                         const int nx = x + kDx[k], ny = y + kDy[k];
                         if (nx < 0 || nx >= W || ny >= H) continue;
                         const std::int64_t j = std::int64_t(ny) * W + nx;
-                        const std::int32_t nj = node[std::size_t(basin_[std::size_t(j)])];
+                        const std::int32_t nj = cell_node[std::size_t(j)];
                         if (ni == nj) continue;
                         const double pass = std::max(h[i], h[j]);
                         if (ni < nj)
@@ -206,13 +227,23 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
                             out.push_back({pass, nj, ni, std::int32_t(j), std::int32_t(i)});
                     }
                 }
+            std::sort(out.begin(), out.end(), [](const Link& l, const Link& r) {
+                if (l.a != r.a) return l.a < r.a;
+                if (l.b != r.b) return l.b < r.b;
+                return link_before(l, r);
+            });
+            std::size_t kept = 0;
+            for (std::size_t e = 0; e < out.size(); ++e)
+                if (e == 0 || out[e].a != out[kept - 1].a || out[e].b != out[kept - 1].b) out[kept++] = out[e];
+            out.resize(kept);
         }
     });
+    const auto& per_pit = per_block;
     std::vector<Link> links;
     std::size_t total = 0;
-    for (const auto& v : per_block) total += v.size();
+    for (const auto& v : per_pit) total += v.size();
     links.reserve(total);
-    for (const auto& v : per_block) links.insert(links.end(), v.begin(), v.end());
+    for (const auto& v : per_pit) links.insert(links.end(), v.begin(), v.end());
     per_block.clear();
     std::sort(links.begin(), links.end(), link_before);  // a total order: the result is independent of collection order
 
@@ -231,9 +262,9 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
     }
 
     // Orient the tree from the sea: each pit basin's way out, and its lake level.
-    std::vector<double> level(std::size_t(nodes), -std::numeric_limits<double>::infinity());
-    std::vector<std::int32_t> out_link(std::size_t(nodes), -1);
-    std::vector<std::uint8_t> seen(std::size_t(nodes), 0);
+    std::vector<double> level(static_cast<std::size_t>(nodes), -std::numeric_limits<double>::infinity());
+    std::vector<std::int32_t> out_link(static_cast<std::size_t>(nodes), -1);
+    std::vector<std::uint8_t> seen(static_cast<std::size_t>(nodes), 0);
     std::vector<std::int32_t> queue{0};
     seen[0] = 1;
     for (std::size_t q = 0; q < queue.size(); ++q) {
@@ -248,13 +279,19 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
             queue.push_back(u);
         }
     }
+    if (std::int32_t(queue.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
 
-    for (std::size_t b = 0; b < nb; ++b) {
-        const std::int32_t v = node[b];
-        if (v == 0) continue;
-        if (out_link[std::size_t(v)] < 0) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
+    // Fill, then carve: reverse the path pass cell → pit and send the pass cell's water across.
+    auto bit_from = [W](std::int32_t c, std::int32_t to) {  // the donor bit of neighbour c in `to`'s byte
+        const int dx = c % W - to % W, dy = c / W - to / W;
+        for (int k = 0; k < 8; ++k)
+            if (kDx[k] == dx && kDy[k] == dy) return std::uint8_t(1u << k);
+        return std::uint8_t(0);
+    };
+    for (std::int32_t v = 1; v < nodes; ++v) {
+        const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
         const Link& l = links[std::size_t(out_link[std::size_t(v)])];
-        const std::int32_t inside = l.a == v ? l.i : l.j, across = l.a == v ? l.j : l.i;
+        const std::int32_t in = l.a == v ? l.i : l.j, across = l.a == v ? l.j : l.i;
         if (mode == Depressions::fill) {
             const double lv = level[std::size_t(v)];
             for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
@@ -262,25 +299,37 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
                 if (h[c] < lv) h[c] = lv;
             }
         }
-        // Reverse the path pass cell → pit, and send the pass cell's water across.
-        std::int32_t prev = across, c = inside;
+        std::int32_t prev = across, c = in;
         for (;;) {
             const std::int32_t next = receiver_[std::size_t(c)];
             receiver_[std::size_t(c)] = prev;
+            // Donor bits follow: c leaves `next`'s donors and joins `prev`'s.
+            if (next != c) donors_[std::size_t(next)] &= std::uint8_t(~bit_from(c, next));
+            donors_[std::size_t(prev)] |= bit_from(c, prev);
             if (next == c) break;
             prev = c;
             c = next;
         }
     }
+
+    // The new stack: a walk up from the outlets again, now through the passes.
+    build_stack(false);
 }
+
 
 void FlowRouter::accumulate() {
     const double a0 = cell_ * cell_;
-    std::fill(area_.begin(), area_.end(), a0);
-    for (std::size_t s = size_; s-- > 0;) {
-        const std::int32_t i = stack_[s], r = receiver_[std::size_t(i)];
-        if (r != i) area_[std::size_t(r)] += area_[std::size_t(i)];
-    }
+    const std::int64_t groups = std::int64_t(chunks_.size()) - 1;
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const std::int64_t b = chunks_[std::size_t(g)], e = chunks_[std::size_t(g + 1)];
+            for (std::int64_t s = b; s < e; ++s) area_[std::size_t(stack_[std::size_t(s)])] = a0;
+            for (std::int64_t s = e; s-- > b;) {
+                const std::int32_t i = stack_[std::size_t(s)], r = receiver_[std::size_t(i)];
+                if (r != i) area_[std::size_t(r)] += area_[std::size_t(i)];
+            }
+        }
+    });
 }
 
 }  // namespace orogen::stream_power

@@ -71,11 +71,14 @@ public:
     double distance(std::int64_t i) const;
     /// D8 direction code of the receiver (kDx/kDy), −1 for an outlet.
     int direction(std::int64_t i) const;
+    /// Stack positions that cut it into groups of whole outlet basins (first 0, last size()):
+    /// each group can be solved on its own thread, in stack order, with the same result.
+    const std::vector<std::int64_t>& chunks() const { return chunks_; }
     /// Pits found (before resolution) by the last route().
     std::int64_t pits() const { return pits_; }
 
 private:
-    void receivers_from(const double* h);
+    void receivers_from(const double* h);  // and the donor bits
     void build_stack(bool label_basins);
     void resolve_pits(double* h, Depressions mode);
 
@@ -90,6 +93,8 @@ private:
     std::vector<std::int32_t> basin_;    // index of the basin's root in roots_ (during pit resolution)
     std::vector<std::int32_t> roots_;    // outlets and pits, index order
     std::vector<std::int64_t> basin_start_;  // first stack position of each basin (+ end)
+    std::vector<std::int64_t> chunks_;       // see chunks()
+    static constexpr std::int64_t kChunks = 64;
     std::vector<double> area_;
     std::vector<std::int32_t> walk_;     // DFS scratch
     std::int64_t pits_ = 0;

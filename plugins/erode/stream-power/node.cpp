@@ -67,11 +67,24 @@ NodeOutputs run(NodeContext& ctx) {
         if (!hm->has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
         const ConstGridView u = std::as_const(*hm).layer(layer);
         const double years = ctx.real("uplift_layer_years");
-        double fastest = 0.0;
+        std::vector<double> rate(n);
         for (std::size_t i = 0; i < n; ++i) {
             if (!std::isfinite(u.data[i]))
                 throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " + std::to_string(i));
-            uplift[i] += double(u.data[i]) / years;
+            rate[i] = double(u.data[i]) / years;
+        }
+        // Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp
+        // relief. Four implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides).
+        const double sigma = ctx.real("uplift_smoothing");
+        if (sigma > 0.0) {
+            diffusion::Settings ds;
+            ds.diffusivity = 1.0;
+            diffusion::Solver blur(hm->width(), hm->height(), hm->cell(), ds);
+            for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
+        }
+        double fastest = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            uplift[i] += rate[i];
             fastest = std::max(fastest, std::abs(uplift[i]));
         }
         if (fastest * 1e3 > kMaxUpliftMmYr) {
@@ -148,6 +161,8 @@ void check(CheckContext& ctx) {
         ctx.require_layer(0, "uplift_layer", layer, "tectonics:plates writes 'uplift'; or give \"\" for none");
     else if (ctx.given("uplift_layer_years"))
         ctx.error("uplift_layer_years", "uplift_layer_years scales an uplift layer; name one with uplift_layer");
+    else if (ctx.given("uplift_smoothing"))
+        ctx.error("uplift_smoothing", "uplift_smoothing spreads an uplift layer; name one with uplift_layer");
     // Memory: the model holds about kBytesPerCell bytes per cell beside the heightmap.
     const ValueInfo* in = ctx.input(0);
     const double w = in && in->width > 0 ? in->width : ctx.grid().width;
@@ -180,7 +195,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "solves the incision implicitly in flow order (Braun & Willett 2013: stable at any dt; Newton's method "
             "for n != 1) and diffuses implicitly. Water leaves by the open sides, whose vertices are held at base "
             "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
-            "uplift_layer, that layer's metres gained over uplift_layer_years (e.g. the plates' 'uplift'). The same "
+            "uplift_layer, that layer's metres gained over uplift_layer_years (e.g. the plates' 'uplift'), spread over "
+            "uplift_smoothing metres. The same "
             "result on any number of threads. Adds the layers drainage (upstream area, m^2: draw rivers where it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
             "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",
@@ -218,6 +234,11 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(1e9)
                     .unit("yr")
                     .help("years over which the uplift layer's metres were gained (1e6: metres per Myr = mm/yr)"),
+                Param::real("uplift_smoothing", 0.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("spread the uplift layer over about this distance (flexure of the crust; 0 = as is)"),
                 Param::real("diffusivity", 0.01)
                     .min(0.0)
                     .max(10.0)

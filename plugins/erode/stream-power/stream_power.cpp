@@ -112,38 +112,45 @@ void Model::incise(double dt) {
         }
     });
     double* h = h_.data();
-    const std::vector<std::int32_t>& stack = flow_.stack();
+    const std::int32_t* stack = flow_.stack().data();
     const double* f = factor_.data();
-    if (ns == 1.0) {
-        for (std::size_t s = 0; s < n; ++s) {
-            const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
-            const double hr = h[r], hi = h[i];
-            if (r == i || hi <= hr) continue;
-            const double F = f[i];
-            h[i] = (hi + F * hr) / (1.0 + F);
+    const auto& chunks = flow_.chunks();
+    // Outlet basins exchange nothing: each group of them is solved by one thread, in stack order.
+    parallel_for(0, std::int64_t(chunks.size()) - 1, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
+            if (ns == 1.0) {
+                for (std::int64_t s = b; s < e; ++s) {
+                    const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+                    const double hr = h[r], hi = h[i];
+                    if (r == i || hi <= hr) continue;
+                    const double F = f[i];
+                    h[i] = (hi + F * hr) / (1.0 + F);
+                }
+                continue;
+            }
+            for (std::int64_t s = b; s < e; ++s) {
+                const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+                const double hr = h[r], hi = h[i];
+                if (r == i || hi <= hr) continue;
+                const double F = f[i], delta = hi - hr;
+                // x − Δ + F·x^n = 0 for x = h_i' − h_r' in (0, Δ].
+                double x = delta;
+                for (int it = 0; it < 60; ++it) {
+                    const double xn1 = std::pow(x, ns - 1.0);
+                    const double gx = x - delta + F * xn1 * x;
+                    const double dg = 1.0 + ns * F * xn1;
+                    double next = x - gx / dg;
+                    if (next <= 0.0) next = 0.5 * x;  // n < 1: the concave residual can overshoot past zero
+                    if (next > delta) next = delta;
+                    const bool done = std::abs(next - x) <= 1e-12 * delta;
+                    x = next;
+                    if (done) break;
+                }
+                h[i] = hr + x;
+            }
         }
-        return;
-    }
-    for (std::size_t s = 0; s < n; ++s) {
-        const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
-        const double hr = h[r], hi = h[i];
-        if (r == i || hi <= hr) continue;
-        const double F = f[i], delta = hi - hr;
-        // x − Δ + F·x^n = 0 for x = h_i' − h_r' in (0, Δ].
-        double x = delta;
-        for (int it = 0; it < 60; ++it) {
-            const double xn1 = std::pow(x, ns - 1.0);
-            const double g = x - delta + F * xn1 * x;
-            const double dg = 1.0 + ns * F * xn1;
-            double next = x - g / dg;
-            if (next <= 0.0) next = 0.5 * x;  // n < 1: the concave residual can overshoot past zero
-            if (next > delta) next = delta;
-            const bool done = std::abs(next - x) <= 1e-12 * delta;
-            x = next;
-            if (done) break;
-        }
-        h[i] = hr + x;
-    }
+    });
 }
 
 void Model::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {
