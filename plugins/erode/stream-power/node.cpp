@@ -165,13 +165,14 @@ void check(CheckContext& ctx) {
         ctx.error("uplift_smoothing", "uplift_smoothing spreads an uplift layer; name one with uplift_layer");
     // Memory: the model holds about kBytesPerCell bytes per cell beside the heightmap.
     const ValueInfo* in = ctx.input(0);
-    const double w = in && in->width > 0 ? in->width : ctx.grid().width;
-    const double hgt = in && in->height > 0 ? in->height : ctx.grid().height;
-    const double need = w * hgt * double(stream_power::kBytesPerCell);
+    const std::int64_t w = in && in->width > 0 ? in->width : ctx.grid().width;
+    const std::int64_t hgt = in && in->height > 0 ? in->height : ctx.grid().height;
+    const double need = double(w) * double(hgt) * double(stream_power::kBytesPerCell);
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (have > 0 && need > 0.5 * have) {
         std::ostringstream msg;
-        msg.precision(3);
+        msg.setf(std::ios::fixed);
+        msg.precision(1);
         msg << "a " << w << " x " << hgt << " grid needs " << need / 1e9 << " GB for the landscape model, more than "
             << "half of this machine's " << have / 1e9 << " GB; use a smaller grid";
         ctx.error("", msg.str());
