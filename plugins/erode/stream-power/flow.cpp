@@ -180,19 +180,127 @@ void FlowRouter::route(double* h, Depressions mode) {
     if (pits_ > 0) resolve_pits(h, mode);
 }
 
+bool FlowRouter::spill_locally(double* h, Depressions mode, std::int32_t b, const std::vector<std::uint8_t>& drains) {
+    // A priority flood out of the pit, lowest cell first (Barnes et al. 2014),
+    // over at most kMaxLake cells. When every cell below a height P has been
+    // taken, the first cell taken outside the basin is its lowest way out
+    // (any lower link would have been reached first); the cells of the basin
+    // taken below P are its lake. Gives up (false) if the way out leads to a
+    // basin that does not drain yet, or the lake grows too large.
+    constexpr std::size_t kMaxLake = 4096;
+    const int W = width_, H = height_;
+    const std::int32_t c = roots_[std::size_t(b)];
+    if (++epoch_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), epoch_ = 1;
+    using Entry = std::pair<double, std::int32_t>;
+    auto& heap = heap_;  // a binary min-heap on (height, index): a total order, so the flood is deterministic
+    heap.clear();
+    const auto later = std::greater<Entry>();
+    lake_.clear();
+    auto push_around = [&](std::int32_t cell) {
+        const int x = cell % W, y = cell / W;
+        for (int k = 0; k < 8; ++k) {
+            const int nx = x + kDx[k], ny = y + kDy[k];
+            if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+            const std::int32_t j = std::int32_t(std::int64_t(ny) * W + nx);
+            if (mark_[std::size_t(j)] == epoch_) continue;
+            mark_[std::size_t(j)] = epoch_;
+            pusher_[std::size_t(j)] = cell;
+            heap.emplace_back(h[j], j);
+            std::push_heap(heap.begin(), heap.end(), later);
+        }
+    };
+    mark_[std::size_t(c)] = epoch_;
+    lake_.push_back(c);
+    double level = h[c];
+    push_around(c);
+    std::int32_t exit = -1;
+    while (!heap.empty()) {
+        const auto [hq, q] = heap.front();
+        if (exit >= 0 && hq >= level) break;  // the lake below the spill level is complete
+        std::pop_heap(heap.begin(), heap.end(), later);
+        heap.pop_back();
+        if (basin_[std::size_t(q)] != b) {
+            if (exit < 0) {
+                if (!drains[std::size_t(basin_[std::size_t(q)])]) return false;
+                exit = q;
+                level = std::max(level, hq);
+            }
+            continue;  // cells outside the basin are not part of the lake
+        }
+        if (exit < 0) level = std::max(level, hq);
+        lake_.push_back(q);
+        if (lake_.size() > kMaxLake) return false;
+        push_around(q);
+    }
+    if (exit < 0) return false;
+    if (mode == Depressions::fill)
+        for (const std::int32_t l : lake_)
+            if (h[l] < level) h[l] = level;
+    reroute(pusher_[std::size_t(exit)], exit);
+    return true;
+}
+
+void FlowRouter::reroute(std::int32_t inside, std::int32_t across) {
+    // Reverse the receivers from the pass cell down to the pit, send the pass
+    // cell's water across, and keep the donor bits in step.
+    const int W = width_;
+    auto bit_from = [W](std::int32_t cell, std::int32_t to) {
+        const int dx = cell % W - to % W, dy = cell / W - to / W;
+        for (int k = 0; k < 8; ++k)
+            if (kDx[k] == dx && kDy[k] == dy) return std::uint8_t(1u << k);
+        return std::uint8_t(0);
+    };
+    std::int32_t prev = across, c = inside;
+    for (;;) {
+        const std::int32_t next = receiver_[std::size_t(c)];
+        receiver_[std::size_t(c)] = prev;
+        if (next != c) donors_[std::size_t(next)] &= std::uint8_t(~bit_from(c, next));
+        donors_[std::size_t(prev)] |= bit_from(c, prev);
+        if (next == c) break;
+        prev = c;
+        c = next;
+    }
+}
+
 void FlowRouter::resolve_pits(double* h, Depressions mode) {
     const int W = width_, H = height_;
     const std::size_t nb = roots_.size();
-    // Graph nodes: 0 = the sea (every outlet basin), 1..P = the pit basins.
-    std::vector<std::int32_t> node(nb), node_basin{0};
-    std::int32_t nodes = 1;
+    // 1. Most pits (a channel cell left low by diffusion or uneven uplift) spill
+    // over a small lake into a basin that drains: found by a local flood, in
+    // index order, passes repeated while they resolve more.
+    std::vector<std::uint8_t> drains(nb, 0);
+    std::vector<std::int32_t> pending, next;
     for (std::size_t b = 0; b < nb; ++b) {
-        if (outlet_[std::size_t(roots_[b])]) {
-            node[b] = 0;
-        } else {
-            node[b] = nodes++;
-            node_basin.push_back(std::int32_t(b));
+        if (outlet_[std::size_t(roots_[b])])
+            drains[b] = 1;
+        else
+            pending.push_back(std::int32_t(b));
+    }
+    if (mark_.size() != size_) mark_.assign(size_, 0u), pusher_.resize(size_), epoch_ = 0;
+    for (int pass = 0; pass < 8 && !pending.empty(); ++pass) {
+        next.clear();
+        for (const std::int32_t b : pending) {
+            if (spill_locally(h, mode, b, drains))
+                drains[std::size_t(b)] = 1;
+            else
+                next.push_back(b);
         }
+        const bool progress = next.size() < pending.size();
+        pending.swap(next);
+        if (!progress) break;
+    }
+    if (pending.empty()) {
+        build_stack(false);
+        return;
+    }
+
+    // 2. The others over the basin graph. Nodes: 0 = the sea (every basin
+    // that drains), 1..P = the pit basins left.
+    std::vector<std::int32_t> node(nb, 0), node_basin{0};
+    std::int32_t nodes = 1;
+    for (const std::int32_t b : pending) {
+        node[std::size_t(b)] = nodes++;
+        node_basin.push_back(b);
     }
 
     // Links over every edge (4 forward neighbours: E, SE, S, SW) between two
@@ -281,13 +389,7 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
     }
     if (std::int32_t(queue.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
 
-    // Fill, then carve: reverse the path pass cell → pit and send the pass cell's water across.
-    auto bit_from = [W](std::int32_t c, std::int32_t to) {  // the donor bit of neighbour c in `to`'s byte
-        const int dx = c % W - to % W, dy = c / W - to / W;
-        for (int k = 0; k < 8; ++k)
-            if (kDx[k] == dx && kDy[k] == dy) return std::uint8_t(1u << k);
-        return std::uint8_t(0);
-    };
+    // Fill, then carve.
     for (std::int32_t v = 1; v < nodes; ++v) {
         const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
         const Link& l = links[std::size_t(out_link[std::size_t(v)])];
@@ -299,17 +401,7 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
                 if (h[c] < lv) h[c] = lv;
             }
         }
-        std::int32_t prev = across, c = in;
-        for (;;) {
-            const std::int32_t next = receiver_[std::size_t(c)];
-            receiver_[std::size_t(c)] = prev;
-            // Donor bits follow: c leaves `next`'s donors and joins `prev`'s.
-            if (next != c) donors_[std::size_t(next)] &= std::uint8_t(~bit_from(c, next));
-            donors_[std::size_t(prev)] |= bit_from(c, prev);
-            if (next == c) break;
-            prev = c;
-            c = next;
-        }
+        reroute(in, across);
     }
 
     // The new stack: a walk up from the outlets again, now through the passes.

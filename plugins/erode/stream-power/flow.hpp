@@ -28,6 +28,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace orogen::stream_power {
@@ -81,6 +82,8 @@ private:
     void receivers_from(const double* h);  // and the donor bits
     void build_stack(bool label_basins);
     void resolve_pits(double* h, Depressions mode);
+    bool spill_locally(double* h, Depressions mode, std::int32_t basin, const std::vector<std::uint8_t>& drains);
+    void reroute(std::int32_t inside, std::int32_t across);
 
     int width_, height_;
     std::size_t size_;
@@ -98,6 +101,11 @@ private:
     std::vector<double> area_;
     std::vector<std::int32_t> walk_;     // DFS scratch
     std::int64_t pits_ = 0;
+    std::vector<std::uint32_t> mark_;     // local floods: cells seen in flood number epoch_
+    std::vector<std::int32_t> pusher_;   // local floods: the lake cell that reached each cell
+    std::vector<std::int32_t> lake_;
+    std::vector<std::pair<double, std::int32_t>> heap_;
+    std::uint32_t epoch_ = 0;
 };
 
 }  // namespace orogen::stream_power
