@@ -61,7 +61,6 @@ FlowRouter::FlowRouter(int width, int height, double cell, OpenSides open, std::
     stack_.resize(size_);
     basin_.resize(size_);
     area_.resize(size_);
-    walk_.reserve(1024);
 }
 
 double FlowRouter::distance(std::int64_t i) const {
@@ -143,27 +142,51 @@ void FlowRouter::build_stack(bool label_basins) {
     std::int64_t off[8];
     for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
     basin_start_.assign(roots_.size() + 1, 0);
-    std::size_t pos = 0;
-    std::int32_t* stack = stack_.data();
-    for (std::size_t b = 0; b < roots_.size(); ++b) {
-        basin_start_[b] = std::int64_t(pos);
-        walk_.clear();
-        walk_.push_back(roots_[b]);
-        while (!walk_.empty()) {
-            const std::int32_t c = walk_.back();
-            walk_.pop_back();
-            stack[pos++] = c;
-            if (label_basins) basin_[std::size_t(c)] = std::int32_t(b);
-            unsigned m = donors_[std::size_t(c)];
-            while (m) {
-                const int k = std::countr_zero(m);
-                m &= m - 1;
-                walk_.push_back(std::int32_t(c + off[k]));
+    // Depth-first walks from the roots, in root order. The roots are cut into
+    // fixed groups; each group walks into its own buffer (in parallel), and
+    // the buffers are joined in group order: the same stack as one walk over
+    // all roots, whatever the thread count.
+    const std::int64_t nr = std::int64_t(roots_.size());
+    const std::int64_t groups = std::min<std::int64_t>(kChunks, nr);
+    if (std::int64_t(walk_buffers_.size()) < groups) walk_buffers_.resize(std::size_t(groups));
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        std::vector<std::int32_t> walk;
+        walk.reserve(256);
+        for (std::int64_t g = g0; g < g1; ++g) {
+            auto& out = walk_buffers_[std::size_t(g)];
+            out.clear();
+            for (std::int64_t b = g * nr / groups; b < (g + 1) * nr / groups; ++b) {
+                basin_start_[std::size_t(b)] = std::int64_t(out.size());  // within the group for now
+                walk.push_back(roots_[std::size_t(b)]);
+                while (!walk.empty()) {
+                    const std::int32_t c = walk.back();
+                    walk.pop_back();
+                    out.push_back(c);
+                    if (label_basins) basin_[std::size_t(c)] = std::int32_t(b);
+                    unsigned m = donors_[std::size_t(c)];
+                    while (m) {
+                        const int k = std::countr_zero(m);
+                        m &= m - 1;
+                        walk.push_back(std::int32_t(c + off[k]));
+                    }
+                }
             }
         }
-    }
-    basin_start_[roots_.size()] = std::int64_t(pos);
+    });
+    std::vector<std::int64_t> offset(std::size_t(groups) + 1, 0);
+    for (std::int64_t g = 0; g < groups; ++g)
+        offset[std::size_t(g + 1)] = offset[std::size_t(g)] + std::int64_t(walk_buffers_[std::size_t(g)].size());
+    const std::size_t pos = std::size_t(offset[std::size_t(groups)]);
     if (pos != size_) throw std::logic_error("FlowRouter: the receivers hold a loop");  // cannot happen: drops are strict
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const auto& buf = walk_buffers_[std::size_t(g)];
+            std::copy(buf.begin(), buf.end(), stack_.begin() + offset[std::size_t(g)]);
+            for (std::int64_t b = g * nr / groups; b < (g + 1) * nr / groups; ++b)
+                basin_start_[std::size_t(b)] += offset[std::size_t(g)];
+        }
+    });
+    basin_start_[roots_.size()] = std::int64_t(pos);
     // Groups of whole basins, about size/kChunks cells each: the work the
     // solver can share between threads (basins do not exchange water).
     chunks_.assign(1, 0);

@@ -99,7 +99,7 @@ private:
     std::vector<std::int64_t> chunks_;       // see chunks()
     static constexpr std::int64_t kChunks = 64;
     std::vector<double> area_;
-    std::vector<std::int32_t> walk_;     // DFS scratch
+    std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
     std::int64_t pits_ = 0;
     std::vector<std::uint32_t> mark_;     // local floods: cells seen in flood number epoch_
     std::vector<std::int32_t> pusher_;   // local floods: the lake cell that reached each cell
