@@ -7,6 +7,7 @@ packages=(
   cmake ninja-build g++ pkg-config
   libglm-dev libbox2d-dev libosmesa6-dev libvtk9-dev libopenvdb-dev libtinygltf-dev nlohmann-json3-dev
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
+  libgdal-dev gdal-bin
   libstb-dev libpng-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
 )

@@ -1,0 +1,121 @@
+// import:geotiff — any raster GDAL reads (GeoTIFF, SRTM .hgt, ESRI .asc, USGS .dem...) as a heightmap.
+#include "geotiff.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/plugin.hpp>
+
+#include <cmath>
+#include <sstream>
+
+#include <unistd.h>
+
+namespace {
+
+using namespace orogen;
+
+double physical_memory() { return double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE)); }
+
+std::string gib(double bytes) {
+    std::ostringstream s;
+    s.precision(3);
+    s << bytes / double(1ull << 30) << " GiB";
+    return s.str();
+}
+
+geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band, const std::string& holes,
+                                  double cell, const GridSpec& grid) {
+    geotiff::ReadOptions o;
+    o.band = int(band);
+    if (resample != "none") {
+        o.resample = geotiff::parse_resample(resample);
+        o.size = std::make_pair(grid.width, grid.height);
+    }
+    o.holes = holes == "refuse" ? geotiff::Holes::refuse : geotiff::Holes::fill;
+    o.cell = cell;
+    return o;
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    const auto o = options_from(ctx.text("resample"), ctx.integer("band"), ctx.text("holes"), ctx.real("cell"),
+                                ctx.grid());
+    auto result = geotiff::read(ctx.input_path("path"), o);
+    const double scale = ctx.real("z_scale"), offset = ctx.real("z_offset");
+    if (scale != 1.0 || offset != 0.0)
+        for (float& h : result.terrain->heights()) h = float(double(h) * scale + offset);
+    ctx.check_finite(result.terrain->heights(), "height", 0);
+    if (result.holes_filled)
+        ctx.info("filled " + std::to_string(result.holes_filled) + " nodata samples from their surroundings");
+    std::ostringstream msg;
+    msg << result.terrain->width() << "×" << result.terrain->height() << " vertices, cell " << result.terrain->cell()
+        << " m";
+    ctx.info(msg.str());
+    ctx.progress(1.0);
+    return result.terrain;
+}
+
+void check(CheckContext& ctx) {
+    geotiff::RasterInfo info;
+    try {
+        info = geotiff::probe(ctx.resolved_path("path"), int(ctx.integer("band")));
+    } catch (const BadInput& e) {
+        ctx.error(ctx.given("band") ? "band" : "path", e.what());
+        return;
+    }
+    // The band is read whole before resampling: it and its hole mask must fit.
+    const double bytes = double(info.width) * double(info.height) * 5.0;
+    if (bytes > physical_memory() / 4) {
+        ctx.error("path", "this raster is " + std::to_string(info.width) + "×" + std::to_string(info.height) +
+                              " samples and needs " + gib(bytes) + " to read, more than the " +
+                              gib(physical_memory() / 4) + " allowed here (a quarter of this machine's memory); "
+                              "cut it down first, e.g. gdal_translate -outsize 25% 25%");
+        return;
+    }
+    if (ctx.real("cell") <= 0.0 && info.cell_metres <= 0.0)
+        ctx.error("cell", "the raster has no georeference to take a cell size from; give cell=METRES");
+    const bool resampled = ctx.text("resample") != "none";
+    ValueInfo& out = ctx.output();
+    out.width = resampled ? ctx.grid().width : info.width;
+    out.height = resampled ? ctx.grid().height : info.height;
+    if (ctx.real("cell") > 0.0) {
+        out.cell = ctx.real("cell");
+    } else if (info.cell_metres > 0.0) {
+        out.cell = resampled && out.width > 1 ? info.cell_metres * double(info.width - 1) / double(out.width - 1)
+                                              : info.cell_metres;
+    }
+    out.layers_known = true;
+}
+
+}  // namespace
+
+OROGEN_PLUGIN("import-geotiff", "0.1.0", registry) {
+    registry.add({
+        .kind = "import",
+        .name = "geotiff",
+        .summary = "read a DEM (GeoTIFF, SRTM .hgt, ESRI .asc, USGS .dem, any GDAL raster) as a heightmap",
+        .description =
+            "One band of any raster GDAL opens, in metres (times z_scale, plus z_offset). By default it is "
+            "resampled to the spec's grid, keeping its first and last samples on the grid's corners; "
+            "resample=none keeps the raster's own size. The cell size comes from the georeference (a geographic "
+            "CRS's degrees are converted at the raster's mid latitude) unless cell is given. Nodata samples are "
+            "filled from their surroundings (holes=fill: layer by layer inward, each the mean of its valid "
+            "neighbours) or refused (holes=refuse).",
+        .inputs = {},
+        .output = ValueType::heightmap,
+        .params =
+            {
+                Param::path("path", PathRole::input).help("the raster, relative to the spec's folder"),
+                Param::integer("band", 1).min(1).max(65535).help("band to read"),
+                Param::choice("resample", {"bilinear", "cubic", "nearest", "none"}, "bilinear")
+                    .help("how to resample to the spec's grid; none keeps the raster's size"),
+                Param::choice("holes", {"fill", "refuse"}, "fill").help("what to do with nodata samples"),
+                Param::real("cell", 0.0).min(0.0).max(1e6).unit("m").help("vertex spacing; 0 = from the file"),
+                Param::real("z_scale", 1.0)
+                    .min(-1e6)
+                    .max(1e6)
+                    .help("multiplies the samples (e.g. 0.3048 for a DEM in feet)"),
+                Param::real("z_offset", 0.0).min(-1e7).max(1e7).unit("m").help("added after z_scale"),
+            },
+        .check = check,
+        .run = run,
+    });
+}
