@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -48,10 +49,17 @@ NodeOutputs run(NodeContext& ctx) {
     std::vector<double> h(hm->heights().begin(), hm->heights().end());
     const std::vector<float> before = hm->heights();
     diffusion::Solver solver(hm->width(), hm->height(), hm->cell(), s);
-    std::vector<float> probe;
+    const std::int64_t every = ctx.integer("timelapse_every");
+    Timelapse lapse(every, dt * 31'557'600.0);  // the series' clock is in seconds (Julian years)
+    lapse.record(0, *hm);
+    std::vector<float> frame;
     for (std::int64_t i = 1; i <= steps; ++i) {
         ctx.check_cancelled();
         solver.step(h.data(), i < steps ? dt : years - dt * double(steps - 1));
+        if (every > 0 && (i % every == 0 || i == steps)) {
+            frame.assign(h.begin(), h.end());
+            lapse.record(i, ConstGridView(frame.data(), hm->width(), hm->height(), hm->cell()));
+        }
         if (i % 16 == 0 || i == steps) {
             for (std::size_t k = 0; k < h.size(); ++k)
                 if (!std::isfinite(h[k])) {
@@ -71,7 +79,10 @@ NodeOutputs run(NodeContext& ctx) {
     std::ostringstream msg;
     msg << steps << " steps of " << dt << " yr, D = " << s.diffusivity << " m²/yr";
     ctx.info(msg.str());
-    return hm;
+    lapse.finish(steps, *hm);
+    NodeOutputs result(hm);
+    if (lapse.enabled()) result.side["timelapse"] = Value(lapse.series());
+    return result;
 }
 
 void check(CheckContext& ctx) {
@@ -82,6 +93,7 @@ void check(CheckContext& ctx) {
                                "\"ns\", or all or none");
     if (ctx.real("dt") > ctx.real("years"))
         ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
+    check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));
     ctx.output().layers.insert("eroded");
 }
 
@@ -102,7 +114,7 @@ OROGEN_PLUGIN("erode-diffusion", "0.1.0", registry) {
             "listed in fixed. Adds the layer eroded (net change, m).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to diffuse"}},
         .output = ValueType::heightmap,
-        .side_outputs = {},
+        .side_outputs = {timelapse_output()},
         .params =
             {
                 Param::real("diffusivity", 0.01)
@@ -122,6 +134,7 @@ OROGEN_PLUGIN("erode-diffusion", "0.1.0", registry) {
                     .help("threshold hillslope angle for nonlinear diffusion (Roering: about 40-50°); 0 = linear"),
                 Param::string("fixed", "none")
                     .help("sides whose heights stay (letters n e s w, all or none); the others let nothing through"),
+                timelapse_param(),
             },
         .adds_layers = {"eroded"},
         .check = check,

@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
 
 #include <algorithm>
 #include <charconv>
@@ -103,9 +104,18 @@ NodeOutputs run(NodeContext& ctx) {
             if (model.flow().is_outlet(std::int64_t(i))) model.heights()[i] = *base;
     }
     const double years = ctx.real("years"), dt = ctx.real("dt");
+    constexpr double kSecondsPerYear = 31'557'600.0;  // the series' clock is in seconds (Julian years)
+    const std::int64_t every = ctx.integer("timelapse_every");
+    Timelapse lapse(every, dt * kSecondsPerYear);
+    lapse.record(0, *hm);
+    std::vector<float> frame;
     std::int64_t pits = 0, last = 0;
     model.run(years, dt, [&](std::int64_t step, std::int64_t steps) {
         ctx.check_cancelled();
+        if (every > 0 && (step % every == 0 || step == steps)) {
+            frame.assign(model.heights().begin(), model.heights().end());
+            lapse.record(step, ConstGridView(frame.data(), hm->width(), hm->height(), hm->cell()));
+        }
         pits += model.flow().pits();
         last = steps;
         const std::int64_t bad = model.first_non_finite();
@@ -143,7 +153,10 @@ NodeOutputs run(NodeContext& ctx) {
     std::ostringstream msg;
     msg << last << " steps of " << dt << " yr; " << pits << " pits resolved; relief " << (*hi - *lo) << " m";
     ctx.info(msg.str());
-    return hm;
+    lapse.finish(last, *hm);
+    NodeOutputs result(hm);
+    if (lapse.enabled()) result.side["timelapse"] = Value(lapse.series());
+    return result;
 }
 
 void check(CheckContext& ctx) {
@@ -177,6 +190,7 @@ void check(CheckContext& ctx) {
             << "half of this machine's " << have / 1e9 << " GB; use a smaller grid";
         ctx.error("", msg.str());
     }
+    check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));
     for (const char* l : {"drainage", "flow_direction", "eroded"}) ctx.output().layers.insert(l);
     if (ctx.flag("chi")) ctx.output().layers.insert("chi");
 }
@@ -203,7 +217,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"}},
         .output = ValueType::heightmap,
-        .side_outputs = {},
+        .side_outputs = {timelapse_output()},
         .params =
             {
                 Param::real("years", 1e6).min(0.0, true).max(1e9).unit("yr").help("simulated time"),
@@ -254,6 +268,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
                           "the heights stay)"),
                 Param::boolean("chi", false).help("also write the layer chi (m; reference area 1 m^2)"),
+                timelapse_param(),
             },
         .adds_layers = {"drainage", "flow_direction", "eroded"},
         .check = check,

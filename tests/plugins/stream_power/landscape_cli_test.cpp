@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <sstream>
 #include <unistd.h>
 
 namespace {
@@ -91,6 +92,43 @@ TEST(LandscapeCli, RunsWritesItsLayersAndGivesTheSameBytesOnOneAndTwoThreads) {
     EXPECT_FALSE(bytes[0].empty());
     EXPECT_EQ(bytes[0], bytes[1]);
 }
+
+#ifdef OROGEN_FAKE_PLUGIN_DIR
+TEST(LandscapeCli, TimelapseRecordsEveryKStepsOnAClockOfYears) {
+    // export:test-series (tests/kernel/fake_plugins) writes "time sample0" per entry.
+    TempDir dir;
+    dir.write("s.orogen",
+              "orogen 1\ngrid 33 cell=30\n"
+              "b = generate:shape(kind=cone, height=300)\n"
+              "t = erode:stream-power(b, years=1e5, dt=1e4, uplift=2, timelapse_every=4)\n"
+              "d = erode:diffusion(t, years=3e4, dt=1e4, timelapse_every=2)\n"
+              "export:test-series(t.timelapse, path=\"t.txt\")\n"
+              "export:test-series(d.timelapse, path=\"d.txt\")\n"
+              "export:raw(t, path=\"t.r32\")\n");
+    const RunResult r = run_orogen("run s.orogen --out out --quiet", std::string("OROGEN_PLUGIN_PATH=") + OROGEN_FAKE_PLUGIN_DIR,
+                                   dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto read = [&](const char* name) {
+        std::istringstream in(slurp(dir / "out" / name));
+        std::vector<std::pair<double, float>> v;
+        double t;
+        float h;
+        while (in >> t >> h) v.emplace_back(t, h);
+        return v;
+    };
+    const double year = 31557600.0;
+    const auto t = read("t.txt");
+    ASSERT_EQ(t.size(), 4u);  // the input, steps 4 and 8, the last (10)
+    const double want[] = {0.0, 4e4, 8e4, 1e5};
+    for (int i = 0; i < 4; ++i)  // the writer prints 6 significant digits
+        EXPECT_NEAR(t[std::size_t(i)].first, want[i] * year, 1e-5 * want[i] * year + 1.0) << i;
+    const std::string bytes = slurp(dir / "out/t.r32");
+    float last;
+    std::memcpy(&last, bytes.data(), 4);
+    EXPECT_EQ(t.back().second, last);  // the last entry is the output
+    EXPECT_EQ(read("d.txt").size(), 3u);  // the input, step 2, the last (3)
+}
+#endif
 
 TEST(LandscapeCli, OrogenyPipelineHasTheStatisticsOfARealRange) {
     // The shipped pipeline as users run it; the bands and their sources are in docs/landscape.md.
