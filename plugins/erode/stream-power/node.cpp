@@ -205,8 +205,9 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
         .description =
             "dh/dt = U - K A^m S^n + D lap(h): rock uplift U against detachment-limited fluvial incision (drainage "
             "area A, slope S to the receiver) and hillslope diffusion D. Each step of dt years uplifts the land, "
-            "routes water D8 (steepest of 8 neighbours) with pits resolved over the basin graph (Cordonnier et al. "
-            "2019: each lake spills at its lowest pass; depressions=fill also fills it), accumulates drainage area, "
+            "routes water D8 (steepest of 8 neighbours) with pits resolved by local priority floods (Barnes et al. "
+            "2014) and, where those do not reach, over the basin graph (Cordonnier et al. 2019): each lake spills at "
+            "its lowest pass (depressions=fill also fills it). It accumulates drainage area, "
             "solves the incision implicitly in flow order (Braun & Willett 2013: stable at any dt; Newton's method "
             "for n != 1) and diffuses implicitly. Water leaves by the open sides, whose vertices are held at base "
             "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
