@@ -27,6 +27,7 @@ const Case cases[] = {
     {"erosion-pipe-rain", "--set storm.steps=300 --set after.steps=50"},
     {"erosion-shapes-4.1", ""},
     {"erosion-thermal-4.3", ""},
+    {"orogeny", "--set range.dt=2e5 --set storm.steps=60"},
 };
 
 /// relative path → sha256 of every file under `dir` but the manifest (which names plugin versions).

@@ -1,0 +1,84 @@
+// diffusion.hpp — hillslope diffusion, dh/dt = ∇·(D ∇h), solved implicitly by
+// alternating directions so that any time step is stable.
+//
+// Soil creep moves material down-slope at a flux proportional to the slope,
+// q = −D ∇h (Culling 1960; D in m²/yr, 10⁻³–10⁻¹ for soil-mantled hillslopes,
+// Fernandes & Dietrich 1997, Roering et al. 1999). On a grid of vertices
+// `cell` metres apart each step solves, one direction after the other, a
+// tridiagonal system per row and per column (Thomas algorithm), so a step costs
+// O(cells) whatever D·dt/cell² is:
+//
+//  * Scheme::implicit (default) — locally one-dimensional backward Euler:
+//        (1 − r δxx) h* = hⁿ,   (1 − r δyy) hⁿ⁺¹ = h*,     r = D·dt/cell².
+//    First order in time, and for every dt it keeps a maximum principle (no new
+//    extremum, no overshoot at a scarp): what long geological steps need.
+//  * Scheme::adi — Peaceman–Rachford (what fastscape does):
+//        (1 − r/2 δxx) h* = (1 + r/2 δyy) hⁿ,   (1 − r/2 δyy) hⁿ⁺¹ = (1 + r/2 δxx) h*.
+//    Second order in time; stable for every dt, but the shortest waves are
+//    multiplied by ≈ −1 per step when r ≫ 1 (they ring rather than decay).
+//
+// Sides are either fixed (their vertices keep their height: a base level) or
+// closed (no flux across them). Closed sides use the finite-volume form
+// δxx h₀ = h₁ − h₀, so with every side closed Σh is conserved to round-off.
+//
+// Critical-slope (nonlinear) diffusion, q = −D ∇h / (1 − (|∇h|/Sc)²) (Roering,
+// Kirchner & Dietrich 1999), is solved with the same sweeps and the
+// diffusivity of each link taken from the slopes at the start of the step
+// (lagged coefficients), the factor capped at `max_factor` so that slopes
+// at or beyond Sc stay finite.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace orogen::diffusion {
+
+enum class Scheme {
+    implicit,  ///< locally one-dimensional backward Euler (monotone, first order)
+    adi,       ///< Peaceman–Rachford ADI (second order, can ring at r ≫ 1)
+};
+
+/// Which sides hold their height (fixed) rather than let nothing through (closed).
+struct FixedSides {
+    bool north = false, east = false, south = false, west = false;  ///< north = row 0, west = column 0
+};
+
+struct Settings {
+    double diffusivity = 0.01;  ///< D, m²/yr (or m² per unit of the time step's unit)
+    Scheme scheme = Scheme::implicit;
+    FixedSides fixed;
+    /// Sc for critical-slope diffusion (tan of the threshold angle, e.g. 1.25 ≈ 51°); 0 = linear.
+    double critical_slope = 0.0;
+    /// Largest factor 1/(1 − (S/Sc)²) a link may get (nonlinear only).
+    double max_factor = 100.0;
+};
+
+/// Diffuses a width × height grid of heights (double, row-major, row 0 = north).
+/// Holds the scratch memory, so one Solver steps a grid many times without allocating.
+class Solver {
+public:
+    Solver(int width, int height, double cell, const Settings& settings);
+
+    /// One step of `dt` (the time unit of D) on `heights` in place. Same bits
+    /// for any thread count (each row and each column is solved by one thread).
+    void step(double* heights, double dt);
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+
+private:
+    void linear_step(double* h, double dt);
+    void nonlinear_step(double* h, double dt);
+
+    int width_, height_;
+    double cell_;
+    Settings settings_;
+    std::vector<double> scratch_;  // h* between the two sweeps
+    std::vector<double> scratch2_;  // column-sweep forward values / nonlinear coefficients
+    std::vector<double> kx_, ky_;   // nonlinear: per-link diffusivity factors
+};
+
+/// Σ heights over a grid (fixed order: the same double every time).
+double total(const double* heights, std::size_t count);
+
+}  // namespace orogen::diffusion

@@ -1,0 +1,450 @@
+// flow.cpp — D8 routing, pit resolution over the basin graph, stack, drainage area (see flow.hpp).
+#include "flow.hpp"
+
+#include <orogen/parallel.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace orogen::stream_power {
+
+namespace {
+
+constexpr double kSqrt2 = 1.4142135623730951;
+
+struct Link {
+    double pass;        // max(h_i, h_j): the water level at which the two basins join, m
+    std::int32_t a, b;  // basin graph nodes, a < b (0 = the sea: every outlet basin)
+    std::int32_t i, j;  // the two cells (i in a's basin, j in b's)
+};
+
+bool link_before(const Link& l, const Link& r) {
+    if (l.pass != r.pass) return l.pass < r.pass;
+    if (l.a != r.a) return l.a < r.a;
+    if (l.b != r.b) return l.b < r.b;
+    if (l.i != r.i) return l.i < r.i;
+    return l.j < r.j;
+}
+
+std::int32_t find(std::vector<std::int32_t>& parent, std::int32_t v) {
+    while (parent[std::size_t(v)] != v) {
+        parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
+        v = parent[std::size_t(v)];
+    }
+    return v;
+}
+
+}  // namespace
+
+FlowRouter::FlowRouter(int width, int height, double cell, OpenSides open, std::int64_t outlet_cell)
+    : width_(width), height_(height), size_(std::size_t(width) * std::size_t(height)), cell_(cell), open_(open) {
+    if (width < 1 || height < 1 || !(cell > 0.0)) throw std::invalid_argument("FlowRouter: empty grid or cell <= 0");
+    if (size_ >= std::size_t(std::numeric_limits<std::int32_t>::max()))
+        throw std::invalid_argument("FlowRouter: more than 2^31 cells");
+    outlet_.assign(size_, 0);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const bool o = (y == 0 && open.north) || (y == height - 1 && open.south) || (x == 0 && open.west) ||
+                           (x == width - 1 && open.east);
+            outlet_[std::size_t(y) * std::size_t(width) + std::size_t(x)] = o ? 1 : 0;
+        }
+    if (!open.any()) {
+        if (outlet_cell < 0 || std::size_t(outlet_cell) >= size_) throw std::invalid_argument("FlowRouter: outlet outside the grid");
+        outlet_[std::size_t(outlet_cell)] = 1;
+    }
+    receiver_.resize(size_);
+    donors_.resize(size_);
+    stack_.resize(size_);
+    basin_.resize(size_);
+    area_.resize(size_);
+}
+
+double FlowRouter::distance(std::int64_t i) const {
+    const std::int64_t r = receiver_[std::size_t(i)];
+    if (r == i) return 0.0;
+    const std::int64_t d = r - i;
+    return (d == 1 || d == -1 || d == width_ || d == -width_) ? cell_ : cell_ * kSqrt2;
+}
+
+int FlowRouter::direction(std::int64_t i) const {
+    const std::int64_t r = receiver_[std::size_t(i)];
+    if (r == i) return -1;
+    const int dx = int(r % width_ - i % width_), dy = int(r / width_ - i / width_);
+    for (int k = 0; k < 8; ++k)
+        if (kDx[k] == dx && kDy[k] == dy) return k;
+    return -1;
+}
+
+void FlowRouter::receivers_from(const double* h) {
+    // Receivers and donor bits in one pass. A cell's donor byte is written by
+    // the (up to 8) cells around it: inside a band of rows only this band's
+    // iterations touch it, so the OR is plain; in the two rows at each end of
+    // a band (shared with the neighbouring bands) it is atomic. OR is
+    // commutative, so the bytes do not depend on the split.
+    const int W = width_, H = height_;
+    const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
+    std::fill(donors_.begin(), donors_.end(), std::uint8_t(0));
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y) {
+            const bool inner_row = y > 0 && y < H - 1;
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                if (outlet_[std::size_t(i)]) {
+                    receiver_[std::size_t(i)] = std::int32_t(i);
+                    continue;
+                }
+                const double hi = h[i];
+                double best = 0.0;
+                int dir = -1;
+                if (inner_row && x > 0 && x < W - 1) {
+                    for (int k = 0; k < 8; ++k) {  // branch-free: the comparisons are unpredictable on rough ground
+                        const double s = (hi - h[i + off[k]]) * inv[k];
+                        const bool better = s > best;
+                        best = better ? s : best;
+                        dir = better ? k : dir;
+                    }
+                } else {
+                    for (int k = 0; k < 8; ++k) {
+                        const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                        if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                        const double s = (hi - h[i + off[k]]) * inv[k];
+                        if (s > best) best = s, dir = k;
+                    }
+                }
+                if (dir < 0) {
+                    receiver_[std::size_t(i)] = std::int32_t(i);
+                    continue;
+                }
+                const std::int64_t to = i + off[dir];
+                receiver_[std::size_t(i)] = std::int32_t(to);
+                const auto bit = std::uint8_t(1u << ((dir + 4) & 7));  // seen from `to`, i is neighbour dir+4
+                const std::int64_t ty = y + kDy[dir];
+                if (ty <= y0 || ty >= y1 - 1)
+                    std::atomic_ref<std::uint8_t>(donors_[std::size_t(to)]).fetch_or(bit, std::memory_order_relaxed);
+                else
+                    donors_[std::size_t(to)] = std::uint8_t(donors_[std::size_t(to)] | bit);
+            }
+        }
+    });
+}
+
+void FlowRouter::build_stack(bool label_basins) {
+    const int W = width_;
+    roots_.clear();
+    for (std::size_t i = 0; i < size_; ++i)
+        if (receiver_[i] == std::int32_t(i)) roots_.push_back(std::int32_t(i));
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
+    basin_start_.assign(roots_.size() + 1, 0);
+    // Depth-first walks from the roots, in root order. The roots are cut into
+    // fixed groups; each group walks into its own buffer (in parallel), and
+    // the buffers are joined in group order: the same stack as one walk over
+    // all roots, whatever the thread count.
+    const std::int64_t nr = std::int64_t(roots_.size());
+    const std::int64_t groups = std::min<std::int64_t>(kChunks, nr);
+    if (std::int64_t(walk_buffers_.size()) < groups) walk_buffers_.resize(std::size_t(groups));
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        std::vector<std::int32_t> walk;
+        walk.reserve(256);
+        for (std::int64_t g = g0; g < g1; ++g) {
+            auto& out = walk_buffers_[std::size_t(g)];
+            out.clear();
+            for (std::int64_t b = g * nr / groups; b < (g + 1) * nr / groups; ++b) {
+                basin_start_[std::size_t(b)] = std::int64_t(out.size());  // within the group for now
+                walk.push_back(roots_[std::size_t(b)]);
+                while (!walk.empty()) {
+                    const std::int32_t c = walk.back();
+                    walk.pop_back();
+                    out.push_back(c);
+                    if (label_basins) basin_[std::size_t(c)] = std::int32_t(b);
+                    unsigned m = donors_[std::size_t(c)];
+                    while (m) {
+                        const int k = std::countr_zero(m);
+                        m &= m - 1;
+                        walk.push_back(std::int32_t(c + off[k]));
+                    }
+                }
+            }
+        }
+    });
+    std::vector<std::int64_t> offset(std::size_t(groups) + 1, 0);
+    for (std::int64_t g = 0; g < groups; ++g)
+        offset[std::size_t(g + 1)] = offset[std::size_t(g)] + std::int64_t(walk_buffers_[std::size_t(g)].size());
+    const std::size_t pos = std::size_t(offset[std::size_t(groups)]);
+    if (pos != size_) throw std::logic_error("FlowRouter: the receivers hold a loop");  // cannot happen: drops are strict
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const auto& buf = walk_buffers_[std::size_t(g)];
+            std::copy(buf.begin(), buf.end(), stack_.begin() + offset[std::size_t(g)]);
+            for (std::int64_t b = g * nr / groups; b < (g + 1) * nr / groups; ++b)
+                basin_start_[std::size_t(b)] += offset[std::size_t(g)];
+        }
+    });
+    basin_start_[roots_.size()] = std::int64_t(pos);
+    // Groups of whole basins, about size/kChunks cells each: the work the
+    // solver can share between threads (basins do not exchange water).
+    chunks_.assign(1, 0);
+    const std::int64_t target = std::max<std::int64_t>(1, std::int64_t(size_) / kChunks);
+    for (std::size_t b = 1; b <= roots_.size(); ++b)
+        if (basin_start_[b] - chunks_.back() >= target || b == roots_.size()) chunks_.push_back(basin_start_[b]);
+}
+
+void FlowRouter::route(double* h, Depressions mode) {
+    receivers_from(h);
+    pits_ = 0;
+    for (std::size_t i = 0; i < size_; ++i) pits_ += (receiver_[i] == std::int32_t(i) && !outlet_[i]) ? 1 : 0;
+    build_stack(pits_ > 0);
+    if (pits_ > 0) resolve_pits(h, mode);
+}
+
+bool FlowRouter::spill_locally(double* h, Depressions mode, std::int32_t b, const std::vector<std::uint8_t>& drains) {
+    // A priority flood out of the pit, lowest cell first (Barnes et al. 2014),
+    // over at most kMaxLake cells. When every cell below a height P has been
+    // taken, the first cell taken outside the basin is its lowest way out
+    // (any lower link would have been reached first); the cells of the basin
+    // taken below P are its lake. Gives up (false) if the way out leads to a
+    // basin that does not drain yet, or the lake grows too large.
+    constexpr std::size_t kMaxLake = 4096;
+    const int W = width_, H = height_;
+    const std::int32_t c = roots_[std::size_t(b)];
+    if (++epoch_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), epoch_ = 1;
+    using Entry = std::pair<double, std::int32_t>;
+    auto& heap = heap_;  // a binary min-heap on (height, index): a total order, so the flood is deterministic
+    heap.clear();
+    const auto later = std::greater<Entry>();
+    lake_.clear();
+    auto push_around = [&](std::int32_t cell) {
+        const int x = cell % W, y = cell / W;
+        for (int k = 0; k < 8; ++k) {
+            const int nx = x + kDx[k], ny = y + kDy[k];
+            if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+            const std::int32_t j = std::int32_t(std::int64_t(ny) * W + nx);
+            if (mark_[std::size_t(j)] == epoch_) continue;
+            mark_[std::size_t(j)] = epoch_;
+            pusher_[std::size_t(j)] = cell;
+            heap.emplace_back(h[j], j);
+            std::push_heap(heap.begin(), heap.end(), later);
+        }
+    };
+    mark_[std::size_t(c)] = epoch_;
+    lake_.push_back(c);
+    double level = h[c];
+    push_around(c);
+    std::int32_t exit = -1;
+    while (!heap.empty()) {
+        const auto [hq, q] = heap.front();
+        if (exit >= 0 && hq >= level) break;  // the lake below the spill level is complete
+        std::pop_heap(heap.begin(), heap.end(), later);
+        heap.pop_back();
+        if (basin_[std::size_t(q)] != b) {
+            if (exit < 0) {
+                if (!drains[std::size_t(basin_[std::size_t(q)])]) return false;
+                exit = q;
+                level = std::max(level, hq);
+            }
+            continue;  // cells outside the basin are not part of the lake
+        }
+        if (exit < 0) level = std::max(level, hq);
+        lake_.push_back(q);
+        if (lake_.size() > kMaxLake) return false;
+        push_around(q);
+    }
+    if (exit < 0) return false;
+    if (mode == Depressions::fill)
+        for (const std::int32_t l : lake_)
+            if (h[l] < level) h[l] = level;
+    reroute(pusher_[std::size_t(exit)], exit);
+    return true;
+}
+
+void FlowRouter::reroute(std::int32_t inside, std::int32_t across) {
+    // Reverse the receivers from the pass cell down to the pit, send the pass
+    // cell's water across, and keep the donor bits in step.
+    const int W = width_;
+    auto bit_from = [W](std::int32_t cell, std::int32_t to) {
+        const int dx = cell % W - to % W, dy = cell / W - to / W;
+        for (int k = 0; k < 8; ++k)
+            if (kDx[k] == dx && kDy[k] == dy) return std::uint8_t(1u << k);
+        return std::uint8_t(0);
+    };
+    std::int32_t prev = across, c = inside;
+    for (;;) {
+        const std::int32_t next = receiver_[std::size_t(c)];
+        receiver_[std::size_t(c)] = prev;
+        if (next != c) donors_[std::size_t(next)] &= std::uint8_t(~bit_from(c, next));
+        donors_[std::size_t(prev)] |= bit_from(c, prev);
+        if (next == c) break;
+        prev = c;
+        c = next;
+    }
+}
+
+void FlowRouter::resolve_pits(double* h, Depressions mode) {
+    const int W = width_, H = height_;
+    const std::size_t nb = roots_.size();
+    // 1. Most pits (a channel cell left low by diffusion or uneven uplift) spill
+    // over a small lake into a basin that drains: found by a local flood, in
+    // index order, passes repeated while they resolve more.
+    std::vector<std::uint8_t> drains(nb, 0);
+    std::vector<std::int32_t> pending, next;
+    for (std::size_t b = 0; b < nb; ++b) {
+        if (outlet_[std::size_t(roots_[b])])
+            drains[b] = 1;
+        else
+            pending.push_back(std::int32_t(b));
+    }
+    if (mark_.size() != size_) mark_.assign(size_, 0u), pusher_.resize(size_), epoch_ = 0;
+    for (int pass = 0; pass < 8 && !pending.empty(); ++pass) {
+        next.clear();
+        for (const std::int32_t b : pending) {
+            if (spill_locally(h, mode, b, drains))
+                drains[std::size_t(b)] = 1;
+            else
+                next.push_back(b);
+        }
+        const bool progress = next.size() < pending.size();
+        pending.swap(next);
+        if (!progress) break;
+    }
+    if (pending.empty()) {
+        build_stack(false);
+        return;
+    }
+
+    // 2. The others over the basin graph. Nodes: 0 = the sea (every basin
+    // that drains), 1..P = the pit basins left.
+    std::vector<std::int32_t> node(nb, 0), node_basin{0};
+    std::int32_t nodes = 1;
+    for (const std::int32_t b : pending) {
+        node[std::size_t(b)] = nodes++;
+        node_basin.push_back(b);
+    }
+
+    // Links over every edge (4 forward neighbours: E, SE, S, SW) between two
+    // basins, one of them a pit basin, collected per fixed block of rows;
+    // each block keeps only its lowest link per pair of nodes (by the total
+    // order the global sort uses, so the result does not depend on blocks).
+    std::vector<std::int32_t>& cell_node = basin_;  // basin → node, in place: the labels are not needed after
+    parallel_for(0, std::int64_t(size_), 1 << 15, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i) cell_node[std::size_t(i)] = node[std::size_t(basin_[std::size_t(i)])];
+    });
+    constexpr int kRowBlock = 16;
+    const std::int64_t blocks = (H + kRowBlock - 1) / kRowBlock;
+    std::vector<std::vector<Link>> per_block(static_cast<std::size_t>(blocks));
+    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t blk = b0; blk < b1; ++blk) {
+            auto& out = per_block[std::size_t(blk)];
+            const int y0 = int(blk) * kRowBlock, y1 = std::min(H, y0 + kRowBlock);
+            for (int y = y0; y < y1; ++y)
+                for (int x = 0; x < W; ++x) {
+                    const std::int64_t i = std::int64_t(y) * W + x;
+                    const std::int32_t ni = cell_node[std::size_t(i)];
+                    for (int k = 0; k < 4; ++k) {
+                        const int nx = x + kDx[k], ny = y + kDy[k];
+                        if (nx < 0 || nx >= W || ny >= H) continue;
+                        const std::int64_t j = std::int64_t(ny) * W + nx;
+                        const std::int32_t nj = cell_node[std::size_t(j)];
+                        if (ni == nj) continue;
+                        const double pass = std::max(h[i], h[j]);
+                        if (ni < nj)
+                            out.push_back({pass, ni, nj, std::int32_t(i), std::int32_t(j)});
+                        else
+                            out.push_back({pass, nj, ni, std::int32_t(j), std::int32_t(i)});
+                    }
+                }
+            std::sort(out.begin(), out.end(), [](const Link& l, const Link& r) {
+                if (l.a != r.a) return l.a < r.a;
+                if (l.b != r.b) return l.b < r.b;
+                return link_before(l, r);
+            });
+            std::size_t kept = 0;
+            for (std::size_t e = 0; e < out.size(); ++e)
+                if (e == 0 || out[e].a != out[kept - 1].a || out[e].b != out[kept - 1].b) out[kept++] = out[e];
+            out.resize(kept);
+        }
+    });
+    const auto& per_pit = per_block;
+    std::vector<Link> links;
+    std::size_t total = 0;
+    for (const auto& v : per_pit) total += v.size();
+    links.reserve(total);
+    for (const auto& v : per_pit) links.insert(links.end(), v.begin(), v.end());
+    per_block.clear();
+    std::sort(links.begin(), links.end(), link_before);  // a total order: the result is independent of collection order
+
+    // Kruskal: the minimum spanning tree of the basin graph.
+    std::vector<std::int32_t> parent(static_cast<std::size_t>(nodes));
+    for (std::int32_t v = 0; v < nodes; ++v) parent[std::size_t(v)] = v;
+    std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
+    std::int32_t joined = 0;
+    for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
+        const std::int32_t ra = find(parent, links[e].a), rb = find(parent, links[e].b);
+        if (ra == rb) continue;
+        parent[std::size_t(ra)] = rb;
+        ++joined;
+        adjacent[std::size_t(links[e].a)].push_back(std::int32_t(e));
+        adjacent[std::size_t(links[e].b)].push_back(std::int32_t(e));
+    }
+
+    // Orient the tree from the sea: each pit basin's way out, and its lake level.
+    std::vector<double> level(static_cast<std::size_t>(nodes), -std::numeric_limits<double>::infinity());
+    std::vector<std::int32_t> out_link(static_cast<std::size_t>(nodes), -1);
+    std::vector<std::uint8_t> seen(static_cast<std::size_t>(nodes), 0);
+    std::vector<std::int32_t> queue{0};
+    seen[0] = 1;
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+        const std::int32_t v = queue[q];
+        for (std::int32_t e : adjacent[std::size_t(v)]) {
+            const Link& l = links[std::size_t(e)];
+            const std::int32_t u = l.a == v ? l.b : l.a;
+            if (seen[std::size_t(u)]) continue;
+            seen[std::size_t(u)] = 1;
+            out_link[std::size_t(u)] = e;
+            level[std::size_t(u)] = std::max(l.pass, level[std::size_t(v)]);
+            queue.push_back(u);
+        }
+    }
+    if (std::int32_t(queue.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
+
+    // Fill, then carve.
+    for (std::int32_t v = 1; v < nodes; ++v) {
+        const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
+        const Link& l = links[std::size_t(out_link[std::size_t(v)])];
+        const std::int32_t in = l.a == v ? l.i : l.j, across = l.a == v ? l.j : l.i;
+        if (mode == Depressions::fill) {
+            const double lv = level[std::size_t(v)];
+            for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
+                const std::int32_t c = stack_[std::size_t(s)];
+                if (h[c] < lv) h[c] = lv;
+            }
+        }
+        reroute(in, across);
+    }
+
+    // The new stack: a walk up from the outlets again, now through the passes.
+    build_stack(false);
+}
+
+
+void FlowRouter::accumulate() {
+    const double a0 = cell_ * cell_;
+    const std::int64_t groups = std::int64_t(chunks_.size()) - 1;
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const std::int64_t b = chunks_[std::size_t(g)], e = chunks_[std::size_t(g + 1)];
+            for (std::int64_t s = b; s < e; ++s) area_[std::size_t(stack_[std::size_t(s)])] = a0;
+            for (std::int64_t s = e; s-- > b;) {
+                const std::int32_t i = stack_[std::size_t(s)], r = receiver_[std::size_t(i)];
+                if (r != i) area_[std::size_t(r)] += area_[std::size_t(i)];
+            }
+        }
+    });
+}
+
+}  // namespace orogen::stream_power

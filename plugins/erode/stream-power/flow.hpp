@@ -1,0 +1,111 @@
+// flow.hpp — single-flow (D8) routing with depressions resolved, the order
+// in which the implicit stream-power solver visits the cells, and drainage area.
+//
+// Every cell sends its water to one receiver: the neighbour (of 8) with the
+// steepest drop, (h_i − h_k)/distance. Cells on an open side are outlets
+// (their own receiver); with every side closed, the lowest cell of the start
+// heights is the one outlet (a declared sink, the base level). A cell with
+// no lower neighbour that is not an outlet is a pit.
+//
+// Pits are resolved as Cordonnier, Bovy & Braun (2019) do: the cells are cut
+// into basins (the cells that drain to one outlet or pit), adjacent basins are
+// joined at their lowest pass (the lower of the higher cell over each edge
+// between them), and a minimum spanning tree of the basin graph (Kruskal; every
+// outlet basin is one node, the sea) gives each pit basin the pass its water
+// leaves by. The receivers on the path from the pass cell down to the pit are
+// reversed and the pass cell sends its water across: the result is a tree
+// rooted at the outlets, so every cell drains to an outlet and there is no
+// loop. With Depressions::fill the cells of a lake are also raised to its
+// spill level (the highest pass on the way out, lakes that spill into a higher
+// lake take its level): the lake is filled with sediment at once, and no
+// cell's receiver is higher than itself. With Depressions::route the heights
+// are left alone (lakes persist; the solver does not erode below a receiver).
+//
+// The "stack" (Braun & Willett 2013) lists the cells so that each cell's
+// receiver comes before it: a depth-first walk up from each outlet over its
+// donors, outlets in index order, donors in neighbour order. It is a pure
+// function of the receivers, so the result does not depend on the thread count.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+namespace orogen::stream_power {
+
+/// Which sides let water (and sediment) leave: their vertices are outlets held at base level.
+struct OpenSides {
+    bool north = true, east = true, south = true, west = true;  ///< north = row 0, west = column 0
+    bool any() const { return north || east || south || west; }
+};
+
+enum class Depressions {
+    fill,   ///< route across and fill each lake to its spill level
+    route,  ///< route across, leave the heights
+};
+
+/// D8 neighbour k: 0 east, 1 south-east, 2 south, 3 south-west, 4 west, 5 north-west, 6 north, 7 north-east.
+inline constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
+inline constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+
+class FlowRouter {
+public:
+    /// `outlet_cell` (with every side closed): the one outlet; ignored if a side is open.
+    FlowRouter(int width, int height, double cell, OpenSides open, std::int64_t outlet_cell = 0);
+
+    /// Route water over `h` (row-major, width × height metres): receivers,
+    /// depressions (with Depressions::fill, `h` is raised in lakes), stack.
+    void route(double* h, Depressions mode);
+    /// Drainage area of every cell (m²): its own cell² plus all its donors'.
+    void accumulate();
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    std::size_t size() const { return size_; }
+    double cell() const { return cell_; }
+
+    bool is_outlet(std::int64_t i) const { return outlet_[std::size_t(i)] != 0; }
+    const std::vector<std::int32_t>& receivers() const { return receiver_; }  ///< i itself for an outlet
+    const std::vector<std::int32_t>& stack() const { return stack_; }  ///< receivers before donors
+    const std::vector<double>& area() const { return area_; }  ///< m², after accumulate()
+    /// Distance to the receiver, metres (0 for an outlet).
+    double distance(std::int64_t i) const;
+    /// D8 direction code of the receiver (kDx/kDy), −1 for an outlet.
+    int direction(std::int64_t i) const;
+    /// Stack positions that cut it into groups of whole outlet basins (first 0, last size()):
+    /// each group can be solved on its own thread, in stack order, with the same result.
+    const std::vector<std::int64_t>& chunks() const { return chunks_; }
+    /// Pits found (before resolution) by the last route().
+    std::int64_t pits() const { return pits_; }
+
+private:
+    void receivers_from(const double* h);  // and the donor bits
+    void build_stack(bool label_basins);
+    void resolve_pits(double* h, Depressions mode);
+    bool spill_locally(double* h, Depressions mode, std::int32_t basin, const std::vector<std::uint8_t>& drains);
+    void reroute(std::int32_t inside, std::int32_t across);
+
+    int width_, height_;
+    std::size_t size_;
+    double cell_;
+    OpenSides open_;
+    std::vector<std::uint8_t> outlet_;   // 1 where a cell is an outlet (open side or the declared sink)
+    std::vector<std::int32_t> receiver_;
+    std::vector<std::uint8_t> donors_;   // bit k: neighbour k sends its water here
+    std::vector<std::int32_t> stack_;
+    std::vector<std::int32_t> basin_;    // index of the basin's root in roots_ (during pit resolution)
+    std::vector<std::int32_t> roots_;    // outlets and pits, index order
+    std::vector<std::int64_t> basin_start_;  // first stack position of each basin (+ end)
+    std::vector<std::int64_t> chunks_;       // see chunks()
+    static constexpr std::int64_t kChunks = 64;
+    std::vector<double> area_;
+    std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
+    std::int64_t pits_ = 0;
+    std::vector<std::uint32_t> mark_;     // local floods: cells seen in flood number epoch_
+    std::vector<std::int32_t> pusher_;   // local floods: the lake cell that reached each cell
+    std::vector<std::int32_t> lake_;
+    std::vector<std::pair<double, std::int32_t>> heap_;
+    std::uint32_t epoch_ = 0;
+};
+
+}  // namespace orogen::stream_power

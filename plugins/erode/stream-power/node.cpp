@@ -1,0 +1,278 @@
+// erode:stream-power — registers the implicit stream-power landscape model (stream_power.hpp) with the kernel.
+#include "stream_power.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using namespace orogen;
+
+/// Fastest rock uplift measured in active ranges (Taiwan, Nanga Parbat, the Southern Alps: 5–10 mm/yr),
+/// with a margin; a faster rate from a layer is an error in its scale.
+constexpr double kMaxUpliftMmYr = 20.0;
+
+std::optional<stream_power::OpenSides> parse_sides(const std::string& text) {
+    stream_power::OpenSides s{false, false, false, false};
+    if (text == "none") return s;
+    if (text == "all") return stream_power::OpenSides{};
+    for (char c : text) {
+        switch (c) {
+            case 'n': s.north = true; break;
+            case 'e': s.east = true; break;
+            case 's': s.south = true; break;
+            case 'w': s.west = true; break;
+            default: return std::nullopt;
+        }
+    }
+    return s;
+}
+
+/// "edge" → nullopt (outlets keep their heights); a number → that height in metres.
+std::optional<std::optional<double>> parse_base_level(const std::string& text) {
+    if (text == "edge") return std::optional<double>{};
+    double v = 0.0;
+    const char* end = text.data() + text.size();
+    const auto [p, ec] = std::from_chars(text.data(), end, v);
+    if (ec != std::errc() || p != end || !std::isfinite(v)) return std::nullopt;
+    return std::optional<double>{v};
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    auto hm = ctx.take_heightmap(0);
+    const std::size_t n = hm->size();
+    stream_power::Settings s;
+    s.erodibility = ctx.real("erodibility");
+    s.area_exponent = ctx.real("m");
+    s.slope_exponent = ctx.real("n");
+    s.diffusivity = ctx.real("diffusivity");
+    s.open = *parse_sides(ctx.text("open"));
+    s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
+
+    std::vector<double> h(hm->heights().begin(), hm->heights().end());
+    // Uplift: the uniform rate plus the layer read as metres accumulated over uplift_layer_years.
+    std::vector<double> uplift(n, ctx.real("uplift") * 1e-3);
+    const std::string& layer = ctx.text("uplift_layer");
+    if (!layer.empty()) {
+        if (!hm->has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
+        const ConstGridView u = std::as_const(*hm).layer(layer);
+        const double years = ctx.real("uplift_layer_years");
+        std::vector<double> rate(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!std::isfinite(u.data[i]))
+                throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " + std::to_string(i));
+            rate[i] = double(u.data[i]) / years;
+        }
+        // Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp
+        // relief. Four implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides).
+        const double sigma = ctx.real("uplift_smoothing");
+        if (sigma > 0.0) {
+            diffusion::Settings ds;
+            ds.diffusivity = 1.0;
+            diffusion::Solver blur(hm->width(), hm->height(), hm->cell(), ds);
+            for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
+        }
+        double fastest = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            uplift[i] += rate[i];
+            fastest = std::max(fastest, std::abs(uplift[i]));
+        }
+        if (fastest * 1e3 > kMaxUpliftMmYr) {
+            std::ostringstream msg;
+            msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives "
+                << fastest * 1e3 << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
+                << " mm/yr); give a longer uplift_layer_years";
+            throw BadInput(msg.str());
+        }
+    }
+    const auto base = *parse_base_level(ctx.text("base_level"));
+
+    stream_power::Model model(hm->width(), hm->height(), hm->cell(), std::move(h), std::move(uplift), s);
+    if (base) {
+        for (std::size_t i = 0; i < n; ++i)
+            if (model.flow().is_outlet(std::int64_t(i))) model.heights()[i] = *base;
+    }
+    const double years = ctx.real("years"), dt = ctx.real("dt");
+    constexpr double kSecondsPerYear = 31'557'600.0;  // the series' clock is in seconds (Julian years)
+    const std::int64_t every = ctx.integer("timelapse_every");
+    Timelapse lapse(every, dt * kSecondsPerYear);
+    lapse.record(0, *hm);
+    std::vector<float> frame;
+    std::int64_t pits = 0, last = 0;
+    model.run(years, dt, [&](std::int64_t step, std::int64_t steps) {
+        ctx.check_cancelled();
+        if (every > 0 && (step % every == 0 || step == steps)) {
+            frame.assign(model.heights().begin(), model.heights().end());
+            lapse.record(step, ConstGridView(frame.data(), hm->width(), hm->height(), hm->cell()));
+        }
+        pits += model.flow().pits();
+        last = steps;
+        const std::int64_t bad = model.first_non_finite();
+        if (bad >= 0) {
+            std::ostringstream msg;
+            msg << "non-finite height (" << model.heights()[std::size_t(bad)] << ") at sample " << bad
+                << " after step " << step << " of " << steps << "; the simulation became unstable";
+            throw Error(msg.str());
+        }
+        ctx.progress(double(step) / double(steps));
+    });
+
+    // Outputs: heights, the last step's flow graph as layers.
+    const std::vector<float> before = hm->heights();
+    std::vector<float>& out = hm->heights();
+    const auto& hd = model.heights();
+    for (std::size_t i = 0; i < n; ++i) out[i] = float(hd[i]);
+    ctx.check_finite(out, "height", last);
+    model.route_only();  // drainage and directions of the final surface
+    GridView drainage = hm->layer("drainage", 0.0f);
+    GridView direction = hm->layer("flow_direction", -1.0f);
+    const auto& area = model.flow().area();
+    for (std::size_t i = 0; i < n; ++i) {
+        drainage.data[i] = float(area[i]);
+        direction.data[i] = float(model.flow().direction(std::int64_t(i)));
+    }
+    GridView eroded = hm->layer("eroded", 0.0f);
+    for (std::size_t i = 0; i < n; ++i) eroded.data[i] += out[i] - before[i];
+    if (ctx.flag("chi")) {
+        const std::vector<double> chi = model.chi(1.0);
+        GridView c = hm->layer("chi", 0.0f);
+        for (std::size_t i = 0; i < n; ++i) c.data[i] = float(chi[i]);
+    }
+    const auto [lo, hi] = std::minmax_element(out.begin(), out.end());
+    std::ostringstream msg;
+    msg << last << " steps of " << dt << " yr; " << pits << " pits resolved; relief " << (*hi - *lo) << " m";
+    ctx.info(msg.str());
+    lapse.finish(last, *hm);
+    NodeOutputs result(hm);
+    if (lapse.enabled()) result.side["timelapse"] = Value(lapse.series());
+    return result;
+}
+
+void check(CheckContext& ctx) {
+    if (!parse_sides(ctx.text("open")))
+        ctx.error("open", "'" + ctx.text("open") +
+                              "' is not a set of sides; write the letters of the open sides (n, e, s, w), e.g. "
+                              "\"nesw\", or all or none (every side closed: the lowest cell is the outlet)");
+    if (!parse_base_level(ctx.text("base_level")))
+        ctx.error("base_level", "'" + ctx.text("base_level") +
+                                    "' is not a height; give edge (outlets keep their heights) or metres, e.g. \"0\"");
+    if (ctx.real("dt") > ctx.real("years"))
+        ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
+    const std::string& layer = ctx.text("uplift_layer");
+    if (!layer.empty())
+        ctx.require_layer(0, "uplift_layer", layer, "tectonics:plates writes 'uplift'; or give \"\" for none");
+    else if (ctx.given("uplift_layer_years"))
+        ctx.error("uplift_layer_years", "uplift_layer_years scales an uplift layer; name one with uplift_layer");
+    else if (ctx.given("uplift_smoothing"))
+        ctx.error("uplift_smoothing", "uplift_smoothing spreads an uplift layer; name one with uplift_layer");
+    // Memory: the model holds about kBytesPerCell bytes per cell beside the heightmap.
+    const ValueInfo* in = ctx.input(0);
+    const std::int64_t w = in && in->width > 0 ? in->width : ctx.grid().width;
+    const std::int64_t hgt = in && in->height > 0 ? in->height : ctx.grid().height;
+    const double need = double(w) * double(hgt) * double(stream_power::kBytesPerCell);
+    const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+    if (have > 0 && need > 0.5 * have) {
+        std::ostringstream msg;
+        msg.setf(std::ios::fixed);
+        msg.precision(1);
+        msg << "a " << w << " x " << hgt << " grid needs " << need / 1e9 << " GB for the landscape model, more than "
+            << "half of this machine's " << have / 1e9 << " GB; use a smaller grid";
+        ctx.error("", msg.str());
+    }
+    check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));
+    for (const char* l : {"drainage", "flow_direction", "eroded"}) ctx.output().layers.insert(l);
+    if (ctx.flag("chi")) ctx.output().layers.insert("chi");
+}
+
+}  // namespace
+
+OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
+    registry.add({
+        .kind = "erode",
+        .name = "stream-power",
+        .summary = "landscape evolution over geological time: rivers incise (stream power) against rock uplift",
+        .description =
+            "dh/dt = U - K A^m S^n + D lap(h): rock uplift U against detachment-limited fluvial incision (drainage "
+            "area A, slope S to the receiver) and hillslope diffusion D. Each step of dt years uplifts the land, "
+            "routes water D8 (steepest of 8 neighbours) with pits resolved by local priority floods (Barnes et al. "
+            "2014) and, where those do not reach, over the basin graph (Cordonnier et al. 2019): each lake spills at "
+            "its lowest pass (depressions=fill also fills it). It accumulates drainage area, "
+            "solves the incision implicitly in flow order (Braun & Willett 2013: stable at any dt; Newton's method "
+            "for n != 1) and diffuses implicitly. Water leaves by the open sides, whose vertices are held at base "
+            "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
+            "uplift_layer, that layer's metres gained over uplift_layer_years (e.g. the plates' 'uplift'), spread over "
+            "uplift_smoothing metres. The same "
+            "result on any number of threads. Adds the layers drainage (upstream area, m^2: draw rivers where it "
+            "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
+            "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"}},
+        .output = ValueType::heightmap,
+        .side_outputs = {timelapse_output()},
+        .params =
+            {
+                Param::real("years", 1e6).min(0.0, true).max(1e9).unit("yr").help("simulated time"),
+                Param::real("dt", 1e4)
+                    .min(0.0, true)
+                    .max(1e8)
+                    .unit("yr")
+                    .help("time step (any size is stable; 1e3-1e5 resolve the transient)"),
+                Param::real("erodibility", 2e-5)
+                    .min(0.0, true)
+                    .max(1e-2)
+                    .unit("m^(1-2m)/yr")
+                    .help("K: 1e-7 (hard rock, dry) to 1e-4 (soft rock, wet) for m ~ 0.5, n = 1 "
+                          "(Stock & Montgomery 1999)"),
+                Param::real("m", 0.45).min(0.1).max(1.5).help("area exponent (0.3-0.6 with n = 1; m/n is the concavity, "
+                                                              "0.35-0.6 in real rivers)"),
+                Param::real("n", 1.0).min(0.5).max(4.0).help("slope exponent (2/3-2 measured, Whipple & Tucker 1999; "
+                                                               "up to 4, Lague 2014)"),
+                Param::real("uplift", 1.0)
+                    .min(0.0)
+                    .max(kMaxUpliftMmYr)
+                    .unit("mm/yr")
+                    .help("uniform rock uplift rate (0.1-10 mm/yr in active ranges)"),
+                Param::string("uplift_layer", "")
+                    .help("a layer of the input read as uplift (m) gained over uplift_layer_years, added to "
+                          "`uplift`; \"\" = none"),
+                Param::real("uplift_layer_years", 1e6)
+                    .min(1.0)
+                    .max(1e9)
+                    .unit("yr")
+                    .help("years over which the uplift layer's metres were gained (1e6: metres per Myr = mm/yr)"),
+                Param::real("uplift_smoothing", 0.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("spread the uplift layer over about this distance (flexure of the crust; 0 = as is)"),
+                Param::real("diffusivity", 0.01)
+                    .min(0.0)
+                    .max(10.0)
+                    .unit("m²/yr")
+                    .help("D of hillslope diffusion applied each step (1e-3 to 1e-1; 0 = none)"),
+                Param::string("open", "nesw")
+                    .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
+                          "level. none: the lowest cell is the one outlet"),
+                Param::string("base_level", "edge")
+                    .help("height of the outlets: edge (they keep the input's heights) or metres, e.g. \"0\""),
+                Param::choice("depressions", {"fill", "route"}, "fill")
+                    .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
+                          "the heights stay)"),
+                Param::boolean("chi", false).help("also write the layer chi (m; reference area 1 m^2)"),
+                timelapse_param(),
+            },
+        .adds_layers = {"drainage", "flow_direction", "eroded"},
+        .check = check,
+        .run = run,
+    });
+}

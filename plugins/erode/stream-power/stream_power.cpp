@@ -1,0 +1,187 @@
+// stream_power.cpp — the implicit stream-power model (see stream_power.hpp).
+#include "stream_power.hpp"
+
+#include <orogen/parallel.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace orogen::stream_power {
+
+namespace {
+
+constexpr double kSqrt2 = 1.4142135623730951;
+/// A^m for drainage areas of fewer than this many cells comes from a table:
+/// areas are exact multiples of cell² (sums of integers), and most cells
+/// drain few cells, so the per-cell pow() becomes a lookup.
+constexpr std::int64_t kPowTable = 1 << 16;
+
+}  // namespace
+
+std::int64_t lowest_cell(const std::vector<double>& heights) {
+    std::int64_t best = 0;
+    for (std::size_t i = 1; i < heights.size(); ++i)
+        if (heights[i] < heights[std::size_t(best)]) best = std::int64_t(i);
+    return best;
+}
+
+Model::Model(int width, int height, double cell, std::vector<double> heights, std::vector<double> uplift,
+             const Settings& settings)
+    : width_(width),
+      height_(height),
+      cell_(cell),
+      settings_(settings),
+      h_(std::move(heights)),
+      uplift_(std::move(uplift)),
+      flow_(width, height, cell, settings.open, settings.open.any() ? 0 : lowest_cell(h_)) {
+    if (h_.size() != flow_.size()) throw std::invalid_argument("stream_power::Model: heights are not width × height");
+    if (!uplift_.empty() && uplift_.size() != h_.size())
+        throw std::invalid_argument("stream_power::Model: uplift is not width × height");
+    factor_.resize(h_.size());
+    pow_table_.resize(std::size_t(kPowTable));
+    for (std::int64_t c = 0; c < kPowTable; ++c)
+        pow_table_[std::size_t(c)] = std::pow(double(c) * cell * cell, settings.area_exponent);
+    if (settings.diffusivity > 0.0) {
+        diffusion::Settings ds;
+        ds.diffusivity = settings.diffusivity;
+        ds.scheme = diffusion::Scheme::implicit;
+        ds.fixed = {settings.open.north, settings.open.east, settings.open.south, settings.open.west};
+        diffusion_ = std::make_unique<diffusion::Solver>(width, height, cell, ds);
+    }
+}
+
+void Model::route_only() {
+    std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
+    flow_.route(copy.data(), settings_.depressions);
+    flow_.accumulate();
+}
+
+std::int64_t Model::step(double dt) {
+    const std::size_t n = h_.size();
+    double* h = h_.data();
+    // 1. Uplift (outlets are base level: they stay).
+    if (!uplift_.empty()) {
+        parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
+            for (std::int64_t i = b; i < e; ++i)
+                if (!flow_.is_outlet(i)) h[i] += uplift_[std::size_t(i)] * dt;
+        });
+    }
+    // 2. Routing, depressions, drainage area.
+    flow_.route(h, settings_.depressions);
+    flow_.accumulate();
+    const std::int64_t pits = flow_.pits();
+    // 3. Implicit incision.
+    incise(dt);
+    // 4. Hillslope diffusion.
+    if (diffusion_) {
+        std::vector<std::pair<std::int64_t, double>> sink;
+        if (!settings_.open.any())
+            for (std::size_t i = 0; i < n; ++i)
+                if (flow_.is_outlet(std::int64_t(i))) sink.emplace_back(std::int64_t(i), h[i]);
+        diffusion_->step(h, dt);
+        for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
+    }
+    return pits;
+}
+
+void Model::incise(double dt) {
+    const std::size_t n = h_.size();
+    const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
+    const double a0 = cell_ * cell_;
+    const auto& area = flow_.area();
+    const auto& rcv = flow_.receivers();
+    // K·dt·A^m / L^n, in parallel (the pow is the costly part), with a table for small areas.
+    const double* tab = pow_table_.data();
+    const double l1 = std::pow(cell_, ns), l2 = std::pow(cell_ * kSqrt2, ns);
+    const std::int64_t W = width_;
+    parallel_for(0, std::int64_t(n), 1 << 14, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i) {
+            const std::int64_t r = rcv[std::size_t(i)];
+            if (r == i) {
+                factor_[std::size_t(i)] = 0.0;
+                continue;
+            }
+            const double a = area[std::size_t(i)];
+            const double cells = a / a0;
+            const double am = cells < double(kPowTable) && cells == std::floor(cells) ? tab[std::size_t(cells)]
+                                                                                       : std::pow(a, m);
+            const std::int64_t d = r - i;
+            const double len = (d == 1 || d == -1 || d == W || d == -W) ? l1 : l2;
+            factor_[std::size_t(i)] = K * dt * am / len;
+        }
+    });
+    double* h = h_.data();
+    const std::int32_t* stack = flow_.stack().data();
+    const double* f = factor_.data();
+    const auto& chunks = flow_.chunks();
+    // Outlet basins exchange nothing: each group of them is solved by one thread, in stack order.
+    parallel_for(0, std::int64_t(chunks.size()) - 1, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
+            if (ns == 1.0) {
+                for (std::int64_t s = b; s < e; ++s) {
+                    const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+                    const double hr = h[r], hi = h[i];
+                    if (r == i || hi <= hr) continue;
+                    const double F = f[i];
+                    h[i] = (hi + F * hr) / (1.0 + F);
+                }
+                continue;
+            }
+            for (std::int64_t s = b; s < e; ++s) {
+                const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+                const double hr = h[r], hi = h[i];
+                if (r == i || hi <= hr) continue;
+                const double F = f[i], delta = hi - hr;
+                // x − Δ + F·x^n = 0 for x = h_i' − h_r' in (0, Δ].
+                double x = delta;
+                for (int it = 0; it < 60; ++it) {
+                    const double xn1 = std::pow(x, ns - 1.0);
+                    const double gx = x - delta + F * xn1 * x;
+                    const double dg = 1.0 + ns * F * xn1;
+                    double next = x - gx / dg;
+                    if (next <= 0.0) next = 0.5 * x;  // n < 1: the concave residual can overshoot past zero
+                    if (next > delta) next = delta;
+                    const bool done = std::abs(next - x) <= 1e-12 * delta;
+                    x = next;
+                    if (done) break;
+                }
+                h[i] = hr + x;
+            }
+        }
+    });
+}
+
+void Model::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {
+    if (!(years > 0.0) || !(dt > 0.0)) throw std::invalid_argument("stream_power::Model::run: years and dt must be > 0");
+    const auto steps = std::int64_t(std::ceil(years / dt * (1.0 - 1e-12)));
+    for (std::int64_t s = 1; s <= steps; ++s) {
+        const double this_dt = s < steps ? dt : years - dt * double(steps - 1);
+        step(this_dt);
+        if (on_step) on_step(s, steps);
+    }
+}
+
+std::vector<double> Model::chi(double a0) const {
+    const std::size_t n = h_.size();
+    std::vector<double> out(n, 0.0);
+    const double p = settings_.area_exponent / settings_.slope_exponent;
+    const auto& stack = flow_.stack();
+    const auto& rcv = flow_.receivers();
+    const auto& area = flow_.area();
+    for (std::size_t s = 0; s < n; ++s) {
+        const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+        if (r == i) continue;
+        out[std::size_t(i)] = out[std::size_t(r)] + std::pow(a0 / area[std::size_t(i)], p) * flow_.distance(i);
+    }
+    return out;
+}
+
+std::int64_t Model::first_non_finite() const {
+    for (std::size_t i = 0; i < h_.size(); ++i)
+        if (!std::isfinite(h_[i])) return std::int64_t(i);
+    return -1;
+}
+
+}  // namespace orogen::stream_power

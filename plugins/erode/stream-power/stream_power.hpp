@@ -1,0 +1,94 @@
+// stream_power.hpp — landscape evolution by detachment-limited fluvial
+// incision against rock uplift, with hillslope diffusion between the rivers:
+//
+//     ∂h/∂t = U − K·A^m·S^n + D·∇²h
+//
+// h elevation (m), t time (yr), U rock uplift rate (m/yr), A drainage area
+// (m²), S the slope to the receiver (m/m), K erodibility (m^(1−2m)/yr for
+// n = 1), D hillslope diffusivity (m²/yr).
+//
+// Each step of dt years: uplift every cell but the outlets (h* = h + U·dt);
+// route water (flow.hpp: D8, pits resolved over the basin graph); accumulate
+// drainage area; then solve the incision implicitly in stack order (Braun &
+// Willett 2013), the receiver's new height known before its donors':
+//
+//     h_i' − h_i* + K·dt·A_i^m·((h_i' − h_r')/L)^n = 0,
+//
+// for n = 1 directly, h_i' = (h_i* + F·h_r')/(1 + F) with F = K·dt·A^m/L; for
+// n ≠ 1 by Newton's method on x = h_i' − h_r' (converges from x = h_i* − h_r'
+// for n ≥ 1; safeguarded for n < 1). The scheme is stable for any dt, and a
+// cell never drops below its receiver. A cell at or below its receiver's new
+// height (a lake in Depressions::route, or a reach dammed by faster uplift
+// downstream) is not eroded. Last, with D > 0, one implicit alternating-
+// direction diffusion step (diffusion.hpp) with open sides fixed and closed
+// sides closed.
+//
+// Every part is a pure function of the previous heights with a fixed visiting
+// order, so the result is the same on any number of threads.
+#pragma once
+
+#include "flow.hpp"
+
+#include <diffusion.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+namespace orogen::stream_power {
+
+struct Settings {
+    double erodibility = 2e-5;  ///< K, m^(1−2m)/yr (n = 1)
+    double area_exponent = 0.45;  ///< m
+    double slope_exponent = 1.0;  ///< n
+    double diffusivity = 0.0;     ///< D, m²/yr (0: no hillslope diffusion)
+    OpenSides open;
+    Depressions depressions = Depressions::fill;
+};
+
+/// The state of one landscape: heights (double, m) and the flow graph of the last step.
+class Model {
+public:
+    /// `heights` width × height, metres; `uplift` per cell (m/yr) or empty (none).
+    /// With every side closed the lowest start cell is the outlet.
+    Model(int width, int height, double cell, std::vector<double> heights, std::vector<double> uplift,
+          const Settings& settings);
+
+    /// One step of `dt` years. Returns the pits found (before they were resolved).
+    std::int64_t step(double dt);
+    /// Run `years` in steps of `dt` (the last one shorter); on_step(step, steps) after each.
+    void run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step = {});
+
+    /// Route and accumulate over the current heights without eroding (for the output layers).
+    void route_only();
+
+    const std::vector<double>& heights() const { return h_; }
+    std::vector<double>& heights() { return h_; }
+    const FlowRouter& flow() const { return flow_; }
+    /// χ (m) of every cell for reference area a0 (m²): ∫ (a0/A)^(m/n) dx from the outlet upstream.
+    std::vector<double> chi(double a0 = 1.0) const;
+    /// Index of the first non-finite height, or −1.
+    std::int64_t first_non_finite() const;
+    const Settings& settings() const { return settings_; }
+
+private:
+    void incise(double dt);
+
+    int width_, height_;
+    double cell_;
+    Settings settings_;
+    std::vector<double> h_, uplift_;
+    FlowRouter flow_;
+    std::vector<double> factor_;
+    std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16  // K·dt·A^m / L^n per cell for the current step
+    std::unique_ptr<diffusion::Solver> diffusion_;
+};
+
+/// The outlet with every side closed: the lowest cell (lowest index among equals).
+std::int64_t lowest_cell(const std::vector<double>& heights);
+
+/// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
+inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 8 + 4 + 4 + 4 + 1 + 1 + 8 + 16;
+
+}  // namespace orogen::stream_power

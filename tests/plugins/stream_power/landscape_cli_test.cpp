@@ -1,0 +1,159 @@
+// End to end through the real binary: erode:stream-power and erode:diffusion's
+// check-time errors, their layers, and the realism check on the output of
+// pipelines/orogeny.orogen against published statistics of real ranges
+// (docs/landscape.md cites the bands).
+#include "landscape_stats.hpp"
+#include "orogen_test.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <sstream>
+#include <unistd.h>
+
+namespace {
+
+using namespace orogen::test;
+
+TEST(LandscapeCli, OutOfRangeParametersAreCheckTimeErrors) {
+    TempDir dir;
+    const auto spec = dir.write("bad.orogen",
+                                "orogen 1\n"
+                                "grid 65 cell=30\n"
+                                "base = generate:shape(kind=pyramid, height=300)\n"
+                                "a = erode:stream-power(base, m=5, n=0.1, erodibility=1, uplift=100)\n"
+                                "b = erode:stream-power(base, diffusivity=100, dt=0, years=-1)\n"
+                                "c = erode:stream-power(base, uplift_layer=\"uplift\", open=\"nxw\", base_level=\"sea\")\n"
+                                "d = erode:diffusion(base, diffusivity=0)\n"
+                                "e = erode:diffusion(base, years=10, dt=100, fixed=\"top\")\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want : {
+             "bad.orogen:4:32: error: 'm' of erode:stream-power is 5, out of range [0.1, 1.5]",
+             "'n' of erode:stream-power is 0.1, out of range [0.5, 4]",
+             "'erodibility' of erode:stream-power is 1, out of range (0, 0.01] m^(1-2m)/yr",
+             "'uplift' of erode:stream-power is 100, out of range [0, 20] mm/yr",
+             "'diffusivity' of erode:stream-power is 100, out of range [0, 10] m²/yr",
+             "'dt' of erode:stream-power is 0, out of range (0, 100000000] yr",
+             "'years' of erode:stream-power is -1, out of range (0, 1000000000] yr",
+             "bad.orogen:6:43: error: erode:stream-power: no layer 'uplift' on the input (the input has no layers); "
+             "tectonics:plates writes 'uplift'",
+             "erode:stream-power: 'nxw' is not a set of sides",
+             "erode:stream-power: 'sea' is not a height",
+             "'diffusivity' of erode:diffusion is 0, out of range (0, 10] m²/yr",
+             "bad.orogen:8:40: error: erode:diffusion: the time step is longer than the run (years); give dt <= years",
+             "erode:diffusion: 'top' is not a set of sides",
+         })
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+}
+
+TEST(LandscapeCli, AGridTooLargeForMemorySaysHowMuchItNeeds) {
+    // A grid the kernel accepts (its heightmap, 4 bytes a vertex, fits in a quarter of memory) but
+    // the model, about 70 bytes a cell, does not fit in half: about memory / 50 cells.
+    const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
+    const int side = int(std::sqrt(memory / 50.0));
+    TempDir dir;
+    const auto spec = dir.write("huge.orogen",
+                                "orogen 1\n"
+                                "grid " + std::to_string(side) + " cell=30\n"
+                                "base = generate:shape(kind=flat)\n"
+                                "a = erode:stream-power(base)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    const std::string want = "huge.orogen:4:5: error: erode:stream-power: a " + std::to_string(side) + " x " +
+                             std::to_string(side) + " grid needs ";
+    EXPECT_NE(r.err.find(want), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(" GB for the landscape model, more than half of this machine's "), std::string::npos) << r.err;
+}
+
+TEST(LandscapeCli, RunsWritesItsLayersAndGivesTheSameBytesOnOneAndTwoThreads) {
+    TempDir dir;
+    const auto spec = dir.write("cone.orogen",
+                                "orogen 1\n"
+                                "grid 97 cell=30\n"
+                                "base = generate:shape(kind=cone, height=400)\n"
+                                "a = erode:stream-power(base, years=2e5, dt=1e4, uplift=2, chi=true)\n"
+                                "b = erode:diffusion(a, years=1e4, dt=1e3, critical_angle=40)\n"
+                                "export:raw(b, path=\"b.r32\")\n"
+                                "export:png(b, path=\"drainage.png\", layer=\"drainage\", bits=16)\n"
+                                "export:png(b, path=\"direction.png\", layer=\"flow_direction\")\n"
+                                "export:png(b, path=\"chi.png\", layer=\"chi\", bits=16)\n");
+    std::string bytes[2];
+    for (int t = 0; t < 2; ++t) {
+        const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
+        const RunResult r = run_orogen("run " + q(spec) + " --quiet --threads " + std::to_string(t + 1) + " --out " + q(out));
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        bytes[t] = slurp(out + "/b.r32");
+        bytes[t] += slurp(out + "/drainage.png") + slurp(out + "/direction.png") + slurp(out + "/chi.png");
+        // The heights changed: rivers cut the cone.
+        ASSERT_EQ(slurp(out + "/b.r32").size(), std::size_t(97 * 97 * 4));
+    }
+    EXPECT_FALSE(bytes[0].empty());
+    EXPECT_EQ(bytes[0], bytes[1]);
+}
+
+#ifdef OROGEN_FAKE_PLUGIN_DIR
+TEST(LandscapeCli, TimelapseRecordsEveryKStepsOnAClockOfYears) {
+    // export:test-series (tests/kernel/fake_plugins) writes "time sample0" per entry.
+    TempDir dir;
+    dir.write("s.orogen",
+              "orogen 1\ngrid 33 cell=30\n"
+              "b = generate:shape(kind=cone, height=300)\n"
+              "t = erode:stream-power(b, years=1e5, dt=1e4, uplift=2, timelapse_every=4)\n"
+              "d = erode:diffusion(t, years=3e4, dt=1e4, timelapse_every=2)\n"
+              "export:test-series(t.timelapse, path=\"t.txt\")\n"
+              "export:test-series(d.timelapse, path=\"d.txt\")\n"
+              "export:raw(t, path=\"t.r32\")\n");
+    const RunResult r = run_orogen("run s.orogen --out out --quiet", std::string("OROGEN_PLUGIN_PATH=") + OROGEN_FAKE_PLUGIN_DIR,
+                                   dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    auto read = [&](const char* name) {
+        std::istringstream in(slurp(dir / "out" / name));
+        std::vector<std::pair<double, float>> v;
+        double t;
+        float h;
+        while (in >> t >> h) v.emplace_back(t, h);
+        return v;
+    };
+    const double year = 31557600.0;
+    const auto t = read("t.txt");
+    ASSERT_EQ(t.size(), 4u);  // the input, steps 4 and 8, the last (10)
+    const double want[] = {0.0, 4e4, 8e4, 1e5};
+    for (int i = 0; i < 4; ++i)  // the writer prints 6 significant digits
+        EXPECT_NEAR(t[std::size_t(i)].first, want[i] * year, 1e-5 * want[i] * year + 1.0) << i;
+    const std::string bytes = slurp(dir / "out/t.r32");
+    float last;
+    std::memcpy(&last, bytes.data(), 4);
+    EXPECT_EQ(t.back().second, last);  // the last entry is the output
+    EXPECT_EQ(read("d.txt").size(), 3u);  // the input, step 2, the last (3)
+}
+#endif
+
+TEST(LandscapeCli, OrogenyPipelineHasTheStatisticsOfARealRange) {
+    // The shipped pipeline as users run it; the bands and their sources are in docs/landscape.md.
+    TempDir dir;
+    const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / "orogeny.orogen";
+    const RunResult r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string raw = slurp(dir / "terrain.r32");
+    ASSERT_EQ(raw.size(), std::size_t(513 * 513 * 4));
+    std::vector<float> h(513 * 513);
+    std::memcpy(h.data(), raw.data(), raw.size());
+    const auto s = orogen::landscape::measure(h.data(), 513, 513, 30.0);
+    RecordProperty("median_slope_deg", std::to_string(s.median_slope_deg));
+    std::printf("median slope %.1f°, >40°: %.1f %%, pits %.3f %%, concavity %.2f (%d bins), Hack %.2f (%d bins), relief %.0f m\n",
+                s.median_slope_deg, 100 * s.steeper_than_40, 100 * s.pit_share, s.concavity, s.concavity_bins, s.hack,
+                s.hack_bins, s.relief);
+    EXPECT_GE(s.median_slope_deg, 15.0);  // Montgomery & Brandon 2002: 20-30° medians, threshold ~30-35° means
+    EXPECT_LE(s.median_slope_deg, 35.0);
+    EXPECT_GE(s.concavity, 0.3);  // Tucker & Whipple 2002, Kirby & Whipple 2012: 0.35-0.6, most 0.4-0.6
+    EXPECT_LE(s.concavity, 0.7);
+    EXPECT_GE(s.concavity_bins, 5);
+    EXPECT_LE(s.pit_share, 0.01);  // real terrain drains: closed depressions are rare outside lakes and karst
+    EXPECT_GE(s.hack, 0.45);  // Hack 1957: 0.6; Rigon et al. 1996: 0.5-0.6; Montgomery & Dietrich 1992
+    EXPECT_LE(s.hack, 0.7);
+    EXPECT_GE(s.relief, 800.0);  // a mountain range, not hills
+}
+
+}  // namespace

@@ -1,0 +1,310 @@
+// Tests of the stream-power landscape model's core: the analytical steady
+// state, a 1-D river against the implicit scheme and against the travelling
+// knickpoint of the kinematic wave, depression handling (every cell drains to
+// an outlet, no loops, the outlet's area is the map's), and determinism.
+#include "stream_power.hpp"
+
+#include <orogen/random.hpp>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <vector>
+
+namespace {
+
+using namespace orogen;
+using namespace orogen::stream_power;
+
+std::vector<double> noise(int w, int h, std::uint64_t seed, double amplitude) {
+    std::vector<double> v(std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) v[std::size_t(y) * w + x] = amplitude * random::uniform(seed, x, y);
+    return v;
+}
+
+/// Least-squares slope and intercept of y on x.
+std::pair<double, double> fit(const std::vector<double>& x, const std::vector<double>& y) {
+    const double n = double(x.size());
+    const double mx = std::accumulate(x.begin(), x.end(), 0.0) / n, my = std::accumulate(y.begin(), y.end(), 0.0) / n;
+    double sxy = 0.0, sxx = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) sxy += (x[i] - mx) * (y[i] - my), sxx += (x[i] - mx) * (x[i] - mx);
+    return {sxy / sxx, my - sxy / sxx * mx};
+}
+
+struct SteadyCase {
+    double n;
+    double k;
+};
+
+class SteadyState : public ::testing::TestWithParam<SteadyCase> {};
+
+TEST_P(SteadyState, ChannelsObeyTheAnalyticalSlopeAreaRelation) {
+    // Uniform U and K, no diffusion: at steady state every channel has
+    // S = (U/K)^(1/n) A^(−m/n). The model starts from noise and runs 60 Myr (drainage divides settle slowly for n < 1).
+    const int w = 81, h = 61;
+    const double cell = 50.0, U = 1e-3;
+    Settings s;
+    s.erodibility = GetParam().k;
+    s.area_exponent = 0.5 * GetParam().n;  // m/n = 0.5
+    s.slope_exponent = GetParam().n;
+    s.diffusivity = 0.0;
+    s.open = {true, false, true, false};  // rivers run north and south
+    Model model(w, h, cell, noise(w, h, 1, 10.0), std::vector<double>(std::size_t(w) * h, U), s);
+    model.run(6e7, 2e5);
+    // Slopes of the final heights to the last step's receivers (the heights no longer change).
+    const auto& f = model.flow();
+    const auto& hh = model.heights();
+    std::vector<double> la, ls;
+    int channels = 0;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < hh.size(); ++i) {
+        const double a = f.area()[i];
+        const std::int32_t r = f.receivers()[i];
+        if (r == std::int32_t(i) || a < 10 * cell * cell) continue;
+        const double slope = (hh[i] - hh[std::size_t(r)]) / f.distance(std::int64_t(i));
+        const double expected = std::pow(U / s.erodibility, 1.0 / s.slope_exponent) *
+                                std::pow(a, -s.area_exponent / s.slope_exponent);
+        worst = std::max(worst, std::abs(slope / expected - 1.0));
+        la.push_back(std::log(a));
+        ls.push_back(std::log(slope));
+        ++channels;
+    }
+    ASSERT_GT(channels, 200);
+    EXPECT_LT(worst, 0.02) << "largest relative deviation from S = (U/K)^(1/n) A^(-m/n)";
+    const auto [slope, intercept] = fit(la, ls);
+    EXPECT_NEAR(-slope, 0.5, 0.01) << "concavity m/n from the slope-area fit";
+    EXPECT_NEAR(std::exp(intercept), std::pow(U / s.erodibility, 1.0 / s.slope_exponent), 0.02 * std::pow(U / s.erodibility, 1.0 / s.slope_exponent));
+}
+
+INSTANTIATE_TEST_SUITE_P(StreamPower, SteadyState, ::testing::Values(SteadyCase{1.0, 1e-5}, SteadyCase{2.0, 1e-7}, SteadyCase{0.7, 3e-5}),
+                         [](const auto& info) {
+                             return "n" + std::to_string(int(info.param.n * 10));
+                         });
+
+// A river along one row: outlet at the west end, every cell drains all the
+// cells east of it. Settings for the 1-D tests.
+Settings river_settings(double n) {
+    Settings s;
+    s.erodibility = n == 1.0 ? 2e-5 : 4e-6;
+    s.area_exponent = 0.4;
+    s.slope_exponent = n;
+    s.diffusivity = 0.0;
+    s.open = {false, false, false, true};
+    return s;
+}
+
+TEST(StreamPower, OneStepOfARiverEqualsTheImplicitSchemeSolvedByHand) {
+    for (double n : {1.0, 2.0, 0.6}) {
+        const int w = 200;
+        const double cell = 25.0, U = 2e-3, dt = 5e4;
+        std::vector<double> h0(w);
+        for (int x = 0; x < w; ++x) h0[std::size_t(x)] = 0.3 * cell * x + 5.0 * std::sin(0.3 * x) + 2.0 * x * 0.0;
+        for (int x = 1; x < w; ++x) h0[std::size_t(x)] = std::max(h0[std::size_t(x)], h0[std::size_t(x - 1)] + 0.5);
+        const Settings s = river_settings(n);
+        Model model(w, 1, cell, h0, std::vector<double>(std::size_t(w), U), s);
+        model.step(dt);
+        // By hand: h_x' solves h' − (h + U dt) + K dt A^m ((h' − h'_{x−1})/cell)^n = 0, by bisection.
+        std::vector<double> expect(w);
+        expect[0] = h0[0];
+        for (int x = 1; x < w; ++x) {
+            const double area = double(w - x) * cell * cell;
+            const double F = s.erodibility * dt * std::pow(area, s.area_exponent);
+            const double top = h0[std::size_t(x)] + U * dt, base = expect[std::size_t(x - 1)];
+            double lo = base, hi = top;
+            for (int it = 0; it < 200; ++it) {
+                const double mid = 0.5 * (lo + hi);
+                const double g = mid - top + F * std::pow((mid - base) / cell, n);
+                (g > 0 ? hi : lo) = mid;
+            }
+            expect[std::size_t(x)] = 0.5 * (lo + hi);
+        }
+        for (int x = 0; x < w; ++x)
+            ASSERT_NEAR(model.heights()[std::size_t(x)], expect[std::size_t(x)], 1e-7 * (1.0 + std::abs(expect[std::size_t(x)])))
+                << "n = " << n << ", x = " << x;
+    }
+}
+
+TEST(StreamPower, AKnickpointTravelsUpstreamAtTheKinematicWaveSpeed) {
+    // n = 1, no uplift: dh/dt = −K A^m dh/dx is a wave moving upstream at c(x) = K A(x)^m.
+    // A river at steady state for uplift U0 sees its outlet drop by 100 m at t = 0 (the
+    // equivalent: raise every other cell by 100 m); after time t the knickpoint stands
+    // where ∫ dx / c from the outlet equals t.
+    const int w = 400;
+    const double cell = 50.0;
+    Settings s = river_settings(1.0);
+    std::vector<double> h0(w);
+    const double U0 = 1e-4;
+    h0[0] = 0.0;
+    for (int x = 1; x < w; ++x) {
+        const double area = double(w - x) * cell * cell;
+        h0[std::size_t(x)] = h0[std::size_t(x - 1)] + cell * U0 / (s.erodibility * std::pow(area, s.area_exponent));
+    }
+    std::vector<double> start = h0;
+    for (int x = 1; x < w; ++x) start[std::size_t(x)] += 100.0;
+    Model model(w, 1, cell, start, std::vector<double>(std::size_t(w), U0), s);
+    const double t = 2e6;
+    model.run(t, 2e3);
+    // Where the analytical knickpoint stands.
+    double travel = 0.0;
+    int expected = 0;
+    for (int x = 1; x < w; ++x) {
+        const double area = double(w - x) * cell * cell;
+        travel += cell / (s.erodibility * std::pow(area, s.area_exponent));
+        if (travel > t) break;
+        expected = x;
+    }
+    ASSERT_GT(expected, 20);
+    ASSERT_LT(expected, w - 20);
+    // Where the model's stands: the cell where the drop has reached half its 100 m.
+    int found = 0;
+    for (int x = 1; x < w; ++x)
+        if (model.heights()[std::size_t(x)] - h0[std::size_t(x)] < 50.0) found = x;
+    EXPECT_NEAR(found, expected, 5) << "knickpoint position, cells";
+    // Well downstream of it the river is back at its old profile; well upstream nothing has moved yet
+    // (the implicit upwind scheme smears the front over about sqrt(distance · cell)).
+    for (int x = 1; x < expected - 50; ++x) EXPECT_NEAR(model.heights()[std::size_t(x)], h0[std::size_t(x)], 2.0) << x;
+    for (int x = expected + 50; x < w; ++x) EXPECT_NEAR(model.heights()[std::size_t(x)], start[std::size_t(x)], 2.0) << x;
+}
+
+/// Follows receivers from every cell; checks each reaches an outlet within size() hops.
+void expect_every_cell_drains(const FlowRouter& f) {
+    const auto& r = f.receivers();
+    for (std::size_t i = 0; i < f.size(); ++i) {
+        std::int64_t c = std::int64_t(i);
+        std::size_t hops = 0;
+        while (!f.is_outlet(c) && hops <= f.size()) c = r[std::size_t(c)], ++hops;
+        ASSERT_TRUE(f.is_outlet(c)) << "cell " << i << " never reaches an outlet (a loop or a sink)";
+        if (!f.is_outlet(std::int64_t(i))) {
+            // A receiver is a neighbour.
+            const std::int64_t d = r[i] - std::int64_t(i), W = f.width();
+            const bool neighbour = d == 1 || d == -1 || d == W || d == -W || d == W + 1 || d == W - 1 ||
+                                   d == -W + 1 || d == -W - 1;
+            ASSERT_TRUE(neighbour) << "cell " << i;
+        }
+    }
+    // The stack holds each cell once, receivers before donors.
+    std::vector<std::int64_t> position(f.size(), -1);
+    for (std::size_t s = 0; s < f.size(); ++s) {
+        ASSERT_EQ(position[std::size_t(f.stack()[s])], -1);
+        position[std::size_t(f.stack()[s])] = std::int64_t(s);
+    }
+    for (std::size_t i = 0; i < f.size(); ++i) {
+        if (!f.is_outlet(std::int64_t(i))) ASSERT_LT(position[std::size_t(r[i])], position[i]);
+    }
+}
+
+TEST(FlowRouting, NoiseWithClosedSidesDrainsEverythingToTheOneOutlet) {
+    for (Depressions mode : {Depressions::fill, Depressions::route}) {
+        const int w = 123, h = 97;
+        const double cell = 30.0;
+        auto hts = noise(w, h, 42, 100.0);  // about a third of the cells are pits
+        const auto original = hts;
+        const std::int64_t outlet = lowest_cell(hts);
+        FlowRouter f(w, h, cell, OpenSides{false, false, false, false}, outlet);
+        f.route(hts.data(), mode);
+        f.accumulate();
+        EXPECT_GT(f.pits(), 1000);
+        expect_every_cell_drains(f);
+        EXPECT_DOUBLE_EQ(f.area()[std::size_t(outlet)], double(w) * h * cell * cell);
+        if (mode == Depressions::fill) {
+            // Filled: no cell's receiver is higher than the cell, and nothing was lowered.
+            for (std::size_t i = 0; i < hts.size(); ++i) {
+                EXPECT_LE(hts[std::size_t(f.receivers()[i])], hts[i]);
+                EXPECT_GE(hts[i], original[i]);
+            }
+        } else {
+            EXPECT_EQ(hts, original);
+        }
+    }
+}
+
+TEST(FlowRouting, OpenSidesShareTheMapsArea) {
+    const int w = 90, h = 70;
+    const double cell = 10.0;
+    auto hts = noise(w, h, 8, 50.0);
+    FlowRouter f(w, h, cell, OpenSides{true, false, false, true});
+    f.route(hts.data(), Depressions::fill);
+    f.accumulate();
+    expect_every_cell_drains(f);
+    double out = 0.0;
+    for (std::size_t i = 0; i < f.size(); ++i)
+        if (f.is_outlet(std::int64_t(i))) out += f.area()[i];
+    EXPECT_DOUBLE_EQ(out, double(w) * h * cell * cell);
+    // Closed sides are not outlets: the east and south edges (but their corners with open sides).
+    EXPECT_FALSE(f.is_outlet(std::int64_t(h / 2) * w + (w - 1)));
+    EXPECT_FALSE(f.is_outlet(std::int64_t(h - 1) * w + w / 2));
+    EXPECT_TRUE(f.is_outlet(std::int64_t(h / 2) * w));
+}
+
+TEST(FlowRouting, ALakeSpillsOverItsLowestPass) {
+    // A bowl whose rim is lowest (10 m) at one place on its east side: the lake fills to 10 m
+    // and its water leaves there.
+    const int w = 21, h = 21;
+    std::vector<double> hts(std::size_t(w) * h, 0.0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const int ring = std::max(std::abs(x - 10), std::abs(y - 10));
+            double v = ring == 6 ? 30.0 : ring < 6 ? 5.0 - 0.1 * (6 - ring) : 30.0 - 2.0 * (ring - 6);
+            v = ring > 6 ? 1.0 * (10 - ring) : v;
+            hts[std::size_t(y) * w + x] = v;
+        }
+    hts[std::size_t(10) * w + 16] = 10.0;  // the pass
+    FlowRouter f(w, h, 1.0, OpenSides{});
+    f.route(hts.data(), Depressions::fill);
+    f.accumulate();
+    expect_every_cell_drains(f);
+    EXPECT_EQ(f.pits(), 1);
+    for (int y = 5; y <= 15; ++y)
+        for (int x = 5; x <= 15; ++x) EXPECT_DOUBLE_EQ(hts[std::size_t(y) * w + x], 10.0) << x << "," << y;
+    // The pass receives the whole lake (11 x 11 cells) and itself.
+    EXPECT_DOUBLE_EQ(f.area()[std::size_t(10) * w + 16], 122.0);
+}
+
+TEST(StreamPower, SameBitsOnOneAndTwoThreads) {
+    const int w = 161, h = 129;  // 129 rows: many row bands and root groups on 2 threads
+    std::vector<double> results[2];
+    std::vector<double> areas[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        Settings s;
+        s.diffusivity = 0.02;
+        s.open = {true, true, false, true};
+        auto up = noise(w, h, 77, 2e-3);  // uneven uplift: lakes form and fill each step
+        Model model(w, h, 30.0, noise(w, h, 5, 200.0), up, s);
+        model.run(2e5, 1e4);
+        results[t] = model.heights();
+        areas[t] = model.flow().area();
+    }
+    EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
+    EXPECT_EQ(0, std::memcmp(areas[0].data(), areas[1].data(), areas[0].size() * sizeof(double)));
+}
+
+TEST(StreamPower, NonFiniteHeightsAreFound) {
+    Settings s;
+    std::vector<double> hts = noise(20, 20, 3, 10.0);
+    hts[57] = std::nan("");
+    Model model(20, 20, 10.0, hts, {}, s);
+    EXPECT_EQ(model.first_non_finite(), 57);
+}
+
+TEST(StreamPower, ChiGrowsUpstreamByTheIntegral) {
+    const int w = 50;
+    Settings s = river_settings(1.0);
+    std::vector<double> h0(w);
+    for (int x = 0; x < w; ++x) h0[std::size_t(x)] = 3.0 * x;
+    Model model(w, 1, 10.0, h0, {}, s);
+    model.route_only();
+    const auto chi = model.chi(1.0);
+    double expect = 0.0;
+    for (int x = 1; x < w; ++x) {
+        expect += std::pow(1.0 / (double(w - x) * 100.0), 0.4) * 10.0;
+        EXPECT_NEAR(chi[std::size_t(x)], expect, 1e-12 * expect);
+    }
+}
+
+}  // namespace
