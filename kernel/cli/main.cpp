@@ -258,7 +258,7 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
     std::printf("\ninputs:%s\n", n->inputs.empty() ? " none" : "");
     for (std::size_t i = 0; i < n->inputs.size(); ++i) {
         const auto& in = n->inputs[i];
-        std::printf("  %zu. %-14s %s%s%s\n", i + 1, in.name.c_str(), std::string(to_string(in.type)).c_str(),
+        std::printf("  %zu. %-14s %s%s%s\n", i + 1, in.name.c_str(), (in.type == ValueType::none ? std::string("any") : std::string(to_string(in.type))).c_str(),
                     in.need == Need::optional ? ", optional" : "", in.help.empty() ? "" : (" — " + in.help).c_str());
     }
     std::printf("output: %s\n", std::string(to_string(n->output)).c_str());

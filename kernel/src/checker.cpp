@@ -364,7 +364,8 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                 inputs_ok = false;
                 continue;
             }
-            if (it->second.type != want.type) {
+            // An input declared ValueType::none takes any value; the node's check hook says which it accepts.
+            if (want.type != ValueType::none && it->second.type != want.type) {
                 diags.error(in.where, call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name +
                                           "') must be a " + std::string(to_string(want.type)) + ", but '" + in.full() +
                                           "' is a " + std::string(to_string(it->second.type)));
@@ -378,7 +379,10 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             if (node->inputs[i].need == Need::required) {
                 diags.error(call.where, call.qualified() + " needs input " + std::to_string(i + 1) + " ('" +
                                             node->inputs[i].name + "', a " +
-                                            std::string(to_string(node->inputs[i].type)) + "): " +
+                                            (node->inputs[i].type == ValueType::none
+                                                 ? std::string("value")
+                                                 : std::string(to_string(node->inputs[i].type))) +
+                                            "): " +
                                             call.qualified() + "(NAME, ...)");
                 inputs_ok = false;
             }

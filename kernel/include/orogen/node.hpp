@@ -95,6 +95,9 @@ enum class Need { required, optional };
 
 struct InputSpec {
     std::string name;  ///< for help and messages
+    /// The value type it takes; ValueType::none takes any (the node's check
+    /// hook then refuses the types it cannot use, e.g. export:png takes a
+    /// heightmap or an image).
     ValueType type = ValueType::heightmap;
     Need need = Need::required;
     std::string help;
