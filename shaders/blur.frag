@@ -9,11 +9,11 @@ uniform int radius;        // taps each side
 uniform float weights[257]; // weights[k] for offset k = 0..radius
 out vec4 colour;
 int mirror(int i, int n) {
-    // half-sample symmetric: ... 1 0 | 0 1 2 ... n-1 | n-1 n-2 ...
-    int period = 2 * n;
-    i = i % period;
-    if (i < 0) i += period;
-    return i < n ? i : period - 1 - i;
+    // half-sample symmetric: ... 1 0 | 0 1 2 ... n-1 | n-1 n-2 ... (GLSL's % is undefined for
+    // negative operands, so no modulo; a kernel wider than the image clamps at the far edge)
+    if (i < 0) i = -1 - i;
+    if (i >= n) i = 2 * n - 1 - i;
+    return clamp(i, 0, n - 1);
 }
 void main() {
     ivec2 size = textureSize(image, 0);

@@ -53,7 +53,7 @@ uniform float sun_disc;       // 1 draws the disc, 0 only its glow (reflections,
 
 vec3 sky_colour(vec3 dir, float with_disc) {
     float up = max(dir.y, 0.0);
-    vec3 sky = mix(sky_horizon, sky_zenith, pow(up, 0.45));
+    vec3 sky = mix(sky_horizon, sky_zenith, pow(up, 0.35));
     // below the horizon: the haze continues, a little darker
     if (dir.y < 0.0) sky = sky_horizon * (1.0 - 0.25 * min(-dir.y * 3.0, 1.0));
     float mu = max(dot(dir, sun_direction), 0.0);

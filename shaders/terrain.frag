@@ -5,6 +5,7 @@
 // overriding grass and snow with rock, nested mix) with procedural textures,
 // lit by the sun (shadow map) and the sky, then fogged.
 in vec3 world;
+flat in vec3 wall_normal;
 uniform sampler2D heights;
 uniform ivec2 grid;
 uniform float cell;
@@ -54,6 +55,17 @@ vec4 splat(float t, float normal_y) {
 }
 
 void main() {
+    if (wall_normal != vec3(0.0)) {
+        // The skirt: layered earth and rock, lit like the rest.
+        vec2 q = vec2(dot(world.xz, wall_normal.zx), world.y) / texture_scale;
+        float layers = 0.5 + 0.5 * sin(world.y / exaggeration * 0.05 + 4.0 * fbm(q * vec2(1.0, 0.3), 3));
+        vec3 earth = mix(material[2] * 0.5, material[0] * 0.6, 0.35 + 0.3 * layers) * (0.9 + 0.2 * fbm(q * 30.0, 2));
+        if (output_mode == 1) { colour = vec4(earth, 1.0); return; }
+        if (output_mode == 2) { colour = vec4(wall_normal * 0.5 + 0.5, 1.0); return; }
+        vec3 wl = sun_colour * max(dot(wall_normal, sun_direction), 0.0) + ambient_colour * 0.5;
+        colour = vec4(apply_fog(earth * wl, normalize(world - eye), distance(eye, world)), 1.0);
+        return;
+    }
     vec2 s = world.xz / cell;  // position in samples
     // Normals from the heights at full resolution (whatever the mesh's level of detail).
     float hl = height_at(s - vec2(1.0, 0.0)), hr = height_at(s + vec2(1.0, 0.0));
@@ -75,7 +87,7 @@ void main() {
     vec3 sand = material[0] * (0.92 + 0.12 * fine + 0.06 * broad);
     vec3 grass = mix(material[1], material[1] * vec3(1.25, 1.12, 0.62), smoothstep(-0.3, 0.5, broad));
     grass *= 0.85 + 0.2 * fine;
-    float strata = 0.5 + 0.5 * sin(h * 0.35 + 6.0 * broad);  // layered rock, bent by the broad noise
+    float strata = 0.5 + 0.5 * sin(h * 0.04 + 5.0 * broad);  // layered rock, bent by the broad noise
     vec3 rock = material[2] * (0.78 + 0.28 * strata + 0.12 * fine);
     rock = mix(rock, rock * vec3(1.12, 0.98, 0.88), 0.5 + 0.5 * broad);
     vec3 snow = material[3] * (0.96 + 0.04 * fine);

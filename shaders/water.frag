@@ -4,7 +4,8 @@
 // reflection (the sky, and the terrain mirrored in the water plane where a
 // reflection map is given) and the water body, transparent where shallow
 // (Beer–Lambert), then fogged. Blended over the terrain with
-// glBlendFunc(ONE, SRC_ALPHA): alpha is how much of the ground shows through.
+// glBlendFuncSeparate(ONE, SRC_ALPHA, ZERO, ONE): alpha is how much of the
+// ground shows through (the frame's own alpha stays 1).
 in vec3 world;
 in float depth;
 uniform vec3 eye;
@@ -16,6 +17,11 @@ uniform sampler2D reflection;    // the terrain mirrored in the water plane (lin
 uniform int has_reflection;
 uniform vec2 viewport;           // pixels
 uniform vec3 ambient_colour;
+uniform int sea_plane;           // 1: depth = sea level − ground (heights), deep beyond the terrain
+uniform float sea_level;
+uniform sampler2D heights;
+uniform ivec2 grid;
+uniform float cell;
 out vec4 colour;
 
 // Height field of the waves (m) at xz: four directional sines and noise.
@@ -30,11 +36,20 @@ float waves(vec2 p) {
 }
 
 void main() {
-    if (depth <= 0.0) discard;
+    float water_depth = depth;
+    if (sea_plane == 1) {
+        vec2 s = world.xz / cell;
+        bool inside = all(greaterThanEqual(s, vec2(0.0))) && all(lessThanEqual(s, vec2(grid - 1)));
+        water_depth = inside ? sea_level - texture(heights, (s + 0.5) / vec2(grid)).r : 200.0;
+    }
+    if (water_depth <= 0.0) discard;
     const float e = 0.5;  // m, finite-difference step
     float h0 = waves(world.xz);
     vec3 n = normalize(vec3(-(waves(world.xz + vec2(e, 0.0)) - h0) / e, 1.0,
                             -(waves(world.xz + vec2(0.0, e)) - h0) / e));
+    // Waves finer than a pixel would sparkle: flatten them where a pixel spans metres.
+    float footprint = length(fwidth(world.xz));
+    n = normalize(mix(vec3(0.0, 1.0, 0.0), n, 1.0 / (1.0 + footprint * footprint * 0.02)));
     vec3 v = normalize(eye - world);
     float cos_theta = max(dot(n, v), 0.0);
     float fresnel = 0.02 + 0.98 * pow(1.0 - cos_theta, 5.0);
@@ -51,11 +66,11 @@ void main() {
     reflected += sun_colour * sun_glint;
     float lambert = max(sun_direction.y, 0.0);
     vec3 body = water_colour * (sun_colour * lambert + ambient_colour);
-    float transmitted = exp(-depth / clarity);  // of the ground's light
+    float transmitted = exp(-water_depth / clarity);  // of the ground's light
     vec3 c = fresnel * reflected + (1.0 - fresnel) * (1.0 - transmitted) * body;
     float alpha = (1.0 - fresnel) * transmitted;
     // fog: the water's own light and what shows through fade alike
     float f = 1.0 - exp(-fog_density * distance(eye, world));
     c = mix(c, sky_colour(-v, 0.0) * (1.0 - alpha), f);
-    colour = vec4(c, alpha * (1.0 - f) + 0.0);
+    colour = vec4(c, alpha * (1.0 - f));
 }

@@ -164,27 +164,21 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
     if (style_.texture_scale <= 0) style_.texture_scale = std::max(m.extent_x(), m.extent_z()) / 8.0;
     if (style_.particle_radius <= 0) style_.particle_radius = 3.0 * m.terrain->cell();
 
-    // Water surface and depth per sample.
+    // Water from the layer: surface and depth per sample (the sea is one plane, drawn apart).
     const bool layer = !style_.water_layer.empty() && m.terrain->has_layer(style_.water_layer);
-    m.has_water = style_.sea || layer;
     std::vector<float> surface;
-    if (m.has_water) {
+    if (layer) {
         surface.resize(2 * m.terrain->size());
         const ConstGridView h = m.terrain->view();
-        const ConstGridView w = layer ? m.terrain->layer(style_.water_layer) : ConstGridView{};
+        const ConstGridView w = m.terrain->layer(style_.water_layer);
         const float min_depth = float(style_.water_min_depth);
-        bool any = false;
         for (std::size_t i = 0; i < m.terrain->size(); ++i) {
-            const float g = h.data[i];
             // Continuous across the shore: a dry vertex gets a negative depth,
             // so the fragment shader cuts the water where the depth crosses 0.
-            float s = g + (layer ? w.data[i] - min_depth : -min_depth);
-            if (style_.sea) s = std::max(s, float(style_.sea_level));
-            surface[2 * i] = layer && w.data[i] > min_depth ? g + w.data[i] : s;
-            surface[2 * i + 1] = s - g;
-            any = any || s - g > 0;
+            surface[2 * i] = h.data[i] + std::max(w.data[i], 0.0f);
+            surface[2 * i + 1] = w.data[i] - min_depth;
+            m.has_water = m.has_water || w.data[i] > min_depth;
         }
-        m.has_water = any;
     }
 
     gl::Lock lock("render:terrain");
@@ -219,7 +213,9 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         throw BadInput("render:terrain: the field of view must be between 0 and 180 degrees (exclusive), got " +
                        std::to_string(camera.fov));
     const double exag = st.exaggeration;
-    const glm::dvec3 box_min(0, m.lo * exag, 0), box_max(m.extent_x(), m.hi * exag, m.extent_z());
+    const double skirt = 0.08 * std::max(double(m.hi - m.lo), 1.0);  // m below the lowest point (and the sea)
+    const double floor_height = st.sea ? std::min(double(m.lo), st.sea_level) - skirt : m.lo - skirt;
+    const glm::dvec3 box_min(0, floor_height * exag, 0), box_max(m.extent_x(), m.hi * exag, m.extent_z());
     const glm::dvec3 centre = (box_min + box_max) * 0.5;
     const double radius = glm::length(box_max - box_min) * 0.5;
     const double aspect = double(width) / double(std::max(height, 1));
@@ -277,7 +273,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
                            " m); raise its elevation, distance or height");
         // Near and far: around the terrain's bounding sphere.
         const double to_centre = glm::length(centre - eye);
-        far_plane = to_centre + radius * 1.05;
+        far_plane = to_centre + radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
         near_plane = std::max(std::max(to_centre - radius, 0.0) * 0.8, far_plane * 2e-5);
         projection = glm::perspective(camera.fov * kDegree, aspect, near_plane, far_plane);
     }
@@ -398,6 +394,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glBindTexture(GL_TEXTURE_2D, m.heights);
         set(prog.shadow, "heights", 0);
         set_grid(prog.shadow, glm::mat4(light_vp));
+        set(prog.shadow, "skirt_edge", -1);
         glBindVertexArray(m.vao);
         glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
         glDisable(GL_POLYGON_OFFSET_FILL);
@@ -464,10 +461,17 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.terrain, "jitter", float(st.jitter));
         set(prog.terrain, "texture_scale", float(st.texture_scale));
         set(prog.terrain, "output_mode", mode);
+        set(prog.terrain, "skirt_edge", -1);
         set(prog.terrain, "light_view_projection", glm::mat4(light_vp));
         set(prog.terrain, "shadow_texel", 1.0f / float(m.shadow_size));
         glBindVertexArray(m.vao);
         glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        // The skirt, down to below the lowest point (and below the sea).
+        set(prog.terrain, "floor_height", float(floor_height * exag));
+        for (int edge = 0; edge < 4; ++edge) {
+            set(prog.terrain, "skirt_edge", edge);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
+        }
     };
     draw_terrain(vp, int(st.output));
 
@@ -501,15 +505,18 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     }
 
     // Water, blended over the terrain: what shows through is scaled by alpha.
-    if (shaded && m.has_water) {
+    if (shaded && (m.has_water || st.sea)) {
         glEnable(GL_DEPTH_TEST);
         glDepthMask(GL_FALSE);
         glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_SRC_ALPHA);
+        glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);  // the frame stays opaque
         glUseProgram(prog.water);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.surface);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, m.heights);
         set(prog.water, "surface", 0);
+        set(prog.water, "heights", 1);
         set_grid(prog.water, vp);
         set_light(prog.water, 0.0f);
         set(prog.water, "time", float(st.time));
@@ -518,8 +525,20 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.water, "clarity", float(st.clarity));
         set(prog.water, "has_reflection", 0);
         set(prog.water, "viewport", glm::vec2(float(width), float(height)));
+        set(prog.water, "sea_level", float(st.sea_level));
         glBindVertexArray(m.vao);
-        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        if (m.has_water) {
+            set(prog.water, "sea_plane", 0);
+            glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        }
+        if (st.sea) {
+            const double reach = radius * 38.0;
+            set(prog.water, "sea_plane", 1);
+            const glm::vec4 extent(float(centre.x - reach), float(centre.z - reach), float(centre.x + reach),
+                                   float(centre.z + reach));
+            glUniform4fv(loc(prog.water, "plane_extent"), 1, glm::value_ptr(extent));
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+        }
         glDisable(GL_BLEND);
         glDepthMask(GL_TRUE);
     }
