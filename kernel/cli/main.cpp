@@ -258,17 +258,19 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
     std::printf("\ninputs:%s\n", n->inputs.empty() ? " none" : "");
     for (std::size_t i = 0; i < n->inputs.size(); ++i) {
         const auto& in = n->inputs[i];
-        std::printf("  %zu. %-14s %s%s%s\n", i + 1, in.name.c_str(), (in.type == ValueType::none ? std::string("any") : std::string(to_string(in.type))).c_str(),
+        const std::string type = in.many == Many::either ? describe_type(in.type, false) + " or " + describe_type(in.type, true)
+                                                          : describe_type(in.type, in.many == Many::series);
+        std::printf("  %zu. %-14s %s%s%s\n", i + 1, in.name.c_str(), type.c_str(),
                     in.need == Need::optional ? ", optional" : "", in.help.empty() ? "" : (" — " + in.help).c_str());
     }
-    std::printf("output: %s\n", std::string(to_string(n->output)).c_str());
+    std::printf("output: %s\n", describe_type(n->output, n->output_series).c_str());
     if (!n->adds_layers.empty()) {
         std::string layers;
         for (const auto& l : n->adds_layers) layers += (layers.empty() ? "" : ", ") + l;
         std::printf("adds layers: %s\n", layers.c_str());
     }
     for (const auto& s : n->side_outputs)
-        std::printf("side value: NAME.%s (%s)%s\n", s.name.c_str(), std::string(to_string(s.type)).c_str(),
+        std::printf("side value: NAME.%s (%s)%s\n", s.name.c_str(), describe_type(s.type, s.series).c_str(),
                     s.help.empty() ? "" : (" — " + s.help).c_str());
     std::printf("\nparameters:%s\n", n->params.empty() ? " none" : "");
     for (const auto& p : n->params) {

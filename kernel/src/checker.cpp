@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <sstream>
 #include <unistd.h>
 
@@ -322,6 +323,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
 
         // Inputs
         bool inputs_ok = true;
+        std::unique_ptr<ValueInfo> mapped_entry;  // what the check hook sees of a mapped series input
         std::vector<const ValueInfo*> input_infos(node->inputs.size(), nullptr);
         planned.inputs.assign(node->inputs.size(), "");
         if (call.inputs.size() > node->inputs.size()) {
@@ -364,24 +366,46 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                 inputs_ok = false;
                 continue;
             }
+            // One value, a series, or either; a series given for one value maps the node over it.
+            const ValueInfo& have = it->second;
+            const bool have_series = have.type == ValueType::series;
+            const ValueType have_entry = have_series ? have.element : have.type;
+            const bool maps = want.many == Many::one && have_series && node->output != ValueType::none &&
+                              !node->output_series && planned.mapped_input < 0;
             // An input declared ValueType::none takes any value; the node's check hook says which it accepts.
-            if (want.type != ValueType::none && it->second.type != want.type) {
-                diags.error(in.where, call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name +
-                                          "') must be a " + std::string(to_string(want.type)) + ", but '" + in.full() +
-                                          "' is a " + std::string(to_string(it->second.type)));
+            const bool fits = (want.type == ValueType::none || have_entry == want.type) &&
+                              (want.many == Many::either || (want.many == Many::series) == have_series || maps);
+            if (!fits) {
+                std::string msg = call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name +
+                                  "') must be a " + describe_type(want.type, want.many == Many::series) +
+                                  (want.many == Many::either ? " or a " + describe_type(want.type, true) : "") +
+                                  ", but '" + in.full() + "' is a " + describe_type(have_entry, have_series);
+                if ((want.type == ValueType::none || have_entry == want.type) && want.many == Many::one && have_series)
+                    msg += node->output == ValueType::none
+                               ? " (a node that only writes files is not mapped over a series)"
+                               : " (a node is mapped over one series input at a time)";
+                diags.error(in.where, msg);
                 inputs_ok = false;
                 continue;
             }
-            input_infos[i] = &it->second;
+            if (maps) {
+                planned.mapped_input = int(i);
+                ValueInfo entry = have;  // the node's check hook sees one entry
+                entry.type = have.element;
+                entry.element = ValueType::none;
+                entry.count = 0;
+                mapped_entry = std::make_unique<ValueInfo>(std::move(entry));
+                input_infos[i] = mapped_entry.get();
+            } else {
+                input_infos[i] = &have;
+            }
             planned.inputs[i] = in.full();
         }
         for (std::size_t i = call.inputs.size(); i < node->inputs.size(); ++i) {
             if (node->inputs[i].need == Need::required) {
                 diags.error(call.where, call.qualified() + " needs input " + std::to_string(i + 1) + " ('" +
                                             node->inputs[i].name + "', a " +
-                                            (node->inputs[i].type == ValueType::none
-                                                 ? std::string("value")
-                                                 : std::string(to_string(node->inputs[i].type))) +
+                                            describe_type(node->inputs[i].type, node->inputs[i].many == Many::series) +
                                             "): " +
                                             call.qualified() + "(NAME, ...)");
                 inputs_ok = false;
@@ -526,6 +550,8 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                 out.cell = plan.grid.cell;
             }
             out.type = ValueType::heightmap;
+            out.element = ValueType::none;  // the base may have been a series of heightmaps
+            out.count = 0;
             for (const auto& l : node->adds_layers) out.layers.insert(l);
         }
 
@@ -540,13 +566,21 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             }
             out = ctx.take_output();
         }
+        // A series output: `out` describes its entries.
+        if (node->output_series || planned.mapped_input >= 0) {
+            out.element = out.type;
+            out.type = ValueType::series;
+            if (planned.mapped_input >= 0) out.count = values[planned.inputs[std::size_t(planned.mapped_input)]].count;
+        }
 
         if (!st.name.empty()) {
             defined_at.emplace(st.name, st.name_where);
             values[st.name] = out;
+            // A mapped node's side values are not kept (it ran once per entry): they hold nothing.
             for (const auto& side : node->side_outputs) {
                 ValueInfo si;
-                si.type = side.type;
+                si.type = planned.mapped_input >= 0 ? ValueType::none : side.series ? ValueType::series : side.type;
+                if (side.series && planned.mapped_input < 0) si.element = side.type;
                 values[st.name + "." + side.name] = si;
             }
         }

@@ -20,6 +20,15 @@ std::string_view to_string(ParamType type) {
     return "?";
 }
 
+std::string describe_type(ValueType type, bool series) {
+    if (type == ValueType::none) return series ? "series" : "value";  // an input that takes any value
+    if (!series) return std::string(to_string(type));
+    // Plurals: heightmaps, images, plates (already plural), particles (already plural).
+    std::string entry(to_string(type));
+    if (type == ValueType::heightmap || type == ValueType::image) entry += "s";
+    return "series of " + entry;
+}
+
 Param Param::integer(std::string name, std::optional<std::int64_t> def) {
     Param p;
     p.name = std::move(name);

@@ -26,9 +26,9 @@ namespace {
 class Context : public NodeContext {
 public:
     Context(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs, const RunOptions& options,
-            std::vector<fs::path>& outputs)
+            std::vector<fs::path>& outputs, bool for_entry = false)
         : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), outputs_(outputs),
-          seed_(node_seed(plan.seed, node.label)) {}
+          seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
 
     const std::string& label() const override { return node_.label; }
     std::uint64_t seed() const override { return seed_; }
@@ -54,6 +54,9 @@ public:
         return std::make_shared<Heightmap>(*hm);
     }
     fs::path output_path(const std::string& relative) override {
+        if (for_entry_)
+            throw Error("internal error: " + node_.node->qualified_name() +
+                        " writes files, so it cannot be mapped over a series");
         const fs::path rel(relative);
         const fs::path full = rel.is_absolute() ? rel : options_.out_dir / rel;
         std::error_code ec;
@@ -69,7 +72,8 @@ public:
         return p.is_absolute() ? p : plan_.spec_folder / p;
     }
     void progress(double fraction) override {
-        if (options_.progress) options_.progress->update(fraction);
+        // An entry of a mapped series is made while another node runs: that node's bar speaks.
+        if (options_.progress && !for_entry_) options_.progress->update(fraction);
     }
     void check_cancelled() override {
         if (options_.cancel && options_.cancel->load()) throw Cancelled();
@@ -88,7 +92,41 @@ private:
     const RunOptions& options_;
     std::vector<fs::path>& outputs_;
     std::uint64_t seed_;
+    bool for_entry_;
 };
+
+/// The series a node mapped over input `mapped` of `inputs` yields: entry j
+/// runs the node on entry j of that input (other inputs as given), when a
+/// consumer asks for it. It runs inside run(), which keeps plan, node and
+/// options alive for as long as any node can pull an entry.
+std::shared_ptr<Series> map_over_series(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs,
+                                        std::size_t mapped, const RunOptions& options, std::vector<fs::path>& outputs) {
+    const std::shared_ptr<const Series> source = inputs[mapped].series();
+    auto result = std::make_shared<Series>();
+    result->element = node.node->output;
+    result->times = source->times;
+    result->make = [&plan, &node, &options, &outputs, inputs = std::move(inputs), mapped,
+                    source](std::size_t j) -> Value {
+        std::vector<Value> entry_inputs = inputs;
+        entry_inputs[mapped] = source->at(j);
+        Context ctx(plan, node, std::move(entry_inputs), options, outputs, true);
+        try {
+            ctx.check_cancelled();
+            Value v = node.node->run(ctx).main;
+            if (v.type() != node.node->output)
+                throw Error("internal error: it returned a " + std::string(to_string(v.type())) + " but declares a " +
+                            std::string(to_string(node.node->output)));
+            return v;
+        } catch (const Cancelled&) {
+            throw;
+        } catch (const Error& e) {
+            throw Error("entry " + std::to_string(j) + " of '" + node.label + "' (" + node.node->qualified_name() +
+                            ", line " + std::to_string(node.where.line) + "): " + e.what(),
+                        e.kind());
+        }
+    };
+    return result;
+}
 
 std::string node_error(const PlannedNode& node, const std::string& message) {
     spec::Diagnostic d;
@@ -175,13 +213,18 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             auto it = plan.last_use.find(key);
             if (!key.empty() && it != plan.last_use.end() && it->second == i) values.erase(key);
         }
+        const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
         Context ctx(plan, node, std::move(inputs), options, result.outputs);
         if (options.progress) options.progress->start(int(i) + 1, total, node.label, node.node->qualified_name());
         const auto start = std::chrono::steady_clock::now();
         NodeOutputs out;
         try {
             ctx.check_cancelled();
-            out = node.node->run(ctx);
+            if (node.mapped_input >= 0)  // entries are made when a later node pulls them
+                out = NodeOutputs(map_over_series(plan, node, mapped_inputs, std::size_t(node.mapped_input), options,
+                                                  result.outputs));
+            else
+                out = node.node->run(ctx);
         } catch (const Cancelled&) {
             result.exit_code = 130;
             result.error = node_error(node, "cancelled by the user");
@@ -207,10 +250,15 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         if (options.progress) options.progress->finish(seconds);
         result.timings.push_back({node.label, node.node->qualified_name(), node.where.line, seconds});
 
-        if (out.main.type() != node.node->output) {
+        const bool series_out = node.node->output_series || node.mapped_input >= 0;
+        const ValueType returned_entry = out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
+        if ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output) {
             result.exit_code = 1;
-            result.error = node_error(node, "internal error: it returned a " + std::string(to_string(out.main.type())) +
-                                                " but declares a " + std::string(to_string(node.node->output)));
+            result.error = node_error(node, "internal error: it returned a " +
+                                                (returned_entry == ValueType::none
+                                                     ? std::string("nothing")
+                                                     : describe_type(returned_entry, out.main.type() == ValueType::series)) +
+                                                " but declares a " + describe_type(node.node->output, series_out));
             break;
         }
         if (!node.value_name.empty()) {

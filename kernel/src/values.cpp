@@ -12,6 +12,7 @@ std::string_view to_string(ValueType type) {
         case ValueType::image: return "image";
         case ValueType::particles: return "particles";
         case ValueType::plates: return "plates";
+        case ValueType::series: return "series";
     }
     return "?";
 }
@@ -76,6 +77,34 @@ const std::shared_ptr<const ParticleSeries>& Value::particles() const {
 const std::shared_ptr<const PlateHistory>& Value::plates() const {
     if (type() != ValueType::plates) wrong_type(ValueType::plates, type());
     return std::get<4>(v_);
+}
+const std::shared_ptr<const Series>& Value::series() const {
+    if (type() != ValueType::series) wrong_type(ValueType::series, type());
+    return std::get<5>(v_);
+}
+
+Value Series::at(std::size_t i) const {
+    if (i >= size())
+        throw Error("internal error: series entry " + std::to_string(i) + " asked of a series of " +
+                    std::to_string(size()));
+    if (!make) throw Error("internal error: a series without a way to make its entries");
+    Value v = make(i);
+    if (v.type() != element)
+        throw Error("internal error: entry " + std::to_string(i) + " of a series of " +
+                    std::string(to_string(element)) + "s is a " + std::string(to_string(v.type())));
+    return v;
+}
+
+std::shared_ptr<Series> series_of(ValueType element, std::vector<double> times, std::vector<Value> entries) {
+    if (times.size() != entries.size())
+        throw Error("internal error: a series of " + std::to_string(entries.size()) + " entries with " +
+                    std::to_string(times.size()) + " times");
+    auto s = std::make_shared<Series>();
+    s->element = element;
+    s->times = std::move(times);
+    auto held = std::make_shared<const std::vector<Value>>(std::move(entries));
+    s->make = [held](std::size_t i) { return (*held)[i]; };
+    return s;
 }
 
 }  // namespace orogen

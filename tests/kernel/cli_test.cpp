@@ -1,6 +1,7 @@
 // The `orogen` command end to end: diagnostics word for word, the plugin
 // seam's failure modes, the runner's error handling, determinism, outputs.
 #include <orogen/io.hpp>
+#include <orogen/plugin.hpp>
 
 #include <gtest/gtest.h>
 
@@ -130,7 +131,7 @@ TEST(Cli, ListHelpAndVersionDescribeThePlugins) {
 
     r = run_orogen("version");
     ASSERT_EQ(r.exit_code, 0);
-    EXPECT_NE(r.out.find("(plugin API 1)"), std::string::npos);
+    EXPECT_NE(r.out.find("(plugin API " + std::to_string(OROGEN_PLUGIN_API_VERSION) + ")"), std::string::npos);
     EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  fault +0\\.1\\.0 +.*orogen_generate_fault\\.so\n")));
 }
 
@@ -144,7 +145,9 @@ TEST(PluginSeam, BrokenPluginsAreRefusedOneByOneAndTheRestStillLoad) {
     ASSERT_EQ(r.exit_code, 0);
     const std::string w = "orogen: warning: plugin ";
     EXPECT_NE(r.err.find(w + fake_plugins + "/wrong_version.so: wrong plugin API version in plugin 'future-plugin': "
-                             "got version 2, supported version is 1; rebuild the plugin against this orogen's headers; skipped\n"),
+                             "got version " + std::to_string(OROGEN_PLUGIN_API_VERSION + 1) + ", supported version is " +
+                             std::to_string(OROGEN_PLUGIN_API_VERSION) +
+                             "; rebuild the plugin against this orogen's headers; skipped\n"),
               std::string::npos)
         << r.err;
     EXPECT_NE(r.err.find(w + fake_plugins + "/no_entry.so: not an orogen plugin: it has no entry point "

@@ -93,22 +93,40 @@ struct Param {
 /// Whether an input must be given.
 enum class Need { required, optional };
 
+/// Whether an input takes one value or a series of them (values.hpp: Series).
+enum class Many {
+    /// One value of the input's type. Given a series of that type instead, the
+    /// kernel maps the node over it: the node's result becomes a series with
+    /// the same times whose entry j is the node run on entry j (made on demand,
+    /// other inputs unchanged). So an image pass applies to every frame of a
+    /// turntable with no code of its own. Only nodes with a main output map,
+    /// and over one input at a time.
+    one,
+    series,  ///< a series whose entries are of the input's type
+    either,  ///< one value or a series of the input's type; the node looks at input(i).type()
+};
+
 struct InputSpec {
     std::string name;  ///< for help and messages
-    /// The value type it takes; ValueType::none takes any (the node's check
-    /// hook then refuses the types it cannot use, e.g. export:png takes a
-    /// heightmap or an image).
+    /// The value type it takes (with Many::series/either: the type of the
+    /// entries); ValueType::none takes any (the node's check hook then refuses
+    /// the types it cannot use, e.g. export:png takes a heightmap or an image).
     ValueType type = ValueType::heightmap;
     Need need = Need::required;
     std::string help;
+    Many many = Many::one;
 };
 
 /// A value a node produces besides its main one, addressed `node.name` in the spec.
 struct SideOutput {
     std::string name;
-    ValueType type = ValueType::none;
+    ValueType type = ValueType::none;  ///< with `series`: the type of the entries
     std::string help;
+    bool series = false;  ///< a series of `type` (e.g. an eroder's heightmap time-lapse)
 };
+
+/// "heightmap", or "series of heightmaps" when `series`.
+std::string describe_type(ValueType type, bool series);
 
 // ------------------------------------------------------------ check context
 
@@ -119,6 +137,9 @@ struct ValueInfo {
     double cell = 0.0;          ///< heightmap cell size in metres, 0 if unknown
     std::set<std::string, std::less<>> layers;  ///< heightmap layers known to exist
     bool layers_known = true;  ///< false if an input may carry layers nobody declared (imports)
+    /// For a series: the type of its entries (the fields above then describe an entry).
+    ValueType element = ValueType::none;
+    std::size_t count = 0;  ///< for a series: entries, 0 if unknown
 };
 
 /// The default grid from the spec's `grid` statement.
@@ -230,6 +251,8 @@ struct NodeDescriptor {
     std::string description;  ///< longer text for `orogen help` (optional)
     std::vector<InputSpec> inputs;
     ValueType output = ValueType::none;
+    /// The main output is a series whose entries are of type `output` (e.g. render:turntable's frames).
+    bool output_series = false;
     std::vector<SideOutput> side_outputs;
     std::vector<Param> params;
     /// Heightmap layers this node adds to its output (for the checker and help).

@@ -6,6 +6,8 @@
 //   image      an RGBA frame, 8-bit or float.
 //   particles  a time series of particle frames (structure of arrays).
 //   plates     plate polygons over time and collision events.
+//   series     an ordered sequence of one of the above, each entry with a time
+//              (a heightmap time-lapse, a frame sequence), made on demand.
 //
 // Values are immutable once a node has produced them; a node that changes its
 // input works on a copy (NodeContext::take_heightmap gives one cheaply: the
@@ -15,6 +17,7 @@
 #include <orogen/grid.hpp>
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -24,7 +27,7 @@
 
 namespace orogen {
 
-enum class ValueType { none, heightmap, image, particles, plates };
+enum class ValueType { none, heightmap, image, particles, plates, series };
 
 /// "heightmap", "image", ...
 std::string_view to_string(ValueType type);
@@ -146,6 +149,8 @@ struct PlateHistory {
 
 // -------------------------------------------------------------------- value
 
+struct Series;
+
 /// Any value, shared and immutable. Empty (`type() == none`) for nodes that
 /// only write files.
 class Value {
@@ -159,6 +164,8 @@ public:
     Value(std::shared_ptr<Image> v) : v_(std::shared_ptr<const Image>(std::move(v))) {}
     Value(std::shared_ptr<ParticleSeries> v) : v_(std::shared_ptr<const ParticleSeries>(std::move(v))) {}
     Value(std::shared_ptr<PlateHistory> v) : v_(std::shared_ptr<const PlateHistory>(std::move(v))) {}
+    Value(std::shared_ptr<const Series> v) : v_(std::move(v)) {}
+    Value(std::shared_ptr<Series> v) : v_(std::shared_ptr<const Series>(std::move(v))) {}
 
     ValueType type() const { return ValueType(v_.index()); }
     explicit operator bool() const { return type() != ValueType::none; }
@@ -168,12 +175,41 @@ public:
     const std::shared_ptr<const Image>& image() const;
     const std::shared_ptr<const ParticleSeries>& particles() const;
     const std::shared_ptr<const PlateHistory>& plates() const;
+    const std::shared_ptr<const Series>& series() const;
 
 private:
     // Order matches ValueType.
     std::variant<std::monostate, std::shared_ptr<const Heightmap>, std::shared_ptr<const Image>,
-                 std::shared_ptr<const ParticleSeries>, std::shared_ptr<const PlateHistory>>
+                 std::shared_ptr<const ParticleSeries>, std::shared_ptr<const PlateHistory>,
+                 std::shared_ptr<const Series>>
         v_;
 };
+
+// ------------------------------------------------------------------- series
+
+/// An ordered sequence of values of one type — a heightmap time-lapse
+/// recorded by an eroder, the frames of a turntable — each with a time.
+///
+/// Entries are made on demand by `make`, so a consumer (a video encoder, an
+/// exporter writing numbered files) pulls them one at a time and never holds
+/// them all: a 300-frame 1080p turntable costs one frame of memory, not 300.
+/// A producer that already holds its entries (a time-lapse) returns them
+/// from `make`; one that computes them (a render) captures what it needs by
+/// value (shared_ptrs to its inputs, its parameters).
+struct Series {
+    ValueType element = ValueType::none;  ///< type of every entry (never series)
+    std::vector<double> times;            ///< one per entry, in the producer's clock (seconds, or years)
+    /// Makes entry i (0 ≤ i < size()). May be called more than once, in any
+    /// order, from one thread at a time; must be deterministic.
+    std::function<Value(std::size_t)> make;
+
+    std::size_t size() const { return times.size(); }
+    /// make(i), checked: throws orogen::Error if i is out of range or the
+    /// entry is not of type `element`.
+    Value at(std::size_t i) const;
+};
+
+/// A series over values already made (a recorded time-lapse).
+std::shared_ptr<Series> series_of(ValueType element, std::vector<double> times, std::vector<Value> entries);
 
 }  // namespace orogen

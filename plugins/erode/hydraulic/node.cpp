@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
 
 #include <string>
 #include <utility>
@@ -37,9 +38,12 @@ NodeOutputs run(NodeContext& ctx) {
 
     const std::vector<float> before = hm->heights();
     const std::int64_t iterations = ctx.integer("iterations");
+    Timelapse lapse(ctx.integer("timelapse_every"), 1.0);  // time = step count
+    lapse.record(0, *hm);
     hydraulic::erode({hm->view(), water, sediment}, iterations, s, layer,
                      [&](std::int64_t i, const hydraulic::ConstState& st) {
                          ctx.check_cancelled();
+                         lapse.record(i, st.height, st.water.data);
                          if (i % 64 == 0 || i == iterations) {
                              ctx.check_finite(st.height.span(), "height", i);
                              ctx.check_finite(st.water.span(), "water", i);
@@ -57,7 +61,10 @@ NodeOutputs run(NodeContext& ctx) {
     GridView flow = hm->layer("flow", 0.0f);
     hydraulic::outflow({hm->view(), water, sediment}, s, layer, flow);
     if (s.hardness == hydraulic::Hardness::steepness) hydraulic::steepness_hardness(hm->view(), hm->layer("hardness", 0.0f));
-    return hm;
+    lapse.finish(iterations, *hm);
+    NodeOutputs out(hm);
+    if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
+    return out;
 }
 
 void check(CheckContext& ctx) {
@@ -67,6 +74,7 @@ void check(CheckContext& ctx) {
     }
     for (const char* l : {"water", "sediment", "eroded", "flow"}) ctx.output().layers.insert(l);
     if (hardness == "steepness") ctx.output().layers.insert("hardness");
+    check_timelapse(ctx, ctx.integer("iterations"));
 }
 
 }  // namespace
@@ -88,6 +96,7 @@ OROGEN_PLUGIN("erode-hydraulic", "0.1.0", registry) {
             "falling toward 0 on cliffs).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"}},
         .output = ValueType::heightmap,
+        .side_outputs = {timelapse_output()},
         .params =
             {
                 Param::integer("iterations", 100).min(0).max(10'000'000).help("number of steps"),
@@ -106,6 +115,7 @@ OROGEN_PLUGIN("erode-hydraulic", "0.1.0", registry) {
                 Param::string("hardness", "steepness")
                     .help("steepness (the thesis's (1 - |n_y|)^3: flat ground resists), constant, or the name of a "
                           "layer holding hardness 0..1"),
+                timelapse_param(),
             },
         .adds_layers = {"water", "sediment", "eroded", "flow"},
         .check = check,

@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
 
 #include <algorithm>
 
@@ -75,11 +76,14 @@ NodeOutputs run(NodeContext& ctx) {
 
     const std::int64_t steps = ctx.integer("steps");
     const double dt = ctx.real("dt");
+    Timelapse lapse(ctx.integer("timelapse_every"), dt);  // time in seconds
+    lapse.record(0, *hm);
     {
         pipe::Solver solver(st, s, mask.empty() ? nullptr : mask.data());
         for (std::int64_t i = 1; i <= steps; ++i) {
             ctx.check_cancelled();
             solver.advance(dt, i);
+            if (i < steps) lapse.record(i, solver.current_height(), st.water.data);
             if (i % 16 == 0 || i == steps) ctx.progress(double(i) / double(steps));
         }
         solver.finish();
@@ -92,7 +96,10 @@ NodeOutputs run(NodeContext& ctx) {
     ctx.check_finite(st.sediment.span(), "sediment", steps);
     const std::vector<float>& after = hm->heights();
     for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
-    return hm;
+    lapse.finish(steps, *hm);
+    NodeOutputs out(hm);
+    if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
+    return out;
 }
 
 void check(CheckContext& ctx) {
@@ -112,6 +119,7 @@ void check(CheckContext& ctx) {
     }
     for (const char* l : {"water", "sediment", "flow", "eroded"}) ctx.output().layers.insert(l);
     for (const char* l : kFluxLayers) ctx.output().layers.insert(l);
+    check_timelapse(ctx, ctx.integer("steps"));
 }
 
 }  // namespace
@@ -137,6 +145,7 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
                    {"rain_mask", ValueType::heightmap, Need::optional,
                     "rain factor per cell (its heights, >= 0), same size as the terrain"}},
         .output = ValueType::heightmap,
+        .side_outputs = {timelapse_output()},
         .params =
             {
                 Param::integer("steps", 200).min(0).max(100'000'000).help("number of time steps"),
@@ -179,6 +188,7 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
                           "alone amplifies (0 = Mei's original; at most 0.2*cell²/dt per sub-step)"),
                 Param::choice("boundary", {"closed", "open"}, "closed")
                     .help("closed: walls keep the water in; open: water flows off the edges"),
+                timelapse_param(),
             },
         .adds_layers = {"water", "sediment", "flow", "eroded", "flux_west", "flux_east", "flux_north", "flux_south"},
         .check = check,

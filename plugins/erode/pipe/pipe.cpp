@@ -554,6 +554,11 @@ void Solver::finish() {
     m.b_cur = m.st.height.data;
 }
 
+ConstGridView Solver::current_height() const {
+    const Impl& m = *impl_;
+    return {m.b_cur, m.st.height.width, m.st.height.height, m.st.height.cell};
+}
+
 double Solver::total_water() const {
     double t = 0.0;
     for (double r : impl_->row_water) t += r;

@@ -100,6 +100,9 @@ public:
     /// Write everything back into the state (sediment fix-up, speed, terrain).
     /// Call once at the end; advance() may not be called afterwards.
     void finish();
+    /// The terrain as it stands after the last advance() (the solver keeps it
+    /// in its own buffer until finish()); water is State::water itself.
+    ConstGridView current_height() const;
 
     std::int64_t substeps() const { return substeps_; }
     /// Sums of the last sub-step, in double (m³ = m·cell²... here in m summed over cells).

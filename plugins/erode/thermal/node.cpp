@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -40,8 +41,11 @@ NodeOutputs run(NodeContext& ctx) {
 
     const std::vector<float> before = hm->heights();
     const std::int64_t iterations = ctx.integer("iterations");
+    Timelapse lapse(ctx.integer("timelapse_every"), 1.0);  // time = step count
+    lapse.record(0, *hm);
     thermal::erode(hm->view(), iterations, s, layer, [&](std::int64_t i, ConstGridView current) {
         ctx.check_cancelled();
+        lapse.record(i, current);
         if (i % 64 == 0 || i == iterations) {
             ctx.check_finite(current.span(), "height", i);
             ctx.progress(double(i) / double(iterations));
@@ -57,7 +61,10 @@ NodeOutputs run(NodeContext& ctx) {
         for (std::size_t i = 0; i < after.size(); ++i)
             k.data[i] = thermal::height_hardness(after[i], s.height_min, s.height_max);
     }
-    return hm;
+    lapse.finish(iterations, *hm);
+    NodeOutputs out(hm);
+    if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
+    return out;
 }
 
 void check(CheckContext& ctx) {
@@ -70,6 +77,7 @@ void check(CheckContext& ctx) {
         ctx.require_layer(0, "hardness", hardness, "use constant, height or the name of an existing layer");
     }
     ctx.output().layers.insert("eroded");
+    check_timelapse(ctx, ctx.integer("iterations"));
 }
 
 }  // namespace
@@ -88,6 +96,7 @@ OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
             "m) and, with hardness=height, hardness.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"}},
         .output = ValueType::heightmap,
+        .side_outputs = {timelapse_output()},
         .params =
             {
                 Param::integer("iterations", 50).min(0).max(10'000'000).help("number of steps"),
@@ -111,6 +120,7 @@ OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
                 Param::string("hardness", "constant")
                     .help("constant; height (the thesis's height-aware hardness: high ground is hard, "
                           "softness ((max - h)/(max - min))^2); or the name of a layer holding hardness 0..1"),
+                timelapse_param(),
             },
         .adds_layers = {"eroded"},
         .check = check,

@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/timelapse.hpp>
 
 #include <algorithm>
 #include <memory>
@@ -49,10 +50,16 @@ NodeOutputs run(NodeContext& ctx) {
     layers.plate = hm->layer("plate", -1.0f);
     layers.terrain = hm->view();
 
-    auto result = plates::simulate(start, bounded, ctx.seed(), layers, [&](std::int64_t step) {
-        ctx.check_cancelled();
-        if (step % 32 == 0) ctx.progress(double(step) / double(params.steps));
-    });
+    Timelapse lapse(ctx.integer("timelapse_every"), params.dt);  // time in simulated seconds
+    lapse.record(0, *hm);
+    auto result = plates::simulate(
+        start, bounded, ctx.seed(), layers,
+        [&](std::int64_t step) {
+            ctx.check_cancelled();
+            if (step % 32 == 0) ctx.progress(double(step) / double(params.steps));
+        },
+        ctx.integer("timelapse_every"), [&](std::int64_t step, ConstGridView terrain) { lapse.record(step, terrain); });
+    lapse.finish(params.steps, *hm);
     ctx.check_finite(hm->heights(), "height", params.steps);
     const auto& s = result.stats;
     ctx.info(std::to_string(s.events[1]) + " convergent (" + std::to_string(s.subductions) + " subducting), " +
@@ -61,6 +68,7 @@ NodeOutputs run(NodeContext& ctx) {
 
     NodeOutputs out(hm);
     out.side["plates"] = Value(std::make_shared<PlateHistory>(std::move(result.history)));
+    if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
     return out;
 }
 
@@ -75,6 +83,7 @@ void check(CheckContext& ctx) {
                                 std::to_string(most) + " plates (each needs 16 × 16 samples); ask for fewer plates "
                                 "or a larger grid");
     for (const char* layer : {"uplift", "boundary", "plate"}) ctx.output().layers.insert(layer);
+    check_timelapse(ctx, ctx.integer("steps"));
 }
 
 }  // namespace
@@ -101,7 +110,8 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
             "every contact event).",
         .inputs = {{"crust", ValueType::heightmap, Need::required, "the heightmap before tectonics"}},
         .output = ValueType::heightmap,
-        .side_outputs = {{"plates", ValueType::plates, "plate polygons over time and the boundary events"}},
+        .side_outputs = {{"plates", ValueType::plates, "plate polygons over time and the boundary events"},
+                         timelapse_output()},
         .params =
             {
                 Param::integer("plates", 12).min(2).max(256).help("number of plates cut from the area at the start"),
@@ -159,6 +169,7 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
                     .unit("N·s")
                     .help("collision impulse (simulation units) a plate takes before it splits in two; 0 = never"),
                 Param::integer("record_every", 10).min(1).help("record the plate polygons every this many steps"),
+                timelapse_param(),
             },
         .adds_layers = {"uplift", "boundary", "plate"},
         .check = check,

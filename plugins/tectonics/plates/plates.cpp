@@ -200,7 +200,8 @@ public:
         }
     }
 
-    Result run(const std::function<void(std::int64_t)>& on_step) {
+    Result run(const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every = 0,
+               const SnapshotFn& on_snapshot = {}) {
         snapshot(0);
         for (std::int64_t step = 1; step <= params_.steps; ++step) {
             step_ = step;
@@ -214,6 +215,13 @@ public:
             result_.stats.relief_seconds += seconds_since(t1);
             if (params_.rift_threshold > 0.0) rift(step);
             if (step % std::max(1, params_.record_every) == 0 || step == params_.steps) snapshot(step);
+            if (on_snapshot && snapshot_every > 0 && step % snapshot_every == 0 && step < params_.steps) {
+                const GridView& t = layers_.terrain;
+                scratch_.assign(t.data, t.data + t.size());
+                GridView copy{scratch_.data(), t.width, t.height, t.cell};
+                relief_->apply(copy);
+                on_snapshot(step, copy);
+            }
             if (on_step) on_step(step);
         }
         const auto t2 = Clock::now();
@@ -517,6 +525,7 @@ private:
     std::vector<PendingEvent> pending_;
     std::int64_t step_ = 0;
     std::optional<BoundaryRelief> relief_;
+    std::vector<float> scratch_;  ///< a time-lapse snapshot: the terrain with the relief so far
     Result result_;
 };
 
@@ -598,6 +607,12 @@ std::vector<PlateSpec> random_plates(Point2 size, int count, double oceanic_frac
 
 Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
                 const std::function<void(std::int64_t)>& on_step) {
+    return simulate(plates, params, seed, layers, on_step, 0, {});
+}
+
+Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
+                const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every,
+                const SnapshotFn& on_snapshot) {
     if (!layers.terrain.data || layers.terrain.width < 2 || layers.terrain.height < 2)
         throw BadInput("the plate simulation needs a heightmap of at least 2 × 2 samples");
     if (params.steps < 1) throw BadInput("steps must be at least 1, got " + std::to_string(params.steps));
@@ -625,7 +640,7 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
     double total_area = 0.0;
     for (const PlateSpec& p : plates) total_area += signed_area(p.polygon);
     sim.set_min_rift_part(0.5 * total_area / double(plates.size()));
-    return sim.run(on_step);
+    return sim.run(on_step, snapshot_every, on_snapshot);
 }
 
 // ------------------------------------------------------------- rasterising

@@ -162,6 +162,16 @@ struct Result {
 Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
                 const std::function<void(std::int64_t)>& on_step = {});
 
+/// Called with the terrain as it would stand if the run ended after `step`:
+/// the input terrain plus the relief of every boundary so far (the relief is
+/// composed once at the end of a run, so this is a copy with it applied).
+using SnapshotFn = std::function<void(std::int64_t step, ConstGridView terrain)>;
+/// simulate(), calling `on_snapshot` after every `snapshot_every`-th step
+/// (before the last step's; the caller has the final terrain itself).
+Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
+                const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every,
+                const SnapshotFn& on_snapshot);
+
 /// Draw segment a–b (sample coordinates) into `layer` with `value`, `radius`
 /// samples thick on each side (Bresenham walk, clipped to the grid).
 void draw_segment(GridView layer, Point2 a, Point2 b, float value, int radius);
