@@ -179,9 +179,72 @@ NodeOutputs run_terrain(NodeContext& ctx) {
     return NodeOutputs(std::make_shared<Image>(std::move(image)));
 }
 
+
+std::vector<Param> turntable_params() {
+    std::vector<Param> p = frame_size_params(1280, 720);
+    p.push_back(Param::integer("frames", 120).min(1).max(100000).help("frames in one turn (and the series' length)"));
+    p.push_back(Param::real("turns", 1.0).min(-100).max(100).help("turns around the target over the frames (negative: clockwise seen from above)"));
+    p.push_back(Param::real("fps", 30.0).min(0, true).max(240).unit("1/s").help("frame rate the series' times (and the waves) follow"));
+    for (auto& q : camera_params())
+        if (q.name != "camera" && q.name != "from" && q.name != "from_height" && q.name != "to" && q.name != "to_height")
+            p.push_back(std::move(q));
+    for (auto& q : style_params())
+        if (q.name != "particle_frame" && q.name != "particle_radius") p.push_back(std::move(q));
+    for (auto& q : p)
+        if (q.name == "azimuth") q.help_text = "where the camera starts, clockwise from north (then it circles the target)";
+    return p;
+}
+
+/// A series of `frames` images orbiting the target; each frame is rendered
+/// when the consumer asks for it (the encoder pulls them one at a time).
+NodeOutputs run_turntable(NodeContext& ctx) {
+    auto renderer = std::make_shared<TerrainRenderer>(ctx.input(0).heightmap(), style_from(ctx));
+    Camera base = camera_from(ctx);
+    base.mode = Camera::Mode::orbit;
+    const int width = int(ctx.integer("width")), height = int(ctx.integer("height"));
+    const auto frames = std::size_t(ctx.integer("frames"));
+    const double turns = ctx.real("turns"), fps = ctx.real("fps"), start_time = ctx.real("time");
+    // Fail now, not half way through an encode: the first frame's camera and size.
+    renderer->render(std::min(width, 16), std::min(height, 16), base);
+    auto series = std::make_shared<Series>();
+    series->element = ValueType::image;
+    for (std::size_t i = 0; i < frames; ++i) series->times.push_back(double(i) / fps);
+    series->make = [renderer, base, width, height, frames, turns, fps, start_time](std::size_t i) -> Value {
+        Camera c = base;
+        c.azimuth = std::fmod(base.azimuth + 360.0 * turns * double(i) / double(frames) + 3600.0 * 100, 360.0);
+        renderer->set_time(start_time + double(i) / fps);
+        return Value(std::make_shared<Image>(renderer->render(width, height, c)));
+    };
+    return NodeOutputs(Value(std::shared_ptr<Series>(std::move(series))));
+}
+
 }  // namespace
 
 OROGEN_PLUGIN("render-terrain", "0.1.0", registry) {
+    registry.add({
+        .kind = "render",
+        .name = "turntable",
+        .summary = "a series of frames orbiting the terrain (frames=N), rendered as render:terrain, one at a time on demand",
+        .description =
+            "The camera circles the target at the given elevation and distance, `turns` times over `frames` frames,\n"
+            "starting at `azimuth`; the waves move with the frames' times (fps). Frames are made only when a\n"
+            "consumer asks (export:video pulls them one by one), so a long turntable never sits in memory.\n"
+            "Image passes map over it frame by frame: render:bloom(turntable).",
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to draw"}},
+        .output = ValueType::image,
+        .output_series = true,
+        .params = turntable_params(),
+        .check =
+            [](CheckContext& ctx) {
+                check_style(ctx);
+                ctx.output().type = ValueType::image;
+                ctx.output().width = int(ctx.integer("width"));
+                ctx.output().height = int(ctx.integer("height"));
+                ctx.output().count = std::size_t(ctx.integer("frames"));
+                ctx.output().layers.clear();
+            },
+        .run = run_turntable,
+    });
     registry.add({
         .kind = "render",
         .name = "terrain",

@@ -93,6 +93,8 @@ public:
                  Timings* timings = nullptr);
 
     const Style& style() const { return style_; }
+    /// Move the waves to `seconds` (a turntable's frames animate them).
+    void set_time(double seconds) { style_.time = seconds; }
 
 private:
     struct Impl;
