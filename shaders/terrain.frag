@@ -59,7 +59,7 @@ void main() {
         // The skirt: layered earth and rock, lit like the rest.
         vec2 q = vec2(dot(world.xz, wall_normal.zx), world.y) / texture_scale;
         float layers = 0.5 + 0.5 * sin(world.y / exaggeration * 0.05 + 4.0 * fbm(q * vec2(1.0, 0.3), 3));
-        vec3 earth = mix(material[2] * 0.5, material[0] * 0.6, 0.35 + 0.3 * layers) * (0.9 + 0.2 * fbm(q * 30.0, 2));
+        vec3 earth = mix(material[2] * 0.42, material[0] * 0.45, 0.25 + 0.3 * layers) * (0.9 + 0.2 * fbm(q * 30.0, 2));
         if (output_mode == 1) { colour = vec4(earth, 1.0); return; }
         if (output_mode == 2) { colour = vec4(wall_normal * 0.5 + 0.5, 1.0); return; }
         vec3 wl = sun_colour * max(dot(wall_normal, sun_direction), 0.0) + ambient_colour * 0.5;

@@ -72,6 +72,8 @@ std::vector<Param> style_params() {
         Param::real("haze", 0.3).min(0).help("aerial perspective: optical depth of the air across the terrain's diagonal"),
         Param::boolean("sea", false).help("draw a sea at sea_level"),
         Param::real("sea_level", 0.0).unit("m").help("height of the sea (with sea=true)"),
+        Param::real("sea_fraction", -1.0).min(-1).max(1).help(
+            "with sea=true: put the sea at this fraction of the terrain's height range instead (-1: use sea_level)"),
         Param::string("water_layer", "water").help("draw water from this layer when the heightmap has it (\"\": none)"),
         Param::real("water_min_depth", 0.05).min(0).unit("m").help("thinner water is not drawn"),
         Param::real("wave_height", 1.0).min(0).unit("m").help("amplitude of the waves"),
@@ -134,6 +136,7 @@ Style style_from(NodeContext& ctx) {
     s.haze = ctx.real("haze");
     s.sea = ctx.flag("sea");
     s.sea_level = ctx.real("sea_level");
+    s.sea_fraction = ctx.real("sea_fraction");
     s.water_layer = ctx.text("water_layer");
     s.water_min_depth = ctx.real("water_min_depth");
     s.wave_height = ctx.real("wave_height");

@@ -161,6 +161,7 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
         m.lo = std::min(m.lo, h);
         m.hi = std::max(m.hi, h);
     }
+    if (style_.sea_fraction >= 0) style_.sea_level = m.lo + style_.sea_fraction * double(m.hi - m.lo);
     if (style_.texture_scale <= 0) style_.texture_scale = std::max(m.extent_x(), m.extent_z()) / 8.0;
     if (style_.particle_radius <= 0) style_.particle_radius = 3.0 * m.terrain->cell();
 

@@ -48,6 +48,7 @@ struct Style {
     double haze = 0.3;             ///< optical depth of the air across the terrain's diagonal (0: clear)
     bool sea = false;              ///< a sea at sea_level
     double sea_level = 0.0;        ///< m
+    double sea_fraction = -1.0;    ///< if ≥ 0: the sea at this fraction of the height range instead of sea_level
     std::string water_layer = "water";  ///< water from this layer when the heightmap has it ("" none)
     double water_min_depth = 0.05; ///< m: thinner water layers are not drawn
     double wave_height = 1.0;      ///< m, amplitude of the waves
