@@ -12,6 +12,7 @@ extern "C" {
 #include <libswscale/swscale.h>
 }
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -80,6 +81,7 @@ std::string why_not(Codec codec, double fps, int width, int height) {
 void encode_video(const std::filesystem::path& target, std::size_t count, const std::function<Image(std::size_t)>& frame,
                   const VideoSettings& s, const std::function<void(std::size_t)>& progress) {
     if (count == 0) throw BadInput("export:video: the sequence has no frames");
+    av_log_set_level(AV_LOG_ERROR);  // libx264 reports its statistics on stderr otherwise
     const AVCodec* encoder = find_encoder(s.codec);
     if (!encoder)
         throw Error(std::string("export:video: this FFmpeg has no ") + (s.codec == Codec::h264 ? "H.264" : "MPEG-2") +
@@ -128,7 +130,7 @@ void encode_video(const std::filesystem::path& target, std::size_t count, const 
     st.codec->pix_fmt = AV_PIX_FMT_YUV420P;
     st.codec->time_base = av_inv_q(rate);
     st.codec->framerate = rate;
-    st.codec->gop_size = 12;
+    st.codec->gop_size = std::max(1, int(std::lround(2 * s.fps)));  // a key frame every 2 s
     st.codec->thread_count = 2;  // fixed, so the bytes do not depend on the machine's cores
     st.codec->colorspace = AVCOL_SPC_SMPTE170M;  // what libswscale's default RGB → YUV matrix is
     st.codec->color_primaries = AVCOL_PRI_BT709;  // sRGB's primaries
@@ -138,6 +140,9 @@ void encode_video(const std::filesystem::path& target, std::size_t count, const 
     if (st.format->oformat->flags & AVFMT_GLOBALHEADER) st.codec->flags |= AV_CODEC_FLAG_GLOBAL_HEADER;
     AVDictionary* options = nullptr;
     if (s.codec == Codec::h264) {
+        // No B-frames: frame i is packet i, no negative decode times or edit list that
+        // some players (and ffprobe's frame count) trip over; a few % larger files.
+        st.codec->max_b_frames = 0;
         av_dict_set(&options, "preset", "veryfast", 0);
         av_dict_set(&options, "crf", std::to_string(s.quality).c_str(), 0);
     } else {
@@ -151,7 +156,12 @@ void encode_video(const std::filesystem::path& target, std::size_t count, const 
     check(avcodec_parameters_from_context(stream->codecpar, st.codec), "to describe the stream");
     stream->time_base = st.codec->time_base;
     check(avio_open(&st.format->pb, temporary.c_str(), AVIO_FLAG_WRITE), "to open the file");
-    check(avformat_write_header(st.format, nullptr), "to write the header");
+    AVDictionary* mux = nullptr;
+    // No MP4 edit list: at some rates FFmpeg 5.1's wrote one a frame short, which hid the last frame.
+    if (s.codec == Codec::h264) av_dict_set(&mux, "use_editlist", "0", 0);
+    const int header = avformat_write_header(st.format, &mux);
+    av_dict_free(&mux);
+    check(header, "to write the header");
 
     st.picture = av_frame_alloc();
     st.packet = av_packet_alloc();

@@ -192,7 +192,7 @@ std::vector<Param> turntable_params() {
         if (q.name != "camera" && q.name != "from" && q.name != "from_height" && q.name != "to" && q.name != "to_height")
             p.push_back(std::move(q));
     for (auto& q : style_params())
-        if (q.name != "particle_frame" && q.name != "particle_radius") p.push_back(std::move(q));
+        if (q.name != "particle_frame") p.push_back(std::move(q));
     for (auto& q : p)
         if (q.name == "azimuth") q.help_text = "where the camera starts, clockwise from north (then it circles the target)";
     return p;
@@ -202,8 +202,12 @@ std::vector<Param> turntable_params() {
 /// when the consumer asks for it (the encoder pulls them one at a time).
 NodeOutputs run_turntable(NodeContext& ctx) {
     auto renderer = std::make_shared<TerrainRenderer>(ctx.input(0).heightmap(), style_from(ctx));
-    Camera base = camera_from(ctx);
-    base.mode = Camera::Mode::orbit;
+    Camera base;  // orbit: the turntable has no look-at or top camera
+    base.azimuth = ctx.real("azimuth");
+    base.elevation = ctx.real("elevation");
+    base.distance = ctx.real("distance");
+    base.target = ctx.point("target");
+    base.fov = ctx.real("fov");
     const int width = int(ctx.integer("width")), height = int(ctx.integer("height"));
     const auto frames = std::size_t(ctx.integer("frames"));
     const double turns = ctx.real("turns"), fps = ctx.real("fps"), start_time = ctx.real("time");

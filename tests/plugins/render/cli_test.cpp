@@ -63,3 +63,47 @@ TEST(RenderCli, BadSizesFieldsOfViewAndCamerasExitTwo) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find("applies to a heightmap"), std::string::npos) << r.err;
 }
+
+TEST(RenderCli, ATurntableBloomedFrameByFrameBecomesAVideo) {
+    TempDir dir;
+    dir.write("t.orogen", std::string(kHeader) +
+                              "spin = render:turntable(hill, frames=5, width=64, height=48, fps=10)\n"
+                              "glow = render:bloom(spin)\n"
+                              "export:video(glow, path=\"spin.mp4\", fps=10)\n"
+                              "export:video(spin, path=\"spin.mpg\", fps=25)\n");
+    const RunResult r = run_orogen("run " + q(dir / "t.orogen") + " --out " + q(dir / "out"), "DISPLAY=");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string probe = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                              "stream=codec_name,nb_read_frames,width,r_frame_rate -of csv=p=0 ";
+    FILE* p = ::popen((probe + q(dir / "out/spin.mp4") + " 2>&1").c_str(), "r");
+    char buf[256] = {};
+    ASSERT_NE(p, nullptr);
+    const std::size_t n = std::fread(buf, 1, sizeof buf - 1, p);
+    ::pclose(p);
+    EXPECT_EQ(std::string(buf, n), "h264,64,10/1,5\n");
+}
+
+TEST(RenderCli, VideoCodecsAndExtensionsAreCheckedBeforeAnythingRuns) {
+    TempDir dir;
+    struct Case {
+        std::string line, words;
+    } cases[] = {
+        {"export:video(spin, path=\"spin.avi\")", "extension"},
+        {"export:video(spin, path=\"spin.mp4\", codec=mpeg2)", "change one of them"},
+        {"export:video(spin, path=\"spin.mpg\", fps=17)", "MPEG-2"},
+        {"export:video(hill, path=\"spin.mp4\")", "series"},
+    };
+    for (const auto& c : cases) {
+        dir.write("v.orogen", std::string(kHeader) + "spin = render:turntable(hill, frames=3, width=64, height=48)\n" +
+                                  c.line + "\n");
+        const RunResult r = run_orogen("check " + q(dir / "v.orogen"));
+        EXPECT_EQ(r.exit_code, 2) << c.line << "\n" << r.err;
+        EXPECT_NE(r.err.find(c.words), std::string::npos) << c.line << "\n" << r.err;
+    }
+    // An odd size is known at check time from the turntable's parameters.
+    dir.write("odd.orogen", std::string(kHeader) + "spin = render:turntable(hill, frames=3, width=65, height=48)\n"
+                                                   "export:video(spin, path=\"spin.mp4\")\n");
+    const RunResult r = run_orogen("check " + q(dir / "odd.orogen"));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("even"), std::string::npos) << r.err;
+}
