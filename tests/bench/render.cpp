@@ -13,6 +13,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -30,6 +32,13 @@ std::shared_ptr<const Heightmap> terrain_1025() {
         return h;
     }();
     return t;
+}
+
+/// CPU seconds of the whole process (every thread: llvmpipe rasterises on its own threads).
+double process_cpu() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
@@ -51,6 +60,7 @@ void BM_Frame1080p(benchmark::State& state) {
     render::Timings total;
     double bloom_seconds = 0;
     render::bloom(renderer.render(1920, 1080, camera), {});  // llvmpipe compiles each shader on first use
+    const double cpu0 = process_cpu();
     for (auto _ : state) {
         render::Timings t;
         Image frame = renderer.render(1920, 1080, camera, nullptr, &t);
@@ -63,6 +73,8 @@ void BM_Frame1080p(benchmark::State& state) {
         total.resolve_and_read += t.resolve_and_read;
     }
     const double n = double(state.iterations());
+    // All threads' CPU per frame: on an idle 2-core machine the frame takes about half of it.
+    state.counters["cpu_all_threads_s"] = (process_cpu() - cpu0) / n;
     state.counters["shadow_s"] = total.shadow / n;
     state.counters["scene_s"] = total.scene / n;
     state.counters["resolve_read_s"] = total.resolve_and_read / n;
@@ -76,10 +88,12 @@ void BM_Bloom1080p(benchmark::State& state) {
     render::TerrainRenderer renderer(terrain_1025(), {});
     const Image frame = renderer.render(1920, 1080, {});
     render::bloom(frame, {});  // warm-up: llvmpipe compiles each shader on first use
+    const double cpu0 = process_cpu();
     for (auto _ : state) {
         Image out = render::bloom(frame, {});
         benchmark::DoNotOptimize(out.rgba32f.data());
     }
+    state.counters["cpu_all_threads_s"] = (process_cpu() - cpu0) / double(state.iterations());
 }
 BENCHMARK(BM_Bloom1080p)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -89,6 +103,7 @@ void BM_Turntable(benchmark::State& state) {
     const int frames = int(state.range(0)), width = int(state.range(1)), height = width * 9 / 16;
     render::TerrainRenderer renderer(terrain_1025(), {});
     const auto path = std::filesystem::temp_directory_path() / "orogen-bench-turntable.mp4";
+    const double cpu0 = process_cpu();
     for (auto _ : state) {
         video::encode_video(path, std::size_t(frames), [&](std::size_t i) {
             render::Camera c;
@@ -97,6 +112,7 @@ void BM_Turntable(benchmark::State& state) {
         }, {});
     }
     state.counters["frames"] = frames;
+    state.counters["cpu_all_threads_s"] = (process_cpu() - cpu0) / double(state.iterations());
     state.counters["s_per_frame"] = benchmark::Counter(double(frames) * double(state.iterations()),
                                                        benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
     state.counters["peak_rss_MB"] = double(peak_rss_kb()) / 1024.0;

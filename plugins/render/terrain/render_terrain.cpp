@@ -299,9 +299,11 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     gl::Lock lock("render:terrain");
     const Programs& prog = programs();
     gl::check_frame_size("render:terrain", width, height, bytes_per_pixel(st.samples));
+    // Auto detail: at most one kept sample per 2.5 pixels of the frame's longer side
+    // (llvmpipe pays per triangle; normals and colours come from the full grid anyway).
     m.build_mesh(st.detail > 0 ? st.detail
-                               : std::max(1, int(std::lround(std::max(m.width, m.height) /
-                                                             (std::max(width, height) / 2.5)))));
+                               : std::max(1, int(std::ceil(std::max(m.width, m.height) /
+                                                           (std::max(width, height) / 2.5)))));
     auto t0 = std::chrono::steady_clock::now();
     auto mark = [&](double Timings::*field) {
         if (!timings) return;
