@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 
 namespace orogen::rmp {
@@ -90,7 +91,12 @@ ConeRenderer::ConeRenderer(int width, int height) : impl_(std::make_unique<Impl>
     m.width = width;
     m.height = height;
     // The process's one GL context (gl_context.hpp), shared with the render passes.
-    gl::Lock lock("cones");
+    std::optional<gl::Lock> lock;
+    try {
+        lock.emplace("cones");
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + "; or use method=voronoi, which gives the same diagram on the CPU");
+    }
     m.made = true;
     const int limit = gl::max_framebuffer_size();
     if (width < 1 || height < 1 || width > limit || height > limit)
