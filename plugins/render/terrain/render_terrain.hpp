@@ -59,7 +59,6 @@ struct Style {
     /// The mesh keeps every detail-th sample (normals and colours stay at full
     /// resolution); 0 picks it per frame so a triangle spans about 2.5 pixels.
     int detail = 0;
-    bool reflections = true;       ///< reflect the terrain in a sea (one more terrain pass at half size)
     double particle_radius = 0.0;  ///< m; 0: three cells
     std::array<float, 3> particle_colour{0.10f, 0.32f, 0.75f};  ///< linear
 
