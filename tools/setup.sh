@@ -9,6 +9,7 @@ packages=(
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
   libgdal-dev gdal-bin
   libstb-dev libpng-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev
 )
 

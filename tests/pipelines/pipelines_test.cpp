@@ -23,7 +23,9 @@ struct Case {
 };
 
 const Case cases[] = {
-    {"default", "--set rivers.steps=400"},
+    {"default",
+     "--set rivers.steps=400 --set beauty.width=320 --set beauty.height=180 --set beauty.samples=1 "
+     "--set spin.frames=4 --set spin.width=160 --set spin.height=90"},
     {"erosion-pipe-rain", "--set storm.steps=300 --set after.steps=50"},
     {"erosion-shapes-4.1", ""},
     {"erosion-thermal-4.3", ""},
@@ -60,7 +62,17 @@ TEST_P(Pipeline, GivesTheSameBytesOnOneAndTwoThreadsAndMatchesItsGoldenHashes) {
 
     const fs::path golden = fs::path(OROGEN_SOURCE_DIR) / "tests" / "pipelines" / "golden" / (std::string(c.name) + ".sha256");
     std::string text;  // the `sha256sum` format: "<hash>  <file>"
-    for (const auto& [file, hash] : one) text += hash + "  " + file + "\n";
+    for (const auto& [file, hash] : one) {
+        // Frames drawn by llvmpipe repeat exactly on one machine (checked above) but their
+        // bytes follow the CPU's vector width (AVX2 or AVX-512 code); tests/plugins/render
+        // compares rendered frames to golden images by PSNR instead.
+        if (file == "beauty.png" || file == "turntable.mp4") continue;
+        text += hash + "  " + file + "\n";
+    }
+    if (std::string(c.name) == "default") {
+        EXPECT_EQ(one.count("beauty.png"), 1u);
+        EXPECT_EQ(one.count("turntable.mp4"), 1u);
+    }
     if (std::getenv("OROGEN_UPDATE_GOLDEN")) std::ofstream(golden, std::ios::binary) << text;
     EXPECT_EQ(text, slurp(golden)) << "outputs of pipelines/" << c.name
                                    << ".orogen changed; if on purpose, rerun with OROGEN_UPDATE_GOLDEN=1";

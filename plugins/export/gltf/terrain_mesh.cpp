@@ -202,14 +202,15 @@ void chunk_indices(const MeshChunk& chunk, std::span<std::uint16_t> out) {
 
 // ------------------------------------------------------------------ colour
 
-SplatWeights splat_weights(float height, float min_height, float max_height, float normal_y) {
-    // Height bands: t in [0, 1] across the terrain's range, band k = [k/4, (k+1)/4).
+SplatWeights splat_weights(float height, float min_height, float max_height, float normal_y, const SplatRules& rules) {
+    // Height bands: t in [0, 1] across the terrain's range; band k starts at start[k].
     const float range = max_height - min_height;
     const float t = range > 0 ? std::clamp((height - min_height) / range, 0.0f, 1.0f) : 0.0f;
+    const float start[5] = {0.0f, rules.band_start[0], rules.band_start[1], rules.band_start[2], 1.0f};
     float w[4] = {0, 0, 0, 0};  // sand, grass, rock, snow
-    const float band = 0.25f, blend = band * 0.5f;
-    const int k = std::min(int(t / band), 3);
-    const float into = t - float(k) * band;  // how far into band k
+    const int k = t >= start[3] ? 3 : t >= start[2] ? 2 : t >= start[1] ? 1 : 0;
+    const float blend = rules.blend_fraction * (start[k + 1] - start[k]);
+    const float into = t - start[k];  // how far into band k
     if (k == 0 || into >= blend) {
         w[k] = 1;
     } else {
@@ -217,13 +218,27 @@ SplatWeights splat_weights(float height, float min_height, float max_height, flo
         w[k - 1] = 1 - f;
         w[k] = f;
     }
-    // Slope: grass and snow do not hold on steep ground; n_y 0.75 → 0.5 turns them to rock.
-    const float steep = std::clamp((0.75f - normal_y) / 0.25f, 0.0f, 1.0f);
+    // Slope: grass and snow do not hold on steep ground; they turn to rock
+    // between n_y = slope_start and slope_full.
+    const float steep = std::clamp((rules.slope_start - normal_y) / (rules.slope_start - rules.slope_full), 0.0f, 1.0f);
     const float moved = steep * (w[1] + w[3]);
     w[1] *= 1 - steep;
     w[3] *= 1 - steep;
     w[2] += moved;
     return {w[0], w[1], w[2], w[3]};
+}
+
+void validate(const SplatRules& r) {
+    const auto& b = r.band_start;
+    if (!(0 < b[0] && b[0] < b[1] && b[1] < b[2] && b[2] < 1))
+        throw BadInput("splatting: the bands must start in increasing order between 0 and 1 (grass < rock < snow), got " +
+                       std::to_string(b[0]) + ", " + std::to_string(b[1]) + ", " + std::to_string(b[2]));
+    if (!(r.blend_fraction >= 0 && r.blend_fraction <= 1))
+        throw BadInput("splatting: the blend fraction must be in [0, 1], got " + std::to_string(r.blend_fraction));
+    if (!(0 <= r.slope_full && r.slope_full < r.slope_start && r.slope_start <= 1))
+        throw BadInput("splatting: rock must start covering at a flatter slope than it covers fully (0 ≤ slope_full < "
+                       "slope_start ≤ 1, normal y), got " + std::to_string(r.slope_start) + " and " +
+                       std::to_string(r.slope_full));
 }
 
 std::array<std::uint8_t, 3> splat_colour(const SplatWeights& w) {

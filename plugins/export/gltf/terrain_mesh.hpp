@@ -106,12 +106,29 @@ struct SplatWeights {
     float sand = 0, grass = 0, rock = 0, snow = 0;
 };
 
-/// The thesis's texture splatting (§3.7.1): four height bands of width
-/// δ = (max − min)/4 — sand, grass, rock, snow — each blended into from the
-/// one below over the first half of its band; then slope: where the normal's
-/// y falls below 0.75, grass and snow turn to rock, completely at 0.5 (a
-/// 0.25-wide blend band).
-SplatWeights splat_weights(float height, float min_height, float max_height, float normal_y);
+/// Where the materials go. The defaults are the thesis's (§3.7.1): four
+/// height bands of width δ = (max − min)/4 — sand, grass, rock, snow — each
+/// blended into from the one below over the first half of its band; then
+/// slope: where the normal's y falls below 0.75, grass and snow turn to rock,
+/// completely at 0.5 (a 0.25-wide blend band). The render:terrain shader
+/// applies these same rules (its uniforms come from this struct).
+struct SplatRules {
+    /// Fraction of the height range (0 = lowest, 1 = highest) where grass,
+    /// rock and snow start; increasing, in (0, 1). Sand starts at 0.
+    std::array<float, 3> band_start{0.25f, 0.5f, 0.75f};
+    /// A band blends in from the one below over this fraction of its own width.
+    float blend_fraction = 0.5f;
+    /// Normal y (1 flat, 0 vertical) below which rock starts to cover grass and
+    /// snow, and at which it covers them completely; slope_full < slope_start.
+    float slope_start = 0.75f, slope_full = 0.5f;
+};
+
+/// The splatting weights at a point of `height` (min/max: the terrain's range)
+/// whose unit normal has y = `normal_y`.
+SplatWeights splat_weights(float height, float min_height, float max_height, float normal_y,
+                           const SplatRules& rules = {});
+/// Throws orogen::BadInput saying what is wrong if `rules` are not ordered as SplatRules says.
+void validate(const SplatRules& rules);
 
 /// 8-bit sRGB colours of the four materials.
 inline constexpr std::array<std::uint8_t, 3> sand_colour{194, 178, 128};

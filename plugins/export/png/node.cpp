@@ -1,6 +1,8 @@
 // export:png — a heightmap (or one of its layers, or its hillshade) as an 8- or 16-bit grayscale PNG,
-// or a colour relief map (the thesis's splatting colours, hillshaded).
+// or a colour relief map (the thesis's splatting colours, hillshaded); or an image (a rendered
+// frame) as 8-bit sRGB.
 #include "heightmap_png.hpp"
+#include "image_srgb.hpp"
 #include "terrain_mesh.hpp"
 
 #include <orogen/io.hpp>
@@ -11,6 +13,25 @@ using namespace orogen;
 namespace {
 
 void check(CheckContext& ctx) {
+    const ValueInfo* in = ctx.input(0);
+    if (in && in->type != ValueType::heightmap && in->type != ValueType::image) {
+        ctx.error("", "export:png writes a heightmap or an image, but its input is " +
+                          std::string(to_string(in->type)));
+        return;
+    }
+    if (in && in->type == ValueType::image) {
+        for (const char* p : {"bits", "layer", "hillshade", "relief", "azimuth", "elevation"})
+            if (ctx.given(p)) {
+                ctx.error(p, std::string(p) + "= applies to a heightmap; an image is written as 8-bit sRGB "
+                                              "(tonemap= and exposure= set how its linear colours are encoded)");
+                return;
+            }
+        return;
+    }
+    if (ctx.given("tonemap") || ctx.given("exposure")) {
+        ctx.error(ctx.given("tonemap") ? "tonemap" : "exposure", "tonemap= and exposure= apply to an image input");
+        return;
+    }
     const auto bits = ctx.integer("bits");
     if (bits != 8 && bits != 16) ctx.error("bits", "bits must be 8 or 16, got " + std::to_string(bits));
     const std::string& layer = ctx.text("layer");
@@ -42,6 +63,14 @@ std::vector<std::uint8_t> relief_map(ConstGridView heights, double azimuth, doub
 }
 
 NodeOutputs run(NodeContext& ctx) {
+    if (ctx.input(0).type() == ValueType::image) {
+        const Image& image = *ctx.input(0).image();
+        const auto rgba = png_export::to_srgb8(image, png_export::parse_tonemap(ctx.text("tonemap")), ctx.real("exposure"));
+        AtomicFile file(ctx.output_path(ctx.text("path")));
+        write_rgba_png(file.stream(), image.width, image.height, rgba);
+        file.commit();
+        return {};
+    }
     const Heightmap& hm = *ctx.input(0).heightmap();
     if (ctx.flag("relief")) {
         const auto rgba = relief_map(hm.view(), ctx.real("azimuth"), ctx.real("elevation"));
@@ -71,14 +100,16 @@ OROGEN_PLUGIN("png-export", "0.1.0", registry) {
     registry.add({
         .kind = "export",
         .name = "png",
-        .summary = "write a heightmap, one of its layers, or its hillshade as a grayscale PNG (8 or 16 bits)",
+        .summary = "write a heightmap (grayscale 8/16-bit, a layer, hillshade or colour relief) or an image (8-bit sRGB) as PNG",
         .description =
             "The lowest vertex becomes black and the highest white; 16 bits keep 65536 levels,\n"
             "which a 1025² terrain needs (8 bits band visibly beyond about 512²). layer= writes a layer\n"
             "(water, sediment, eroded...) min-max normalised the same way; hillshade=true writes the\n"
             "terrain lit from azimuth/elevation instead (Lambert: black = facing away, white = facing the light);\n"
-            "relief=true writes a colour map: the thesis's splatting colours, hillshaded.",
-        .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to write"}},
+            "relief=true writes a colour map: the thesis's splatting colours, hillshaded.\n"
+            "An image (render:terrain, render:bloom...) is written as 8-bit sRGB RGBA: its linear colours times\n"
+            "2^exposure, through the tone curve (aces by default, so the HDR sun and snow roll off instead of clipping).",
+        .inputs = {{"input", ValueType::none, Need::required, "the heightmap or image to write"}},
         .output = ValueType::none,
         .params =
             {
@@ -92,6 +123,9 @@ OROGEN_PLUGIN("png-export", "0.1.0", registry) {
                 Param::real("azimuth", 315.0).min(0).max(360).unit("°").help(
                     "hillshade light direction, clockwise from north (315 = north-west, the cartographers' default)"),
                 Param::real("elevation", 45.0).min(0).max(90).unit("°").help("hillshade light height above the horizon"),
+                Param::choice("tonemap", {"clamp", "reinhard", "aces"}, "aces")
+                    .help("image input: how linear colours above 1 become 8-bit (clamp: clip)"),
+                Param::real("exposure", 0.0).min(-20).max(20).help("image input: scale the colours by 2^exposure first"),
             },
         .check = check,
         .run = run,

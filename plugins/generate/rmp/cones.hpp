@@ -29,7 +29,8 @@ namespace orogen::rmp {
 
 class ConeRenderer {
 public:
-    /// An OSMesa GL 3.3 core context and a width × height offscreen target.
+    /// A width × height offscreen target in the process's one OSMesa context
+    /// (orogen/gl_context.hpp, shared with the render passes).
     /// Throws orogen::Error (failed run) if OSMesa cannot create or bind the
     /// context, orogen::BadInput if the grid is larger than it can draw.
     ConeRenderer(int width, int height);

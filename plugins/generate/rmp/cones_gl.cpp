@@ -5,16 +5,17 @@
 
 #include "voronoi.hpp"
 
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
 
 #include <orogen/error.hpp>
+#include <orogen/gl_context.hpp>
 #include <orogen/parallel.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <string>
 
 namespace orogen::rmp {
@@ -61,25 +62,10 @@ void main() {
 }
 )";
 
-GLuint compile(GLenum kind, const char* source) {
-    const GLuint s = glCreateShader(kind);
-    glShaderSource(s, 1, &source, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[2048] = {};
-        glGetShaderInfoLog(s, sizeof log, nullptr, log);
-        throw Error(std::string("cones: the OSMesa shader did not compile: ") + log);
-    }
-    return s;
-}
-
 }  // namespace
 
 struct ConeRenderer::Impl {
-    OSMesaContext context = nullptr;
-    std::vector<std::uint8_t> dummy = std::vector<std::uint8_t>(4 * 4 * 4);  // the default framebuffer, unused
+    bool made = false;  // GL objects exist (in the process's shared context)
     int width = 0, height = 0;
     GLuint program = 0, vao = 0, fan = 0, instances = 0, fbo = 0, colour_rb = 0, depth_rb = 0;
     GLint u_grid = -1, u_depth_scale = -1;
@@ -88,8 +74,8 @@ struct ConeRenderer::Impl {
     std::vector<double> radii;
 
     ~Impl() {
-        if (!context) return;
-        OSMesaMakeCurrent(context, dummy.data(), GL_UNSIGNED_BYTE, 4, 4);
+        if (!made) return;
+        gl::Lock lock("cones");
         if (fbo) glDeleteFramebuffers(1, &fbo);
         if (colour_rb) glDeleteRenderbuffers(1, &colour_rb);
         if (depth_rb) glDeleteRenderbuffers(1, &depth_rb);
@@ -97,7 +83,6 @@ struct ConeRenderer::Impl {
         if (instances) glDeleteBuffers(1, &instances);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (program) glDeleteProgram(program);
-        OSMesaDestroyContext(context);
     }
 };
 
@@ -105,36 +90,21 @@ ConeRenderer::ConeRenderer(int width, int height) : impl_(std::make_unique<Impl>
     Impl& m = *impl_;
     m.width = width;
     m.height = height;
-    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                           OSMESA_CONTEXT_MAJOR_VERSION, 3, OSMESA_CONTEXT_MINOR_VERSION, 3, 0};
-    m.context = OSMesaCreateContextAttribs(attribs, nullptr);
-    if (!m.context)
-        throw Error(
-            "cones: OSMesa could not create an OpenGL 3.3 core context (is Mesa's libOSMesa with the llvmpipe "
-            "driver installed? Debian: libosmesa6); use method=voronoi, which gives the same diagram on the CPU");
-    if (!OSMesaMakeCurrent(m.context, m.dummy.data(), GL_UNSIGNED_BYTE, 4, 4))
-        throw Error("cones: OSMesa could not make its context current; use method=voronoi instead");
-
-    GLint max_rb = 0, max_vp[2] = {0, 0};
-    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_rb);
-    glGetIntegerv(GL_MAX_VIEWPORT_DIMS, max_vp);
-    const int limit = std::min({max_rb, max_vp[0], max_vp[1]});
+    // The process's one GL context (gl_context.hpp), shared with the render passes.
+    std::optional<gl::Lock> lock;
+    try {
+        lock.emplace("cones");
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + "; or use method=voronoi, which gives the same diagram on the CPU");
+    }
+    m.made = true;
+    const int limit = gl::max_framebuffer_size();
     if (width < 1 || height < 1 || width > limit || height > limit)
         throw BadInput("cones: the grid is " + std::to_string(width) + " × " + std::to_string(height) +
                        " vertices but OSMesa draws at most " + std::to_string(limit) + " × " +
                        std::to_string(limit) + " pixels (one per vertex); use method=voronoi for larger grids");
 
-    const GLuint vs = compile(GL_VERTEX_SHADER, kVertexShader);
-    const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragmentShader);
-    m.program = glCreateProgram();
-    glAttachShader(m.program, vs);
-    glAttachShader(m.program, fs);
-    glLinkProgram(m.program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(m.program, GL_LINK_STATUS, &ok);
-    if (!ok) throw Error("cones: the OSMesa shader program did not link");
+    m.program = gl::link_program("cones", kVertexShader, kFragmentShader);
     m.u_grid = glGetUniformLocation(m.program, "grid");
     m.u_depth_scale = glGetUniformLocation(m.program, "depth_scale");
 
@@ -179,11 +149,7 @@ ConeRenderer::ConeRenderer(int width, int height) : impl_(std::make_unique<Impl>
 
 ConeRenderer::~ConeRenderer() = default;
 
-std::string ConeRenderer::renderer_name() const {
-    OSMesaMakeCurrent(impl_->context, impl_->dummy.data(), GL_UNSIGNED_BYTE, 4, 4);
-    const auto* s = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
-    return s ? s : "unknown";
-}
+std::string ConeRenderer::renderer_name() const { return gl::renderer_name(); }
 
 const std::vector<std::uint32_t>& ConeRenderer::render(std::span<const Point2> sites, double radius) {
     impl_->radii.assign(sites.size(), radius);
@@ -197,7 +163,7 @@ const std::vector<std::uint32_t>& ConeRenderer::render(std::span<const Point2> s
     double max_radius = 0;
     for (double r : radii) max_radius = std::max(max_radius, r);
     if (sites.size() >= (1u << 24) - 1) throw BadInput("cones: at most 16777214 cones fit in a 24-bit colour id");
-    OSMesaMakeCurrent(m.context, m.dummy.data(), GL_UNSIGNED_BYTE, 4, 4);
+    gl::Lock lock("cones");
     glBindFramebuffer(GL_FRAMEBUFFER, m.fbo);
     glViewport(0, 0, m.width, m.height);
     glEnable(GL_DEPTH_TEST);

@@ -1,0 +1,562 @@
+// The scene pass through OSMesa. GL headers stay in this file.
+#define GL_GLEXT_PROTOTYPES 1
+#include "render_terrain.hpp"
+
+#include "orogen_shaders.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/gl_context.hpp>
+#include <orogen/gl_image.hpp>
+#include <orogen/parallel.hpp>
+
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <glm/glm.hpp>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+namespace orogen::render {
+
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The programs, compiled once per process (in the one shared context).
+struct Programs {
+    GLuint sky = 0, terrain = 0, shadow = 0, water = 0, particles = 0;
+};
+
+const Programs& programs() {
+    static Programs p = [] {
+        Programs q;
+        q.sky = gl::link_program("render:terrain sky", shaders::fullscreen_vert, shaders::sky_frag);
+        q.terrain = gl::link_program("render:terrain", shaders::terrain_vert, shaders::terrain_frag);
+        q.shadow = gl::link_program("render:terrain shadow map", shaders::terrain_vert, shaders::shadow_frag);
+        q.water = gl::link_program("render:terrain water", shaders::water_vert, shaders::water_frag);
+        q.particles = gl::link_program("render:terrain particles", shaders::particles_vert, shaders::particles_frag);
+        return q;
+    }();
+    return p;
+}
+
+GLint loc(GLuint program, const char* name) { return glGetUniformLocation(program, name); }
+void set(GLuint p, const char* n, float v) { glUniform1f(loc(p, n), v); }
+void set(GLuint p, const char* n, int v) { glUniform1i(loc(p, n), v); }
+void set(GLuint p, const char* n, glm::vec3 v) { glUniform3fv(loc(p, n), 1, glm::value_ptr(v)); }
+void set(GLuint p, const char* n, glm::vec2 v) { glUniform2fv(loc(p, n), 1, glm::value_ptr(v)); }
+void set(GLuint p, const char* n, glm::ivec2 v) { glUniform2iv(loc(p, n), 1, glm::value_ptr(v)); }
+void set(GLuint p, const char* n, const glm::mat4& m) { glUniformMatrix4fv(loc(p, n), 1, GL_FALSE, glm::value_ptr(m)); }
+
+/// Unit vector towards a bearing (degrees clockwise from north) and an elevation.
+glm::dvec3 direction(double azimuth_degrees, double elevation_degrees) {
+    const double a = azimuth_degrees * kDegree, e = elevation_degrees * kDegree;
+    return {std::sin(a) * std::cos(e), std::sin(e), -std::cos(a) * std::cos(e)};
+}
+
+}  // namespace
+
+std::array<std::array<float, 3>, 4> Style::default_materials() {
+    std::array<std::array<float, 3>, 4> m{};
+    const std::array<std::array<std::uint8_t, 3>, 4> srgb{terrain::sand_colour, terrain::grass_colour,
+                                                          terrain::rock_colour, terrain::snow_colour};
+    for (std::size_t i = 0; i < 4; ++i)
+        for (std::size_t c = 0; c < 3; ++c) m[i][c] = gl::srgb_to_linear(srgb[i][c]);
+    return m;
+}
+
+double bytes_per_pixel(int samples) {
+    // multisampled RGBA16F colour + 32-bit depth, the resolved RGBA32F target,
+    // the read-back buffer and the image (RGBA32F each), the reflection at a quarter.
+    return double(samples) * (8 + 4) + 16 * 3 + 0.25 * (16 + 4);
+}
+
+struct TerrainRenderer::Impl {
+    std::shared_ptr<const Heightmap> terrain;
+    int width = 0, height = 0;  // samples
+    float lo = 0, hi = 0;       // height range, m
+    bool has_water = false;
+    GLuint heights = 0, surface = 0, indices = 0, vao = 0;
+    GLsizei index_count = 0;
+    glm::ivec2 kept{0, 0};
+    int stride = 1;
+    GLuint shadow_fbo = 0, shadow_depth = 0;
+    int shadow_size = 0;
+    GLuint particle_vbo = 0, particle_vao = 0;
+
+    ~Impl() {
+        gl::Lock lock("render:terrain");
+        GLuint textures[] = {heights, surface, shadow_depth};
+        for (GLuint t : textures)
+            if (t) glDeleteTextures(1, &t);
+        if (indices) glDeleteBuffers(1, &indices);
+        if (particle_vbo) glDeleteBuffers(1, &particle_vbo);
+        if (vao) glDeleteVertexArrays(1, &vao);
+        if (particle_vao) glDeleteVertexArrays(1, &particle_vao);
+        if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
+    }
+
+    /// The grid as one triangle strip per row (every stride-th sample), joined by primitive restart.
+    void build_mesh(int new_stride) {
+        if (new_stride == stride && indices) return;
+        stride = new_stride;
+        kept = {(width - 1 + stride - 1) / stride + 1, (height - 1 + stride - 1) / stride + 1};
+        std::vector<std::uint32_t> index;
+        index.reserve(std::size_t(kept.y - 1) * (2 * std::size_t(kept.x) + 1));
+        for (int y = 0; y + 1 < kept.y; ++y) {
+            for (int x = 0; x < kept.x; ++x) {
+                index.push_back(std::uint32_t(y * kept.x + x));
+                index.push_back(std::uint32_t((y + 1) * kept.x + x));
+            }
+            index.push_back(0xFFFFFFFFu);
+        }
+        index_count = GLsizei(index.size());
+        glBindVertexArray(vao);
+        if (!indices) glGenBuffers(1, &indices);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indices);
+        glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(index.size() * 4), index.data(), GL_STATIC_DRAW);
+        glBindVertexArray(0);
+    }
+
+    double extent_x() const { return double(width - 1) * terrain->cell(); }
+    double extent_z() const { return double(height - 1) * terrain->cell(); }
+
+    /// Ground height (m, unexaggerated) at world x, z, bilinear; NaN outside.
+    double ground(double x, double z) const {
+        const double sx = x / terrain->cell(), sy = z / terrain->cell();
+        if (sx < 0 || sy < 0 || sx > width - 1 || sy > height - 1) return std::numeric_limits<double>::quiet_NaN();
+        const int x0 = std::min(int(sx), width - 2), y0 = std::min(int(sy), height - 2);
+        const double fx = sx - x0, fy = sy - y0;
+        const ConstGridView v = terrain->view();
+        return (1 - fy) * ((1 - fx) * v.at(x0, y0) + fx * v.at(x0 + 1, y0)) +
+               fy * ((1 - fx) * v.at(x0, y0 + 1) + fx * v.at(x0 + 1, y0 + 1));
+    }
+};
+
+TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style style)
+    : impl_(std::make_unique<Impl>()), style_(std::move(style)) {
+    Impl& m = *impl_;
+    m.terrain = std::move(terrain);
+    m.width = m.terrain->width();
+    m.height = m.terrain->height();
+    if (m.width < 2 || m.height < 2)
+        throw BadInput("render:terrain: the heightmap is " + std::to_string(m.width) + " × " +
+                       std::to_string(m.height) + " samples; it needs at least 2 × 2");
+    terrain::validate(style_.splat);
+    const auto span = m.terrain->view().span();
+    m.lo = m.hi = span[0];
+    for (float h : span) {
+        if (!std::isfinite(h)) throw BadInput("render:terrain: the heightmap holds NaN or infinite heights");
+        m.lo = std::min(m.lo, h);
+        m.hi = std::max(m.hi, h);
+    }
+    if (style_.sea_fraction >= 0) style_.sea_level = m.lo + style_.sea_fraction * double(m.hi - m.lo);
+    if (style_.texture_scale <= 0) style_.texture_scale = std::max(m.extent_x(), m.extent_z()) / 8.0;
+    if (style_.particle_radius <= 0) style_.particle_radius = 3.0 * m.terrain->cell();
+
+    // Water from the layer: surface and depth per sample (the sea is one plane, drawn apart).
+    const bool layer = !style_.water_layer.empty() && m.terrain->has_layer(style_.water_layer);
+    std::vector<float> surface;
+    if (layer) {
+        surface.resize(2 * m.terrain->size());
+        const ConstGridView h = m.terrain->view();
+        const ConstGridView w = m.terrain->layer(style_.water_layer);
+        const float min_depth = float(style_.water_min_depth);
+        for (std::size_t i = 0; i < m.terrain->size(); ++i) {
+            // Continuous across the shore: a dry vertex gets a negative depth,
+            // so the fragment shader cuts the water where the depth crosses 0.
+            surface[2 * i] = h.data[i] + std::max(w.data[i], 0.0f);
+            surface[2 * i + 1] = w.data[i] - min_depth;
+            m.has_water = m.has_water || w.data[i] > min_depth;
+        }
+    }
+
+    gl::Lock lock("render:terrain");
+    programs();
+    glGenTextures(1, &m.heights);
+    glBindTexture(GL_TEXTURE_2D, m.heights);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R32F, m.width, m.height, 0, GL_RED, GL_FLOAT, span.data());
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    if (m.has_water) {
+        glGenTextures(1, &m.surface);
+        glBindTexture(GL_TEXTURE_2D, m.surface);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RG32F, m.width, m.height, 0, GL_RG, GL_FLOAT, surface.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+
+    glGenVertexArrays(1, &m.vao);
+    gl::check_errors("render:terrain", "uploading the terrain");
+}
+
+TerrainRenderer::~TerrainRenderer() = default;
+
+Image TerrainRenderer::render(int width, int height, const Camera& camera, const ParticleFrame* particles,
+                              Timings* timings) {
+    Impl& m = *impl_;
+    const Style& st = style_;
+    if (!(camera.fov > 0 && camera.fov < 180))
+        throw BadInput("render:terrain: the field of view must be between 0 and 180 degrees (exclusive), got " +
+                       std::to_string(camera.fov));
+    const double exag = st.exaggeration;
+    const double skirt = 0.08 * std::max(double(m.hi - m.lo), 1.0);  // m below the lowest point (and the sea)
+    const double floor_height = st.sea ? std::min(double(m.lo), st.sea_level) - skirt : m.lo - skirt;
+    const glm::dvec3 box_min(0, floor_height * exag, 0), box_max(m.extent_x(), m.hi * exag, m.extent_z());
+    const glm::dvec3 centre = (box_min + box_max) * 0.5;
+    const double radius = glm::length(box_max - box_min) * 0.5;
+    const double aspect = double(width) / double(std::max(height, 1));
+
+    // ---- camera
+    glm::dvec3 eye, target, up(0, 1, 0);
+    glm::dmat4 projection;
+    double near_plane = 1, far_plane = 1;
+    if (camera.mode == Camera::Mode::top) {
+        target = {centre.x, centre.y, centre.z};
+        eye = {centre.x, box_max.y + radius, centre.z};
+        up = {0, 0, -1};  // north up
+        double half_w = m.extent_x() * 0.5, half_h = m.extent_z() * 0.5;
+        if (half_w / half_h > aspect) half_h = half_w / aspect;
+        else half_w = half_h * aspect;
+        near_plane = radius * 0.5;
+        far_plane = eye.y - box_min.y + radius * 0.5;
+        projection = glm::ortho(-half_w, half_w, -half_h, half_h, near_plane, far_plane);
+    } else {
+        if (camera.mode == Camera::Mode::orbit) {
+            target = {camera.target.x * m.extent_x(), centre.y, camera.target.y * m.extent_z()};
+            double distance = camera.distance;
+            const glm::dvec3 back = direction(camera.azimuth, camera.elevation);
+            if (distance <= 0) {
+                // The nearest distance at which every corner of the terrain's box is in the frame
+                // (with a 4 % margin), by bisection: nearer than the bounding sphere's fit.
+                const glm::dmat4 proj = glm::perspective(camera.fov * kDegree, aspect, radius * 1e-3, radius * 100);
+                auto fits = [&](double d) {
+                    const glm::dvec3 e = target + back * d;
+                    const glm::dmat4 vp = proj * glm::lookAt(e, target, std::abs(back.y) > 0.9999 ? glm::dvec3(0, 0, -1) : up);
+                    for (int c = 0; c < 8; ++c) {
+                        const glm::dvec4 p = vp * glm::dvec4(c & 1 ? box_max.x : box_min.x, c & 2 ? box_max.y : box_min.y,
+                                                             c & 4 ? box_max.z : box_min.z, 1.0);
+                        if (p.w <= 0 || std::abs(p.x / p.w) > 0.96 || std::abs(p.y / p.w) > 0.96) return false;
+                    }
+                    return true;
+                };
+                double lo = 0, hi = radius / std::sin(std::min(camera.fov, 179.0) * 0.5 * kDegree) * 4 + radius;
+                for (int i = 0; i < 40; ++i) (fits(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+                distance = hi;
+            }
+            eye = target + back * distance;
+        } else {
+            eye = {camera.from.x * m.extent_x(), (m.lo + camera.from_height) * exag, camera.from.y * m.extent_z()};
+            target = {camera.to.x * m.extent_x(), (m.lo + camera.to_height) * exag, camera.to.y * m.extent_z()};
+            if (glm::length(target - eye) < 1e-6)
+                throw BadInput("render:terrain: the camera's from and to are the same point; move one of them");
+        }
+        const glm::dvec3 forward = glm::normalize(target - eye);
+        if (std::abs(forward.y) > 0.9999) up = {0, 0, -1};
+        const double g = m.ground(eye.x, eye.z);
+        if (!std::isnan(g) && eye.y <= g * exag)
+            throw BadInput("render:terrain: the camera is inside the terrain (at " + std::to_string(int(eye.y / exag)) +
+                           " m where the ground is " + std::to_string(int(g)) +
+                           " m); raise its elevation, distance or height");
+        // Near and far: around the terrain's bounding sphere.
+        const double to_centre = glm::length(centre - eye);
+        far_plane = to_centre + radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
+        near_plane = std::max(std::max(to_centre - radius, 0.0) * 0.8, far_plane * 2e-5);
+        projection = glm::perspective(camera.fov * kDegree, aspect, near_plane, far_plane);
+    }
+    const glm::dmat4 view = glm::lookAt(eye, target, up);
+    const glm::dmat4 view_projection = projection * view;
+    // Looking at nothing: every corner of the terrain's box outside one clip plane.
+    {
+        bool outside_all[6] = {true, true, true, true, true, true};
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec4 p = view_projection * glm::dvec4(c & 1 ? box_max.x : box_min.x,
+                                                              c & 2 ? box_max.y : box_min.y,
+                                                              c & 4 ? box_max.z : box_min.z, 1.0);
+            const double v[6] = {p.x + p.w, p.w - p.x, p.y + p.w, p.w - p.y, p.z + p.w, p.w - p.z};
+            for (int k = 0; k < 6; ++k) outside_all[k] = outside_all[k] && v[k] < 0;
+        }
+        for (bool o : outside_all)
+            if (o)
+                throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
+                               "(target, to, azimuth/elevation) or widen the field of view");
+    }
+
+    gl::Lock lock("render:terrain");
+    const Programs& prog = programs();
+    gl::check_frame_size("render:terrain", width, height, bytes_per_pixel(st.samples));
+    // Auto detail: at most one kept sample per 2.5 pixels of the frame's longer side
+    // (llvmpipe pays per triangle; normals and colours come from the full grid anyway).
+    m.build_mesh(st.detail > 0 ? st.detail
+                               : std::max(1, int(std::ceil(std::max(m.width, m.height) /
+                                                           (std::max(width, height) / 2.5)))));
+    auto t0 = std::chrono::steady_clock::now();
+    auto mark = [&](double Timings::*field) {
+        if (!timings) return;
+        glFinish();
+        timings->*field += seconds_since(t0);
+        t0 = std::chrono::steady_clock::now();
+    };
+
+    // ---- light
+    const glm::dvec3 sun = direction(st.sun_azimuth, st.sun_elevation);
+    const glm::vec3 sun_colour = glm::vec3(1.0f, 0.93f, 0.82f) * float(st.sun_intensity);
+    // Sky: bluer at the zenith, warmer and paler at the horizon when the sun is low.
+    const float low = float(std::clamp(1.0 - st.sun_elevation / 45.0, 0.0, 1.0));
+    const glm::vec3 zenith = glm::mix(glm::vec3(0.05f, 0.14f, 0.42f), glm::vec3(0.08f, 0.16f, 0.38f), low);
+    const glm::vec3 horizon = glm::mix(glm::vec3(0.42f, 0.52f, 0.68f), glm::vec3(0.62f, 0.52f, 0.46f), low * 0.5f);
+    const glm::vec3 ambient = (zenith * 0.6f + horizon * 0.4f) * 0.9f;
+    const float fog_density = float(st.haze / std::max(2.0 * radius, 1e-6));
+    auto set_light = [&](GLuint p, float disc) {
+        set(p, "sun_direction", glm::vec3(sun));
+        set(p, "sun_colour", sun_colour);
+        set(p, "sky_zenith", zenith);
+        set(p, "sky_horizon", horizon);
+        set(p, "sun_disc", disc);
+        set(p, "fog_density", fog_density);
+        set(p, "ambient_colour", ambient);
+        set(p, "eye", glm::vec3(eye));
+    };
+    auto set_grid = [&](GLuint p, const glm::mat4& vp) {
+        set(p, "grid", glm::ivec2(m.width, m.height));
+        set(p, "stride", m.stride);
+        set(p, "kept", m.kept);
+        set(p, "cell", float(m.terrain->cell()));
+        set(p, "exaggeration", float(exag));
+        set(p, "view_projection", vp);
+    };
+    glEnable(GL_PRIMITIVE_RESTART);
+    glPrimitiveRestartIndex(0xFFFFFFFFu);
+    glDisable(GL_CULL_FACE);
+
+    // ---- shadow map: depth seen from the sun, orthographic around the terrain's box
+    if (m.shadow_size != st.shadow_size) {
+        if (m.shadow_fbo) glDeleteFramebuffers(1, &m.shadow_fbo);
+        if (m.shadow_depth) glDeleteTextures(1, &m.shadow_depth);
+        m.shadow_size = st.shadow_size;
+        glGenTextures(1, &m.shadow_depth);
+        glBindTexture(GL_TEXTURE_2D, m.shadow_depth);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, m.shadow_size, m.shadow_size, 0, GL_DEPTH_COMPONENT,
+                     GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+        const float white[4] = {1, 1, 1, 1};
+        glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, white);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        glGenFramebuffers(1, &m.shadow_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, m.shadow_depth, 0);
+        glDrawBuffer(GL_NONE);
+        glReadBuffer(GL_NONE);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            throw Error("render:terrain: OSMesa could not set up the shadow map");
+    }
+    glm::dmat4 light_vp(1.0);
+    {
+        const glm::dvec3 light_up = std::abs(sun.y) > 0.999 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+        const glm::dmat4 light_view = glm::lookAt(centre + sun * radius * 2.0, centre, light_up);
+        glm::dvec3 lo(1e300), hi(-1e300);
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 p = glm::dvec3(light_view * glm::dvec4(c & 1 ? box_max.x : box_min.x,
+                                                                    c & 2 ? box_max.y : box_min.y,
+                                                                    c & 4 ? box_max.z : box_min.z, 1.0));
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        light_vp = glm::ortho(lo.x, hi.x, lo.y, hi.y, -hi.z - 1.0, -lo.z + 1.0) * light_view;
+    }
+    const bool shaded = st.output == Style::Output::beauty;
+    glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
+    glViewport(0, 0, m.shadow_size, m.shadow_size);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    if (shaded && st.sun_elevation > 0) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(1.5f, 2.0f);
+        glUseProgram(prog.shadow);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m.heights);
+        set(prog.shadow, "heights", 0);
+        set_grid(prog.shadow, glm::mat4(light_vp));
+        set(prog.shadow, "skirt_edge", -1);
+        glBindVertexArray(m.vao);
+        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+    mark(&Timings::shadow);
+
+    // ---- the frame: multisampled half-float colour and float depth
+    const int samples = std::max(1, st.samples);
+    GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
+    glGenFramebuffers(1, &fbo);
+    glGenRenderbuffers(1, &colour_rb);
+    glGenRenderbuffers(1, &depth_rb);
+    struct Cleanup {
+        GLuint& f; GLuint& c; GLuint& d;
+        ~Cleanup() { glDeleteFramebuffers(1, &f); glDeleteRenderbuffers(1, &c); glDeleteRenderbuffers(1, &d); }
+    } cleanup{fbo, colour_rb, depth_rb};
+    glBindRenderbuffer(GL_RENDERBUFFER, colour_rb);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_RGBA16F, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, depth_rb);
+    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_DEPTH_COMPONENT32F, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_rb);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        throw Error("render:terrain: OSMesa could not set up a " + std::to_string(width) + " × " +
+                    std::to_string(height) + " framebuffer with " + std::to_string(samples) + " samples");
+    glViewport(0, 0, width, height);
+    glDepthMask(GL_TRUE);
+    glClearDepth(1.0);
+    glClear(GL_DEPTH_BUFFER_BIT);
+
+    const glm::mat4 vp(view_projection);
+    // Sky (also clears the colour).
+    glUseProgram(prog.sky);
+    set_light(prog.sky, 1.0f);
+    set(prog.sky, "inverse_view_projection", glm::mat4(glm::inverse(view_projection)));
+    gl::draw_fullscreen();
+
+    // Terrain.
+    auto draw_terrain = [&](const glm::mat4& matrix, int mode) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_BLEND);
+        glUseProgram(prog.terrain);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m.heights);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, m.shadow_depth);
+        set(prog.terrain, "heights", 0);
+        set(prog.terrain, "shadow_map", 1);
+        set_grid(prog.terrain, matrix);
+        set_light(prog.terrain, 0.0f);
+        set(prog.terrain, "height_min", m.lo);
+        set(prog.terrain, "height_max", m.hi);
+        const float starts[4] = {0.0f, st.splat.band_start[0], st.splat.band_start[1], st.splat.band_start[2]};
+        glUniform1fv(loc(prog.terrain, "band_start"), 4, starts);
+        set(prog.terrain, "blend_fraction", st.splat.blend_fraction);
+        set(prog.terrain, "slope_start", st.splat.slope_start);
+        set(prog.terrain, "slope_full", st.splat.slope_full);
+        float materials[12];
+        for (int i = 0; i < 4; ++i)
+            for (int c = 0; c < 3; ++c) materials[3 * i + c] = st.materials[std::size_t(i)][std::size_t(c)];
+        glUniform3fv(loc(prog.terrain, "material"), 4, materials);
+        set(prog.terrain, "jitter", float(st.jitter));
+        set(prog.terrain, "texture_scale", float(st.texture_scale));
+        set(prog.terrain, "output_mode", mode);
+        set(prog.terrain, "skirt_edge", -1);
+        set(prog.terrain, "light_view_projection", glm::mat4(light_vp));
+        set(prog.terrain, "shadow_texel", 1.0f / float(m.shadow_size));
+        glBindVertexArray(m.vao);
+        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        // The skirt, down to below the lowest point (and below the sea).
+        set(prog.terrain, "floor_height", float(floor_height * exag));
+        for (int edge = 0; edge < 4; ++edge) {
+            set(prog.terrain, "skirt_edge", edge);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
+        }
+    };
+    draw_terrain(vp, int(st.output));
+
+    // Particles: lit spheres (points).
+    if (shaded && particles && particles->count() > 0) {
+        const auto it = particles->attributes.find("position");
+        if (it == particles->attributes.end() || it->second.components != 3)
+            throw BadInput("render:terrain: the particle frame has no 3-component 'position' attribute");
+        if (!m.particle_vao) {
+            glGenVertexArrays(1, &m.particle_vao);
+            glGenBuffers(1, &m.particle_vbo);
+        }
+        glBindVertexArray(m.particle_vao);
+        glBindBuffer(GL_ARRAY_BUFFER, m.particle_vbo);
+        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(it->second.data.size() * sizeof(float)), it->second.data.data(),
+                     GL_STREAM_DRAW);
+        glEnableVertexAttribArray(0);
+        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+        glEnable(GL_PROGRAM_POINT_SIZE);
+        glUseProgram(prog.particles);
+        set(prog.particles, "view_projection", vp);
+        set(prog.particles, "exaggeration", float(exag));
+        set(prog.particles, "radius", float(st.particle_radius));
+        const double ppm = camera.mode == Camera::Mode::top ? 0.0
+                                                             : height / (2.0 * std::tan(camera.fov * 0.5 * kDegree));
+        set(prog.particles, "pixels_per_metre_at_unit_distance", float(ppm));
+        set(prog.particles, "particle_colour", glm::vec3(st.particle_colour[0], st.particle_colour[1], st.particle_colour[2]));
+        set_light(prog.particles, 0.0f);
+        glDrawArrays(GL_POINTS, 0, GLsizei(particles->count()));
+        glDisable(GL_PROGRAM_POINT_SIZE);
+    }
+
+    // Water, blended over the terrain: what shows through is scaled by alpha.
+    if (shaded && (m.has_water || st.sea)) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthMask(GL_FALSE);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);  // the frame stays opaque
+        glUseProgram(prog.water);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m.surface);
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, m.heights);
+        set(prog.water, "surface", 0);
+        set(prog.water, "heights", 1);
+        set_grid(prog.water, vp);
+        set_light(prog.water, 0.0f);
+        set(prog.water, "time", float(st.time));
+        set(prog.water, "wave_height", float(st.wave_height));
+        set(prog.water, "water_colour", glm::vec3(0.02f, 0.09f, 0.12f));
+        set(prog.water, "clarity", float(st.clarity));
+        set(prog.water, "has_reflection", 0);
+        set(prog.water, "viewport", glm::vec2(float(width), float(height)));
+        set(prog.water, "sea_level", float(st.sea_level));
+        glBindVertexArray(m.vao);
+        if (m.has_water) {
+            set(prog.water, "sea_plane", 0);
+            glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        }
+        if (st.sea) {
+            const double reach = radius * 38.0;
+            set(prog.water, "sea_plane", 1);
+            const glm::vec4 extent(float(centre.x - reach), float(centre.z - reach), float(centre.x + reach),
+                                   float(centre.z + reach));
+            glUniform4fv(loc(prog.water, "plane_extent"), 1, glm::value_ptr(extent));
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+        }
+        glDisable(GL_BLEND);
+        glDepthMask(GL_TRUE);
+    }
+    mark(&Timings::scene);
+
+    // ---- resolve the samples into a float target and read it back
+    gl::Target resolved(width, height);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved.framebuffer);
+    glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved.framebuffer);
+    Image image = gl::read_rgba32f(width, height);
+    gl::check_errors("render:terrain", "drawing the frame");
+    mark(&Timings::resolve_and_read);
+    return image;
+}
+
+}  // namespace orogen::render

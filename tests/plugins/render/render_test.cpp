@@ -1,0 +1,238 @@
+// render:terrain's core: splatting by height and slope, shadows, the camera's
+// bad cases, golden images and repeatability, on llvmpipe without a display.
+#include "render_support.hpp"
+#include "render_terrain.hpp"
+
+#include "bloom.hpp"
+#include "image_srgb.hpp"
+#include "orogen_test.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb_image.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+
+using namespace orogen;
+using namespace orogen::render;
+using namespace orogen::test;
+
+namespace {
+
+const auto* const no_display = ::testing::AddGlobalTestEnvironment(new NoDisplay);
+
+enum { sand, grass, rock, snow };
+
+std::shared_ptr<Heightmap> grid(int n, double cell, float h) { return std::make_shared<Heightmap>(n, n, cell, h); }
+
+Camera top() {
+    Camera c;
+    c.mode = Camera::Mode::top;
+    return c;
+}
+
+Style albedo() {
+    Style s;
+    s.output = Style::Output::albedo;
+    return s;
+}
+
+}  // namespace
+
+TEST(Splatting, FlatGroundBelowTheFirstBandIsSand) {
+    // A plain at 0 m with one 1000 m column in a corner (so the range is 0..1000 m):
+    // the plain is at t = 0, below grass_from = 0.25.
+    auto hm = grid(65, 10.0, 0.0f);
+    hm->view().at(0, 0) = 1000.0f;
+    TerrainRenderer r(hm, albedo());
+    const Image im = r.render(64, 64, top());
+    const auto colours = Style::default_materials();
+    int counted = 0;
+    for (int y = 8; y < 64; ++y)
+        for (int x = 8; x < 64; ++x) {
+            EXPECT_EQ(nearest(im, std::size_t(y * 64 + x), colours), sand) << "pixel " << x << "," << y;
+            ++counted;
+        }
+    EXPECT_GT(counted, 3000);
+    // Lit (sun, sky, shadows, haze), the plain stays sand-coloured: yellow, red > green > blue clearly.
+    TerrainRenderer lit(hm, Style{});
+    const Image b = lit.render(64, 64, top());
+    for (int y = 8; y < 64; ++y)
+        for (int x = 8; x < 64; ++x) {
+            const float* p = &b.rgba32f[4 * std::size_t(y * 64 + x)];
+            EXPECT_GT(p[0], p[1]);
+            EXPECT_GT(p[1], 1.3f * p[2]) << "pixel " << x << "," << y;
+        }
+}
+
+TEST(Splatting, ASixtyDegreeSlopeAtSnowHeightIsRockAndTheFlatTopIsSnow) {
+    // Range 0..1100 m (a pit and a peak in two corners); the middle is a plane
+    // rising tan 60° per metre to the east around 1000 m (t ≈ 0.9: the snow band),
+    // whose normal has y = cos 60° = 0.5: where rock covers snow completely.
+    const int n = 65;
+    auto slope = grid(n, 1.0, 0.0f);
+    auto flat = grid(n, 1.0, 1000.0f);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) slope->view().at(x, y) = float(1000.0 + std::tan(std::numbers::pi / 3) * (x - 32));
+    for (auto* h : {slope.get(), flat.get()}) {
+        h->view().at(0, 0) = 0.0f;
+        h->view().at(n - 1, n - 1) = 1100.0f;
+    }
+    const auto colours = Style::default_materials();
+    TerrainRenderer steep(slope, albedo()), level(flat, albedo());
+    const Image a = steep.render(64, 64, top()), b = level.render(64, 64, top());
+    for (int y = 16; y < 48; ++y)
+        for (int x = 16; x < 48; ++x) {
+            EXPECT_EQ(nearest(a, std::size_t(y * 64 + x), colours), rock) << "slope pixel " << x << "," << y;
+            EXPECT_EQ(nearest(b, std::size_t(y * 64 + x), colours), snow) << "flat pixel " << x << "," << y;
+        }
+}
+
+TEST(Splatting, TheShaderFollowsTheRulesOfSplatWeights) {
+    // A ramp across the whole range, jitter off: each pixel's colour is the CPU's
+    // splat_weights mix of the four materials (textures vary brightness by < 30 %).
+    const int n = 129;
+    auto ramp = grid(n, 10.0, 0.0f);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) ramp->view().at(x, y) = float(x);  // 1 m per 10 m: normal y ≈ 0.995
+    Style s = albedo();
+    s.jitter = 0;
+    TerrainRenderer r(ramp, s);
+    const Image im = r.render(128, 128, top());
+    const auto colours = Style::default_materials();
+    for (int x = 2; x < 126; ++x) {
+        const float h = float((x + 0.5) / 128.0 * (n - 1));
+        const terrain::SplatWeights w = terrain::splat_weights(h, 0, float(n - 1), 0.995f);
+        const float want_g = w.sand * colours[0][1] + w.grass * colours[1][1] + w.rock * colours[2][1] + w.snow * colours[3][1];
+        const float got_g = im.rgba32f[4 * std::size_t(64 * 128 + x) + 1];
+        EXPECT_NEAR(got_g / want_g, 1.0, 0.3) << "column " << x << " height " << h << " got " << got_g << " want " << want_g;
+    }
+}
+
+TEST(Shadows, ATallColumnsShadowFallsAwayFromTheSun) {
+    // A 300 m column in the middle of a plain, the sun in the east at 30°:
+    // the shadow (300 m / tan 30° = 520 m = 52 cells long) lies to the west.
+    const int n = 129;
+    auto hm = grid(n, 10.0, 0.0f);
+    for (int y = 62; y <= 66; ++y)
+        for (int x = 62; x <= 66; ++x) hm->view().at(x, y) = 300.0f;
+    Style s;
+    s.sun_azimuth = 90;
+    s.sun_elevation = 30;
+    s.haze = 0;
+    s.jitter = 0;
+    TerrainRenderer r(hm, s);
+    const Image im = r.render(128, 128, top());
+    auto luminance = [&](int x0, int x1) {
+        double sum = 0;
+        int count = 0;
+        for (int y = 62; y <= 65; ++y)
+            for (int x = x0; x <= x1; ++x) {
+                const float* p = &im.rgba32f[4 * std::size_t(y * 128 + x)];
+                sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+                ++count;
+            }
+        return sum / count;
+    };
+    const double west = luminance(30, 56), east = luminance(72, 98);
+    EXPECT_LT(west, 0.6 * east) << "west " << west << " east " << east;
+    // And with the sun in the west it is the other way round.
+    s.sun_azimuth = 270;
+    TerrainRenderer r2(hm, s);
+    const Image im2 = r2.render(128, 128, top());
+    double w2 = 0, e2 = 0;
+    for (int y = 62; y <= 65; ++y)
+        for (int x = 30; x <= 56; ++x) {
+            w2 += im2.rgba32f[4 * std::size_t(y * 128 + x) + 1];
+            e2 += im2.rgba32f[4 * std::size_t(y * 128 + (128 - 1 - x)) + 1];
+        }
+    EXPECT_LT(e2, 0.6 * w2);
+}
+
+TEST(Camera, BadCamerasAreRefusedWithTheReason) {
+    auto hm = grid(33, 10.0, 100.0f);
+    TerrainRenderer r(hm, Style{});
+    Camera c;
+    c.mode = Camera::Mode::look_at;
+    c.from = {0.5, 0.5};
+    c.from_height = -50;  // under the ground
+    try {
+        r.render(32, 32, c);
+        FAIL() << "a camera under the ground must be refused";
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("inside the terrain"), std::string::npos) << e.what();
+    }
+    c.from = {0.5, 3.0};
+    c.from_height = 500;
+    c.to = {0.5, 6.0};  // looking away from the terrain
+    try {
+        r.render(32, 32, c);
+        FAIL() << "a camera that sees no terrain must be refused";
+    } catch (const BadInput& e) {
+        EXPECT_NE(std::string(e.what()).find("sees none of the terrain"), std::string::npos) << e.what();
+    }
+    Camera wide;
+    wide.fov = 180;
+    EXPECT_THROW(r.render(32, 32, wide), BadInput);
+    EXPECT_THROW(r.render(0, 32, Camera{}), BadInput);
+    EXPECT_THROW(r.render(32, 20000, Camera{}), BadInput);
+}
+
+namespace {
+
+// A small scene with every feature: hills, a water layer, a sea, shadows, sky, bloom.
+Image golden_scene() {
+    const int n = 97;
+    auto hm = std::make_shared<Heightmap>(n, n, 20.0);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const double u = x / double(n - 1), v = y / double(n - 1);
+            hm->view().at(x, y) = float(600 * std::exp(-((u - 0.5) * (u - 0.5) + (v - 0.45) * (v - 0.45)) * 12) +
+                                        80 * std::sin(9 * u) * std::cos(7 * v) + 40);
+        }
+    GridView water = hm->layer("water");
+    for (int y = 40; y < 50; ++y)
+        for (int x = 10; x < 20; ++x) water.at(x, y) = 2.0f;
+    Style s;
+    s.sea = true;
+    s.sea_level = 60;
+    s.samples = 4;
+    TerrainRenderer r(hm, s);
+    return bloom(r.render(160, 96, Camera{}), {});
+}
+
+std::vector<std::uint8_t> read_png_rgba(const std::filesystem::path& p, int& w, int& h) {
+    int channels = 0;
+    unsigned char* data = stbi_load(p.c_str(), &w, &h, &channels, 4);
+    if (!data) return {};
+    std::vector<std::uint8_t> out(data, data + std::size_t(w) * std::size_t(h) * 4);
+    stbi_image_free(data);
+    return out;
+}
+
+}  // namespace
+
+TEST(Golden, TheSceneMatchesItsGoldenImageAndRepeatsExactly) {
+    const Image a = golden_scene(), b = golden_scene();
+    ASSERT_EQ(a.rgba32f.size(), b.rgba32f.size());
+    EXPECT_TRUE(a.rgba32f == b.rgba32f) << "the same scene rendered twice differs";
+    const auto bytes = png_export::to_srgb8(a, png_export::Tonemap::aces, 0);
+    const std::filesystem::path golden = std::filesystem::path(OROGEN_SOURCE_DIR) / "tests/plugins/render/golden_scene.png";
+    if (std::getenv("OROGEN_UPDATE_GOLDEN")) {
+        AtomicFile f(golden);
+        write_rgba_png(f.stream(), a.width, a.height, bytes);
+        f.commit();
+    }
+    int w = 0, h = 0;
+    const auto want = read_png_rgba(golden, w, h);
+    ASSERT_EQ(w, a.width) << "missing golden " << golden << " (OROGEN_UPDATE_GOLDEN=1 writes it)";
+    ASSERT_EQ(h, a.height);
+    // 40 dB: an RMS error of 2.5 codes of 255, far below anything a changed pass makes.
+    EXPECT_GE(psnr(bytes, want), 40.0);
+}
