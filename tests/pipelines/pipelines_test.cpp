@@ -24,7 +24,7 @@ struct Case {
 
 const Case cases[] = {
     {"default",
-     "--set rivers.steps=400 --set beauty.width=320 --set beauty.height=180 --set beauty.samples=1 "
+     "--set range.dt=2e5 --set rivers.steps=400 --set beauty.width=320 --set beauty.height=180 --set beauty.samples=1 "
      "--set spin.frames=4 --set spin.width=160 --set spin.height=90"},
     {"erosion-pipe-rain", "--set storm.steps=300 --set after.steps=50"},
     {"erosion-shapes-4.1", ""},
@@ -83,3 +83,34 @@ INSTANTIATE_TEST_SUITE_P(Shipped, Pipeline, testing::ValuesIn(cases), [](const t
     std::replace_if(n.begin(), n.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)); }, '_');
     return n;
 });
+
+// Every spec in pipelines/ checks out with the plugins built here, so none of
+// them rots when a node's parameters change.
+TEST(Pipelines, EveryShippedSpecChecks) {
+    std::vector<fs::path> specs;
+    for (const auto& e : fs::directory_iterator(fs::path(OROGEN_SOURCE_DIR) / "pipelines"))
+        if (e.path().extension() == ".orogen") specs.push_back(e.path());
+    std::sort(specs.begin(), specs.end());
+    EXPECT_GE(specs.size(), 10u);
+    for (const auto& spec : specs) {
+        const RunResult r = run_orogen("check " + q(spec));
+        EXPECT_EQ(r.exit_code, 0) << spec.filename() << ":\n" << r.err;
+    }
+}
+
+// The time-lapse pipeline, small: the plates' snapshots become video frames
+// through the kernel's series mapping (render:terrain and render:bloom run
+// once per snapshot); ffprobe counts them.
+TEST(Pipelines, ThePlatesTimelapseBecomesAVideoWithAFramePerSnapshot) {
+    TempDir dir;
+    const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / "plates-timelapse.orogen";
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "out") +
+                                   " --quiet --set plates.steps=60 --set plates.timelapse_every=20"
+                                   " --set frames.width=160 --set frames.height=90");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string probe = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                              "stream=nb_read_frames,width,height -of csv=p=0 " +
+                              q(dir / "out" / "plates-timelapse.mp4") + " > " + q(dir / "probe.txt");
+    ASSERT_EQ(std::system(probe.c_str()), 0);
+    EXPECT_EQ(slurp(dir / "probe.txt"), "160,90,4\n");  // steps 0, 20, 40 and 60
+}
