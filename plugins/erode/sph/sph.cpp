@@ -308,49 +308,61 @@ struct Simulation::Impl {
         sorted = n;
     }
 
-    /// Call f(j, dx, dy, dz, r2) for every particle j within h of particle i
-    /// (i itself included), in a fixed order.
-    template <typename F>
-    void neighbours(std::size_t i, F&& f) const {
+    /// The particles within h of particle i (i itself included), in a fixed
+    /// order (27 cells in order, each bucket's particles in sorted order),
+    /// into nb[] with their squared distances; returns how many. The filter
+    /// is branch-free (write always, advance on a hit): most candidates miss.
+    std::size_t gather(std::size_t i, std::uint32_t* nb, float* r2s, std::size_t room) const {
         const Vec3 p = pos[i];
         const std::uint32_t cx = cell_coord(p.x), cy = cell_coord(p.y), cz = cell_coord(p.z);
+        std::size_t c = 0;
         for (std::uint32_t ox = cx - 1; ox != cx + 2; ++ox)
             for (std::uint32_t oy = cy - 1; oy != cy + 2; ++oy)
                 for (std::uint32_t oz = cz - 1; oz != cz + 2; ++oz) {
                     const std::uint32_t b = bucket_of(ox, oy, oz, mask);
-                    for (std::uint32_t k = start[b], e = start[b + 1]; k < e; ++k) {
+                    const std::uint32_t e = start[b + 1];
+                    std::uint32_t k = start[b];
+                    if (c + (e - k) > room) k = e - std::uint32_t(room - c);  // cannot happen below 4× rest density
+                    for (; k < e; ++k) {
                         const std::uint32_t j = order[k];
                         const Vec3& q = pos[j];
                         const float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
                         const float r2 = dx * dx + dy * dy + dz * dz;
-                        if (r2 < h2) f(j, dx, dy, dz, r2);
+                        nb[c] = j;
+                        r2s[c] = r2;
+                        c += r2 < h2 ? 1u : 0u;
                     }
                 }
+        return c;
     }
+    static constexpr std::size_t kRoom = 4096;
 
     /// Cubic spline kernel W(r) with support h.
     float kernel(float r2) const {
         const float q = std::sqrt(r2) * inv_h;
-        if (q <= 0.5f) return w_norm * (6.0f * q * q * (q - 1.0f) + 1.0f);
         const float f = 1.0f - q;
-        return w_norm * 2.0f * f * f * f;
+        const float inner = 6.0f * q * q * (q - 1.0f) + 1.0f, outer = 2.0f * f * f * f;
+        return w_norm * (q <= 0.5f ? inner : outer);
     }
     /// dW/dr / r (multiply by the separation vector for ∇W).
     float kernel_grad(float r2) const {
-        const float r = std::sqrt(r2);
-        if (r < 1e-9f * h) return 0.0f;
+        // The particle itself (r = 0) contributes nothing: its separation vector is zero.
+        const float r = std::max(std::sqrt(r2), 1e-12f);
         const float q = r * inv_h;
-        const float g = q <= 0.5f ? grad_norm * q * (3.0f * q - 2.0f) : -grad_norm * (1.0f - q) * (1.0f - q);
-        return g * inv_h / r;
+        const float inner = q * (3.0f * q - 2.0f), outer = -(1.0f - q) * (1.0f - q);
+        return grad_norm * (q <= 0.5f ? inner : outer) * inv_h / r;
     }
 
     void density_pass() {
         parallel_for(0, std::int64_t(n), kGrain, [&](std::int64_t b, std::int64_t e) {
             FlushDenormals ftz;
+            std::vector<std::uint32_t> nb(kRoom);
+            std::vector<float> r2s(kRoom);
             for (std::int64_t ii = b; ii < e; ++ii) {
                 const auto i = std::size_t(ii);
+                const std::size_t c = gather(i, nb.data(), r2s.data(), kRoom);
                 float rho = 0.0f;
-                neighbours(i, [&](std::uint32_t, float, float, float, float r2) { rho += kernel(r2); });
+                for (std::size_t k = 0; k < c; ++k) rho += kernel(r2s[k]);
                 rho *= mass;
                 density[i] = rho;
                 const float ratio = rho / rho0;
@@ -367,15 +379,22 @@ struct Simulation::Impl {
         std::vector<float> block_max(std::size_t(std::max<std::int64_t>(blocks, 1)), 0.0f);
         parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
             FlushDenormals ftz;
+            std::vector<std::uint32_t> nb(kRoom);
+            std::vector<float> r2s(kRoom);
             for (std::int64_t blk = b0; blk < b1; ++blk) {
                 float amax = 0.0f;
                 const std::size_t lo = std::size_t(blk * kGrain), hi = std::min(n, lo + std::size_t(kGrain));
                 for (std::size_t i = lo; i < hi; ++i) {
                     const Vec3 vi = vel[i];
+                    const Vec3 pi3 = pos[i];
                     const float pi = pterm[i], rhoi = density[i];
                     float ax = 0, ay = 0, az = 0;
-                    neighbours(i, [&](std::uint32_t j, float dx, float dy, float dz, float r2) {
-                        if (j == i) return;
+                    const std::size_t c = gather(i, nb.data(), r2s.data(), kRoom);
+                    for (std::size_t k = 0; k < c; ++k) {
+                        const std::uint32_t j = nb[k];
+                        const float r2 = r2s[k];
+                        const Vec3& pj = pos[j];
+                        const float dx = pi3.x - pj.x, dy = pi3.y - pj.y, dz = pi3.z - pj.z;
                         const Vec3& vj = vel[j];
                         const float vx = vi.x - vj.x, vy = vi.y - vj.y, vz = vi.z - vj.z;
                         const float vr = vx * dx + vy * dy + vz * dz;
@@ -388,7 +407,7 @@ struct Simulation::Impl {
                         ax += gw * dx;
                         ay += gw * dy;
                         az += gw * dz;
-                    });
+                    }
                     ay += g;
                     acc[i] = Vec3{ax, ay, az};
                     amax = std::max(amax, ax * ax + ay * ay + az * az);
@@ -466,7 +485,10 @@ struct Simulation::Impl {
                         exchange[i] = std::numeric_limits<double>::quiet_NaN();  // marks "left" for the serial pass
                         continue;
                     }
-                    // Never below the triangulated surface.
+                    // Never below the triangulated surface (at the position as stored, in float).
+                    Vec3 np{float(p[0]), float(p[1]), float(p[2])};
+                    p[0] = np.x;
+                    p[2] = np.z;
                     const double ys = surface(p[0], p[2]);
                     normal(p[0], p[2], n3);
                     if (p[1] < ys + 1e-4 * s.radius) {
@@ -497,7 +519,7 @@ struct Simulation::Impl {
                         }
                     }
                     exchange[i] = take;
-                    Vec3 np{float(p[0]), float(p[1]), float(p[2])};
+                    np.y = float(p[1]);
                     if (double(np.y) < ys) np.y = above(ys);
                     pos[i] = np;
                     vel[i] = Vec3{float(v[0]), float(v[1]), float(v[2])};
