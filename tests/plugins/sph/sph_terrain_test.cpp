@@ -4,11 +4,15 @@
 #include "shape.hpp"
 #include "sph.hpp"
 
+#include <orogen/error.hpp>
+
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstring>
+#include <limits>
+#include <string>
 #include <vector>
 
 namespace {
@@ -173,4 +177,20 @@ TEST(SphDitches, DifferentSeedsCutDifferentDitchesAndTheSameSeedTheSame) {
     }
     EXPECT_GT(norm, 1e-4) << "no ditches were cut";
     EXPECT_GT(std::sqrt(diff), 0.3 * std::sqrt(norm)) << "two seeds cut nearly the same ditches";
+}
+
+TEST(SphFailure, ANonFiniteParticleFailsTheRunNamingTheStepAndTheParticleCount) {
+    const std::vector<float> h = make_shape(shape::Kind::pyramid);
+    sph::Simulation sim(view(h), erosion_settings(), 100);
+    sim.rain(10, 2.0, 1, 1, 2.0f, 10);
+    ASSERT_TRUE(sim.add({30.0f, 30.0f, 30.0f}, {std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f}, 0.0f, 0));
+    try {
+        sim.advance(0.05, 7);
+        FAIL() << "a NaN velocity went unnoticed";
+    } catch (const Error& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("step 7"), std::string::npos) << what;
+        EXPECT_NE(what.find("11 particles"), std::string::npos) << what;
+        EXPECT_NE(what.find("non-finite"), std::string::npos) << what;
+    }
 }
