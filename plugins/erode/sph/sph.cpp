@@ -443,6 +443,10 @@ struct Simulation::Impl {
                     const double o[3] = {pos[i].x, pos[i].y, pos[i].z};
                     const double d[3] = {v[0] * ddt, v[1] * ddt, v[2] * ddt};
                     double p[3] = {o[0] + d[0], o[1] + d[1], o[2] + d[2]};
+                    if (!std::isfinite(p[0] + p[1] + p[2] + v[0] + v[1] + v[2])) {
+                        block_bad[std::size_t(blk)] = 1;  // reported by substep(); never index the terrain with it
+                        continue;
+                    }
                     bool contact = false;
                     // Möller–Trumbore against the tiles beneath the start and the end of the motion.
                     int ti, tj, ui, uj;
