@@ -30,6 +30,11 @@ const Case cases[] = {
     {"erosion-shapes-4.1", ""},
     {"erosion-thermal-4.3", ""},
     {"orogeny", "--set range.dt=2e5 --set storm.steps=60"},
+    {"erosion-sph-4.1", "--set sph_crooked.steps=8 --set sph_pyramid.steps=8 --set sph_hemisphere.steps=8 "
+                        "--set olsen_crooked.iterations=30 --set olsen_pyramid.iterations=30 "
+                        "--set olsen_hemisphere.iterations=30 --set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 "
+                        "--set pipe_hemisphere.steps=60"},
+    {"sph-rain", "--set rain.steps=30"},
 };
 
 /// relative path → sha256 of every file under `dir` but the manifest (which names plugin versions).
