@@ -9,6 +9,7 @@ packages=(
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
   libstb-dev libpng-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth
+  clang-14 libclang-rt-14-dev
 )
 
 missing=()
