@@ -227,7 +227,10 @@ TEST(Runner, CtrlCStopsTheRunAtTheNextCheckWithExit130) {
     dir.write("interrupt.sh", "cd '" + dir.path().string() + "'\n"
                               "OROGEN_PLUGIN_PATH=" + fake_plugins + " " + OROGEN_CLI +
                               " run s.orogen --out out --quiet 2>err.txt &\n"
-                              "pid=$!\nsleep 1\nkill -INT $pid\nwait $pid\necho $? > rc.txt\n");
+                              "pid=$!\n"
+                              // ok.png staged: the handler is in place and the slow node is next
+                              "until ls out/.orogen-staging-*/ok.png >/dev/null 2>&1; do sleep 0.02; done\n"
+                              "kill -INT $pid\nwait $pid\necho $? > rc.txt\n");
     const auto start = std::chrono::steady_clock::now();
     ASSERT_EQ(std::system(("bash '" + (dir / "interrupt.sh").string() + "'").c_str()), 0);
     EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));

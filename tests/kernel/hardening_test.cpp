@@ -14,6 +14,8 @@
 #include <csignal>
 #include <map>
 #include <set>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -379,10 +381,9 @@ TEST(AllOrNothing, ASecondCtrlCEndsAtOnceAndTheNextRunCleansUp) {
                           "s = generate:stubborn()\n");
     const auto start = std::chrono::steady_clock::now();
     const pid_t pid = spawn_orogen(dir.path(), {"run", "m.orogen", "--out", "out", "--quiet"}, dir / "err.txt");
-    while (staged_count(dir / "out") < 1) std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    // a.png is staged: its node is ending and the stubborn one starts (a Ctrl-C before it would be seen by
-    // the runner's check between nodes and end the run politely with 130).
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    // Once the stubborn node runs (a Ctrl-C before it would be seen by the runner's check between nodes and
+    // end the run politely with 130).
+    while (!fs::exists(dir / "stubborn.started")) std::this_thread::sleep_for(std::chrono::milliseconds(2));
     ::kill(pid, SIGINT);  // the stubborn node does not look
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     ::kill(pid, SIGINT);
@@ -510,4 +511,26 @@ TEST(Inputs, ImportRawReadsWhatExportRawWroteAndRefusesACutFileAtCheckTime) {
               std::string::npos)
         << r.err;
     EXPECT_FALSE(fs::exists(dir / "out"));
+}
+
+// The lock, not the pid number, tells a live run from a dead one: a staging folder whose lock is held is left
+// alone even when no process has its pid (pids are reused, or belong to another pid namespace); once the lock
+// is free, the next run removes it.
+TEST(AllOrNothing, AStagingFolderWhoseLockIsHeldIsLeftAlone) {
+    TempDir dir;
+    dir.write("out/.orogen-staging-999999999/x.png", "staged by a live run");
+    const fs::path lock = dir / "out/.orogen-staging-999999999/.lock";
+    const int fd = ::open(lock.c_str(), O_CREAT | O_RDWR, 0600);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX | LOCK_NB), 0);
+    dir.write("s.orogen", spec_writing("t.png"));
+    RunResult r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_EQ(slurp(dir / "out/.orogen-staging-999999999/x.png"), "staged by a live run");
+    ::close(fd);  // the "run" ends
+    r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err, "orogen: removed .orogen-staging-999999999, left by a run that no longer exists (1 file, 20 bytes)\n");
+    EXPECT_FALSE(fs::exists(dir / "out/.orogen-staging-999999999"));
 }

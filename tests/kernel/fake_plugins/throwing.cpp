@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <thread>
 #include <stdexcept>
 
@@ -44,9 +45,12 @@ OROGEN_PLUGIN("test-throwing", "0.0.1", registry) {
                       }
                       return std::make_shared<Heightmap>(2, 2, 1.0);
                   }});
-    registry.add({.kind = "generate", .name = "stubborn", .summary = "sleeps 30 s without looking at cancellation",
+    registry.add({.kind = "generate", .name = "stubborn",
+                  .summary = "creates stubborn.started in the current folder, then sleeps 30 s without looking at "
+                             "cancellation",
                   .output = ValueType::heightmap,
                   .run = [](NodeContext&) -> NodeOutputs {
+                      std::ofstream("stubborn.started") << "started\n";
                       std::this_thread::sleep_for(std::chrono::seconds(30));
                       return std::make_shared<Heightmap>(2, 2, 1.0);
                   }});
