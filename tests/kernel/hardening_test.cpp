@@ -240,6 +240,7 @@ TEST(BoundedPng, AHugeDeclaredSizeFailsFastInLittleMemory) {
     EXPECT_NE(message.find("a quarter of this machine's"), std::string::npos) << message;
     const double cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
                        1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+    std::printf("reading the 100000x100000 PNG: %.3f s of CPU, peak RSS %.1f MB\n", cpu, usage.ru_maxrss / 1024.0);
     EXPECT_LT(cpu, 1.0);                          // seconds of CPU, not wall time: load cannot move it
     EXPECT_LT(usage.ru_maxrss, 100 * 1024);       // KiB: under 100 MB peak
 }
