@@ -177,7 +177,8 @@ Staging::Staging(const fs::path& out_dir) : out_dir_(out_dir) {
 }
 
 Staging::~Staging() {
-    if (!committed_) {
+    // Once marked complete, a staging folder is only ever rolled forward: a failed move leaves it for the next run.
+    if (!committed_ && !marked_) {
         std::error_code ec;
         fs::remove_all(folder_, ec);
     }
@@ -200,6 +201,7 @@ void Staging::commit(const fs::path& last) {
         }
         ::close(fd);
         fsync_folder(folder_);
+        marked_ = true;
     }
     move_into_place(folder_, out_dir_, files, last);
     committed_ = true;

@@ -58,6 +58,7 @@ private:
     std::filesystem::path folder_;
     int lock_fd_ = -1;
     bool committed_ = false;
+    bool marked_ = false;  ///< `.commit` written: the set is complete and must not be thrown away
 };
 
 /// Remove the staging folders and stray temporaries of runs whose process no longer exists, or finish the
