@@ -4,7 +4,7 @@
 BUILD ?= build
 JOBS  ?= 2
 
-.PHONY: all setup configure build demo test bench clean
+.PHONY: all setup configure build demo test bench clean asan asan-configure tsan fuzz-smoke fuzz-long
 
 all: build
 
@@ -27,5 +27,62 @@ test: build
 bench: build
 	@for b in $(BUILD)/bench/bench_*; do echo "== $$b"; $$b --benchmark_min_time=0.2; done
 
+# Sanitizer builds (clang-14, tools/setup.sh installs it); see docs/hardening.md.
+#   make asan        AddressSanitizer + UndefinedBehaviorSanitizer build of the whole tree (-O1) and every
+#                    test in it (the shipped pipelines included), with the libFuzzer targets
+#   make tsan        ThreadSanitizer build of the parallel cores and the exporters, and their tests
+#   make fuzz-smoke  FUZZ_SECONDS (default 20) of each fuzz target (needs `make asan`'s build)
+#   make fuzz-long   FUZZ_RUNS (default 1000000) executions of each target, one job each
+SAN_FLAGS   = -O1 -gline-tables-only -fno-omit-frame-pointer
+ASAN_BUILD ?= build-asan
+TSAN_BUILD ?= build-tsan
+# Every plugin (the tests run specs through several), and the tests of the thread-parallel cores and of
+# the exporters (which write in parallel).
+TSAN_ONLY  ?= /plugins/[^/]+/[^/]+$$|/tests/plugins/(thermal|hydraulic|pipe|plates|png_export|raw|gltf|vtk|vdb)$$
+FUZZ_SECONDS ?= 20
+FUZZ_RUNS    ?= 1000000
+FUZZ_TARGETS  = spec overrides png sidecar
+# Extra cmake arguments for the sanitizer builds, e.g. SAN_CMAKE=-DCMAKE_CXX_COMPILER_LAUNCHER=ccache
+SAN_CMAKE    ?=
+export ASAN_OPTIONS  ?= detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
+export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
+export TSAN_OPTIONS  ?= halt_on_error=1:second_deadlock_stack=1:suppressions=$(CURDIR)/tools/tsan.supp
+
+asan: asan-configure
+	cmake --build $(ASAN_BUILD) -j$(JOBS)
+	cd $(ASAN_BUILD) && ctest --output-on-failure -j$(JOBS)
+
+asan-configure: setup
+	@cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+	  -DCMAKE_CXX_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize=vptr -fno-sanitize-recover=all" \
+	  -DCMAKE_C_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
+	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
+	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined" \
+	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF -DOROGEN_FUZZ=ON $(SAN_CMAKE) >/dev/null
+
+tsan: setup
+	@cmake -S . -B $(TSAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
+	  -DCMAKE_CXX_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=thread" -DCMAKE_C_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=thread" \
+	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=thread" \
+	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=thread" \
+	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF '-DOROGEN_ONLY=$(TSAN_ONLY)' $(SAN_CMAKE) >/dev/null
+	cmake --build $(TSAN_BUILD) -j$(JOBS)
+	cd $(TSAN_BUILD) && ctest --output-on-failure -j$(JOBS) -LE 'pipelines|fuzz'
+
+fuzz-smoke:
+	@cd $(ASAN_BUILD)/tests && for t in $(FUZZ_TARGETS); do \
+	  mkdir -p fuzz-corpus/$$t && \
+	  ./fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 fuzz-corpus/$$t $(CURDIR)/tests/fuzz/corpus/$$t \
+	    2>fuzz-$$t.log || { tail -50 fuzz-$$t.log; exit 1; }; \
+	  echo "fuzz_$$t: $$(grep -h 'stat::number_of_executed_units' fuzz-$$t.log | awk '{print $$2}') executions in $(FUZZ_SECONDS) s, no crash"; \
+	done
+
+fuzz-long:
+	@cd $(ASAN_BUILD)/tests && for t in $(FUZZ_TARGETS); do \
+	  mkdir -p fuzz-corpus/$$t && \
+	  /usr/bin/time -f "fuzz_$$t: %e s wall" ./fuzz_$$t -runs=$(FUZZ_RUNS) -print_final_stats=1 fuzz-corpus/$$t \
+	    $(CURDIR)/tests/fuzz/corpus/$$t 2>fuzz-long-$$t.log || { tail -50 fuzz-long-$$t.log; exit 1; }; \
+	done
+
 clean:
-	rm -rf $(BUILD) out
+	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) out

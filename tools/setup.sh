@@ -11,6 +11,7 @@ packages=(
   libstb-dev libpng-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev
+  clang-14 libclang-rt-14-dev
 )
 
 missing=()

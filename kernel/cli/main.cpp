@@ -1,6 +1,6 @@
 // The `orogen` command: run | check | list | help | version.
 // Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
-// usage), 130 interrupted.
+// usage), 130 interrupted (SIGINT), 143 terminated (SIGTERM).
 #include "../src/loader.hpp"
 #include "../src/plan.hpp"
 #include "../src/progress.hpp"
@@ -26,20 +26,30 @@ namespace {
 constexpr int exit_ok = 0, exit_failed = 1, exit_bad_input = 2;
 
 std::atomic<bool> g_cancel{false};
-extern "C" void on_interrupt(int) {
-    g_cancel.store(true);
-    std::signal(SIGINT, SIG_DFL);  // a second Ctrl-C ends at once
+std::atomic<int> g_signal{0};
+// The first SIGINT or SIGTERM asks the run to stop at the node's next check (its staged outputs are then
+// removed); a second one ends the process at once (a later run removes what it staged).
+extern "C" void on_interrupt(int sig) {
+    if (g_cancel.exchange(true)) {
+        std::signal(sig, SIG_DFL);
+        std::raise(sig);
+        return;
+    }
+    g_signal.store(sig);
 }
 
 const char* usage_text =
     "usage:\n"
     "  orogen run SPEC [--out DIR] [--seed N] [--threads N] [--set NAME.PARAM=VALUE]... [--quiet]\n"
-    "  orogen check SPEC [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
+    "                  [--allow-outside-out]\n"
+    "  orogen check SPEC [--out DIR] [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
     "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
     "  orogen version                                  kernel, plugin API and plugin versions\n"
     "\n"
-    "Output paths in a spec are relative to --out (default: out/). Plugins are loaded from\n"
+    "Output paths in a spec are relative to --out (default: out/) and must stay inside it unless\n"
+    "--allow-outside-out is given. A run's outputs appear together, the manifest last, or not at all.\n"
+    "Plugins are loaded from\n"
     "<prefix>/lib/orogen/plugins and from OROGEN_PLUGIN_PATH (folders or .so files, ':'-separated).\n";
 
 int usage_error(const std::string& message) {
@@ -64,6 +74,7 @@ struct Args {
     std::optional<std::uint64_t> seed;
     int threads = 0;
     bool quiet = false;
+    bool allow_outside_out = false;
     std::vector<std::string> overrides;
 };
 
@@ -109,6 +120,8 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
             auto v = value("--set");
             if (!v) return usage_error("--set needs NAME.PARAM=VALUE");
             a.overrides.push_back(*v);
+        } else if (arg == "--allow-outside-out") {
+            a.allow_outside_out = true;
         } else if (arg == "--quiet" || arg == "-q") {
             a.quiet = true;
         } else if (arg.size() > 1 && arg[0] == '-') {
@@ -150,6 +163,8 @@ std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins,
     CheckOptions options;
     options.overrides = args.overrides;
     options.seed = args.seed;
+    options.out_dir = args.out;
+    options.allow_outside_out = args.allow_outside_out;
     Plan plan = check(parsed, plugins.registry(), path, options, diags);
     if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
     if (diags.has_errors()) {
@@ -182,9 +197,12 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
     options.progress = &progress;
     options.plugins = plugins.plugins();
     options.cancel = &g_cancel;
+    options.cancel_signal = &g_signal;
+    options.on_note = [](const std::string& note) { std::fprintf(stderr, "orogen: %s\n", note.c_str()); };
     RunResult result = run(*plan, options);
     if (result.exit_code != 0) {
         std::fputs(result.error.c_str(), stderr);
+        if (result.exit_code == 130 && g_signal.load() == SIGTERM) return 143;
         return result.exit_code;
     }
     if (!args.quiet) {

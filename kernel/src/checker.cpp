@@ -1,6 +1,9 @@
 #include "plan.hpp"
 
+#include "outputs.hpp"
+
 #include <orogen/error.hpp>
+#include <orogen/io.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -12,18 +15,6 @@
 namespace fs = std::filesystem;
 
 namespace orogen {
-
-std::string human_bytes(double bytes) {
-    static const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
-    int u = 0;
-    while (bytes >= 1024.0 && u < 6) {
-        bytes /= 1024.0;
-        ++u;
-    }
-    char buf[64];
-    std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.1f %s", bytes, units[u]);
-    return buf;
-}
 
 namespace {
 
@@ -221,12 +212,6 @@ private:
     int errors_ = 0;
 };
 
-std::uint64_t physical_memory() {
-    const long pages = ::sysconf(_SC_PHYS_PAGES);
-    const long page = ::sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : (std::uint64_t(8) << 30);
-}
-
 bool has_extension(const std::string& path, const std::string& ext) {
     return path.size() >= ext.size() && lower(path.substr(path.size() - ext.size())) == lower(ext);
 }
@@ -253,20 +238,11 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
     plan.grid.width = parsed.grid_width;
     plan.grid.height = parsed.grid_height;
     plan.grid.cell = parsed.grid_cell;
-    {
-        const std::uint64_t limit =
-            options.heightmap_memory_limit ? options.heightmap_memory_limit : physical_memory() / 4;
-        const double bytes = double(plan.grid.width) * double(plan.grid.height) * 4.0;
-        if (bytes > double(limit)) {
-            const auto side = std::uint64_t(std::sqrt(double(limit) / 4.0));
-            diags.error(parsed.has_grid ? parsed.grid_where : file_start,
-                        "grid " + std::to_string(plan.grid.width) + "x" + std::to_string(plan.grid.height) + " needs " +
-                            human_bytes(bytes) + " for one heightmap (4 bytes a vertex), more than the " +
-                            human_bytes(double(limit)) + " allowed here (a quarter of this machine's " +
-                            human_bytes(double(physical_memory())) + " of memory); use at most about " +
-                            std::to_string(side) + "x" + std::to_string(side));
-        }
-    }
+    if (const std::string problem = heightmap_memory_problem(plan.grid.width, plan.grid.height,
+                                                             options.heightmap_memory_limit);
+        !problem.empty())
+        diags.error(parsed.has_grid ? parsed.grid_where : file_start,
+                    "grid " + std::to_string(plan.grid.width) + "x" + std::to_string(plan.grid.height) + " " + problem);
 
     // --- overrides: parse each, then find its statement
     struct PendingOverride {
@@ -490,8 +466,8 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                                                                               : " (looked for " + resolved.string() +
                                                                                     "; input paths are relative to the spec's folder)"));
                         params_ok = false;
-                    } else if (fs::is_directory(resolved, ec)) {
-                        diags.error(where, value + " is a folder; give a file");
+                    } else if (const std::string problem = regular_file_problem(resolved); !problem.empty()) {
+                        diags.error(where, value + " " + problem);
                         params_ok = false;
                     }
                 } else {
@@ -510,6 +486,12 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                         }
                     }
                     const fs::path out(value);
+                    const OutputPlace place = place_output(options.out_dir, value);
+                    if (!place.inside && !options.allow_outside_out) {
+                        diags.error(where, call.qualified() + ": " + outside_out_message(options.out_dir, value, place));
+                        params_ok = false;
+                        continue;
+                    }
                     if (out.is_absolute()) {
                         std::error_code ec;
                         if (!fs::is_directory(out.parent_path(), ec)) {
@@ -519,7 +501,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                             continue;
                         }
                     }
-                    const std::string key = out.lexically_normal().string();
+                    const std::string key = place.resolved.string();
                     if (auto prev = output_files.find(key); prev != output_files.end()) {
                         diags.error(where, "'" + value + "' is already written by the node on line " +
                                                std::to_string(prev->second.line) + "; give each output its own path");

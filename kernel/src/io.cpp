@@ -2,6 +2,8 @@
 #include <orogen/io.hpp>
 
 #include <atomic>
+#include <cmath>
+#include <sys/stat.h>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -111,15 +113,89 @@ void write_file_atomically(const fs::path& target, std::span<const std::uint8_t>
     f.commit();
 }
 
+namespace {
+std::string kind_problem(mode_t mode) {
+    if (S_ISDIR(mode)) return "is a folder; give a file";
+    const char* kind = S_ISFIFO(mode) ? "a FIFO (named pipe)"
+                       : S_ISCHR(mode) ? "a character device"
+                       : S_ISBLK(mode) ? "a block device"
+                       : S_ISSOCK(mode) ? "a socket"
+                                        : "not a regular file";
+    return std::string("is ") + kind + ", not a regular file; give a file (orogen reads only regular files)";
+}
+}  // namespace
+
+std::string regular_file_problem(const fs::path& path) {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) != 0) return errno == ENOENT ? "does not exist" : "cannot be read (" + errno_text(errno) + ")";
+    if (S_ISREG(st.st_mode)) return "";
+    return kind_problem(st.st_mode);
+}
+
 std::vector<std::uint8_t> read_file(const fs::path& path) {
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw BadInput("cannot read " + path.string() + ": no such file");
-    if (fs::is_directory(path, ec)) throw BadInput("cannot read " + path.string() + ": it is a folder, not a file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw BadInput("cannot read " + path.string() + ": " + errno_text(errno));
-    std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw BadInput("cannot read " + path.string() + ": read error");
+    // O_NONBLOCK: opening a FIFO with no writer must not hang; the fstat below then refuses it.
+    const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) {
+        const int err = errno;
+        if (err == ENOENT) throw BadInput("cannot read " + path.string() + ": no such file");
+        if (err == EISDIR) throw BadInput("cannot read " + path.string() + ": it is a folder, not a file");
+        throw BadInput("cannot read " + path.string() + ": " + errno_text(err));
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        const mode_t mode = st.st_mode;
+        ::close(fd);
+        if (S_ISDIR(mode)) throw BadInput("cannot read " + path.string() + ": it is a folder, not a file");
+        throw BadInput("cannot read " + path.string() + ": it " + kind_problem(mode));
+    }
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    std::vector<std::uint8_t> bytes(std::size_t(st.st_size));
+    std::size_t got = 0;
+    while (got < bytes.size()) {
+        const ssize_t n = ::read(fd, bytes.data() + got, bytes.size() - got);
+        if (n < 0 && errno == EINTR) continue;
+        if (n < 0) {
+            const int err = errno;
+            ::close(fd);
+            throw BadInput("cannot read " + path.string() + ": " + errno_text(err));
+        }
+        if (n == 0) break;  // shrank while we read: keep what is there
+        got += std::size_t(n);
+    }
+    bytes.resize(got);
+    ::close(fd);
     return bytes;
+}
+
+std::uint64_t physical_memory() {
+    const long pages = ::sysconf(_SC_PHYS_PAGES);
+    const long page = ::sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : (std::uint64_t(8) << 30);
+}
+
+std::uint64_t heightmap_memory_limit() { return physical_memory() / 4; }
+
+std::string heightmap_memory_problem(double width, double height, std::uint64_t limit) {
+    if (limit == 0) limit = heightmap_memory_limit();
+    const double bytes = width * height * 4.0;
+    if (bytes <= double(limit)) return "";
+    const auto side = std::uint64_t(std::sqrt(double(limit) / 4.0));
+    return "needs " + human_bytes(bytes) + " for one heightmap (4 bytes a vertex), more than the " +
+           human_bytes(double(limit)) + " allowed here (a quarter of this machine's " +
+           human_bytes(double(physical_memory())) + " of memory); use at most about " + std::to_string(side) + "x" +
+           std::to_string(side);
+}
+
+std::string human_bytes(double bytes) {
+    static const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
+    int u = 0;
+    while (bytes >= 1024.0 && u < 6) {
+        bytes /= 1024.0;
+        ++u;
+    }
+    char buf[64];
+    std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.1f %s", bytes, units[u]);
+    return buf;
 }
 
 }  // namespace orogen

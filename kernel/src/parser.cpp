@@ -1,5 +1,7 @@
 #include "spec.hpp"
 
+#include <cerrno>
+
 #include <cmath>
 
 namespace orogen::spec {
@@ -160,6 +162,10 @@ private:
                 error(first, "the format version is given twice");
                 return;
             }
+            if (!(v.number >= 0 && v.number <= 1e9)) {  // would not fit an int (found by fuzz_spec)
+                error(v, "format version " + v.text + " is not supported; this orogen reads `orogen 1`");
+                return;
+            }
             spec.version = int(v.number);
             spec.version_where = v.where;
             return;
@@ -176,7 +182,15 @@ private:
                 error(first, "the seed is given twice");
                 return;
             }
-            spec.seed = std::stoull(v.text[0] == '+' ? v.text.substr(1) : v.text);
+            // 18446744073709551616 rounds to the same double as 2^64-1: strtoull tells them apart.
+            const std::string digits = v.text[0] == '+' ? v.text.substr(1) : v.text;
+            errno = 0;
+            const unsigned long long seed = std::strtoull(digits.c_str(), nullptr, 10);
+            if (errno == ERANGE || digits.find_first_not_of("0123456789") != std::string::npos) {
+                error(v, "expected a whole number from 0 to 2^64-1 after 'seed', found " + what(v));
+                return;
+            }
+            spec.seed = seed;
             spec.seed_where = v.where;
             return;
         }
@@ -209,15 +223,16 @@ private:
         const Token& x = peek();
         if (x.kind == Tok::word && x.where.line == w.where.line && x.where.column == w.where.column + w.where.length &&
             x.text.size() > 1 && x.text[0] == 'x' && x.text.find_first_not_of("0123456789", 1) == std::string::npos) {
-            height = std::stod(x.text.substr(1));
+            height = std::strtod(x.text.c_str() + 1, nullptr);  // HUGE_VAL for 400 digits, not an exception
             ++p_;
         }
         spec.has_grid = true;
         spec.grid_where = w.where;
         spec.grid_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - w.where.column;
         if (width < 2 || height < 2) {
-            diags_.error(spec.grid_where, "the grid needs at least 2 vertices a side, got " + std::to_string(long(width)) + "x" +
-                                      std::to_string(long(height)));
+            diags_.error(spec.grid_where, "the grid needs at least 2 vertices a side, got " +
+                                              std::to_string(long(std::max(width, -1e18))) + "x" +
+                                              std::to_string(long(std::max(height, -1e18))));
             return;
         }
         spec.grid_width = width > 2e9 ? 2000000000 : int(width);

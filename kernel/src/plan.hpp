@@ -46,6 +46,9 @@ struct CheckOptions {
     std::optional<std::uint64_t> seed;   ///< --seed, overrides the spec's
     /// Memory a single heightmap may take before the grid is refused, bytes (0: a quarter of physical memory).
     std::uint64_t heightmap_memory_limit = 0;
+    /// --out: every output path must resolve inside it, unless allow_outside_out (--allow-outside-out).
+    std::filesystem::path out_dir = "out";
+    bool allow_outside_out = false;
 };
 
 /// Check `parsed` against `registry`. Errors go to `diags`; the plan is only

@@ -91,8 +91,32 @@ int decode(const std::uint8_t* bytes, std::size_t size, bool header_only, ErrorS
     return 0;
 }
 
-GrayImage read_png(const std::filesystem::path& path, bool header_only) {
-    const std::vector<std::uint8_t> bytes = read_file(path);
+std::uint32_t be32(const std::uint8_t* p) {
+    return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
+}
+
+/// Walk the chunks (after the signature) without decoding: "" and the image data's size if the file runs
+/// whole to its end marker, else why it does not. Costs nothing next to inflating, and lets a cut file fail
+/// before a buffer is allocated for its pixels.
+std::string chunk_problem(const std::vector<std::uint8_t>& bytes, std::uint64_t& idat_bytes) {
+    std::size_t at = 8;
+    idat_bytes = 0;
+    while (true) {
+        if (bytes.size() - at < 12)
+            return "truncated PNG (the file ends at byte " + std::to_string(bytes.size()) +
+                   ", before its end marker IEND); it was cut short: copy it again";
+        const std::uint64_t length = be32(&bytes[at]);
+        if (length > 0x7fffffffu) return "damaged PNG (a chunk at byte " + std::to_string(at) + " declares an impossible length)";
+        if (bytes.size() - at - 12 < length)
+            return "truncated PNG (the file ends at byte " + std::to_string(bytes.size()) + ", inside a chunk that declares " +
+                   std::to_string(length) + " bytes; the end marker IEND is missing); it was cut short: copy it again";
+        if (std::memcmp(&bytes[at + 4], "IDAT", 4) == 0) idat_bytes += length;
+        if (std::memcmp(&bytes[at + 4], "IEND", 4) == 0) return "";
+        at += 12 + std::size_t(length);
+    }
+}
+
+GrayImage read_png(const std::vector<std::uint8_t>& bytes, const std::filesystem::path& path, bool header_only) {
     static const std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
     if (bytes.size() < 8 || std::memcmp(bytes.data(), signature, 8) != 0)
         throw BadInput("cannot read " + path.string() + ": not a PNG file (it does not start with the PNG signature)");
@@ -111,6 +135,20 @@ GrayImage read_png(const std::filesystem::path& path, bool header_only) {
                        ", but a heightmap must be a grayscale PNG (8 or 16 bits); convert it, e.g. "
                        "`convert in.png -colorspace gray -depth 16 out.png`");
     }
+    // Bounded decoding: the declared size against the memory budget, then the data against the size,
+    // all before a byte is allocated for pixels.
+    if (const std::string problem = heightmap_memory_problem(double(w), double(h)); !problem.empty())
+        throw BadInput("cannot read " + path.string() + ": its header declares " + std::to_string(w) + "x" +
+                       std::to_string(h) + " pixels, which " + problem);
+    std::uint64_t idat_bytes = 0;
+    if (const std::string problem = chunk_problem(bytes, idat_bytes); !problem.empty())
+        throw BadInput("cannot read " + path.string() + ": " + problem);
+    // Deflate packs at most 1032 bytes into one, so fewer image bytes than pixels/1032 cannot be whole.
+    const double pixel_bytes = double(w) * double(h) * double(bit_depth) / 8.0;
+    if (double(idat_bytes) * 1032.0 + 1024.0 < pixel_bytes)
+        throw BadInput("cannot read " + path.string() + ": damaged PNG (its " + std::to_string(w) + "x" +
+                       std::to_string(h) + " pixels need at least " + human_bytes(pixel_bytes / 1032.0) +
+                       " of compressed image data, but it holds " + human_bytes(double(idat_bytes)) + ")");
     GrayImage image;
     image.width = int(w);
     image.height = int(h);
@@ -160,8 +198,11 @@ int encode(std::ostream& file, int width, int height, int bits, int colour_type,
 
 }  // namespace
 
-GrayImage read_gray_png(const std::filesystem::path& path) { return read_png(path, false); }
-GrayImage read_gray_png_header(const std::filesystem::path& path) { return read_png(path, true); }
+GrayImage read_gray_png(const std::filesystem::path& path) { return read_png(read_file(path), path, false); }
+GrayImage read_gray_png_header(const std::filesystem::path& path) { return read_png(read_file(path), path, true); }
+GrayImage decode_gray_png(const std::vector<std::uint8_t>& bytes, const std::filesystem::path& name, bool header_only) {
+    return read_png(bytes, name, header_only);
+}
 
 void write_gray_png(std::ostream& file, int width, int height, int bits, std::span<const std::uint16_t> samples) {
     if (bits != 8 && bits != 16) throw Error("internal error: PNG bit depth must be 8 or 16");

@@ -1,6 +1,7 @@
 #include "runner.hpp"
 
 #include "json.hpp"
+#include "outputs.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -9,6 +10,8 @@
 #include <tbb/global_control.h>
 
 #include <chrono>
+#include <csignal>
+#include <optional>
 #include <cstdio>
 #include <sstream>
 #include <thread>
@@ -26,9 +29,9 @@ namespace {
 class Context : public NodeContext {
 public:
     Context(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs, const RunOptions& options,
-            std::vector<fs::path>& outputs, bool for_entry = false)
-        : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), outputs_(outputs),
-          seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
+            const Staging& staging, std::vector<fs::path>& outside, bool for_entry = false)
+        : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), staging_(staging),
+          outside_(outside), seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
 
     const std::string& label() const override { return node_.label; }
     std::uint64_t seed() const override { return seed_; }
@@ -53,18 +56,32 @@ public:
         if (hm.use_count() == 1) return std::const_pointer_cast<Heightmap>(hm);  // nobody else reads it: no copy
         return std::make_shared<Heightmap>(*hm);
     }
+    // Outputs inside --out are staged and move into place with the rest at the end of the run; one the
+    // checker allowed outside (--allow-outside-out) is written where it goes, by itself.
     fs::path output_path(const std::string& relative) override {
         if (for_entry_)
             throw Error("internal error: " + node_.node->qualified_name() +
                         " writes files, so it cannot be mapped over a series");
-        const fs::path rel(relative);
-        const fs::path full = rel.is_absolute() ? rel : options_.out_dir / rel;
+        const OutputPlace place = place_output(options_.out_dir, relative);
+        const fs::path full = place.inside ? staging_.folder() / place.relative : place.resolved;
         std::error_code ec;
+        if (place.inside) {  // where it will go must be free: fail now, naming the node, not at the commit
+            const fs::path target = options_.out_dir / place.relative;
+            fs::path prefix = options_.out_dir;
+            for (const auto& part : place.relative.parent_path()) {
+                prefix /= part;
+                if (fs::exists(prefix, ec) && !fs::is_directory(prefix, ec))
+                    throw Error("cannot write " + target.string() + ": " + prefix.string() +
+                                " is a file, not a folder; move it away or write elsewhere");
+            }
+            if (fs::is_directory(target, ec))
+                throw Error("cannot write " + target.string() + ": a folder has that name; move it away or write elsewhere");
+        }
         fs::create_directories(full.parent_path(), ec);
         if (ec)
-            throw Error("cannot write " + full.string() + ": cannot create folder " + full.parent_path().string() +
-                        " (" + ec.message() + ")");
-        outputs_.push_back(full);
+            throw Error("cannot write " + (place.inside ? (options_.out_dir / place.relative) : full).string() +
+                        ": cannot create folder " + full.parent_path().string() + " (" + ec.message() + ")");
+        if (!place.inside) outside_.push_back(full);
         return full;
     }
     fs::path input_path(std::string_view name) const override {
@@ -90,7 +107,8 @@ private:
     const PlannedNode& node_;
     std::vector<Value> inputs_;
     const RunOptions& options_;
-    std::vector<fs::path>& outputs_;
+    const Staging& staging_;
+    std::vector<fs::path>& outside_;
     std::uint64_t seed_;
     bool for_entry_;
 };
@@ -100,16 +118,17 @@ private:
 /// consumer asks for it. It runs inside run(), which keeps plan, node and
 /// options alive for as long as any node can pull an entry.
 std::shared_ptr<Series> map_over_series(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs,
-                                        std::size_t mapped, const RunOptions& options, std::vector<fs::path>& outputs) {
+                                        std::size_t mapped, const RunOptions& options, const Staging& staging,
+                                        std::vector<fs::path>& outside) {
     const std::shared_ptr<const Series> source = inputs[mapped].series();
     auto result = std::make_shared<Series>();
     result->element = node.node->output;
     result->times = source->times;
-    result->make = [&plan, &node, &options, &outputs, inputs = std::move(inputs), mapped,
+    result->make = [&plan, &node, &options, &staging, &outside, inputs = std::move(inputs), mapped,
                     source](std::size_t j) -> Value {
         std::vector<Value> entry_inputs = inputs;
         entry_inputs[mapped] = source->at(j);
-        Context ctx(plan, node, std::move(entry_inputs), options, outputs, true);
+        Context ctx(plan, node, std::move(entry_inputs), options, staging, outside, true);
         try {
             ctx.check_cancelled();
             Value v = node.node->run(ctx).main;
@@ -135,7 +154,10 @@ std::string node_error(const PlannedNode& node, const std::string& message) {
     return spec::format(d);
 }
 
-void write_manifest(const Plan& plan, const RunOptions& options, const RunResult& result) {
+/// manifest.json into the staging folder: `staged` are the run's files relative to --out (and to the
+/// staging folder), `outside` those written outside --out.
+void write_manifest(const Plan& plan, const RunOptions& options, const Staging& staging,
+                    const std::vector<fs::path>& staged, const std::vector<fs::path>& outside) {
     JsonWriter j;
     j.begin_object();
     j.key("orogen").value(OROGEN_VERSION);
@@ -169,20 +191,32 @@ void write_manifest(const Plan& plan, const RunOptions& options, const RunResult
     }
     j.end_array();
     j.key("outputs").begin_array();
-    for (const auto& f : result.outputs) {
+    auto entry = [&](const fs::path& shown, const fs::path& file) {
         std::error_code ec;
-        if (!fs::exists(f, ec)) continue;
         j.begin_object();
-        j.key("path").value(fs::relative(f, options.out_dir, ec).string());
-        j.key("bytes").value(std::uint64_t(fs::file_size(f, ec)));
-        j.key("sha256").value(sha256_file(f));
+        j.key("path").value(shown.string());
+        j.key("bytes").value(std::uint64_t(fs::file_size(file, ec)));
+        j.key("sha256").value(sha256_file(file));
         j.end_object();
-    }
+    };
+    for (const auto& f : staged) entry(f, staging.folder() / f);
+    for (const auto& f : outside)
+        if (std::error_code ec; fs::exists(f, ec)) entry(f, f);
     j.end_array();
     j.end_object();
     const std::string& text = j.str();
-    write_file_atomically(options.out_dir / "manifest.json",
+    write_file_atomically(staging.folder() / "manifest.json",
                           std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+std::string cancel_reason(const RunOptions& options) {
+    const int sig = options.cancel_signal ? options.cancel_signal->load() : 0;
+    return sig == SIGTERM ? "stopped by SIGTERM" : "cancelled by the user";
+}
+
+void cancelled(RunResult& result, std::string message) {
+    result.exit_code = 130;
+    result.error = std::move(message);
 }
 
 }  // namespace
@@ -201,6 +235,19 @@ RunResult run(const Plan& plan, const RunOptions& options) {
                        (ec ? ec.message() : std::string("a file of that name exists")) + "); pick another with --out\n";
         return result;
     }
+    // Debris of earlier runs that were killed, then a staging folder of our own.
+    result.notes = clean_debris(options.out_dir);
+    if (options.on_note)
+        for (const auto& note : result.notes) options.on_note(note);
+    std::optional<Staging> staging;
+    try {
+        staging.emplace(options.out_dir);
+    } catch (const Error& e) {
+        result.exit_code = 1;
+        result.error = std::string("orogen: error: ") + e.what() + "\n";
+        return result;
+    }
+    std::vector<fs::path> outside;  // outputs written outside --out (allowed with --allow-outside-out)
 
     std::map<std::string, Value, std::less<>> values;
     const int total = int(plan.nodes.size());
@@ -214,7 +261,7 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             if (!key.empty() && it != plan.last_use.end() && it->second == i) values.erase(key);
         }
         const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
-        Context ctx(plan, node, std::move(inputs), options, result.outputs);
+        Context ctx(plan, node, std::move(inputs), options, *staging, outside);
         if (options.progress) options.progress->start(int(i) + 1, total, node.label, node.node->qualified_name());
         const auto start = std::chrono::steady_clock::now();
         NodeOutputs out;
@@ -222,12 +269,11 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             ctx.check_cancelled();
             if (node.mapped_input >= 0)  // entries are made when a later node pulls them
                 out = NodeOutputs(map_over_series(plan, node, mapped_inputs, std::size_t(node.mapped_input), options,
-                                                  result.outputs));
+                                                  *staging, outside));
             else
                 out = node.node->run(ctx);
         } catch (const Cancelled&) {
-            result.exit_code = 130;
-            result.error = node_error(node, "cancelled by the user");
+            cancelled(result, node_error(node, cancel_reason(options)));
             break;
         } catch (const Error& e) {
             result.exit_code = e.kind() == Error::Kind::bad_input ? 2 : 1;
@@ -270,16 +316,23 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         }
     }
     result.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (result.exit_code == 0 && options.cancel && options.cancel->load())  // stopped after the last node
+        cancelled(result, "orogen: error: " + cancel_reason(options) + " before the outputs were moved into place\n");
     if (result.exit_code == 0) {
+        // All or nothing: the manifest is staged with the rest and moves into place last.
         try {
-            write_manifest(plan, options, result);
+            const std::vector<fs::path> staged = staging->files();
+            write_manifest(plan, options, *staging, staged, outside);
+            staging->commit("manifest.json");
+            for (const auto& f : staged) result.outputs.push_back(options.out_dir / f);
+            for (const auto& f : outside) result.outputs.push_back(f);
             result.outputs.push_back(options.out_dir / "manifest.json");
         } catch (const std::exception& e) {
             result.exit_code = 1;
             result.error = std::string("orogen: error: ") + e.what() + "\n";
         }
     }
-    return result;
+    return result;  // on failure `staging` goes out of scope and takes every staged file with it
 }
 
 std::string format_timings(const RunResult& result) {

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@ struct RunOptions {
     ProgressDisplay* progress = nullptr;
     std::vector<PluginRecord> plugins;  ///< for the manifest
     const std::atomic<bool>* cancel = nullptr;
+    /// The signal that set `cancel` (SIGINT or SIGTERM), for the message; the caller picks the exit code.
+    const std::atomic<int>* cancel_signal = nullptr;
+    /// Told at once of each piece of debris of killed runs removed before this run (else kept in RunResult::notes).
+    std::function<void(const std::string&)> on_note;
 };
 
 struct NodeTiming {
@@ -34,7 +39,8 @@ struct RunResult {
     int exit_code = 0;        ///< 0 ok, 1 failed run, 2 bad input, 130 cancelled
     std::string error;        ///< formatted diagnostic when exit_code != 0
     std::vector<NodeTiming> timings;
-    std::vector<std::filesystem::path> outputs;  ///< files written, in order
+    std::vector<std::filesystem::path> outputs;  ///< files written (staged ones sorted), the manifest last
+    std::vector<std::string> notes;              ///< debris of killed runs removed before this one, one line each
     double total_seconds = 0.0;
 };
 

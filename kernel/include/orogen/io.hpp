@@ -55,8 +55,31 @@ void commit_all(std::span<AtomicFile*> files);
 /// Write `bytes` to `target` atomically.
 void write_file_atomically(const std::filesystem::path& target, std::span<const std::uint8_t> bytes);
 
-/// Read a whole file; throws orogen::BadInput naming the file if it cannot be read.
+/// Read a whole file; throws orogen::BadInput naming the file if it cannot be read, or if it is not a
+/// regular file (a FIFO or a device would hang or never end).
 std::vector<std::uint8_t> read_file(const std::filesystem::path& path);
+
+/// "" if `path` names a regular file (symbolic links followed) that can be read, else why not, in words
+/// that follow the path: "is a folder; give a file", "is a FIFO, not a regular file; ...".
+std::string regular_file_problem(const std::filesystem::path& path);
+
+// ------------------------------------------------------------ memory budget
+//
+// One rule for every heightmap a spec or a file asks for: at most a quarter of
+// physical memory for one heightmap (4 bytes a vertex), checked before anything
+// is allocated. The checker applies it to the grid, each reader to the size its
+// file declares.
+
+/// Physical memory, bytes (8 GiB if it cannot be found out).
+std::uint64_t physical_memory();
+/// A quarter of physical memory, bytes.
+std::uint64_t heightmap_memory_limit();
+/// "" if a width × height heightmap fits in `limit` bytes (0: heightmap_memory_limit()), else the rest of
+/// a sentence: "needs 37.3 GiB for one heightmap (4 bytes a vertex), more than the 5.9 GiB allowed here (a
+/// quarter of this machine's 23.5 GiB of memory); use at most about 39000x39000".
+std::string heightmap_memory_problem(double width, double height, std::uint64_t limit = 0);
+/// "3.6 TiB", "512 MiB".
+std::string human_bytes(double bytes);
 
 /// SHA-256 of a file as 64 lowercase hex digits (as `sha256sum` prints it).
 std::string sha256_file(const std::filesystem::path& path);
@@ -75,8 +98,11 @@ struct GrayImage {
 /// orogen::BadInput naming the file for anything else: not a PNG, truncated,
 /// colour, palette.
 GrayImage read_gray_png(const std::filesystem::path& path);
-/// Read only the header: size and bit depth, same checks as read_gray_png minus decoding.
+/// Read only the header: size and bit depth, same checks as read_gray_png minus decoding (the declared size
+/// against the memory budget, the chunks complete, enough image data for the size).
 GrayImage read_gray_png_header(const std::filesystem::path& path);
+/// read_gray_png (or _header) on bytes already in memory; `name` is only for messages.
+GrayImage decode_gray_png(const std::vector<std::uint8_t>& bytes, const std::filesystem::path& name, bool header_only);
 
 /// Encode a grayscale PNG (8 or 16 bits) to `file` (usually AtomicFile::stream()).
 void write_gray_png(std::ostream& file, int width, int height, int bits, std::span<const std::uint16_t> samples);

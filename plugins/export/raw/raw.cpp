@@ -11,7 +11,10 @@
 #include <cstring>
 #include <iomanip>
 #include <limits>
+#include <fstream>
 #include <sstream>
+
+#include <nlohmann/json.hpp>
 
 namespace fs = std::filesystem;
 
@@ -99,6 +102,115 @@ Written write_raw(ConstGridView h, const fs::path& target, std::optional<Range> 
     AtomicFile* files[] = {&file, &sidecar};
     commit_all(files);
     return w;
+}
+
+}  // namespace orogen::raw
+
+// ------------------------------------------------------------------ reading
+
+namespace orogen::raw {
+
+Sidecar parse_sidecar(std::string_view text, const std::string& name) {
+    const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
+    if (j.is_discarded())
+        throw BadInput("cannot read " + name + ": it is not valid JSON; export:raw writes it beside the RAW file");
+    if (!j.is_object()) throw BadInput("cannot read " + name + ": a sidecar is a JSON object { \"width\": ..., ... }");
+    auto field = [&](const char* key) -> const nlohmann::json& {
+        auto it = j.find(key);
+        if (it == j.end()) throw BadInput("cannot read " + name + ": \"" + key + "\" is missing");
+        return *it;
+    };
+    auto size = [&](const char* key) {
+        const auto& v = field(key);
+        if (!v.is_number_integer() || v.get<std::int64_t>() < 1 || v.get<std::int64_t>() > 1000000)
+            throw BadInput("cannot read " + name + ": \"" + key + "\" must be a whole number from 1 to 1000000, got " +
+                           v.dump().substr(0, 40));
+        return int(v.get<std::int64_t>());
+    };
+    auto real = [&](const char* key) {
+        const auto& v = field(key);
+        if (!v.is_number() || !std::isfinite(v.get<double>()))
+            throw BadInput("cannot read " + name + ": \"" + key + "\" must be a finite number, got " + v.dump().substr(0, 40));
+        return v.get<double>();
+    };
+    Sidecar s;
+    const auto& format = field("format");
+    if (format == "r16") s.format = Format::r16;
+    else if (format == "r32") s.format = Format::r32;
+    else throw BadInput("cannot read " + name + ": \"format\" must be \"r16\" or \"r32\", got " + format.dump().substr(0, 40));
+    if (auto it = j.find("byte_order"); it != j.end() && *it != "little-endian")
+        throw BadInput("cannot read " + name + ": \"byte_order\" must be \"little-endian\", got " + it->dump().substr(0, 40));
+    s.width = size("width");
+    s.height = size("height");
+    s.cell = real("cell_size");
+    if (!(s.cell > 0)) throw BadInput("cannot read " + name + ": \"cell_size\" must be above 0 m, got " + number(s.cell));
+    s.range.low = real("height_min");
+    s.range.high = real("height_max");
+    if (s.range.high < s.range.low)
+        throw BadInput("cannot read " + name + ": \"height_max\" (" + number(s.range.high) + ") is below \"height_min\" (" +
+                       number(s.range.low) + ")");
+    return s;
+}
+
+Sidecar read_raw_header(const fs::path& file) {
+    const Format format = format_of(file);
+    const fs::path sidecar = fs::path(file.string() + ".json");
+    if (const std::string problem = regular_file_problem(sidecar); !problem.empty())
+        throw BadInput("cannot read " + file.string() + ": its sidecar " + sidecar.string() + " " + problem +
+                       "; a RAW file says nothing of its size, so the sidecar export:raw writes must sit beside it");
+    const auto bytes = read_file(sidecar);
+    if (bytes.size() > (1u << 20))
+        throw BadInput("cannot read " + sidecar.string() + ": " + human_bytes(double(bytes.size())) +
+                       " is far too big for a sidecar (at most 1 MiB)");
+    Sidecar s = parse_sidecar(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+                              sidecar.string());
+    if (s.format != format)
+        throw BadInput("cannot read " + file.string() + ": the sidecar says " + (s.format == Format::r16 ? "r16" : "r32") +
+                       ", but the file's extension says " + file.extension().string());
+    if (const std::string problem = heightmap_memory_problem(s.width, s.height); !problem.empty())
+        throw BadInput("cannot read " + file.string() + ": its sidecar declares " + std::to_string(s.width) + "x" +
+                       std::to_string(s.height) + " samples, which " + problem);
+    if (const std::string problem = regular_file_problem(file); !problem.empty())
+        throw BadInput("cannot read " + file.string() + ": it " + problem);
+    const std::uint64_t want = std::uint64_t(s.width) * std::uint64_t(s.height) * (format == Format::r16 ? 2 : 4);
+    std::error_code ec;
+    const std::uint64_t have = fs::file_size(file, ec);
+    if (ec || have != want)
+        throw BadInput("cannot read " + file.string() + ": it holds " + std::to_string(have) + " bytes, but its sidecar's " +
+                       std::to_string(s.width) + "x" + std::to_string(s.height) + " " +
+                       (format == Format::r16 ? "16-bit" : "32-bit") + " samples need exactly " + std::to_string(want) +
+                       (have < want ? "; it is truncated" : "; the sidecar belongs to another file"));
+    return s;
+}
+
+std::vector<float> read_raw(const fs::path& file, Sidecar& info) {
+    info = read_raw_header(file);
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw BadInput("cannot read " + file.string() + ": " + std::strerror(errno));
+    const std::size_t w = std::size_t(info.width), h = std::size_t(info.height);
+    std::vector<float> heights(w * h);
+    const std::size_t sample = info.format == Format::r16 ? 2 : 4;
+    std::vector<std::uint8_t> row(w * sample);
+    for (std::size_t y = 0; y < h; ++y) {
+        if (!in.read(reinterpret_cast<char*>(row.data()), std::streamsize(row.size())))
+            throw BadInput("cannot read " + file.string() + ": it ends in row " + std::to_string(y) + " of " +
+                           std::to_string(h) + " (it changed while being read?)");
+        float* dst = heights.data() + y * w;
+        for (std::size_t x = 0; x < w; ++x) {
+            const std::uint8_t* b = &row[x * sample];
+            if (info.format == Format::r16) {
+                dst[x] = float(dequantize16(std::uint16_t(b[0] | (b[1] << 8)), info.range));
+            } else {
+                const std::uint32_t bits = std::uint32_t(b[0]) | (std::uint32_t(b[1]) << 8) |
+                                           (std::uint32_t(b[2]) << 16) | (std::uint32_t(b[3]) << 24);
+                dst[x] = std::bit_cast<float>(bits);
+                if (!std::isfinite(dst[x]))
+                    throw BadInput("cannot read " + file.string() + ": sample (" + std::to_string(x) + ", " +
+                                   std::to_string(y) + ") is not a finite number");
+            }
+        }
+    }
+    return heights;
 }
 
 }  // namespace orogen::raw

@@ -49,4 +49,26 @@ Written write_raw(ConstGridView heights, const std::filesystem::path& target, st
 /// The sidecar's text (JSON).
 std::string sidecar_json(Format format, int width, int height, double cell, Range range);
 
+// ------------------------------------------------------------------ reading
+
+/// What a sidecar declares.
+struct Sidecar {
+    Format format = Format::r16;
+    int width = 0, height = 0;
+    double cell = 1.0;   ///< metres
+    Range range;         ///< r16: heights of 0 and 65535, metres
+};
+
+/// Parse a sidecar's text. Throws orogen::BadInput naming `name` and the field that is wrong (not JSON,
+/// missing, wrong type, out of range), so hostile text ends in one clear message.
+Sidecar parse_sidecar(std::string_view json, const std::string& name);
+
+/// Read `file`'s sidecar (`file`.json) and check, before anything is allocated: the format matches the
+/// extension, the declared size fits the memory budget (orogen::heightmap_memory_problem), and `file` holds
+/// exactly width × height samples (a short file is refused, not padded). Throws orogen::BadInput.
+Sidecar read_raw_header(const std::filesystem::path& file);
+
+/// read_raw_header(), then the samples, a row at a time, as heights in metres (r16 dequantised).
+std::vector<float> read_raw(const std::filesystem::path& file, Sidecar& info);
+
 }  // namespace orogen::raw

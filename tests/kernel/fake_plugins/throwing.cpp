@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <thread>
 #include <stdexcept>
 
@@ -34,12 +35,23 @@ OROGEN_PLUGIN("test-throwing", "0.0.1", registry) {
                   .run = [](NodeContext&) -> NodeOutputs { return {}; }});
     registry.add({.kind = "generate", .name = "slow", .summary = "runs for up to 60 s, checking for cancellation",
                   .output = ValueType::heightmap,
+                  .params = {Param::real("seconds", 60).min(0).max(60).unit("s")},
                   .run = [](NodeContext& ctx) -> NodeOutputs {
-                      for (int i = 0; i < 6000; ++i) {
+                      const int steps = int(ctx.real("seconds") * 100);
+                      for (int i = 0; i < steps; ++i) {
                           std::this_thread::sleep_for(std::chrono::milliseconds(10));
                           ctx.check_cancelled();
-                          ctx.progress(i / 6000.0);
+                          ctx.progress(i / double(steps));
                       }
+                      return std::make_shared<Heightmap>(2, 2, 1.0);
+                  }});
+    registry.add({.kind = "generate", .name = "stubborn",
+                  .summary = "creates stubborn.started in the current folder, then sleeps 30 s without looking at "
+                             "cancellation",
+                  .output = ValueType::heightmap,
+                  .run = [](NodeContext&) -> NodeOutputs {
+                      std::ofstream("stubborn.started") << "started\n";
+                      std::this_thread::sleep_for(std::chrono::seconds(30));
                       return std::make_shared<Heightmap>(2, 2, 1.0);
                   }});
 }

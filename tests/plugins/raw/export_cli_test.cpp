@@ -59,7 +59,8 @@ TEST(ExportCli, BadExportsFailAtCheckTimeAndSayWhere) {
              "bad.orogen:9:41: error: export:vtk: decimate applies to .vtp meshes only; .vti keeps every sample",
              "bad.orogen:10:36: error: export:raw: give both low and high (the heights mapped to 0 and 65535), or "
              "neither to use the terrain's own lowest and highest point",
-             "bad.orogen:11:23: error: cannot write /no/such/folder/t.vdb: folder /no/such/folder does not exist",
+             "bad.orogen:11:23: error: export:vdb: '/no/such/folder/t.vdb' is an absolute path, outside the output "
+             "folder out; give a path inside --out, or pass --allow-outside-out to write there",
              "7 errors in ",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;

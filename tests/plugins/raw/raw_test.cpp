@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <fstream>
+#include <functional>
 
 using namespace orogen;
 namespace fs = std::filesystem;
@@ -123,4 +125,80 @@ TEST(Raw, FullDiskKeepsTheGoodFilesAndLeavesNoTemporary) {
     EXPECT_EQ(test::folder_entries(disk.path()), (std::vector<std::string>{"t.r32", "t.r32.json"}));
     EXPECT_EQ(test::file_text(disk.path() / "t.r32"), "good");
     EXPECT_EQ(test::file_text(disk.path() / "t.r32.json"), "good json");
+}
+
+// ------------------------------------------------------------------ reading back (import:raw)
+
+namespace {
+std::string bad_input_text(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const BadInput& e) {
+        return e.what();
+    }
+    return "no error";
+}
+}  // namespace
+
+TEST(RawRead, BothFormatsReadBackWhatWasWritten) {
+    test::TempDir dir;
+    const int w = 65, h = 40;
+    auto heights = test::hills(w, h, 800.0);
+    const ConstGridView g(heights.data(), w, h, 5.0);
+    raw::write_raw(g, dir / "t.r32");
+    raw::write_raw(g, dir / "t.r16");
+    raw::Sidecar s;
+    EXPECT_EQ(raw::read_raw(dir / "t.r32", s), heights);  // exact
+    EXPECT_EQ(s.width, w);
+    EXPECT_EQ(s.height, h);
+    EXPECT_EQ(s.cell, 5.0);
+    const auto q = raw::read_raw(dir / "t.r16", s);
+    const double step = (s.range.high - s.range.low) / 65535.0;
+    ASSERT_EQ(q.size(), heights.size());
+    for (std::size_t i = 0; i < q.size(); ++i) ASSERT_NEAR(q[i], heights[i], 0.5 * step + 1e-3) << i;
+}
+
+TEST(RawRead, AHugeDeclaredSizeACutFileAndABrokenSidecarAreRefusedBeforeReading) {
+    test::TempDir dir;
+    std::vector<float> heights(65 * 40, 1.0f);
+    heights[7] = 9.0f;
+    raw::write_raw(ConstGridView(heights.data(), 65, 40, 5.0), dir / "t.r16");
+    std::string sidecar = test::file_text(dir / "t.r16.json");
+    auto with = [&](const std::string& from, const std::string& to) {
+        std::string s = sidecar;
+        s.replace(s.find(from), from.size(), to);
+        std::ofstream(dir / "t.r16.json", std::ios::binary) << s;
+    };
+    const std::string file = (dir / "t.r16").string();
+    {
+        std::string s = sidecar;
+        s.replace(s.find("\"width\": 65"), 11, "\"width\": 100000");
+        s.replace(s.find("\"height\": 40"), 12, "\"height\": 100000");
+        std::ofstream(dir / "t.r16.json", std::ios::binary) << s;
+    }
+    std::string m = bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); });
+    EXPECT_EQ(m.substr(0, m.find(" more than")),
+              "cannot read " + file + ": its sidecar declares 100000x100000 samples, which needs 37.3 GiB for one "
+              "heightmap (4 bytes a vertex),");
+    std::ofstream(dir / "t.r16.json", std::ios::binary) << sidecar;
+    const std::string data = test::file_text(dir / "t.r16");
+    std::ofstream(dir / "t.r16", std::ios::binary) << data.substr(0, 1000);
+    EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
+              "cannot read " + file + ": it holds 1000 bytes, but its sidecar's 65x40 16-bit samples need exactly "
+              "5200; it is truncated");
+    std::ofstream(dir / "t.r16", std::ios::binary) << data;
+    with("\"width\": 65", "\"width\": -1");
+    EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
+              "cannot read " + file + ".json: \"width\" must be a whole number from 1 to 1000000, got -1");
+    std::ofstream(dir / "t.r16.json", std::ios::binary) << sidecar.substr(0, 40);
+    EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
+              "cannot read " + file + ".json: it is not valid JSON; export:raw writes it beside the RAW file");
+    fs::remove(dir / "t.r16.json");
+    EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
+              "cannot read " + file + ": its sidecar " + file + ".json does not exist; a RAW file says nothing of its "
+              "size, so the sidecar export:raw writes must sit beside it");
+    EXPECT_EQ(bad_input_text([&] { raw::parse_sidecar("{\"format\": \"r16\", \"width\": 3, \"height\": 3, "
+                                                      "\"cell_size\": 1, \"height_min\": 5, \"height_max\": 1}",
+                                                      "s.json"); }),
+              "cannot read s.json: \"height_max\" (1) is below \"height_min\" (5)");
 }
