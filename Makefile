@@ -4,7 +4,7 @@
 BUILD ?= build
 JOBS  ?= 2
 
-.PHONY: all setup configure build demo test bench clean asan asan-configure tsan fuzz-smoke fuzz-long
+.PHONY: all setup configure build demo test bench clean asan asan-ci asan-configure tsan fuzz-smoke fuzz-long
 
 all: build
 
@@ -39,6 +39,11 @@ TSAN_BUILD ?= build-tsan
 # Every plugin (the tests run specs through several), and the tests of the thread-parallel cores and of
 # the exporters (which write in parallel).
 TSAN_ONLY  ?= /plugins/[^/]+/[^/]+$$|/tests/plugins/(thermal|hydraulic|pipe|plates|png_export|raw|gltf|vtk|vdb)$$
+# What `make asan` configures: empty = the whole tree. CI (.ci/run) passes ASAN_CI: the kernel, the fuzz
+# targets and the plugins the kernel's tests run specs through (the whole-tree run is not yet measured
+# on a 2-core CI machine; see docs/hardening.md).
+ASAN_ONLY  ?=
+ASAN_CI     = /tests/(kernel|fuzz)|/plugins/(generate/(diamond-square|fault|rmp)|export/(png|raw|gltf)|import/(png|raw)|erode/thermal|tectonics/plates)
 FUZZ_SECONDS ?= 20
 FUZZ_RUNS    ?= 1000000
 FUZZ_TARGETS  = spec overrides png sidecar
@@ -48,9 +53,13 @@ export ASAN_OPTIONS  ?= detect_leaks=1:abort_on_error=1:strict_string_checks=1:d
 export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
 export TSAN_OPTIONS  ?= halt_on_error=1:second_deadlock_stack=1:suppressions=$(CURDIR)/tools/tsan.supp
 
+# CI's sanitizer phase: ASan + UBSan over the kernel, the fuzz corpora and the plugins its tests use.
+asan-ci: ASAN_ONLY = $(ASAN_CI)
+asan-ci: asan
+
 asan: asan-configure
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
-	cd $(ASAN_BUILD) && ctest --output-on-failure -j$(JOBS)
+	cd $(ASAN_BUILD) && ctest --output-on-failure --no-tests=error -j$(JOBS)
 
 asan-configure: setup
 	@cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
@@ -58,7 +67,7 @@ asan-configure: setup
 	  -DCMAKE_C_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
 	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" \
 	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined" \
-	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF -DOROGEN_FUZZ=ON $(SAN_CMAKE) >/dev/null
+	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF -DOROGEN_FUZZ=ON '-DOROGEN_ONLY=$(ASAN_ONLY)' $(SAN_CMAKE) >/dev/null
 
 tsan: setup
 	@cmake -S . -B $(TSAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
@@ -67,7 +76,7 @@ tsan: setup
 	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=thread" \
 	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF '-DOROGEN_ONLY=$(TSAN_ONLY)' $(SAN_CMAKE) >/dev/null
 	cmake --build $(TSAN_BUILD) -j$(JOBS)
-	cd $(TSAN_BUILD) && ctest --output-on-failure -j$(JOBS) -LE 'pipelines|fuzz'
+	cd $(TSAN_BUILD) && ctest --output-on-failure --no-tests=error -j$(JOBS) -LE 'pipelines|fuzz'
 
 fuzz-smoke:
 	@cd $(ASAN_BUILD)/tests && for t in $(FUZZ_TARGETS); do \
