@@ -118,6 +118,16 @@ void check_style(CheckContext& ctx) {
     check_frame_memory(ctx, bytes_per_pixel(int(samples)));
 }
 
+/// The check both nodes share: the style parameters, and an image of width × height as the output (a
+/// turntable's frames are such images too).
+void check_frame(CheckContext& ctx) {
+    check_style(ctx);
+    ctx.output().type = ValueType::image;
+    ctx.output().width = int(ctx.integer("width"));
+    ctx.output().height = int(ctx.integer("height"));
+    ctx.output().layers.clear();
+}
+
 Style style_from(NodeContext& ctx) {
     Style s;
     s.splat.band_start = {float(ctx.real("grass_from")), float(ctx.real("rock_from")), float(ctx.real("snow_from"))};
@@ -243,12 +253,8 @@ OROGEN_PLUGIN("render-terrain", "0.1.0", registry) {
         .params = turntable_params(),
         .check =
             [](CheckContext& ctx) {
-                check_style(ctx);
-                ctx.output().type = ValueType::image;
-                ctx.output().width = int(ctx.integer("width"));
-                ctx.output().height = int(ctx.integer("height"));
+                check_frame(ctx);
                 ctx.output().count = std::size_t(ctx.integer("frames"));
-                ctx.output().layers.clear();
             },
         .run = run_turntable,
     });
@@ -266,13 +272,7 @@ OROGEN_PLUGIN("render-terrain", "0.1.0", registry) {
         .output = ValueType::image,
         .params = terrain_params(),
         .check =
-            [](CheckContext& ctx) {
-                check_style(ctx);
-                ctx.output().type = ValueType::image;
-                ctx.output().width = int(ctx.integer("width"));
-                ctx.output().height = int(ctx.integer("height"));
-                ctx.output().layers.clear();
-            },
+            check_frame,
         .run = run_terrain,
     });
 }
