@@ -31,7 +31,8 @@ bench: build
 #   make asan        AddressSanitizer + UndefinedBehaviorSanitizer build of the whole tree (-O1) and every
 #                    test in it (the shipped pipelines included), with the libFuzzer targets
 #   make tsan        ThreadSanitizer build of the parallel cores and the exporters, and their tests
-#   make fuzz-smoke  FUZZ_SECONDS (default 20) of each fuzz target (needs `make asan`'s build)
+#   make fuzz-smoke  FUZZ_SECONDS (default 20) of each fuzz target from FUZZ_SEED (default 1), so a failure in CI
+#                    replays here with the same seed; the crashing input is printed in hex (needs `make asan`'s build)
 #   make fuzz-long   FUZZ_RUNS (default 1000000) executions of each target, one job each
 SAN_FLAGS   = -O1 -gline-tables-only -fno-omit-frame-pointer
 ASAN_BUILD ?= build-asan
@@ -45,6 +46,7 @@ TSAN_ONLY  ?= /plugins/[^/]+/[^/]+$$|/tests/plugins/(thermal|hydraulic|pipe|plat
 ASAN_ONLY  ?=
 ASAN_CI     = /tests/(kernel|fuzz)|/plugins/(generate/(diamond-square|fault|rmp)|export/(png|raw|gltf)|import/(png|raw)|erode/thermal|tectonics/plates)
 FUZZ_SECONDS ?= 20
+FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000
 FUZZ_TARGETS  = spec overrides png sidecar
 # Extra cmake arguments for the sanitizer builds, e.g. SAN_CMAKE=-DCMAKE_CXX_COMPILER_LAUNCHER=ccache
@@ -81,8 +83,12 @@ tsan: setup
 fuzz-smoke:
 	@cd $(ASAN_BUILD)/tests && for t in $(FUZZ_TARGETS); do \
 	  mkdir -p fuzz-corpus/$$t && \
-	  ./fuzz_$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 fuzz-corpus/$$t $(CURDIR)/tests/fuzz/corpus/$$t \
-	    2>fuzz-$$t.log || { tail -50 fuzz-$$t.log; exit 1; }; \
+	  ./fuzz_$$t -seed=$(FUZZ_SEED) -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 -artifact_prefix=fuzz-$$t- \
+	    fuzz-corpus/$$t $(CURDIR)/tests/fuzz/corpus/$$t 2>fuzz-$$t.log || { \
+	    grep -m5 -E 'ERROR|runtime error|SUMMARY' fuzz-$$t.log; tail -30 fuzz-$$t.log; \
+	    for c in fuzz-$$t-crash-* fuzz-$$t-leak-* fuzz-$$t-timeout-* fuzz-$$t-oom-*; do \
+	      [ -f "$$c" ] && { echo "fuzz_$$t: the input that failed ($$c), in hex:"; od -An -tx1 -v "$$c" | head -64; }; done; \
+	    exit 1; }; \
 	  echo "fuzz_$$t: $$(grep -h 'stat::number_of_executed_units' fuzz-$$t.log | awk '{print $$2}') executions in $(FUZZ_SECONDS) s, no crash"; \
 	done
 

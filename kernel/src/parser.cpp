@@ -1,5 +1,6 @@
 #include "spec.hpp"
 
+#include <algorithm>
 #include <cerrno>
 
 #include <cmath>
@@ -230,9 +231,10 @@ private:
         spec.grid_where = w.where;
         spec.grid_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - w.where.column;
         if (width < 2 || height < 2) {
-            diags_.error(spec.grid_where, "the grid needs at least 2 vertices a side, got " +
-                                              std::to_string(long(std::max(width, -1e18))) + "x" +
-                                              std::to_string(long(std::max(height, -1e18))));
+            // Either side may be any number the lexer accepted (1e27, or HUGE_VAL from 400 digits): clamp before
+            // converting, since a double outside long's range is undefined behaviour (found by fuzz_spec).
+            const auto side = [](double v) { return std::to_string(long(std::clamp(v, -1e18, 1e18))); };
+            diags_.error(spec.grid_where, "the grid needs at least 2 vertices a side, got " + side(width) + "x" + side(height));
             return;
         }
         spec.grid_width = width > 2e9 ? 2000000000 : int(width);
