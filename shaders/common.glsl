@@ -42,6 +42,28 @@ float fbm(vec2 p, int octaves) {
     return sum * 1.07;
 }
 
+// fbm() with each octave faded out as it nears the pixel's footprint
+// (`footprint`: how far p moves across one pixel, from dFdx/dFdy), and the
+// finer ones not evaluated at all: detail finer than half a pixel cannot be
+// drawn, only aliased (it shimmers from frame to frame in a turntable), and on
+// llvmpipe skipping it is most of what the far terrain costs. Equal to
+// fbm(p, octaves) where every octave is coarser than 4 pixels.
+float fbm_filtered(vec2 p, int octaves, float footprint) {
+    const mat2 turn = mat2(1.6, 1.2, -1.2, 1.6);
+    float sum = 0.0, amplitude = 0.5, frequency = 1.0;
+    for (int i = 0; i < octaves; ++i) {
+        // a simplex octave's features are about one lattice cell (1/frequency) wide: keep it whole while a cell
+        // spans 4+ pixels, fade it out until a cell spans 2 pixels
+        float keep = clamp((0.5 - footprint * frequency) * 4.0, 0.0, 1.0);
+        if (keep <= 0.0) break;
+        sum += amplitude * keep * simplex(p);
+        p = turn * p + vec2(17.1, 9.7);
+        amplitude *= 0.5;
+        frequency *= 2.0;
+    }
+    return sum * 1.07;
+}
+
 // The sky: a gradient from a hazy horizon to a deeper zenith, brighter and
 // warmer towards the sun (single-scattering look), and the sun's disc (HDR,
 // so the bloom makes it glow). `dir` is a unit view ray, y up.

@@ -55,6 +55,8 @@ vec4 splat(float t, float normal_y) {
 }
 
 void main() {
+    // texture_scale units per pixel, taken before any branch (derivatives need the whole 2 × 2 quad)
+    float footprint = max(length(dFdx(world.xz)), length(dFdy(world.xz))) / texture_scale;
     if (wall_normal != vec3(0.0)) {
         // The skirt: layered earth and rock, lit like the rest.
         vec2 q = vec2(dot(world.xz, wall_normal.zx), world.y) / texture_scale;
@@ -77,8 +79,8 @@ void main() {
 
     vec2 p = world.xz / texture_scale;
     // Two noise fields serve every material: broad (texture_scale) and fine (1/40 of it).
-    float broad = fbm(p, 4);
-    float fine = fbm(p * 40.0, 2);
+    float broad = fbm_filtered(p, 4, footprint);
+    float fine = fbm_filtered(p * 40.0, 2, footprint * 40.0);
     float range = max(height_max - height_min, 1e-6);
     float t = clamp((h - height_min) / range, 0.0, 1.0) + jitter * (broad + 0.5 * fine);
     vec4 w = splat(t, true_normal.y);

@@ -15,7 +15,9 @@ uniform mat4 view_projection;
 uniform int skirt_edge;
 uniform float floor_height;   // m, exaggerated
 out vec3 world;
-flat out vec3 wall_normal;    // (0, 0, 0) on the surface
+flat out vec3 wall_normal;
+// The depth pre-pass and the colour pass run this shader in two programs: their depths must be equal bit for bit.
+invariant gl_Position;    // (0, 0, 0) on the surface
 void main() {
     ivec2 s;
     wall_normal = vec3(0.0);

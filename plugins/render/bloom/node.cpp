@@ -101,7 +101,7 @@ OROGEN_PLUGIN("render-bloom", "0.1.0", registry) {
                 return image_out(combine(*ctx.input(0).image(), *ctx.input(1).image(), ctx.real("strength")));
             },
     });
-    std::vector<Param> bloom_params = bright_params(2);
+    std::vector<Param> bloom_params = bright_params(4);
     bloom_params.push_back(Param::real("sigma", 0.028 / 3.0).min(0).max(0.25).help(
         "blur standard deviation, a fraction of the image width (±3 sigma = the thesis's ±0.028 of the frame)"));
     bloom_params.push_back(Param::real("strength", 0.667).min(0).help("how much of the blurred bright pass is added"));

@@ -439,8 +439,30 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     // Terrain.
     auto draw_terrain = [&](const glm::mat4& matrix, int mode) {
         glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
         glDisable(GL_BLEND);
+        glBindVertexArray(m.vao);
+        // Depth pre-pass: the surface and skirt into depth only (the shadow pass's empty fragment shader, the
+        // same vertex shader, whose gl_Position is invariant), so the splatting shader below (noise, five
+        // shadow taps) runs once per pixel instead of once per overlapping triangle: on llvmpipe the
+        // fragment work is the frame's cost, and an oblique view of a range overdraws it 2-3 times.
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glUseProgram(prog.shadow);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, m.heights);
+        set(prog.shadow, "heights", 0);
+        set_grid(prog.shadow, matrix);
+        set(prog.shadow, "skirt_edge", -1);
+        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        set(prog.shadow, "floor_height", float(floor_height * exag));
+        for (int edge = 0; edge < 4; ++edge) {
+            set(prog.shadow, "skirt_edge", edge);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
+        }
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
         glUseProgram(prog.terrain);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.heights);
@@ -475,6 +497,8 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
             set(prog.terrain, "skirt_edge", edge);
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
         }
+        glDepthMask(GL_TRUE);
+        glDepthFunc(GL_LESS);
     };
     draw_terrain(vp, int(st.output));
 
