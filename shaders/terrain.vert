@@ -14,6 +14,7 @@ uniform mat4 view_projection;
 // west (one strip each, two vertices per kept edge sample); −1: the surface.
 uniform int skirt_edge;
 uniform float floor_height;   // m, exaggerated
+uniform vec4 clip_plane;      // world-space plane (a, b, c, d): kept where a·x + b·y + c·z + d ≥ 0
 out vec3 world;
 flat out vec3 wall_normal;
 // The depth pre-pass and the colour pass run this shader in two programs: their depths must be equal bit for bit.
@@ -36,4 +37,6 @@ void main() {
     if (skirt_edge >= 0 && (gl_VertexID & 1) == 1) h = floor_height;
     world = vec3(float(s.x) * cell, h, float(s.y) * cell);
     gl_Position = view_projection * vec4(world, 1.0);
+    // Only used (GL_CLIP_DISTANCE0) by the sea's reflection pass, which keeps what lies above the water.
+    gl_ClipDistance[0] = dot(vec4(world, 1.0), clip_plane);
 }

@@ -78,6 +78,8 @@ std::vector<Param> style_params() {
         Param::real("water_min_depth", 0.05).min(0).unit("m").help("thinner water is not drawn"),
         Param::real("wave_height", 1.0).min(0).unit("m").help("amplitude of the waves"),
         Param::real("clarity", 4.0).min(0, true).unit("m").help("water depth through which 1/e of the ground shows"),
+        Param::real("reflection", 0.5).min(0).max(1).help(
+            "the sea mirrors the terrain, drawn at this fraction of the frame's size (0: it reflects the sky only)"),
         Param::real("time", 0.0).unit("s").help("moves the waves"),
         Param::real("grass_from", 0.25).min(0, true).max(1, true).help("fraction of the height range where grass starts"),
         Param::real("rock_from", 0.5).min(0, true).max(1, true).help("... where rock starts"),
@@ -151,6 +153,7 @@ Style style_from(NodeContext& ctx) {
     s.water_min_depth = ctx.real("water_min_depth");
     s.wave_height = ctx.real("wave_height");
     s.clarity = ctx.real("clarity");
+    s.reflection = ctx.real("reflection");
     s.time = ctx.real("time");
     s.shadow_size = int(ctx.integer("shadow_size"));
     s.samples = int(ctx.integer("samples"));

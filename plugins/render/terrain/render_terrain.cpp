@@ -276,6 +276,10 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         const double to_centre = glm::length(centre - eye);
         far_plane = to_centre + radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
         near_plane = std::max(std::max(to_centre - radius, 0.0) * 0.8, far_plane * 2e-5);
+        // The sea comes up to the camera: a ray at most 60° off the view axis meets it no nearer (along the
+        // axis) than half the camera's height above it, so keep the near plane inside that.
+        if (st.sea && eye.y > st.sea_level * exag)
+            near_plane = std::max(std::min(near_plane, 0.5 * (eye.y - st.sea_level * exag)), far_plane * 2e-6);
         projection = glm::perspective(camera.fov * kDegree, aspect, near_plane, far_plane);
     }
     const glm::dmat4 view = glm::lookAt(eye, target, up);
@@ -321,6 +325,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     const glm::vec3 horizon = glm::mix(glm::vec3(0.42f, 0.52f, 0.68f), glm::vec3(0.62f, 0.52f, 0.46f), low * 0.5f);
     const glm::vec3 ambient = (zenith * 0.6f + horizon * 0.4f) * 0.9f;
     const float fog_density = float(st.haze / std::max(2.0 * radius, 1e-6));
+    glm::dvec3 light_eye = eye;  // the mirrored eye while the reflection is drawn
     auto set_light = [&](GLuint p, float disc) {
         set(p, "sun_direction", glm::vec3(sun));
         set(p, "sun_colour", sun_colour);
@@ -329,7 +334,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(p, "sun_disc", disc);
         set(p, "fog_density", fog_density);
         set(p, "ambient_colour", ambient);
-        set(p, "eye", glm::vec3(eye));
+        set(p, "eye", glm::vec3(light_eye));
     };
     auto set_grid = [&](GLuint p, const glm::mat4& vp) {
         set(p, "grid", glm::ivec2(m.width, m.height));
@@ -531,6 +536,55 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glDisable(GL_PROGRAM_POINT_SIZE);
     }
 
+    // The sea's reflection: the terrain above the water mirrored in its plane, drawn into a smaller texture
+    // (alpha 1 where terrain is, 0 where the water shader keeps its analytic sky), from the mirrored eye so
+    // fog and glints follow the reflected ray's length.
+    GLuint reflection_fbo = 0, reflection_colour = 0, reflection_depth = 0;
+    struct ReflectionCleanup {
+        GLuint& f; GLuint& c; GLuint& d;
+        ~ReflectionCleanup() { glDeleteFramebuffers(1, &f); glDeleteTextures(1, &c); glDeleteRenderbuffers(1, &d); }
+    } reflection_cleanup{reflection_fbo, reflection_colour, reflection_depth};
+    const bool reflect = shaded && st.sea && st.reflection > 0;
+    if (reflect) {
+        const int rw = std::max(1, int(std::lround(width * st.reflection)));
+        const int rh = std::max(1, int(std::lround(height * st.reflection)));
+        glGenTextures(1, &reflection_colour);
+        glBindTexture(GL_TEXTURE_2D, reflection_colour);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA16F, rw, rh);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glGenRenderbuffers(1, &reflection_depth);
+        glBindRenderbuffer(GL_RENDERBUFFER, reflection_depth);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, rw, rh);
+        glGenFramebuffers(1, &reflection_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, reflection_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, reflection_colour, 0);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, reflection_depth);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            throw Error("render:terrain: OSMesa could not set up the " + std::to_string(rw) + " × " +
+                        std::to_string(rh) + " reflection target");
+        glViewport(0, 0, rw, rh);
+        glClearColor(0, 0, 0, 0);
+        glClearDepth(1.0);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        const double water_y = st.sea_level * exag;
+        // y → 2·water_y − y: the mirror in the plane y = water_y
+        const glm::dmat4 mirror = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2 * water_y, 0)) *
+                                  glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
+        light_eye = glm::dvec3(mirror * glm::dvec4(eye, 1.0));
+        glEnable(GL_CLIP_DISTANCE0);
+        for (GLuint p : {prog.shadow, prog.terrain})
+            glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
+        draw_terrain(glm::mat4(view_projection * mirror), int(st.output));
+        glDisable(GL_CLIP_DISTANCE0);
+        for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
+        light_eye = eye;
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glViewport(0, 0, width, height);
+    }
+
     // Water, blended over the terrain: what shows through is scaled by alpha.
     if (shaded && (m.has_water || st.sea)) {
         glEnable(GL_DEPTH_TEST);
@@ -551,6 +605,10 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.water, "water_colour", glm::vec3(0.02f, 0.09f, 0.12f));
         set(prog.water, "clarity", float(st.clarity));
         set(prog.water, "has_reflection", 0);
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D, reflection_colour);
+        set(prog.water, "reflection", 2);
+        glActiveTexture(GL_TEXTURE0);  // the unit every other pass and gl::upload expect to be active
         set(prog.water, "viewport", glm::vec2(float(width), float(height)));
         set(prog.water, "sea_level", float(st.sea_level));
         glBindVertexArray(m.vao);
@@ -561,6 +619,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         if (st.sea) {
             const double reach = radius * 38.0;
             set(prog.water, "sea_plane", 1);
+            set(prog.water, "has_reflection", reflect ? 1 : 0);
             const glm::vec4 extent(float(centre.x - reach), float(centre.z - reach), float(centre.x + reach),
                                    float(centre.z + reach));
             glUniform4fv(loc(prog.water, "plane_extent"), 1, glm::value_ptr(extent));

@@ -53,6 +53,9 @@ struct Style {
     double water_min_depth = 0.05; ///< m: thinner water layers are not drawn
     double wave_height = 1.0;      ///< m, amplitude of the waves
     double clarity = 4.0;          ///< m: water depth through which 1/e of the ground shows
+    /// The sea mirrors the terrain (a planar reflection pass at this fraction of the frame's size; 0: the sky
+    /// only). Rivers and lakes from the water layer lie at many heights and reflect the sky.
+    double reflection = 0.5;
     double time = 0.0;             ///< s, moves the waves
     int shadow_size = 2048;        ///< shadow map side, texels
     int samples = 1;               ///< multisampling (1, 2, 4 or 8): 4 smooths the edges, costs ~3× the scene pass

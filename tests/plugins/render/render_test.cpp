@@ -155,6 +155,70 @@ TEST(Shadows, ATallColumnsShadowFallsAwayFromTheSun) {
     EXPECT_LT(e2, 0.6 * w2);
 }
 
+TEST(Reflection, TheSeaMirrorsWhatStandsAboveItAndNothingBelow) {
+    // A 400 m column standing in a sea over a plain 40 m under water, seen from the south just above the
+    // water with the waves stilled: with the reflection pass the water below the column shows it; the
+    // sky, the column and the open water elsewhere are as without it; and with no column (only the drowned
+    // plain, which the pass must clip away) the reflection changes nothing at all.
+    const int n = 129, w = 160, h = 120;
+    auto scene = [&](bool column, double reflection) {
+        auto hm = grid(n, 10.0, -40.0f);
+        if (column)
+            for (int y = 62; y <= 66; ++y)
+                for (int x = 62; x <= 66; ++x) hm->view().at(x, y) = 400.0f;
+        Style s;
+        s.sea = true;
+        s.sea_level = 0;
+        s.wave_height = 0;
+        s.haze = 0;
+        s.jitter = 0;
+        s.sun_azimuth = 200;
+        s.sun_elevation = 40;
+        s.reflection = reflection;
+        Camera c;
+        c.azimuth = 180;
+        c.elevation = 4;
+        c.distance = 1200;
+        TerrainRenderer r(hm, s);
+        return r.render(w, h, c);
+    };
+    auto differing = [&](const Image& a, const Image& b, double& mean_x, double& mean_y) {
+        int count = 0;
+        mean_x = mean_y = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                double d = 0;
+                for (int k = 0; k < 3; ++k) d += std::abs(a.rgba32f[4 * std::size_t(y * w + x) + k] - b.rgba32f[4 * std::size_t(y * w + x) + k]);
+                if (d > 0.02) {
+                    ++count;
+                    mean_x += x;
+                    mean_y += y;
+                }
+            }
+        if (count) mean_x /= count, mean_y /= count;
+        return count;
+    };
+    double mx = 0, my = 0;
+    EXPECT_EQ(differing(scene(false, 0.5), scene(false, 0.0), mx, my), 0)
+        << "the drowned plain must not show in the reflection (the pass keeps only what is above the water)";
+    const Image with = scene(true, 0.5), without = scene(true, 0.0);
+    EXPECT_TRUE(scene(true, 0.0).rgba32f == without.rgba32f) << "without the reflection, a frame repeats exactly";
+    EXPECT_TRUE(scene(true, 0.5).rgba32f == with.rgba32f) << "with the reflection, a frame repeats exactly";
+    const int changed = differing(with, without, mx, my);
+    EXPECT_GT(changed, 40) << "the column's reflection should show in the water";
+    EXPECT_LT(changed, w * h / 6) << "only the water below the column should change";
+    EXPECT_NEAR(mx, w / 2.0, w * 0.1) << "the reflection lies below the column, in the middle of the frame";
+    // Rows 0.. are the top of the frame: the column stands above the horizon's middle, its mirror below it.
+    int column_top = h;
+    for (int y = 0; y < h && column_top == h; ++y) {
+        const float* p = &without.rgba32f[4 * std::size_t(y * w + w / 2)];
+        const float* q = &scene(false, 0.0).rgba32f[4 * std::size_t(y * w + w / 2)];
+        if (std::abs(p[0] - q[0]) + std::abs(p[1] - q[1]) + std::abs(p[2] - q[2]) > 0.05) column_top = y;
+    }
+    ASSERT_LT(column_top, h) << "the column should be in view";
+    EXPECT_GT(my, column_top + 5) << "the mirror image lies below the column's top";
+}
+
 TEST(Camera, BadCamerasAreRefusedWithTheReason) {
     auto hm = grid(33, 10.0, 100.0f);
     TerrainRenderer r(hm, Style{});
