@@ -69,6 +69,7 @@ void write_grid(AtomicFile& file, openvdb::GridBase::Ptr grid) {
     } catch (const openvdb::Exception& e) {
         throw Error("cannot write " + file.target().string() + ": OpenVDB: " + e.what());
     }
+    stamp_content_uuid(file);
 }
 
 }  // namespace

@@ -294,6 +294,7 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
     } catch (const openvdb::Exception& e) {
         throw Error("cannot write " + target.string() + ": OpenVDB: " + e.what());
     }
+    stamp_content_uuid(file);
     file.commit();  // checks the stream: a full disk is an error, the old file stays
     return summary;
 }

@@ -24,7 +24,15 @@
 #include <cstddef>
 #include <filesystem>
 
+namespace orogen {
+class AtomicFile;
+}
+
 namespace orogen::vdb {
+
+/// Replace the random UUID OpenVDB put in the header of the file being written with one made from the file's
+/// other bytes, so the same data gives the same file (orogen's outputs are bit-identical run to run).
+void stamp_content_uuid(AtomicFile& file);
 
 struct TerrainOptions {
     double voxel_size = 0.0;  ///< metres; 0 = the heightmap's cell size

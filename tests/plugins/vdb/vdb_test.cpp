@@ -109,6 +109,30 @@ TEST(Vdb, HillsAreNegativeBelowAndPositiveAboveEverywhere) {
     EXPECT_GT(checked, 10000);
 }
 
+TEST(Vdb, TheSameDataGivesTheSameBytesAndOpenVdbStillReadsThem) {
+    // OpenVDB stamps each file with a random UUID; orogen replaces it with one made from the content.
+    test::TempDir dir;
+    const int w = 49, h = 33;
+    auto heights = test::hills(w, h, 120.0);
+    vdb::write_terrain({heights.data(), w, h, 5.0}, nullptr, dir / "a.vdb");
+    vdb::write_terrain({heights.data(), w, h, 5.0}, nullptr, dir / "b.vdb");
+    const std::string a = test::slurp(dir / "a.vdb"), b = test::slurp(dir / "b.vdb");
+    ASSERT_GT(a.size(), 57u);
+    EXPECT_TRUE(a == b) << "two exports of the same terrain differ";
+    heights[std::size_t(w * 10 + 10)] += 30.0f;
+    vdb::write_terrain({heights.data(), w, h, 5.0}, nullptr, dir / "c.vdb");
+    const std::string c = test::slurp(dir / "c.vdb");
+    EXPECT_NE(a.substr(21, 36), c.substr(21, 36)) << "other data should get another UUID";
+    EXPECT_EQ(a[21 + 14], '8') << "a version 8 (custom) UUID: " << a.substr(21, 36);
+    // OpenVDB reads the file and its UUID back.
+    vdb::initialize_once();
+    openvdb::io::File f((dir / "c.vdb").string());
+    f.open();
+    EXPECT_EQ(f.getUniqueTag(), c.substr(21, 36));
+    EXPECT_TRUE(float_grid(f.getGrids(), "surface"));
+    f.close();
+}
+
 TEST(Vdb, VoxelSizeResamplesTheColumns) {
     test::TempDir dir;
     const int w = 33, h = 33;
