@@ -73,13 +73,11 @@ TEST(SphDamBreak, SurgeFrontFollowsMartinAndMoyceWithinTenPercentUpToT3) {
     }
 }
 
-// DISABLED — fails today, kept as the statement of what must hold: the walls
-// and the floor are geometric (no boundary particles, no wall density term),
-// so particles there lack half their kernel, crowd against them and the
-// column settles 27 % lower than it was filled; the layer means then miss
-// ρ·g·d by up to 11 % (density itself stays within 0.4 %). Needs a boundary
-// density/pressure term (Akinci et al. 2012) for walls and terrain.
-TEST(SphHydrostatics, DISABLED_SettledColumnHasPressureRhoGDepthAndNearlyConstantDensity) {
+// The floor is the terrain, which carries a boundary density and pressure term (the fluid's rest lattice
+// continued below the ground, Akinci et al. 2012 in table form); without it particles on the floor lacked
+// half their kernel and the layer means missed ρ·g·d by up to 11 %. The box's side walls are the map's
+// closed edges, still geometric: the interior (a kernel support away from them) is what is compared.
+TEST(SphHydrostatics, SettledColumnHasPressureRhoGDepthAndNearlyConstantDensity) {
     const double s = 0.02, g = 9.81;
     const int nx = 8, ny = 16, nz = 8;  // 0.16 × 0.32 × 0.16 m of water
     const Flat box(5, 5, 0.04);
