@@ -68,7 +68,7 @@ Texture upload(const Image& image) {
     return t;
 }
 
-Target::Target(int width, int height) {
+Target::Target(int width, int height, bool with_depth) {
     colour.width = width;
     colour.height = height;
     glGenTextures(1, &colour.id);
@@ -81,6 +81,12 @@ Target::Target(int width, int height) {
     glGenFramebuffers(1, &framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, colour.id, 0);
+    if (with_depth) {
+        glGenRenderbuffers(1, &depth);
+        glBindRenderbuffer(GL_RENDERBUFFER, depth);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+    }
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
         throw Error("OSMesa could not set up a " + std::to_string(width) + " × " + std::to_string(height) +
                     " float framebuffer");
@@ -89,15 +95,19 @@ Target::Target(int width, int height) {
 Target& Target::operator=(Target&& o) noexcept {
     if (this != &o) {
         if (framebuffer) glDeleteFramebuffers(1, &framebuffer);
+        if (depth) glDeleteRenderbuffers(1, &depth);
         framebuffer = o.framebuffer;
+        depth = o.depth;
         colour = std::move(o.colour);
         o.framebuffer = 0;
+        o.depth = 0;
     }
     return *this;
 }
 
 Target::~Target() {
     if (framebuffer) glDeleteFramebuffers(1, &framebuffer);
+    if (depth) glDeleteRenderbuffers(1, &depth);
 }
 
 void Target::bind() const {

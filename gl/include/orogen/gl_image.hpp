@@ -24,13 +24,17 @@ struct Texture {
 /// images are decoded to linear first. Filtering: linear, clamped to edge.
 Texture upload(const Image& image);
 
-/// An offscreen RGBA32F colour target (no depth).
+/// An offscreen RGBA32F colour target, with a 32-bit float depth buffer if asked.
 struct Target {
     unsigned framebuffer = 0;
+    unsigned depth = 0;  ///< renderbuffer, 0 without depth
     Texture colour;
     Target() = default;
-    Target(int width, int height);
-    Target(Target&& o) noexcept : framebuffer(o.framebuffer), colour(std::move(o.colour)) { o.framebuffer = 0; }
+    Target(int width, int height, bool with_depth = false);
+    Target(Target&& o) noexcept : framebuffer(o.framebuffer), depth(o.depth), colour(std::move(o.colour)) {
+        o.framebuffer = 0;
+        o.depth = 0;
+    }
     Target& operator=(Target&& o) noexcept;
     ~Target();
     int width() const { return colour.width; }

@@ -442,6 +442,17 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     gl::draw_fullscreen();
 
     // Terrain.
+    // The surface, then the skirt down to below the lowest point (and below the sea), with `program`.
+    auto draw_surface_and_skirt = [&](GLuint program) {
+        glBindVertexArray(m.vao);
+        set(program, "skirt_edge", -1);
+        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        set(program, "floor_height", float(floor_height * exag));
+        for (int edge = 0; edge < 4; ++edge) {
+            set(program, "skirt_edge", edge);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
+        }
+    };
     auto draw_terrain = [&](const glm::mat4& matrix, int mode) {
         glEnable(GL_DEPTH_TEST);
         glDisable(GL_BLEND);
@@ -458,13 +469,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glBindTexture(GL_TEXTURE_2D, m.heights);
         set(prog.shadow, "heights", 0);
         set_grid(prog.shadow, matrix);
-        set(prog.shadow, "skirt_edge", -1);
-        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
-        set(prog.shadow, "floor_height", float(floor_height * exag));
-        for (int edge = 0; edge < 4; ++edge) {
-            set(prog.shadow, "skirt_edge", edge);
-            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
-        }
+        draw_surface_and_skirt(prog.shadow);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glDepthFunc(GL_LEQUAL);
         glDepthMask(GL_FALSE);
@@ -491,17 +496,9 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.terrain, "jitter", float(st.jitter));
         set(prog.terrain, "texture_scale", float(st.texture_scale));
         set(prog.terrain, "output_mode", mode);
-        set(prog.terrain, "skirt_edge", -1);
         set(prog.terrain, "light_view_projection", glm::mat4(light_vp));
         set(prog.terrain, "shadow_texel", 1.0f / float(m.shadow_size));
-        glBindVertexArray(m.vao);
-        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
-        // The skirt, down to below the lowest point (and below the sea).
-        set(prog.terrain, "floor_height", float(floor_height * exag));
-        for (int edge = 0; edge < 4; ++edge) {
-            set(prog.terrain, "skirt_edge", edge);
-            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
-        }
+        draw_surface_and_skirt(prog.terrain);
         glDepthMask(GL_TRUE);
         glDepthFunc(GL_LESS);
     };
@@ -539,33 +536,12 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     // The sea's reflection: the terrain above the water mirrored in its plane, drawn into a smaller texture
     // (alpha 1 where terrain is, 0 where the water shader keeps its analytic sky), from the mirrored eye so
     // fog and glints follow the reflected ray's length.
-    GLuint reflection_fbo = 0, reflection_colour = 0, reflection_depth = 0;
-    struct ReflectionCleanup {
-        GLuint& f; GLuint& c; GLuint& d;
-        ~ReflectionCleanup() { glDeleteFramebuffers(1, &f); glDeleteTextures(1, &c); glDeleteRenderbuffers(1, &d); }
-    } reflection_cleanup{reflection_fbo, reflection_colour, reflection_depth};
+    gl::Target reflection;
     const bool reflect = shaded && st.sea && st.reflection > 0;
     if (reflect) {
-        const int rw = std::max(1, int(std::lround(width * st.reflection)));
-        const int rh = std::max(1, int(std::lround(height * st.reflection)));
-        glGenTextures(1, &reflection_colour);
-        glBindTexture(GL_TEXTURE_2D, reflection_colour);
-        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA16F, rw, rh);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        glGenRenderbuffers(1, &reflection_depth);
-        glBindRenderbuffer(GL_RENDERBUFFER, reflection_depth);
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, rw, rh);
-        glGenFramebuffers(1, &reflection_fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, reflection_fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, reflection_colour, 0);
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, reflection_depth);
-        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            throw Error("render:terrain: OSMesa could not set up the " + std::to_string(rw) + " × " +
-                        std::to_string(rh) + " reflection target");
-        glViewport(0, 0, rw, rh);
+        reflection = gl::Target(std::max(1, int(std::lround(width * st.reflection))),
+                                std::max(1, int(std::lround(height * st.reflection))), true);
+        reflection.bind();
         glClearColor(0, 0, 0, 0);
         glClearDepth(1.0);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -606,7 +582,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.water, "clarity", float(st.clarity));
         set(prog.water, "has_reflection", 0);
         glActiveTexture(GL_TEXTURE2);
-        glBindTexture(GL_TEXTURE_2D, reflection_colour);
+        glBindTexture(GL_TEXTURE_2D, reflection.colour.id);
         set(prog.water, "reflection", 2);
         glActiveTexture(GL_TEXTURE0);  // the unit every other pass and gl::upload expect to be active
         set(prog.water, "viewport", glm::vec2(float(width), float(height)));
