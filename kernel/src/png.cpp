@@ -1,10 +1,17 @@
-// PNG codec on libpng (16-bit grayscale needs it; stb writes only 8 bits).
-// libpng reports errors by longjmp: each function below keeps only plain data
-// alive across setjmp and turns the recorded message into an exception after.
+// PNG codec: reading on libpng (16-bit grayscale needs it; stb writes only 8
+// bits), writing by hand over libdeflate: at level 6 about twice as fast as
+// libpng + zlib for a file 3 % larger (bench_export_png). libpng reports errors by longjmp: each reading
+// function below keeps only plain data alive across setjmp and turns the
+// recorded message into an exception after.
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/parallel.hpp>
 
+#include <libdeflate.h>
 #include <png.h>
+
+#include <array>
+#include <memory>
 
 #include <csetjmp>
 #include <cstring>
@@ -165,35 +172,89 @@ GrayImage read_png(const std::vector<std::uint8_t>& bytes, const std::filesystem
     return image;
 }
 
-void write_to_stream(png_structp png, png_bytep data, png_size_t n) {
-    auto* out = static_cast<std::ostream*>(png_get_io_ptr(png));
-    out->write(reinterpret_cast<const char*>(data), std::streamsize(n));
-    if (!*out) png_error(png, "write failed (disk full?)");
-}
-void flush_stream(png_structp png) { static_cast<std::ostream*>(png_get_io_ptr(png))->flush(); }
+// ---- writing
 
-int encode(std::ostream& file, int width, int height, int bits, int colour_type, const std::uint8_t* rows,
-           std::size_t row_stride, bool swap16, ErrorSlot& err) {
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
-    png_infop info = png ? png_create_info_struct(png) : nullptr;
-    if (!png || !info) {
-        std::snprintf(err.message, sizeof err.message, "out of memory");
-        return 1;
-    }
-    if (setjmp(png_jmpbuf(png))) {
-        png_destroy_write_struct(&png, &info);
-        return 1;
-    }
-    png_set_write_fn(png, &file, write_to_stream, flush_stream);
-    png_set_compression_level(png, 6);
-    png_set_IHDR(png, info, png_uint_32(width), png_uint_32(height), bits, colour_type, PNG_INTERLACE_NONE,
-                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-    png_write_info(png, info);
-    if (swap16) png_set_swap(png);
-    for (int y = 0; y < height; ++y) png_write_row(png, const_cast<png_bytep>(rows + std::size_t(y) * row_stride));
-    png_write_end(png, nullptr);
-    png_destroy_write_struct(&png, &info);
-    return 0;
+void put_u32(std::uint8_t* p, std::uint32_t v) {
+    p[0] = std::uint8_t(v >> 24), p[1] = std::uint8_t(v >> 16), p[2] = std::uint8_t(v >> 8), p[3] = std::uint8_t(v);
+}
+
+void write_chunk(std::ostream& out, const char type[4], const std::uint8_t* data, std::size_t size) {
+    std::uint8_t head[8];
+    put_u32(head, std::uint32_t(size));
+    std::memcpy(head + 4, type, 4);
+    std::uint32_t crc = libdeflate_crc32(0, head + 4, 4);
+    if (size > 0) crc = libdeflate_crc32(crc, data, size);  // (a null buffer would restart the CRC)
+    std::uint8_t tail[4];
+    put_u32(tail, crc);
+    out.write(reinterpret_cast<const char*>(head), 8);
+    out.write(reinterpret_cast<const char*>(data), std::streamsize(size));
+    out.write(reinterpret_cast<const char*>(tail), 4);
+}
+
+// Each scanline with the filter (none, sub, up, average, Paeth) whose output has the smallest sum of absolute
+// values as signed bytes: libpng's own heuristic for colour and grey images. `raw` holds the rows as PNG
+// stores them (big-endian samples); `bpp` is bytes per pixel (the filters' left neighbour).
+std::vector<std::uint8_t> filter_rows(const std::uint8_t* raw, int height, std::size_t row_bytes, int bpp) {
+    std::vector<std::uint8_t> out(std::size_t(height) * (row_bytes + 1));
+    parallel_for(0, height, 16, [&](std::int64_t y0, std::int64_t y1) {
+        std::array<std::vector<std::uint8_t>, 5> trial;
+        for (auto& t : trial) t.resize(row_bytes);
+        for (std::int64_t y = y0; y < y1; ++y) {
+            const std::uint8_t* row = raw + std::size_t(y) * row_bytes;
+            const std::uint8_t* up = y > 0 ? row - row_bytes : nullptr;
+            std::array<std::uint64_t, 5> cost{};
+            for (std::size_t i = 0; i < row_bytes; ++i) {
+                const int x = row[i];
+                const int a = i >= std::size_t(bpp) ? row[i - std::size_t(bpp)] : 0;
+                const int b = up ? up[i] : 0;
+                const int c = up && i >= std::size_t(bpp) ? up[i - std::size_t(bpp)] : 0;
+                const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
+                const int paeth = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+                const std::uint8_t f[5] = {std::uint8_t(x), std::uint8_t(x - a), std::uint8_t(x - b),
+                                           std::uint8_t(x - ((a + b) >> 1)), std::uint8_t(x - paeth)};
+                for (int k = 0; k < 5; ++k) {
+                    trial[std::size_t(k)][i] = f[k];
+                    cost[std::size_t(k)] += std::uint64_t(std::abs(int(std::int8_t(f[k]))));
+                }
+            }
+            const int best = int(std::min_element(cost.begin(), cost.end()) - cost.begin());
+            std::uint8_t* dst = out.data() + std::size_t(y) * (row_bytes + 1);
+            dst[0] = std::uint8_t(best);
+            std::memcpy(dst + 1, trial[std::size_t(best)].data(), row_bytes);
+        }
+    });
+    return out;
+}
+
+void encode(std::ostream& file, int width, int height, int bits, int colour_type, int channels, const std::uint8_t* raw,
+            int level) {
+    if (width <= 0 || height <= 0) throw Error("internal error: PNG size " + std::to_string(width) + "x" + std::to_string(height));
+    if (level < 0 || level > 12) throw BadInput("PNG compression level must be 0 to 12, got " + std::to_string(level));
+    const int bpp = channels * bits / 8;
+    const std::size_t row_bytes = std::size_t(width) * std::size_t(bpp);
+    const std::vector<std::uint8_t> filtered = filter_rows(raw, height, row_bytes, bpp);
+    std::unique_ptr<libdeflate_compressor, decltype(&libdeflate_free_compressor)> z(libdeflate_alloc_compressor(level),
+                                                                                      libdeflate_free_compressor);
+    if (!z) throw Error("PNG encoding failed: out of memory for the compressor");
+    std::vector<std::uint8_t> idat(libdeflate_zlib_compress_bound(z.get(), filtered.size()));
+    const std::size_t packed = libdeflate_zlib_compress(z.get(), filtered.data(), filtered.size(), idat.data(), idat.size());
+    if (packed == 0) throw Error("PNG encoding failed: the compressed image did not fit its bound");
+
+    static constexpr std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    file.write(reinterpret_cast<const char*>(signature), 8);
+    std::uint8_t ihdr[13];
+    put_u32(ihdr, std::uint32_t(width));
+    put_u32(ihdr + 4, std::uint32_t(height));
+    ihdr[8] = std::uint8_t(bits);
+    ihdr[9] = std::uint8_t(colour_type);
+    ihdr[10] = 0;  // deflate
+    ihdr[11] = 0;  // adaptive filtering
+    ihdr[12] = 0;  // not interlaced
+    write_chunk(file, "IHDR", ihdr, sizeof ihdr);
+    constexpr std::size_t piece = std::size_t(1) << 20;  // IDAT chunks of 1 MiB, as readers stream them
+    for (std::size_t at = 0; at < packed; at += piece) write_chunk(file, "IDAT", idat.data() + at, std::min(piece, packed - at));
+    write_chunk(file, "IEND", nullptr, 0);
+    if (!file) throw Error("PNG encoding failed: write failed (disk full?)");
 }
 
 }  // namespace
@@ -204,27 +265,25 @@ GrayImage decode_gray_png(const std::vector<std::uint8_t>& bytes, const std::fil
     return read_png(bytes, name, header_only);
 }
 
-void write_gray_png(std::ostream& file, int width, int height, int bits, std::span<const std::uint16_t> samples) {
+void write_gray_png(std::ostream& file, int width, int height, int bits, std::span<const std::uint16_t> samples,
+                    int level) {
     if (bits != 8 && bits != 16) throw Error("internal error: PNG bit depth must be 8 or 16");
     if (samples.size() != std::size_t(width) * std::size_t(height)) throw Error("internal error: PNG sample count");
-    ErrorSlot err;
-    int rc;
+    std::vector<std::uint8_t> bytes(samples.size() * std::size_t(bits / 8));
     if (bits == 16) {
-        rc = encode(file, width, height, 16, PNG_COLOR_TYPE_GRAY, reinterpret_cast<const std::uint8_t*>(samples.data()),
-                    std::size_t(width) * 2, true, err);
+        for (std::size_t i = 0; i < samples.size(); ++i) {  // PNG stores 16-bit samples big-endian
+            bytes[2 * i] = std::uint8_t(samples[i] >> 8);
+            bytes[2 * i + 1] = std::uint8_t(samples[i]);
+        }
     } else {
-        std::vector<std::uint8_t> bytes(samples.size());
         for (std::size_t i = 0; i < samples.size(); ++i) bytes[i] = std::uint8_t(samples[i] > 255 ? 255 : samples[i]);
-        rc = encode(file, width, height, 8, PNG_COLOR_TYPE_GRAY, bytes.data(), std::size_t(width), false, err);
     }
-    if (rc != 0) throw Error(std::string("PNG encoding failed: ") + err.message);
+    encode(file, width, height, bits, 0, 1, bytes.data(), level);
 }
 
-void write_rgba_png(std::ostream& file, int width, int height, std::span<const std::uint8_t> rgba) {
+void write_rgba_png(std::ostream& file, int width, int height, std::span<const std::uint8_t> rgba, int level) {
     if (rgba.size() != std::size_t(width) * std::size_t(height) * 4) throw Error("internal error: RGBA byte count");
-    ErrorSlot err;
-    if (encode(file, width, height, 8, PNG_COLOR_TYPE_RGB_ALPHA, rgba.data(), std::size_t(width) * 4, false, err) != 0)
-        throw Error(std::string("PNG encoding failed: ") + err.message);
+    encode(file, width, height, 8, 6, 4, rgba.data(), level);
 }
 
 }  // namespace orogen

@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "orogen_test.hpp"
 
 #include <cmath>
@@ -117,6 +119,34 @@ TEST(Png, SixteenAndEightBitRoundTripsAreExact) {
     back = read_gray_png(dir / "8.png");
     EXPECT_EQ(back.bits, 8);
     EXPECT_EQ(back.samples, samples);
+}
+
+TEST(Png, EveryCompressionLevelDecodesToTheSameSamplesAndHigherLevelsAreSmaller) {
+    // A smooth 16-bit terrain-like ramp with noise in the low bits: what the filters and deflate are for.
+    TempDir dir;
+    const int w = 257, h = 129;
+    std::vector<std::uint16_t> samples(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            samples[std::size_t(y) * w + std::size_t(x)] =
+                std::uint16_t(20000 + 90 * x + 40 * y + ((std::uint32_t(x * 7919 + y * 104729) * 2654435761u) >> 29));
+    std::uintmax_t size[13] = {};
+    for (int level : {0, 1, 6, 12}) {
+        const auto path = dir / ("l" + std::to_string(level) + ".png");
+        {
+            AtomicFile f(path);
+            write_gray_png(f.stream(), w, h, 16, samples, level);
+            f.commit();
+        }
+        EXPECT_EQ(read_gray_png(path).samples, samples) << "level " << level;
+        size[level] = std::filesystem::file_size(path);
+    }
+    EXPECT_GT(size[0], std::uintmax_t(w) * h * 2) << "level 0 stores the filtered rows";
+    EXPECT_LT(size[1], size[0] / 2);
+    EXPECT_LE(size[12], size[6]);
+    EXPECT_LE(size[6], size[1]);
+    std::ostringstream sink;
+    EXPECT_THROW(write_gray_png(sink, w, h, 16, samples, 13), BadInput);
 }
 
 TEST(Png, BadFilesAreRefusedWithTheirName) {

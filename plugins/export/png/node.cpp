@@ -67,7 +67,7 @@ NodeOutputs run(NodeContext& ctx) {
         const Image& image = *ctx.input(0).image();
         const auto rgba = png_export::to_srgb8(image, png_export::parse_tonemap(ctx.text("tonemap")), ctx.real("exposure"));
         AtomicFile file(ctx.output_path(ctx.text("path")));
-        write_rgba_png(file.stream(), image.width, image.height, rgba);
+        write_rgba_png(file.stream(), image.width, image.height, rgba, int(ctx.integer("compression")));
         file.commit();
         return {};
     }
@@ -75,7 +75,7 @@ NodeOutputs run(NodeContext& ctx) {
     if (ctx.flag("relief")) {
         const auto rgba = relief_map(hm.view(), ctx.real("azimuth"), ctx.real("elevation"));
         AtomicFile file(ctx.output_path(ctx.text("path")));
-        write_rgba_png(file.stream(), hm.width(), hm.height(), rgba);
+        write_rgba_png(file.stream(), hm.width(), hm.height(), rgba, int(ctx.integer("compression")));
         file.commit();
         return {};
     }
@@ -89,7 +89,7 @@ NodeOutputs run(NodeContext& ctx) {
         samples = png_export::quantise(grid, bits, png_export::range_of(grid));
     }
     AtomicFile file(ctx.output_path(ctx.text("path")));
-    write_gray_png(file.stream(), hm.width(), hm.height(), bits, samples);
+    write_gray_png(file.stream(), hm.width(), hm.height(), bits, samples, int(ctx.integer("compression")));
     file.commit();
     return {};
 }
@@ -115,6 +115,9 @@ OROGEN_PLUGIN("png-export", "0.1.0", registry) {
             {
                 Param::path("path", PathRole::output, {".png"}).help("output file, relative to --out"),
                 Param::integer("bits", 8).min(8).max(16).help("bits per sample: 8 or 16"),
+                Param::integer("compression", 6).min(0).max(12).help(
+                    "deflate level (libdeflate): 0 stores, 1 is fastest (4x libpng's speed, files 1/4 larger), "
+                    "12 smallest; 6 writes libpng's size about twice as fast"),
                 Param::string("layer", "").help("write this layer instead of the heights (\"\" or \"height\": the heights)"),
                 Param::boolean("hillshade", false).help("write the hillshade of the heights instead"),
                 Param::boolean("relief", false).help(

@@ -78,10 +78,10 @@ TEST(PlatesCli, ShippedPipelinesKeepTheirGoldenOutputs) {
         const char* sha256;
     };
     const Golden goldens[] = {
-        {"plates-relief.orogen", "plates-relief.png", "6728f3eeea7037e00fa5618dfbdac8a246d14f69b5cf733d8609fb680d82c30e"},
+        {"plates-relief.orogen", "plates-relief.png", "ff2a10700a6965e8884a10123c9ac6db66a68ed800c0b69800577c68c767a6c0"},
         {"plates-tectonics.orogen", "plates-tectonics.png",
-         "9de43e30e523ce6e06e855986f3ad0374856c50b3232295f40e9697f8a81521f"},
-        {"plates-thesis.orogen", "plates-thesis.png", "5445ba275bde5fecd16a922a9cb77ef1eeab53fd9753e85e29b4dce424889cb3"},
+         "9b3a287fb52b70e96384475b8f9f53d5446fc48d4b205e22b453290daaaea554"},
+        {"plates-thesis.orogen", "plates-thesis.png", "0b28de4f80cb0d410a92279f479a882412cdd968c6d86033abea38f7abde831e"},
     };
     for (const Golden& g : goldens) {
         TempDir dir;

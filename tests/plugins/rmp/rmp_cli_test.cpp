@@ -128,9 +128,9 @@ TEST(RmpCli, ShippedPipelinesKeepTheirGoldenOutputs) {
         const char* sha256;
     };
     const Golden goldens[] = {
-        {"rmp-jitter.orogen", "rmp-jitter-static.png", "a9bf76d15db5d1ee3dd4bb38de62370fa57ac1ed798228dc01d20716fb4ad5f8"},
-        {"rmp-jitter.orogen", "rmp-jitter-dynamic.png", "fbdfa4722e6cf56f82d2e03953eb6635c3f90cd73eb9695f9245d9ea37921b4f"},
-        {"rmp-mountains.orogen", "rmp-mountains.png", "67aad27ef1d9437e5161e27d37865afc1a1022ce8bd8663cbcad2b248a093c6f"},
+        {"rmp-jitter.orogen", "rmp-jitter-static.png", "6f673d41826d26a831ea59e223008938a2d3df4a74cfcdd913eb7a2154ef11e2"},
+        {"rmp-jitter.orogen", "rmp-jitter-dynamic.png", "c3f71af9634d08446826f6ce381943618b53187ab85013eccd51f55ae0b3f60a"},
+        {"rmp-mountains.orogen", "rmp-mountains.png", "e872a179f0457851111330655367808545d705f373e9e539854c404b00ffead1"},
     };
     for (const Golden& g : goldens) {
         TempDir dir;
