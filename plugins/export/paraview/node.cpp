@@ -102,6 +102,17 @@ NodeOutputs run(NodeContext& ctx) {
         s.particles = stem + "-particles.pvd";
         files += vtk::write_particles(particles, folder / s.particles, o);
         s.particle_colour = particle_colour(particles);
+        if (!s.particle_colour.empty()) {
+            std::vector<float> values;
+            int components = 1;
+            for (const auto& f : particles.frames) {
+                const auto a = f.attributes.find(s.particle_colour);
+                if (a == f.attributes.end()) continue;
+                components = a->second.components;
+                values.insert(values.end(), a->second.data.begin(), a->second.data.end());
+            }
+            s.particle_colours = paraview::attribute_colours(s.particle_colour, values, components);
+        }
     }
 
     AtomicFile file(script);

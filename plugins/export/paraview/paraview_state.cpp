@@ -145,6 +145,25 @@ Colours colours_for(const std::string& name, std::span<const float> values) {
     return c;
 }
 
+Colours attribute_colours(const std::string& name, std::span<const float> values, int components) {
+    std::vector<float> magnitudes;
+    for (std::size_t i = 0; i + std::size_t(components) <= values.size(); i += std::size_t(components)) {
+        double sum = 0;
+        for (int c = 0; c < components; ++c) sum += double(values[i + std::size_t(c)]) * values[i + std::size_t(c)];
+        magnitudes.push_back(float(std::sqrt(sum)));
+    }
+    Colours c;
+    c.kind = Colours::sequential;
+    c.title = name == "velocity" ? "velocity (m/s)" : name;
+    c.ramp = {rgb(198, 219, 239), rgb(66, 146, 198), rgb(8, 48, 107)};  // light = slow, dark = fast
+    if (magnitudes.empty()) return c;
+    const std::size_t k = std::min(magnitudes.size() - 1, std::size_t(double(magnitudes.size()) * 0.98));
+    std::nth_element(magnitudes.begin(), magnitudes.begin() + std::ptrdiff_t(k), magnitudes.end());
+    c.low = 0.0;
+    c.high = std::max(double(magnitudes[k]), 1e-9);
+    return c;
+}
+
 double auto_exaggeration(double relief, double side) {
     if (!(relief > 0) || !(side > 0)) return 1.0;
     const double e = std::clamp(0.2 * side / relief, 1.0, 20.0);
@@ -177,6 +196,7 @@ import math
 import os
 import sys
 
+import paraview.simple
 from paraview.simple import *  # noqa: F401,F403 (ParaView's own scripting API)
 
 
@@ -246,10 +266,13 @@ def _apply_colours(lut, colours):
     lut.RescaleTransferFunction(low, high)
 
 
-def _colour_by(display, view, association, array, colours, bar=True):
+def _colour_by(display, view, association, array, colours, bar=True, separate=False):
     # The table first, then the array: ColorBy() would rescale to the data,
     # which is empty at some time steps (no collisions yet) and is not wanted.
-    lut = GetColorTransferFunction(array)
+    # `separate`: a table of this display's own, so plates or particles
+    # sharing an array name with a terrain layer keep their own colours.
+    display.UseSeparateColorMap = 1 if separate else 0
+    lut = GetColorTransferFunction(array, display, separate=separate)
     _apply_colours(lut, colours)
     display.LookupTable = lut
     display.ColorArrayName = [association, array]
@@ -265,6 +288,9 @@ def _colour_by(display, view, association, array, colours, bar=True):
 
 def open_run():
     """Builds the pipeline, colours and camera; returns the render view."""
+    # Keep the camera set below (ParaView's own state scripts do the same):
+    # the first Render() would otherwise reset it to a default view.
+    paraview.simple._DisableFirstRenderCameraReset()
     view = GetActiveViewOrCreate("RenderView")
     exaggeration = RUN["exaggeration"]
     low, high = RUN["heights"]
@@ -296,14 +322,14 @@ def open_run():
         shown.LineWidth = 2.0
         shown.Ambient = 1.0
         shown.Diffuse = 0.0
-        _colour_by(shown, view, "CELLS", "plate", RUN["plate_colours"], bar=False)
+        _colour_by(shown, view, "CELLS", "plate", RUN["plate_colours"], bar=False, separate=True)
     if RUN["collisions"]:
         collisions = PVDReader(registrationName=RUN["collisions"], FileName=_file(RUN["collisions"]))
         raised = Transform(registrationName="collisions (raised)", Input=collisions)
         raised.Transform.Translate = [0.0, 0.0, lift * 1.001 + 1.0]
         shown = Show(raised, view)
         shown.LineWidth = 4.0
-        _colour_by(shown, view, "CELLS", "kind", RUN["collision_colours"], bar=False)
+        _colour_by(shown, view, "CELLS", "kind", RUN["collision_colours"], bar=False, separate=True)
 
     # Particles: positions in metres, stretched with the terrain.
     if RUN["particles"]:
@@ -312,13 +338,11 @@ def open_run():
         stretched.Transform.Scale = [1.0, 1.0, exaggeration]
         shown = Show(stretched, view)
         shown.SetRepresentationType("Point Gaussian")
-        shown.GaussianRadius = 0.004 * max(RUN["size"])
-        if RUN["particle_colour"]:
-            ColorBy(shown, ("POINTS", RUN["particle_colour"], "Magnitude"))
-            lut = GetColorTransferFunction(RUN["particle_colour"])
-            lut.ApplyPreset("Blues", True)  # light = slow, dark = fast (ParaView's preset)
-            lut.RescaleOnVisibilityChange = 1
-            shown.RescaleTransferFunctionToDataRange(True, False)
+        shown.GaussianRadius = 0.0035 * max(RUN["size"])
+        if RUN["particle_colour"]:  # one range over every frame, so colours compare across time
+            lut = _colour_by(shown, view, "POINTS", RUN["particle_colour"], RUN["particle_colours"], bar=False,
+                             separate=True)
+            lut.VectorMode = "Magnitude"
         else:
             ColorBy(shown, None)
             shown.AmbientColor = shown.DiffuseColor = [0.2, 0.45, 0.9]
@@ -335,7 +359,7 @@ def open_run():
     azimuth, elevation = (math.radians(a) for a in RUN["camera"])
     direction = [math.sin(azimuth) * math.cos(elevation), math.cos(azimuth) * math.cos(elevation), math.sin(elevation)]
     radius = 0.5 * math.sqrt(size_x ** 2 + size_y ** 2 + ((high - low) * exaggeration) ** 2)
-    distance = 0.8 * radius / math.tan(math.radians(30.0) / 2.0)  # the terrain's diagonal just fits
+    distance = 0.9 * radius / math.tan(math.radians(30.0) / 2.0)  # the terrain's diagonal just fits
     view.CameraViewAngle = 30.0
     view.CameraFocalPoint = centre
     view.CameraPosition = [c + distance * d for c, d in zip(centre, direction)]
@@ -394,6 +418,7 @@ std::string state_script(const StateScript& s) {
       << "    \"collision_colours\": "
       << colours_python(colours_for("boundary", std::vector<float>{1.0f, 2.0f, 3.0f})) << ",\n"
       << "    \"particle_colour\": " << optional_file(s.particle_colour) << ",\n"
+      << "    \"particle_colours\": " << colours_python(s.particle_colours) << ",\n"
       << "    \"exaggeration\": " << number(s.exaggeration) << ",  # vertical, applied by Warp By Scalar\n"
       << "    \"heights\": [" << number(s.height_min) << ", " << number(s.height_max) << "],  # m\n"
       << "    \"size\": [" << number(s.size_x) << ", " << number(s.size_y) << "],  # m, east and north\n"

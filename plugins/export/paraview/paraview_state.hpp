@@ -43,6 +43,11 @@ Colours colours_for(const std::string& name, std::span<const float> values);
 /// Categorical colours for plate ids (the plates' polygons).
 Colours plate_colours(std::vector<int> ids);
 
+/// Sequential colours (light to dark blue) from 0 to the 98th percentile of the
+/// magnitudes of `values`, `components` floats per item (a particle attribute
+/// over every frame).
+Colours attribute_colours(const std::string& name, std::span<const float> values, int components);
+
 /// Vertical exaggeration that makes the relief (m) a fifth of the larger
 /// horizontal side (m): at least 1 (never flattened), at most 20, two
 /// significant digits. 1 for a flat terrain.
@@ -58,6 +63,7 @@ struct StateScript {
     Colours colours;          ///< of `layer`
     Colours plates_colours;   ///< of the plate polygons (categorical by id)
     std::string particle_colour;  ///< particle attribute that colours them (empty: solid)
+    Colours particle_colours;     ///< of `particle_colour`, by magnitude
     double exaggeration = 1.0;
     double height_min = 0.0, height_max = 0.0;  ///< m
     double size_x = 0.0, size_y = 0.0;          ///< extent east and north, m

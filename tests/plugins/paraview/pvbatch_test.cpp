@@ -161,7 +161,8 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     EXPECT_GE(report["times"].size(), 4u);  // plate snapshots 0, 20, 40, 60 and SPH frames
     EXPECT_EQ(report["play_mode"], "Snap To TimeSteps");
     EXPECT_GT(report["shown_at_first"]["plates (raised)"], 0);
-    EXPECT_GT(report["shown_at_first"]["particles (stretched)"], 0);
+    EXPECT_GT(report["shown_at_last"]["particles (stretched)"], 0);  // rain falls after the first frame
+    EXPECT_GT(report["shown_at_last"]["collisions (raised)"], 0);
     const auto eye = report["camera_position"].get<std::vector<double>>();
     const auto focus = report["camera_focal_point"].get<std::vector<double>>();
     const double dx = eye[0] - focus[0], dy = eye[1] - focus[1], dz = eye[2] - focus[2];
