@@ -121,7 +121,7 @@ Colours colours_for(const std::string& name, std::span<const float> values) {
     if (name == "eroded" || (lo < 0 && hi > 0 && name != "height")) {
         // Brown where the terrain was cut, white at 0, blue-green where it gained (BrBG).
         c.kind = Colours::diverging;
-        if (name == "eroded") c.title = "eroded (m): − cut, + deposit";
+        if (name == "eroded") c.title = "eroded (m, net change)";
         c.low = -top;
         c.high = top;
         c.ramp = {rgb(140, 81, 10), rgb(216, 179, 101), rgb(245, 245, 245), rgb(90, 180, 172), rgb(1, 102, 94)};
@@ -359,7 +359,7 @@ def open_run():
     azimuth, elevation = (math.radians(a) for a in RUN["camera"])
     direction = [math.sin(azimuth) * math.cos(elevation), math.cos(azimuth) * math.cos(elevation), math.sin(elevation)]
     radius = 0.5 * math.sqrt(size_x ** 2 + size_y ** 2 + ((high - low) * exaggeration) ** 2)
-    distance = 0.9 * radius / math.tan(math.radians(30.0) / 2.0)  # the terrain's diagonal just fits
+    distance = 0.8 * radius / math.tan(math.radians(30.0) / 2.0)  # the terrain's diagonal just fits
     view.CameraViewAngle = 30.0
     view.CameraFocalPoint = centre
     view.CameraPosition = [c + distance * d for c, d in zip(centre, direction)]

@@ -1,14 +1,15 @@
 # Run by pvbatch (tests/plugins/paraview/pvbatch_test.cpp):
 #   pvbatch inspect_state.py STATE.py OUT_FOLDER
 # Runs the shipped state script as a user would (`pvbatch STATE.py --screenshot
-# OUT/first.png --size 640x400`), then reports what ParaView built, as JSON in
+# OUT/first.png --size 640x400 --save-state OUT/view.pvsm`), then reports what ParaView built, as JSON in
 # OUT/report.json, and a second picture at the last time step (OUT/last.png).
 import json
 import os
 import sys
 
 state, out = sys.argv[1], sys.argv[2]
-sys.argv = [state, "--screenshot", os.path.join(out, "first.png"), "--size", "640x400"]
+sys.argv = [state, "--screenshot", os.path.join(out, "first.png"), "--size", "640x400",
+            "--save-state", os.path.join(out, "view.pvsm")]
 run = {"__file__": state, "__name__": "__main__"}
 with open(state) as f:
     exec(compile(f.read(), state, "exec"), run)

@@ -170,6 +170,11 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     EXPECT_NEAR(elevation, 30.0, 0.5);  // oblique: neither from above nor from the side
     EXPECT_EQ(report["camera_view_up"], (std::vector<double>{0, 0, 1}));
 
+    // --save-state wrote ParaView's XML state naming the moved run's terrain.
+    const std::string pvsm = slurp(dir / "pictures" / "view.pvsm");
+    EXPECT_NE(pvsm.find("<ParaView>"), std::string::npos);
+    EXPECT_NE(pvsm.find((dir / "moved" / "run.vti").string()), std::string::npos);
+
     // The picture shows something: a large share of non-background pixels in many colours.
     const Picture first = read_png(dir / "pictures" / "first.png");
     ASSERT_EQ(first.width, 640);
