@@ -23,7 +23,7 @@ TEST(ParaviewState, ErodedIsDivergingAndSymmetricAboutZero) {
     ASSERT_EQ(c.ramp.size() % 2, 1u);
     const auto& middle = c.ramp[c.ramp.size() / 2];  // white-ish at zero
     EXPECT_GT(middle[0] + middle[1] + middle[2], 2.7);
-    EXPECT_NE(c.title.find("(m)"), std::string::npos);
+    EXPECT_EQ(c.title, "eroded (m, net change)");
 }
 
 TEST(ParaviewState, PlateIdsAreCategoriesWithDistinctColoursAndNames) {

@@ -10,6 +10,7 @@
 #include <png.h>
 
 #include <algorithm>
+#include <iostream>
 #include <cmath>
 #include <set>
 
@@ -93,7 +94,16 @@ protected:
         fs::create_directories(out);
         const std::string cmd = std::string(OROGEN_XVFB_RUN) + " " + q(pvbatch) + " " + q(OROGEN_INSPECT_STATE) + " " +
                                 q(state) + " " + q(out) + " >" + q(out / "pvbatch.log") + " 2>&1";
-        const int status = std::system(cmd.c_str());
+        int status = std::system(cmd.c_str());
+        // Two xvfb-runs started in the same instant (ctest -j2, other test programs)
+        // can pick one display number; the loser's X server vanishes under it. That
+        // is the harness, not the state script: try once more on a fresh display.
+        const std::string log = slurp(out / "pvbatch.log");
+        if (status != 0 && (log.find("bad X server connection") != std::string::npos ||
+                            log.find("Could not open display") != std::string::npos)) {
+            std::cerr << "pvbatch lost its X display; retrying once\n";
+            status = std::system(cmd.c_str());
+        }
         EXPECT_EQ(status, 0) << cmd << "\n" << slurp(out / "pvbatch.log");
         if (!fs::exists(out / "report.json")) {
             ADD_FAILURE() << "no report: " << slurp(out / "pvbatch.log");
@@ -172,7 +182,7 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
 
     // --save-state wrote ParaView's XML state naming the moved run's terrain.
     const std::string pvsm = slurp(dir / "pictures" / "view.pvsm");
-    EXPECT_NE(pvsm.find("<ParaView>"), std::string::npos);
+    EXPECT_NE(pvsm.find("<ServerManagerState version=\"5."), std::string::npos);
     EXPECT_NE(pvsm.find((dir / "moved" / "run.vti").string()), std::string::npos);
 
     // The picture shows something: a large share of non-background pixels in many colours.
