@@ -19,11 +19,12 @@ mkdir -p "$dir"
 dir=$(cd "$dir" && pwd)
 packages=(paraview python3-paraview)
 
+rm -f "$dir/unavailable"
 if [[ -x "$dir/pvbatch" && -f "$dir/.complete" ]]; then
   echo "paraview: ready in $dir"
   exit 0
 fi
-rm -f "$dir/unavailable" "$dir/.complete"
+rm -f "$dir/.complete"
 
 # 1. Download the .debs (the version apt knows: 5.11 on Debian 12).
 mkdir -p "$dir/debs"
