@@ -231,8 +231,9 @@ def _options():
     parser.add_argument("--time", type=float, help="show this time step (default: the first)")
     parser.add_argument("--save-state", metavar="PVSM", help="save the state as a .pvsm (absolute paths: on Load "
                         "State choose 'Search files under specified directory' after moving the folder)")
-    argv = getattr(sys, "argv", [])[1:]
-    args = parser.parse_args(argv)
+    # Known options only: inside the ParaView GUI (Load State, --script) sys.argv
+    # holds the application's own arguments, which are not ours to refuse.
+    args, _ = parser.parse_known_args(getattr(sys, "argv", [])[1:])
     try:
         width, height = (int(v) for v in args.size.lower().split("x"))
     except ValueError:
