@@ -141,3 +141,21 @@ TEST(ParaviewStateNode, APathOutsideTheOutputFolderIsRefused) {
     EXPECT_FALSE(fs::exists(dir / "run.py"));
     EXPECT_FALSE(fs::exists(dir / "run.vti"));
 }
+
+// export:vtk's `up` from a spec: z (the default) lays the image in the XY plane, y in the XZ plane.
+TEST(ParaviewStateNode, ExportVtkTakesUpZOrYFromTheSpec) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", std::string(kSpec) +
+                                                "export:vtk(hill, path=\"z.vti\")\n"
+                                                "export:vtk(hill, path=\"y.vti\", up=y)\n"
+                                                "export:vtk-particles(hill, path=\"p.pvd\", up=x)\n");
+    RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("s.orogen:7:"), std::string::npos) << r.err;  // the bad `up` (and the type) on line 7
+    dir.write("s.orogen", std::string(kSpec) + "export:vtk(hill, path=\"z.vti\")\n"
+                                               "export:vtk(hill, path=\"y.vti\", up=y)\n");
+    r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(slurp(dir / "out" / "z.vti").find("WholeExtent=\"0 16 0 16 0 0\""), std::string::npos);
+    EXPECT_NE(slurp(dir / "out" / "y.vti").find("WholeExtent=\"0 16 0 0 0 16\""), std::string::npos);
+}
