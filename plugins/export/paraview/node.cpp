@@ -144,9 +144,9 @@ OROGEN_PLUGIN("export-paraview", "0.1.0", registry) {
         .inputs =
             {
                 {"terrain", ValueType::heightmap, Need::required, "the heightmap to show (with its layers)"},
-                {"more", ValueType::none, Need::optional,
+                {"plates or particles", ValueType::none, Need::optional,
                  "a plate history (plates.plates) or particle frames (an SPH eroder's .particles) to play"},
-                {"more", ValueType::none, Need::optional, "the other of the two, in either order"},
+                {"particles or plates", ValueType::none, Need::optional, "the other of the two, in either order"},
             },
         .output = ValueType::none,
         .params =
