@@ -14,6 +14,12 @@ packages=(
   clang-14 libclang-rt-14-dev
 )
 
+# ParaView's pvbatch (the export:paraview-state test) is not installed here:
+# Debian's python3-paraview conflicts with libvtk9-dev's VTK Python package,
+# so tools/paraview.sh (the ctest fixture paraview_fetch) unpacks the two
+# .debs into build/paraview. Everything pvbatch links is already pulled in by
+# the packages above (checked with ldd against their dependency closure).
+
 missing=()
 for p in "${packages[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)

@@ -8,6 +8,8 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 #include <vtkImageData.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -82,6 +84,53 @@ vtkSmartPointer<vtkFloatArray> float_array(vtkDataArray* a, const std::string& n
     return f;
 }
 
+/// True if export:vtk wrote `data` with Z up (field data "orogen_up" = "z");
+/// files without the mark (written before up=z existed) are Y-up.
+bool z_up(vtkDataObject* data) {
+    auto* mark = vtkStringArray::SafeDownCast(data->GetFieldData()->GetAbstractArray("orogen_up"));
+    return mark && mark->GetNumberOfValues() == 1 && mark->GetValue(0) == "z";
+}
+
+/// A z-up file's points and 3-component arrays back into the viewer's frame
+/// (X east, Y up, Z south): (x, y, z) → (x, z, −y), the inverse of export:vtk's turn.
+void turn_to_y_up(vtkPolyData* poly) {
+    auto back = [](double* p) {
+        const double y = p[1];
+        p[1] = p[2];
+        p[2] = -y + 0.0;
+    };
+    if (vtkPoints* points = poly->GetPoints())
+        for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
+            double p[3];
+            points->GetPoint(i, p);
+            back(p);
+            points->SetPoint(i, p);
+        }
+    for (vtkFieldData* fd : {static_cast<vtkFieldData*>(poly->GetPointData()), static_cast<vtkFieldData*>(poly->GetCellData())})
+        for (int a = 0; a < fd->GetNumberOfArrays(); ++a) {
+            vtkDataArray* arr = fd->GetArray(a);
+            if (!arr || arr->GetNumberOfComponents() != 3) continue;
+            for (vtkIdType i = 0; i < arr->GetNumberOfTuples(); ++i) {
+                double v[3];
+                arr->GetTuple(i, v);
+                back(v);
+                arr->SetTuple(i, v);
+            }
+        }
+    poly->Modified();
+}
+
+/// A z-up image's array (south row first) as the viewer's grid (north row first).
+vtkSmartPointer<vtkFloatArray> north_first(vtkDataArray* a, const std::string& name, int width, int height) {
+    auto f = vtkSmartPointer<vtkFloatArray>::New();
+    f->SetName(name.c_str());
+    f->SetNumberOfTuples(vtkIdType(width) * height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            f->SetValue(vtkIdType(y) * width + x, float(a->GetTuple1(vtkIdType(height - 1 - y) * width + x)));
+    return f;
+}
+
 /// Every 1-component point array except `height` and normals, as layers.
 void take_layers(vtkPointData* pd, vtkIdType count, Terrain& t) {
     for (int i = 0; i < pd->GetNumberOfArrays(); ++i) {
@@ -136,19 +185,29 @@ Terrain read_vti(const fs::path& file) {
         throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
     if (!h)
         throw BadInput("cannot read " + quoted(file) + ": it has no 'height' point array; is it an export:vtk heightmap?");
-    if (dims[1] != 1 || dims[0] < 2 || dims[2] < 2)
-        throw BadInput("cannot show " + quoted(file) + ": expected width × 1 × height points (export:vtk's layout), got " +
+    // export:vtk's layouts: up=z width × height × 1 (XY plane), up=y width × 1 × height (XZ plane).
+    const bool z = dims[2] == 1 && dims[1] > 1;
+    if (dims[0] < 2 || (z ? dims[1] < 2 : (dims[1] != 1 || dims[2] < 2)))
+        throw BadInput("cannot show " + quoted(file) +
+                       ": expected width × height × 1 or width × 1 × height points (export:vtk's layouts), got " +
                        std::to_string(dims[0]) + " × " + std::to_string(dims[1]) + " × " + std::to_string(dims[2]));
     Terrain t;
     t.file = file;
     t.width = dims[0];
-    t.height = dims[2];
+    t.height = z ? dims[1] : dims[2];
     t.cell = image->GetSpacing()[0];
     const vtkIdType n = vtkIdType(t.width) * t.height;
     if (h->GetNumberOfTuples() != n || h->GetNumberOfComponents() != 1)
         throw BadInput("cannot read " + quoted(file) + ": its 'height' array does not hold one value per point");
-    t.heights = float_array(h, "height");
-    take_layers(image->GetPointData(), n, t);
+    if (!z) {
+        t.heights = float_array(h, "height");
+        take_layers(image->GetPointData(), n, t);
+        return t;
+    }
+    t.heights = north_first(h, "height", t.width, t.height);
+    Terrain stored;  // the layers as stored, then turned north first
+    take_layers(image->GetPointData(), n, stored);
+    for (auto& l : stored.layers) t.layers.push_back({l.name, north_first(l.values, l.name, t.width, t.height)});
     return t;
 }
 
@@ -167,12 +226,14 @@ vtkSmartPointer<vtkPolyData> read_polydata(const fs::path& file) {
 }
 
 /// export:vtk's .vtp mesh is its grid's kept rows of kept columns, row-major:
-/// the grid is recovered from the points (width = points sharing the first Z).
+/// the grid is recovered from the points (width = points sharing the first
+/// row coordinate: Z south when Y is up, Y north when Z is up).
 Terrain terrain_from_mesh(const fs::path& file, vtkPolyData* poly) {
     const vtkIdType n = poly->GetNumberOfPoints();
     vtkIdType width = 1;
-    const double z0 = poly->GetPoint(0)[2];
-    while (width < n && poly->GetPoint(width)[2] == z0) ++width;
+    const int row_axis = z_up(poly) ? 1 : 2;
+    const double r0 = poly->GetPoint(0)[row_axis];
+    while (width < n && poly->GetPoint(width)[row_axis] == r0) ++width;
     if (width < 2 || n % width != 0 || n / width < 2)
         throw BadInput("cannot show " + quoted(file) + ": its points are not a grid of rows (export:vtk's .vtp mesh is)");
     Terrain t;
@@ -255,8 +316,9 @@ Terrain read_raw(const fs::path& file, bool r16) {
     return t;
 }
 
-/// Which part of a frame a .vtp fills, by what it holds.
+/// Which part of a frame a .vtp fills, by what it holds (turned into the viewer's frame).
 void place(Frame& frame, vtkSmartPointer<vtkPolyData> poly) {
+    if (z_up(poly)) turn_to_y_up(poly);
     if (poly->GetNumberOfPolys() > 0 || poly->GetCellData()->GetArray("plate"))
         frame.plates = poly;
     else if (poly->GetNumberOfLines() > 0 || poly->GetCellData()->GetArray("plate_a"))

@@ -2,10 +2,13 @@
 //
 // A terrain is a grid (heights + named layers, row-major, sample (x, y) at
 // index y·width + x, X east = x·cell, Z south = y·cell, Y up, metres: the
-// exporters' frame, docs/exporters.md). .vti, the export:vtk .vtp mesh,
+// glTF frame, docs/exporters.md). .vti, the export:vtk .vtp mesh,
 // 16-bit PNG and RAW (.r16/.r32 + <file>.json sidecar) all become one.
 // .pvd series become frames of plates, collisions or particles; .glb/.gltf
 // are imported by the scene (VTK's glTF importer builds textured actors).
+// VTK files written with up=z (X east, Y north, Z up: export:vtk's default,
+// marked by the field data "orogen_up") are turned into this frame as read,
+// so the scene sees one frame whatever the file's; unmarked files are Y-up.
 //
 // Every problem with a file is an orogen::BadInput naming the file and what
 // to do; VTK's own messages never reach the user.

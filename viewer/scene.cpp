@@ -662,12 +662,18 @@ void Scene::show(Content content, bool keep_camera) {
     }
     m.plate_series = m.particle_series = nullptr;
     std::set<double> times;
+    int plate_score = 0;  // the series with plates and collisions, else plates, else collisions (a folder
+                          // holding export:paraview-state's split series besides export:vtk-plates' own)
     for (const auto& s : m.content.series) {
+        bool plates = false, collisions = false;
         for (const auto& f : s.frames) {
             times.insert(f.time);
-            if ((f.plates || f.collisions) && !m.plate_series) m.plate_series = &s;
+            plates = plates || f.plates;
+            collisions = collisions || f.collisions;
             if (f.particles && !m.particle_series) m.particle_series = &s;
         }
+        const int score = 2 * plates + collisions;
+        if (score > plate_score) m.plate_series = &s, plate_score = score;
     }
     if (m.plate_series) {  // one colour per plate id, the same at every time
         std::set<int> ids;

@@ -282,6 +282,46 @@ TEST_F(Viewer, ParticleSeriesFramesShowMovingColouredParticles) {
     EXPECT_GT(differing_pixels(a, b), 500u);   // and they moved
 }
 
+// export:vtk writes Z up by default (ParaView's frame) and Y up on request
+// (glTF's); orogen-view turns either into its own frame, so the pictures match.
+TEST_F(Viewer, ZUpAndYUpFilesShowTheSamePicture) {
+    const auto h = plain_and_plateau();
+    std::vector<float> ramp(h.size());
+    for (std::size_t i = 0; i < ramp.size(); ++i) ramp[i] = float(i / 65);  // rises to the south: shows a flip
+    const std::vector<vtk::NamedGrid> layers = {{"ramp", ConstGridView(ramp.data(), 65, 65, 10.0)}};
+    ParticleSeries particles;
+    particles.frames.emplace_back();
+    ParticleAttribute pos{3, {}}, density{1, {}};
+    for (int i = 0; i < 100; ++i) {
+        pos.data.insert(pos.data.end(), {float(i % 10) * 20 + 20, 120.f, float(i / 10) * 30 + 300});
+        density.data.push_back(float(i));
+    }
+    particles.frames[0].attributes = {{"position", pos}, {"density", density}};
+    for (const auto up : {vtk::Up::z, vtk::Up::y}) {
+        const std::string tag = up == vtk::Up::z ? "z" : "y";
+        vtk::Options o;
+        o.up = up;
+        fs::create_directories(dir / tag);
+        vtk::write_heightmap(ConstGridView(h.data(), 65, 65, 10.0), layers, dir / tag / "t.vti", o);
+        vtk::write_heightmap(ConstGridView(h.data(), 65, 65, 10.0), layers, dir / tag / "m.vtp", o);
+        vtk::write_plates(moving_plates(), dir / tag / "plates.pvd", o);
+        vtk::write_particles(particles, dir / tag / "p.vtp", o);
+        for (const char* input : {"t.vti", "m.vtp"}) {
+            const Result r = view(tag + "/" + input + " " + tag + "/plates.pvd " + tag + "/p.vtp --layer ramp --time 1 " +
+                                  "--screenshot " + tag + "_" + input + ".png " + top_view);
+            ASSERT_EQ(r.code, 0) << r.err;
+        }
+    }
+    for (const char* input : {"t.vti", "m.vtp"}) {
+        const Picture z = read_png(dir / (std::string("z_") + input + ".png")),
+                      y = read_png(dir / (std::string("y_") + input + ".png"));
+        EXPECT_LT(differing_pixels(z, y), 50u) << input;
+    }
+    // The layer is not mirrored: the top of the picture (north) is low on the ramp, the bottom high.
+    const Picture z = read_png(dir / "z_t.vti.png");
+    EXPECT_GT(distance(patch(z, 160, 40), patch(z, 160, 280)), 30.0);
+}
+
 // ---------------------------------------------------------------------- keys
 
 /// A VTK event log (vtkInteractorEventRecorder's format) pressing `keys` in order.

@@ -10,6 +10,14 @@ namespace {
 
 using namespace orogen;
 
+/// The options every VTK node has: up and compress.
+vtk::Options options(const NodeContext& ctx) {
+    vtk::Options o;
+    o.up = vtk::up_from_name(ctx.text("up"));
+    o.compress = ctx.flag("compress");
+    return o;
+}
+
 bool ends_with(const std::string& s, const std::string& tail) {
     return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
@@ -18,8 +26,7 @@ NodeOutputs run_heightmap(NodeContext& ctx) {
     const Heightmap& hm = *ctx.input(0).heightmap();
     std::vector<vtk::NamedGrid> layers;
     for (const auto& name : hm.layer_names()) layers.push_back({name, hm.layer(name)});
-    vtk::Options o;
-    o.compress = ctx.flag("compress");
+    vtk::Options o = options(ctx);
     o.vertical_scale = ctx.real("scale");
     o.decimate = int(ctx.integer("decimate"));
     vtk::write_heightmap(hm.view(), layers, ctx.output_path(ctx.text("path")), o);
@@ -38,19 +45,23 @@ void check_heightmap(CheckContext& ctx) {
 }
 
 NodeOutputs run_particles(NodeContext& ctx) {
-    vtk::Options o;
-    o.compress = ctx.flag("compress");
+    vtk::Options o = options(ctx);
     const auto files = vtk::write_particles(*ctx.input(0).particles(), ctx.output_path(ctx.text("path")), o);
     ctx.info("wrote " + ctx.text("path") + " (" + std::to_string(files) + " file(s))");
     return {};
 }
 
 NodeOutputs run_plates(NodeContext& ctx) {
-    vtk::Options o;
-    o.compress = ctx.flag("compress");
+    vtk::Options o = options(ctx);
     const auto files = vtk::write_plates(*ctx.input(0).plates(), ctx.output_path(ctx.text("path")), o);
     ctx.info("wrote " + ctx.text("path") + " (" + std::to_string(files) + " files)");
     return {};
+}
+
+Param up_param() {
+    return Param::choice("up", {"z", "y"}, "z")
+        .help("which axis points up: z (X east, Y north, Z up: ParaView's and GIS's convention, the terrain in the "
+              "XY plane) or y (X east, Y up, Z south: glTF's)");
 }
 
 Param compress_param() {
@@ -65,10 +76,12 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
         .name = "vtk",
         .summary = "write the heightmap and all its layers as VTK XML for ParaView (.vti image or .vtp mesh)",
         .description =
-            "X east, Y up, Z south, metres (as glTF and the particles). .vti: width x 1 x height points in the XZ plane, "
-            "point arrays 'height' and every layer (in ParaView: Warp By Scalar along 0 1 0 for a surface). .vtp: the "
-            "triangle mesh with Normals and the same arrays. Particles and plates have their own nodes: "
-            "export:vtk-particles and export:vtk-plates.",
+            "Metres, origin at sample (0, 0) (the north-west corner). up=z (default): X east, Y north, Z up; a .vti is "
+            "width x height x 1 points in the XY plane, which ParaView's default camera looks down on and Warp By "
+            "Scalar (height) raises along Z. up=y: X east, Y up, Z south (glTF's frame); a .vti is width x 1 x height "
+            "points in the XZ plane. Point arrays 'height' and every layer. .vtp: the triangle mesh with Normals and "
+            "the same arrays. Particles and plates have their own nodes (export:vtk-particles, export:vtk-plates); "
+            "export:paraview-state writes a script that opens it all in ParaView.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to write"}},
         .output = ValueType::none,
         .params =
@@ -77,6 +90,7 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
                     .help("output file: .vti (image data) or .vtp (surface mesh)"),
                 Param::real("scale", 1.0).min(0, true).max(1000).help(".vtp only: vertical exaggeration"),
                 Param::integer("decimate", 1).min(1).max(4096).help(".vtp only: keep every k-th vertex"),
+                up_param(),
                 compress_param(),
             },
         .check = check_heightmap,
@@ -86,7 +100,8 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
         .kind = "export",
         .name = "vtk-particles",
         .summary = "write particle frames for ParaView: one .vtp per frame with every attribute, and a .pvd",
-        .description = "Positions in metres (X east, Y up, Z south); every other attribute (velocity, density, "
+        .description = "Positions in metres (up=z: X east, Y north, Z up; up=y: X east, Y up, Z south), vectors "
+                       "(velocity) turned the same way; every other attribute (velocity, density, "
                        "sediment...) as a point array. A .pvd lists the frames with their times so ParaView plays them.",
         .inputs = {{"particles", ValueType::particles, Need::required, "particle frames (e.g. an SPH eroder's .particles)"}},
         .output = ValueType::none,
@@ -94,6 +109,7 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
             {
                 Param::path("path", PathRole::output, {".pvd", ".vtp"})
                     .help("output: .pvd (time series; frames as <stem>_NNNNNN.vtp beside it) or .vtp (a single frame)"),
+                up_param(),
                 compress_param(),
             },
         .run = run_particles,
@@ -111,6 +127,7 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
         .params =
             {
                 Param::path("path", PathRole::output, {".pvd"}).help("output .pvd; the .vtp files go beside it"),
+                up_param(),
                 compress_param(),
             },
         .run = run_plates,

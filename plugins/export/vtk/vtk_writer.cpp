@@ -16,12 +16,16 @@
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 #include <vtkSmartPointer.h>
 #include <vtkTypeInt32Array.h>
 #include <vtkTypeInt64Array.h>
 #include <vtkXMLImageDataWriter.h>
 #include <vtkXMLPolyDataWriter.h>
 
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <iomanip>
 #include <limits>
@@ -98,6 +102,44 @@ void commit_series(std::vector<std::unique_ptr<AtomicFile>>& files) {
     commit_all(list);
 }
 
+/// Orogen's frame (x east, y up, z south) in the file's frame; `+ 0.0` keeps
+/// −0 out of the files (a flat row at 0 m shows as 0, not −0, in ParaView).
+std::array<double, 3> turned(double x, double y, double z, Up up) {
+    if (up == Up::y) return {x, y, z};
+    return {x, -z + 0.0, y};
+}
+
+/// Turns `count` xyz triples in place from orogen's frame into the file's.
+void turn_in_place(float* xyz, std::size_t count, Up up) {
+    if (up == Up::y) return;
+    for (std::size_t i = 0; i < count; ++i) {
+        float* p = xyz + 3 * i;
+        const float y = p[1];
+        p[1] = -p[2] + 0.0f;
+        p[2] = y;
+    }
+}
+
+/// Records the frame in the file (field data "orogen_up"), for orogen-view and for people.
+void mark_frame(vtkDataObject* data, Up up) {
+    vtkNew<vtkStringArray> a;
+    a->SetName("orogen_up");
+    a->InsertNextValue(up == Up::z ? "z" : "y");
+    data->GetFieldData()->AddArray(a);
+}
+
+/// The grid with its rows in reverse order (z-up image data stores the south row first).
+vtkSmartPointer<vtkFloatArray> flipped(const std::string& name, ConstGridView g) {
+    auto a = vtkSmartPointer<vtkFloatArray>::New();
+    a->SetName(name.c_str());
+    a->SetNumberOfTuples(vtkIdType(g.size()));
+    float* out = a->GetPointer(0);
+    const std::size_t w = std::size_t(g.width);
+    for (int y = 0; y < g.height; ++y)
+        std::copy_n(g.data + std::size_t(g.height - 1 - y) * w, w, out + std::size_t(y) * w);
+    return a;
+}
+
 void check_layers(ConstGridView heights, std::span<const NamedGrid> layers) {
     for (const auto& l : layers)
         if (l.grid.width != heights.width || l.grid.height != heights.height)
@@ -107,6 +149,12 @@ void check_layers(ConstGridView heights, std::span<const NamedGrid> layers) {
 }
 
 }  // namespace
+
+Up up_from_name(const std::string& name) {
+    if (name == "z") return Up::z;
+    if (name == "y") return Up::y;
+    throw BadInput("up must be z (ParaView, GIS) or y (glTF), not '" + name + "'");
+}
 
 std::string pvd_text(std::span<const PvdEntry> entries) {
     std::ostringstream s;
@@ -134,12 +182,22 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     if (ext == ".vti") {
         if (o.decimate != 1) throw BadInput("decimate applies to .vtp meshes only; .vti keeps every sample");
         vtkNew<vtkImageData> image;
-        image->SetDimensions(heights.width, 1, heights.height);  // X east, Z south: sample order as stored
-        image->SetSpacing(heights.cell, 1.0, heights.cell);
-        image->SetOrigin(0, 0, 0);
-        image->GetPointData()->AddArray(wrap("height", heights.data, heights.size(), 1));
+        if (o.up == Up::z) {
+            // X east, Y north: VTK's j runs north, so the south row comes first (a copy of each array).
+            image->SetDimensions(heights.width, heights.height, 1);
+            image->SetSpacing(heights.cell, heights.cell, 1.0);
+            image->SetOrigin(0, -(heights.height - 1) * heights.cell + 0.0, 0);
+            image->GetPointData()->AddArray(flipped("height", heights));
+            for (const auto& l : layers) image->GetPointData()->AddArray(flipped(l.name, l.grid));
+        } else {
+            image->SetDimensions(heights.width, 1, heights.height);  // X east, Z south: sample order as stored
+            image->SetSpacing(heights.cell, 1.0, heights.cell);
+            image->SetOrigin(0, 0, 0);
+            image->GetPointData()->AddArray(wrap("height", heights.data, heights.size(), 1));
+            for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
+        }
         image->GetPointData()->SetActiveScalars("height");
-        for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
+        mark_frame(image, o.up);
         write_with<vtkXMLImageDataWriter>(image, file, o);
         file.commit();
         return;
@@ -154,6 +212,7 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     xyz->SetNumberOfComponents(3);
     xyz->SetNumberOfTuples(vtkIdType(n));
     terrain::chunk_positions(mesh, chunk, {xyz->GetPointer(0), n * 3});
+    turn_in_place(xyz->GetPointer(0), n, o.up);
     vtkNew<vtkPoints> points;
     points->SetData(xyz);
     vtkNew<vtkFloatArray> normals;
@@ -161,6 +220,7 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     normals->SetNumberOfComponents(3);
     normals->SetNumberOfTuples(vtkIdType(n));
     terrain::chunk_normals(mesh, chunk, {normals->GetPointer(0), n * 3});
+    turn_in_place(normals->GetPointer(0), n, o.up);
     vtkNew<vtkTypeInt32Array> offsets, connectivity;
     offsets->SetNumberOfTuples(vtkIdType(triangles + 1));
     for (std::size_t t = 0; t <= triangles; ++t) offsets->SetValue(vtkIdType(t), std::int32_t(3 * t));
@@ -189,6 +249,7 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     add("height", heights);
     for (const auto& l : layers) add(l.name, l.grid);
     poly->GetPointData()->SetActiveScalars("height");
+    mark_frame(poly, o.up);
     write_with<vtkXMLPolyDataWriter>(poly, file, o);
     file.commit();
 }
@@ -197,14 +258,28 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
 
 namespace {
 
-vtkSmartPointer<vtkPolyData> particle_poly(const ParticleFrame& frame, std::size_t index) {
+/// A particle attribute as a VTK array: the frame's own memory in the y frame,
+/// a turned copy of a 3-component (vector) attribute in the z frame.
+vtkSmartPointer<vtkFloatArray> attribute_array(const std::string& name, const ParticleAttribute& attr, std::size_t n,
+                                               Up up) {
+    if (up == Up::y || attr.components != 3) return wrap(name, attr.data.data(), n, attr.components);
+    auto a = vtkSmartPointer<vtkFloatArray>::New();
+    a->SetName(name.c_str());
+    a->SetNumberOfComponents(3);
+    a->SetNumberOfTuples(vtkIdType(n));
+    std::copy_n(attr.data.data(), n * 3, a->GetPointer(0));
+    turn_in_place(a->GetPointer(0), n, up);
+    return a;
+}
+
+vtkSmartPointer<vtkPolyData> particle_poly(const ParticleFrame& frame, std::size_t index, Up up) {
     const auto pos = frame.attributes.find("position");
     if (pos == frame.attributes.end() || pos->second.components != 3)
         throw Error("particle frame " + std::to_string(index) + " has no 3-component 'position' attribute");
     const std::size_t n = frame.count();
     auto poly = vtkSmartPointer<vtkPolyData>::New();
     vtkNew<vtkPoints> points;
-    points->SetData(wrap("position", pos->second.data.data(), n, 3));
+    points->SetData(attribute_array("position", pos->second, n, up));
     poly->SetPoints(points);
     vtkNew<vtkTypeInt64Array> connectivity;
     connectivity->SetNumberOfTuples(vtkIdType(n));
@@ -218,8 +293,9 @@ vtkSmartPointer<vtkPolyData> particle_poly(const ParticleFrame& frame, std::size
             throw Error("particle frame " + std::to_string(index) + ": attribute '" + name + "' holds " +
                         std::to_string(attr.data.size()) + " values for " + std::to_string(n) + " particles of " +
                         std::to_string(attr.components) + " components");
-        poly->GetPointData()->AddArray(wrap(name, attr.data.data(), n, attr.components));
+        poly->GetPointData()->AddArray(attribute_array(name, attr, n, up));
     }
+    mark_frame(poly, up);
     return poly;
 }
 
@@ -232,7 +308,7 @@ std::size_t write_particles(const ParticleSeries& series, const fs::path& target
             throw BadInput("the particles have " + std::to_string(series.frames.size()) +
                            " frames; write a time series as .pvd (one .vtp per frame), or a single frame as .vtp");
         AtomicFile file(target);
-        auto poly = particle_poly(series.frames[0], 0);
+        auto poly = particle_poly(series.frames[0], 0, o.up);
         write_with<vtkXMLPolyDataWriter>(poly, file, o);
         file.commit();
         return 1;
@@ -245,7 +321,7 @@ std::size_t write_particles(const ParticleSeries& series, const fs::path& target
     for (std::size_t i = 0; i < series.frames.size(); ++i) {
         const std::string name = frame_name(target, "", i);
         files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
-        auto poly = particle_poly(series.frames[i], i);
+        auto poly = particle_poly(series.frames[i], i, o.up);
         write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
         entries.push_back({series.frames[i].time, 0, name});
     }
@@ -258,16 +334,18 @@ std::size_t write_particles(const ParticleSeries& series, const fs::path& target
 
 // ------------------------------------------------------------------- plates
 
-std::size_t write_plates(const PlateHistory& history, const fs::path& target, const Options& o) {
+std::size_t write_plates(const PlateHistory& history, const fs::path& target, const Options& o,
+                         const fs::path& collisions_target) {
     if (target.extension() != ".pvd")
         throw BadInput("export:vtk-plates writes a .pvd time series; '" + target.filename().string() +
                        "' has another extension");
+    const bool split = !collisions_target.empty();
     std::vector<std::unique_ptr<AtomicFile>> files;
-    std::vector<PvdEntry> entries;
+    std::vector<PvdEntry> entries, collision_entries;
     std::int64_t previous_step = std::numeric_limits<std::int64_t>::min();
     for (std::size_t s = 0; s < history.snapshots.size(); ++s) {
         const PlateSnapshot& snap = history.snapshots[s];
-        // Plates: one polygon cell each; heightmap (x, y) → (X, 0, Z).
+        // Plates: one polygon cell each; heightmap (x, y) → orogen's (x, 0, y), turned.
         {
             vtkNew<vtkPoints> points;
             points->SetDataTypeToFloat();
@@ -281,9 +359,10 @@ std::size_t write_plates(const PlateHistory& history, const fs::path& target, co
             density->SetName("density");
             for (const PlateState& p : snap.plates) {
                 polys->InsertNextCell(vtkIdType(p.polygon.size()));
-                for (const Point2& v : p.polygon) polys->InsertCellPoint(points->InsertNextPoint(v.x, 0.0, v.y));
+                for (const Point2& v : p.polygon)
+                    polys->InsertCellPoint(points->InsertNextPoint(turned(v.x, 0.0, v.y, o.up).data()));
                 id->InsertNextValue(p.id);
-                velocity->InsertNextTuple3(p.velocity.x, 0.0, p.velocity.y);
+                velocity->InsertNextTuple(turned(p.velocity.x, 0.0, p.velocity.y, o.up).data());
                 density->InsertNextValue(float(p.density));
             }
             vtkNew<vtkPolyData> poly;
@@ -292,6 +371,7 @@ std::size_t write_plates(const PlateHistory& history, const fs::path& target, co
             poly->GetCellData()->AddArray(id);
             poly->GetCellData()->AddArray(velocity);
             poly->GetCellData()->AddArray(density);
+            mark_frame(poly, o.up);
             const std::string name = frame_name(target, "_plates", s);
             files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
             write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
@@ -313,8 +393,8 @@ std::size_t write_plates(const PlateHistory& history, const fs::path& target, co
             for (const CollisionEvent& e : history.collisions) {
                 if (e.step <= previous_step || e.step > snap.step) continue;
                 lines->InsertNextCell(2);
-                lines->InsertCellPoint(points->InsertNextPoint(e.a.x, 0.0, e.a.y));
-                lines->InsertCellPoint(points->InsertNextPoint(e.b.x, 0.0, e.b.y));
+                lines->InsertCellPoint(points->InsertNextPoint(turned(e.a.x, 0.0, e.a.y, o.up).data()));
+                lines->InsertCellPoint(points->InsertNextPoint(turned(e.b.x, 0.0, e.b.y, o.up).data()));
                 a->InsertNextValue(e.plate_a);
                 b->InsertNextValue(e.plate_b);
                 kind->InsertNextValue(int(e.kind));
@@ -328,16 +408,24 @@ std::size_t write_plates(const PlateHistory& history, const fs::path& target, co
                                       static_cast<vtkDataArray*>(kind), static_cast<vtkDataArray*>(impulse),
                                       static_cast<vtkDataArray*>(step)})
                 poly->GetCellData()->AddArray(arr);
+            mark_frame(poly, o.up);
             const std::string name = frame_name(target, "_collisions", s);
             files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
             write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
-            entries.push_back({snap.time, 1, name});
+            if (split)
+                collision_entries.push_back({snap.time, 0, name});
+            else
+                entries.push_back({snap.time, 1, name});
         }
         previous_step = snap.step;
     }
-    files.push_back(std::make_unique<AtomicFile>(target));
-    const std::string pvd = pvd_text(entries);
-    files.back()->write({reinterpret_cast<const std::uint8_t*>(pvd.data()), pvd.size()});
+    auto collection = [&](const fs::path& file, const std::vector<PvdEntry>& list) {
+        files.push_back(std::make_unique<AtomicFile>(file));
+        const std::string pvd = pvd_text(list);
+        files.back()->write({reinterpret_cast<const std::uint8_t*>(pvd.data()), pvd.size()});
+    };
+    if (split) collection(collisions_target, collision_entries);
+    collection(target, entries);
     commit_series(files);
     return files.size();
 }

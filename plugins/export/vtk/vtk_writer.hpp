@@ -2,22 +2,34 @@
 //
 // Plain interface; VTK's headers are included only by vtk_writer.cpp.
 //
-// One frame of reference for everything, the same as glTF's and the particle
-// values': X east, Y up, Z south, metres, origin at heightmap sample (0, 0).
-// In ParaView click "Set view direction to −Y" to look down on the terrain.
-//   heightmap .vti  image data of width × 1 × height points (the XZ plane),
-//                   spacing (cell, 1, cell); point arrays "height" and every
-//                   layer by its name. "Warp By Scalar" (height, normal 0 1 0)
-//                   raises it into a surface.
+// Two frames of reference, chosen by Options::up (every file records its
+// own in the field-data string array "orogen_up", "z" or "y"; metres, origin
+// at heightmap sample (0, 0), the north-west corner):
+//   z (default)  X east, Y north, Z up: ParaView's and GIS's convention. The
+//                terrain lies in the XY plane (Y = −row·cell, so it spans
+//                Y ∈ [−(h−1)·cell, 0]), ParaView's default camera looks down
+//                on it and "Warp By Scalar" (normal 0 0 1) raises it.
+//   y            X east, Y up, Z south: glTF's convention and orogen's own
+//                (the particle values, plate coordinates, export:gltf).
+// The z frame is the y frame turned +90° about X, (x, y, z) → (x, −z, y): no
+// mirror, so triangle winding and handedness are kept.
+//   heightmap .vti  image data. z: width × height × 1 points, spacing
+//                   (cell, cell, 1), origin (0, −(h−1)·cell, 0), rows stored
+//                   south first (VTK's j axis runs north). y: width × 1 ×
+//                   height points in the XZ plane, rows as stored. Point
+//                   arrays "height" and every layer by its name.
 //   heightmap .vtp  the triangle mesh (as export:gltf lays it out: two CCW
-//                   triangles per tile, Y = height·scale), "Normals", and the
-//                   same point arrays.
+//                   triangles per tile, height·scale along the up axis),
+//                   "Normals", and the same point arrays; points row-major
+//                   as the heightmap, north row first.
 //   particles       one .vtp per frame (points + vertex cells, every attribute
-//                   as a point array), listed with their times in a .pvd.
+//                   as a point array; 3-component attributes are vectors and
+//                   turn with the frame), listed with their times in a .pvd.
 //   plates          per snapshot: a .vtp of plate polygons (cell arrays
 //                   plate, velocity, density) and a .vtp of the collisions
 //                   since the previous snapshot (lines a–b with plate_a,
-//                   plate_b, kind, impulse, step), parts 0 and 1 of a .pvd.
+//                   plate_b, kind, impulse, step), parts 0 and 1 of a .pvd;
+//                   all at height 0.
 // Every file is written through orogen::AtomicFile; a series is committed
 // together, after every file of it has been written.
 #pragma once
@@ -36,7 +48,14 @@ struct NamedGrid {
     ConstGridView grid;
 };
 
+/// Which axis points up in the files (see above).
+enum class Up { z, y };
+
+/// "z" → Up::z, "y" → Up::y (the nodes' `up` parameter).
+Up up_from_name(const std::string& name);
+
 struct Options {
+    Up up = Up::z;                ///< frame of reference of every point and vector
     bool compress = false;        ///< zlib-compress the arrays (smaller, slower)
     double vertical_scale = 1.0;  ///< .vtp heightmap mesh only
     int decimate = 1;             ///< .vtp heightmap mesh only: keep every k-th vertex
@@ -52,8 +71,13 @@ std::size_t write_particles(const ParticleSeries& series, const std::filesystem:
                             const Options& options = {});
 
 /// Plate history: `target` .pvd with <stem>_plates_NNNNNN.vtp and
-/// <stem>_collisions_NNNNNN.vtp per snapshot. Returns the number of files written.
-std::size_t write_plates(const PlateHistory& history, const std::filesystem::path& target, const Options& options = {});
+/// <stem>_collisions_NNNNNN.vtp per snapshot (parts 0 and 1). With
+/// `collisions_target` (a .pvd beside `target`), the collisions are listed
+/// there instead and `target` lists only the polygons: two plain series that
+/// a reader takes one at a time (export:paraview-state). Returns the number
+/// of files written.
+std::size_t write_plates(const PlateHistory& history, const std::filesystem::path& target, const Options& options = {},
+                         const std::filesystem::path& collisions_target = {});
 
 /// The .pvd text for (time, file, part) entries.
 struct PvdEntry {

@@ -66,9 +66,12 @@ TEST(SphNode, ParticleSeriesOpensWithVtksXmlReaderAndAsOpenVdbPoints) {
             EXPECT_LT(rho, 2000.0);
             double p[3];
             poly->GetPoint(0, p);
+            // export:vtk's default frame: X east, Y north (the map spans Y ∈ [−32, 0]), Z up.
             EXPECT_GE(p[0], 0.0);
             EXPECT_LE(p[0], 32.0);
-            EXPECT_GE(p[1], 0.0);
+            EXPECT_LE(p[1], 0.0);
+            EXPECT_GE(p[1], -32.0);
+            EXPECT_GE(p[2], 0.0);
         }
     }
     EXPECT_EQ(last, 20u * 30u) << "20 steps of 30 rain particles, none evaporated yet";

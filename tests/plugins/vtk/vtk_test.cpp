@@ -16,6 +16,8 @@
 #include <vtkPolyData.h>
 #include <vtkXMLImageDataReader.h>
 #include <vtkXMLPolyDataReader.h>
+#include <vtkFieldData.h>
+#include <vtkStringArray.h>
 
 #include <regex>
 
@@ -67,9 +69,64 @@ ParticleFrame frame(std::size_t n, double time, float shift) {
     return f;
 }
 
+/// The frame a file says it is in (field data "orogen_up").
+std::string frame_of(vtkDataObject* data) {
+    auto* a = vtkStringArray::SafeDownCast(data->GetFieldData()->GetAbstractArray("orogen_up"));
+    return a && a->GetNumberOfValues() == 1 ? a->GetValue(0) : std::string("(none)");
+}
+
+ov::Options up_y() {
+    ov::Options o;
+    o.up = ov::Up::y;
+    return o;
+}
+
 }  // namespace
 
-TEST(Vtk, ImageDataHoldsHeightAndEveryLayerInTheXZPlane) {
+// ParaView's convention (the default): the image lies in the XY plane, Y north,
+// so ParaView's default camera (looking down −Z) sees it from above, north up.
+TEST(Vtk, ImageDataLiesInTheXYPlaneNorthUpByDefault) {
+    test::TempDir dir;
+    const int w = 33, h = 17;
+    auto heights = test::hills(w, h);
+    std::vector<float> plate(heights.size());
+    for (std::size_t i = 0; i < heights.size(); ++i) plate[i] = float(i % 3);
+    const std::vector<ov::NamedGrid> layers = {{"plate", {plate.data(), w, h, 25.0}}};
+    ov::write_heightmap({heights.data(), w, h, 25.0}, layers, dir / "t.vti");
+
+    vtkNew<vtkXMLImageDataReader> r;
+    r->SetFileName((dir / "t.vti").c_str());
+    r->Update();
+    vtkImageData* img = r->GetOutput();
+    EXPECT_EQ(frame_of(img), "z");
+    int dims[3];
+    img->GetDimensions(dims);
+    EXPECT_EQ(dims[0], w);
+    EXPECT_EQ(dims[1], h);
+    EXPECT_EQ(dims[2], 1);
+    double bounds[6];
+    img->GetBounds(bounds);
+    EXPECT_DOUBLE_EQ(bounds[0], 0.0);
+    EXPECT_DOUBLE_EQ(bounds[1], 32 * 25.0);   // X east to (w−1)·cell
+    EXPECT_DOUBLE_EQ(bounds[2], -16 * 25.0);  // Y north: the south row at −(h−1)·cell
+    EXPECT_DOUBLE_EQ(bounds[3], 0.0);         // the north row (row 0) at 0
+    EXPECT_DOUBLE_EQ(bounds[4], 0.0);
+    EXPECT_DOUBLE_EQ(bounds[5], 0.0);
+    for (const auto& [name, data] : {std::pair<const char*, const std::vector<float>*>{"height", &heights}, {"plate", &plate}}) {
+        vtkDataArray* a = img->GetPointData()->GetArray(name);
+        ASSERT_NE(a, nullptr) << name;
+        // Sample (x, row) is the point at X = x·cell, Y = −row·cell.
+        for (int y = 0; y < h; y += 4)
+            for (int x = 0; x < w; x += 5) {
+                double at[3] = {x * 25.0, -y * 25.0, 0.0};
+                const vtkIdType id = img->FindPoint(at);
+                ASSERT_GE(id, 0);
+                EXPECT_EQ(float(a->GetTuple1(id)), (*data)[std::size_t(y * w + x)]) << name << " " << x << "," << y;
+            }
+    }
+}
+
+TEST(Vtk, ImageDataWithUpYHoldsHeightAndEveryLayerInTheXZPlane) {
     test::TempDir dir;
     const int w = 33, h = 17;
     auto heights = test::hills(w, h);
@@ -79,12 +136,13 @@ TEST(Vtk, ImageDataHoldsHeightAndEveryLayerInTheXZPlane) {
         plate[i] = float(i % 3);
     }
     const std::vector<ov::NamedGrid> layers = {{"water", {water.data(), w, h, 25.0}}, {"plate", {plate.data(), w, h, 25.0}}};
-    ov::write_heightmap({heights.data(), w, h, 25.0}, layers, dir / "t.vti");
+    ov::write_heightmap({heights.data(), w, h, 25.0}, layers, dir / "t.vti", up_y());
 
     vtkNew<vtkXMLImageDataReader> r;
     r->SetFileName((dir / "t.vti").c_str());
     r->Update();
     vtkImageData* img = r->GetOutput();
+    EXPECT_EQ(frame_of(img), "y");
     int dims[3];
     img->GetDimensions(dims);
     EXPECT_EQ(dims[0], w);
@@ -123,17 +181,53 @@ TEST(Vtk, PolyDataMeshHasTrianglesNormalsAndLayers) {
     EXPECT_EQ(poly->GetNumberOfPoints(), w * h);
     EXPECT_EQ(poly->GetNumberOfPolys(), 2 * (w - 1) * (h - 1));
     EXPECT_EQ(poly->GetPolys()->GetMaxCellSize(), 3);
+    EXPECT_EQ(frame_of(poly), "z");
     double b[6];
     poly->GetBounds(b);
     const auto [lo, hi] = std::minmax_element(heights.begin(), heights.end());
-    EXPECT_FLOAT_EQ(float(b[2]), *lo * 3.0f);
-    EXPECT_FLOAT_EQ(float(b[3]), *hi * 3.0f);
+    EXPECT_FLOAT_EQ(float(b[4]), *lo * 3.0f);  // heights along Z
+    EXPECT_FLOAT_EQ(float(b[5]), *hi * 3.0f);
     EXPECT_DOUBLE_EQ(b[1], 20 * 5.0);
+    EXPECT_DOUBLE_EQ(b[2], -12 * 5.0);  // Y north, row 0 at 0
+    EXPECT_DOUBLE_EQ(b[3], 0.0);
     ASSERT_NE(poly->GetPointData()->GetNormals(), nullptr);
-    EXPECT_GT(poly->GetPointData()->GetNormals()->GetComponent(0, 1), 0.0);
+    EXPECT_GT(poly->GetPointData()->GetNormals()->GetComponent(0, 2), 0.0);  // facing up: +Z
     ASSERT_NE(poly->GetPointData()->GetArray("sediment"), nullptr);
     EXPECT_FLOAT_EQ(float(poly->GetPointData()->GetArray("sediment")->GetTuple1(17)), 0.25f);
     EXPECT_FLOAT_EQ(float(poly->GetPointData()->GetArray("height")->GetTuple1(w + 2)), heights[std::size_t(w + 2)]);
+}
+
+// The two frames hold the same mesh turned +90° about X: (x, y, z) → (x, −z, y),
+// and its triangles keep their winding (the normals turn with the points).
+TEST(Vtk, UpYMeshIsTheUpZMeshTurnedAboutX) {
+    test::TempDir dir;
+    const int w = 11, h = 7;
+    auto heights = test::hills(w, h);
+    ov::write_heightmap({heights.data(), w, h, 2.0}, {}, dir / "z.vtp");
+    ov::write_heightmap({heights.data(), w, h, 2.0}, {}, dir / "y.vtp", up_y());
+    auto z = read_vtp(dir / "z.vtp"), y = read_vtp(dir / "y.vtp");
+    EXPECT_EQ(frame_of(y), "y");
+    ASSERT_EQ(z->GetNumberOfPoints(), y->GetNumberOfPoints());
+    for (vtkIdType i = 0; i < z->GetNumberOfPoints(); ++i) {
+        double pz[3], py[3];
+        z->GetPoint(i, pz);
+        y->GetPoint(i, py);
+        EXPECT_EQ(pz[0], py[0]);
+        EXPECT_EQ(pz[1], -py[2]);
+        EXPECT_EQ(pz[2], py[1]);
+        EXPECT_FLOAT_EQ(float(z->GetPointData()->GetNormals()->GetComponent(i, 2)),
+                        float(y->GetPointData()->GetNormals()->GetComponent(i, 1)));
+    }
+    EXPECT_GT(y->GetPointData()->GetNormals()->GetComponent(0, 1), 0.0);  // up is +Y there
+    // Same triangles, same vertex order.
+    vtkIdType nz = 0, ny = 0;
+    const vtkIdType *cz = nullptr, *cy = nullptr;
+    z->GetPolys()->InitTraversal();
+    y->GetPolys()->InitTraversal();
+    while (z->GetPolys()->GetNextCell(nz, cz) && y->GetPolys()->GetNextCell(ny, cy)) {
+        ASSERT_EQ(nz, ny);
+        for (vtkIdType k = 0; k < nz; ++k) EXPECT_EQ(cz[k], cy[k]);
+    }
 }
 
 TEST(Vtk, DecimatedMeshKeepsEveryKthVertexAndItsLayerValues) {
@@ -162,20 +256,38 @@ TEST(Vtk, ParticleSeriesIsAPvdOfFramesWithEveryAttribute) {
         const std::size_t n = s.frames[i].count();
         EXPECT_EQ(std::size_t(poly->GetNumberOfPoints()), n);
         EXPECT_EQ(std::size_t(poly->GetNumberOfVerts()), n);
+        EXPECT_EQ(frame_of(poly), "z");
+        // orogen's (x, y up, z south) = (k + shift, 2k, −k) is (x, −z, y) = (k + shift, k, 2k) with Z up.
         double p[3];
         poly->GetPoint(vtkIdType(n - 1), p);
         EXPECT_DOUBLE_EQ(p[0], double(n - 1) + double(i));
-        EXPECT_DOUBLE_EQ(p[1], 2.0 * double(n - 1));
+        EXPECT_DOUBLE_EQ(p[1], double(n - 1));
+        EXPECT_DOUBLE_EQ(p[2], 2.0 * double(n - 1));
         vtkDataArray* vel = poly->GetPointData()->GetArray("velocity");
         ASSERT_NE(vel, nullptr);
         EXPECT_EQ(vel->GetNumberOfComponents(), 3);
-        EXPECT_DOUBLE_EQ(vel->GetComponent(2, 2), -1.0);
+        EXPECT_DOUBLE_EQ(vel->GetComponent(2, 1), 1.0);  // (1, 0, −1) turned: (1, 1, 0)
+        EXPECT_DOUBLE_EQ(vel->GetComponent(2, 2), 0.0);
         vtkDataArray* rho = poly->GetPointData()->GetArray("density");
         ASSERT_NE(rho, nullptr);
         EXPECT_FLOAT_EQ(float(rho->GetTuple1(1)), 999.29f);
     }
     EXPECT_EQ(test::folder_entries(dir.path()),
               (std::vector<std::string>{"sph.pvd", "sph_000000.vtp", "sph_000001.vtp", "sph_000002.vtp"}));
+}
+
+TEST(Vtk, ParticlesWithUpYKeepOrogensFrame) {
+    test::TempDir dir;
+    ParticleSeries s;
+    s.frames = {frame(4, 0.0, 0)};
+    ov::write_particles(s, dir / "p.vtp", up_y());
+    auto poly = read_vtp(dir / "p.vtp");
+    EXPECT_EQ(frame_of(poly), "y");
+    double p[3];
+    poly->GetPoint(3, p);
+    EXPECT_DOUBLE_EQ(p[1], 6.0);
+    EXPECT_DOUBLE_EQ(p[2], -3.0);
+    EXPECT_DOUBLE_EQ(poly->GetPointData()->GetArray("velocity")->GetComponent(2, 2), -1.0);
 }
 
 TEST(Vtk, ParticleTimeSeriesAsASingleVtpIsBadInput) {
@@ -222,12 +334,14 @@ TEST(Vtk, PlatesArePolygonsAndCollisionsPerSnapshot) {
     EXPECT_EQ(plates->GetNumberOfPoints(), 7);
     EXPECT_EQ(plates->GetCellData()->GetArray("plate")->GetTuple1(1), 2.0);
     EXPECT_DOUBLE_EQ(plates->GetCellData()->GetArray("velocity")->GetComponent(0, 0), 2.0);
+    EXPECT_DOUBLE_EQ(plates->GetCellData()->GetArray("velocity")->GetComponent(0, 1), -0.5);  // (2, 0.5) south → north −0.5
     EXPECT_FLOAT_EQ(float(plates->GetCellData()->GetArray("density")->GetTuple1(1)), 1.2f);
+    EXPECT_EQ(frame_of(plates), "z");
     double p[3];
-    plates->GetPoint(6, p);  // (700, 600) in the plane → X 700, Z 600
+    plates->GetPoint(6, p);  // (700, 600) in the plane → X 700, Y −600, Z 0
     EXPECT_DOUBLE_EQ(p[0], 700.0);
-    EXPECT_DOUBLE_EQ(p[1], 0.0);
-    EXPECT_DOUBLE_EQ(p[2], 600.0);
+    EXPECT_DOUBLE_EQ(p[1], -600.0);
+    EXPECT_DOUBLE_EQ(p[2], 0.0);
 
     auto first = read_vtp(dir / items[1].file);  // steps ≤ 5: two contacts
     EXPECT_EQ(first->GetNumberOfLines(), 2);
@@ -237,6 +351,51 @@ TEST(Vtk, PlatesArePolygonsAndCollisionsPerSnapshot) {
     EXPECT_EQ(second->GetNumberOfLines(), 1);
     EXPECT_EQ(second->GetCellData()->GetArray("plate_a")->GetTuple1(0), 2.0);
     EXPECT_EQ(second->GetCellData()->GetArray("step")->GetTuple1(0), 12.0);
+}
+
+PlateHistory two_snapshots() {
+    PlateHistory hist;
+    hist.width = hist.height = 1000;
+    for (int s = 0; s < 2; ++s) {
+        PlateSnapshot snap;
+        snap.step = s == 0 ? 5 : 12;
+        snap.time = double(snap.step);
+        snap.plates.push_back({1, {{0, 0}, {400, 0}, {400, 300}}, {1.0, 0.5}, 1.0});
+        hist.snapshots.push_back(snap);
+    }
+    hist.collisions.push_back({1, 1, 2, {400, 10}, {400, 200}, BoundaryKind::convergent, 3.5});
+    return hist;
+}
+
+TEST(Vtk, PlatesWithUpYLieInTheXZPlane) {
+    test::TempDir dir;
+    ov::write_plates(two_snapshots(), dir / "plates.pvd", up_y());
+    auto plates = read_vtp(dir / "plates_plates_000000.vtp");
+    EXPECT_EQ(frame_of(plates), "y");
+    double p[3];
+    plates->GetPoint(2, p);
+    EXPECT_DOUBLE_EQ(p[0], 400.0);
+    EXPECT_DOUBLE_EQ(p[1], 0.0);
+    EXPECT_DOUBLE_EQ(p[2], 300.0);
+    EXPECT_DOUBLE_EQ(plates->GetCellData()->GetArray("velocity")->GetComponent(0, 2), 0.5);
+}
+
+// export:paraview-state's layout: polygons and collisions as two plain series.
+TEST(Vtk, PlatesCanListTheirCollisionsInASecondCollection) {
+    test::TempDir dir;
+    EXPECT_EQ(ov::write_plates(two_snapshots(), dir / "p.pvd", {}, dir / "c.pvd"), 6u);
+    const auto polygons = read_pvd(dir / "p.pvd"), collisions = read_pvd(dir / "c.pvd");
+    ASSERT_EQ(polygons.size(), 2u);
+    ASSERT_EQ(collisions.size(), 2u);
+    for (std::size_t i = 0; i < 2; ++i) {
+        EXPECT_EQ(polygons[i].part, 0);
+        EXPECT_EQ(collisions[i].part, 0);
+        EXPECT_EQ(polygons[i].time, collisions[i].time);
+        EXPECT_EQ(read_vtp(dir / polygons[i].file)->GetNumberOfPolys(), 1);
+        EXPECT_EQ(read_vtp(dir / collisions[i].file)->GetNumberOfPolys(), 0);
+    }
+    EXPECT_EQ(read_vtp(dir / collisions[0].file)->GetNumberOfLines(), 1);
+    EXPECT_EQ(collisions[1].file, "p_collisions_000001.vtp");
 }
 
 TEST(Vtk, BadExtensionsAreBadInput) {

@@ -1,0 +1,433 @@
+// paraview_state.cpp — see paraview_state.hpp.
+#include "paraview_state.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace orogen::paraview {
+
+namespace {
+
+using RGB = std::array<double, 3>;
+
+RGB rgb(int r, int g, int b) { return {r / 255.0, g / 255.0, b / 255.0}; }
+
+/// Qualitative colours (ColorBrewer Set1/Set3 family), as orogen-view's.
+const RGB categorical_palette[] = {
+    rgb(228, 26, 28),   rgb(55, 126, 184),  rgb(77, 175, 74),   rgb(152, 78, 163),  rgb(255, 127, 0),  rgb(255, 255, 51),
+    rgb(166, 86, 40),   rgb(247, 129, 191), rgb(141, 211, 199), rgb(190, 186, 218), rgb(128, 177, 211), rgb(179, 222, 105),
+    rgb(252, 205, 229), rgb(188, 128, 189), rgb(204, 235, 197), rgb(255, 237, 111)};
+
+/// Shortest text that reads back as the same double (deterministic, no locale).
+std::string number(double v) {
+    if (v == 0.0) return "0.0";  // also turns −0 into 0
+    char buffer[64];
+    const auto r = std::to_chars(buffer, buffer + sizeof buffer, v);
+    std::string s(buffer, r.ptr);
+    if (s.find_first_of(".en") == std::string::npos) s += ".0";  // a Python float, not an int
+    return s;
+}
+
+/// A colour channel 0..1 to 4 decimals: 8-bit colours need no more, and the script stays readable.
+std::string channel(double v) { return number(std::round(v * 1e4) / 1e4); }
+
+std::string rgb_list(const RGB& c) {
+    std::string s = "[";
+    for (int i = 0; i < 3; ++i) (s += i ? ", " : "") += channel(c[std::size_t(i)]);
+    return s + "]";
+}
+
+/// More than this many distinct ids is not a categorical layer worth a legend.
+constexpr std::size_t max_categories = 256;
+
+Colours categories(const std::string& title, const std::vector<int>& ids, const std::map<int, std::string>& names = {},
+                   const std::map<int, RGB>& fixed = {}) {
+    Colours c;
+    c.kind = Colours::categorical;
+    c.title = title;
+    std::size_t next = 0;
+    for (int id : ids) {
+        const auto f = fixed.find(id);
+        const auto n = names.find(id);
+        c.categories.push_back({id, n != names.end() ? n->second : std::to_string(id),
+                                f != fixed.end() ? f->second : categorical_palette[next++ % std::size(categorical_palette)]});
+    }
+    if (!ids.empty()) c.low = ids.front(), c.high = ids.back();
+    return c;
+}
+
+}  // namespace
+
+std::string python_string(const std::string& text) {
+    std::string out = "\"";
+    for (unsigned char ch : text) {
+        if (ch == '"' || ch == '\\') {
+            out += '\\';
+            out += char(ch);
+        } else if (ch < 0x20 || ch == 0x7f) {
+            char buffer[8];
+            std::snprintf(buffer, sizeof buffer, "\\x%02x", ch);
+            out += buffer;
+        } else {
+            out += char(ch);  // UTF-8 passes through: a Python 3 source is UTF-8
+        }
+    }
+    return out + "\"";
+}
+
+Colours plate_colours(std::vector<int> ids) {
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    std::map<int, std::string> names;
+    for (int id : ids) names[id] = id < 0 ? "no plate" : "plate " + std::to_string(id);
+    return categories("plate", ids, names, {{-1, rgb(200, 200, 200)}});
+}
+
+Colours colours_for(const std::string& name, std::span<const float> values) {
+    float lo = values[0], hi = values[0];
+    for (float v : values) lo = std::min(lo, v), hi = std::max(hi, v);
+    if (name == "plate" || name == "boundary") {
+        std::set<int> ids;
+        for (float v : values) {
+            ids.insert(int(std::lround(v)));
+            if (ids.size() > max_categories) break;
+        }
+        if (ids.size() <= max_categories) {
+            if (name == "plate") {
+                Colours c = plate_colours({ids.begin(), ids.end()});
+                c.title = "plate (id)";
+                return c;
+            }
+            return categories("boundary", {ids.begin(), ids.end()},
+                              {{0, "none"}, {1, "convergent"}, {2, "divergent"}, {3, "transform"}},
+                              {{0, rgb(200, 200, 200)}, {1, rgb(215, 48, 39)}, {2, rgb(69, 117, 180)},
+                               {3, rgb(26, 152, 80)}});
+        }
+    }
+    const std::string unit = name == "flow" ? "m/s" : name == "hardness" ? "0..1" : name == "plate" ? "id" : "m";
+    Colours c;
+    c.title = name + " (" + unit + ")";
+    // Heavy tails (a few fast cells of flow, a few deep gullies) would wash
+    // the map out: the range ends at the 98th percentile of magnitudes.
+    std::vector<float> mags(values.begin(), values.end());
+    for (float& m : mags) m = std::fabs(m);
+    const std::size_t k = std::min(mags.size() - 1, std::size_t(double(mags.size()) * 0.98));
+    std::nth_element(mags.begin(), mags.begin() + std::ptrdiff_t(k), mags.end());
+    const double top = std::max(double(mags[k]), 1e-9);
+    if (name == "eroded" || (lo < 0 && hi > 0 && name != "height")) {
+        // Brown where the terrain was cut, white at 0, blue-green where it gained (BrBG).
+        c.kind = Colours::diverging;
+        if (name == "eroded") c.title = "eroded (m, net change)";
+        c.low = -top;
+        c.high = top;
+        c.ramp = {rgb(140, 81, 10), rgb(216, 179, 101), rgb(245, 245, 245), rgb(90, 180, 172), rgb(1, 102, 94)};
+        return c;
+    }
+    c.kind = Colours::sequential;
+    if (name == "height") {  // hypsometric: lowlands green to rock brown to snow
+        c.low = lo;
+        c.high = hi > lo ? hi : lo + 1.0;
+        c.ramp = {rgb(38, 115, 77), rgb(140, 180, 100), rgb(210, 190, 130), rgb(140, 100, 70), rgb(245, 245, 245)};
+        return c;
+    }
+    c.low = lo;
+    c.high = lo >= 0 ? std::max(top, double(lo) + 1e-9) : std::max(double(hi), double(lo) + 1e-9);
+    if (name == "water" || name == "flow")
+        c.ramp = {rgb(247, 251, 255), rgb(107, 174, 214), rgb(8, 48, 107)};
+    else if (name == "sediment")
+        c.ramp = {rgb(255, 247, 188), rgb(254, 153, 41), rgb(102, 37, 6)};
+    else  // viridis, sampled
+        c.ramp = {rgb(68, 1, 84), rgb(59, 82, 139), rgb(33, 145, 140), rgb(94, 201, 98), rgb(253, 231, 37)};
+    return c;
+}
+
+Colours attribute_colours(const std::string& name, std::span<const float> values, int components) {
+    std::vector<float> magnitudes;
+    for (std::size_t i = 0; i + std::size_t(components) <= values.size(); i += std::size_t(components)) {
+        double sum = 0;
+        for (int c = 0; c < components; ++c) sum += double(values[i + std::size_t(c)]) * values[i + std::size_t(c)];
+        magnitudes.push_back(float(std::sqrt(sum)));
+    }
+    Colours c;
+    c.kind = Colours::sequential;
+    c.title = name == "velocity" ? "velocity (m/s)" : name;
+    c.ramp = {rgb(198, 219, 239), rgb(66, 146, 198), rgb(8, 48, 107)};  // light = slow, dark = fast
+    if (magnitudes.empty()) return c;
+    const std::size_t k = std::min(magnitudes.size() - 1, std::size_t(double(magnitudes.size()) * 0.98));
+    std::nth_element(magnitudes.begin(), magnitudes.begin() + std::ptrdiff_t(k), magnitudes.end());
+    c.low = 0.0;
+    c.high = std::max(double(magnitudes[k]), 1e-9);
+    return c;
+}
+
+double auto_exaggeration(double relief, double side) {
+    if (!(relief > 0) || !(side > 0)) return 1.0;
+    const double e = std::clamp(0.2 * side / relief, 1.0, 20.0);
+    const double scale = std::pow(10.0, std::floor(std::log10(e)) - 1);  // two significant digits
+    return std::round(e / scale) * scale;
+}
+
+namespace {
+
+std::string colours_python(const Colours& c) {
+    std::ostringstream s;
+    const char* kind = c.kind == Colours::categorical ? "categorical" : c.kind == Colours::diverging ? "diverging" : "sequential";
+    s << "{\n        \"kind\": \"" << kind << "\",\n        \"title\": " << python_string(c.title)
+      << ",\n        \"range\": [" << number(c.low) << ", " << number(c.high) << "],\n        \"ramp\": [";
+    for (std::size_t i = 0; i < c.ramp.size(); ++i) s << (i ? ", " : "") << rgb_list(c.ramp[i]);
+    s << "],\n        \"categories\": [";
+    for (std::size_t i = 0; i < c.categories.size(); ++i)
+        s << (i ? ",\n                       " : "") << "[" << c.categories[i].value << ", "
+          << python_string(c.categories[i].name) << ", " << rgb_list(c.categories[i].rgb) << "]";
+    s << "],\n    }";
+    return s.str();
+}
+
+std::string optional_file(const std::string& f) { return f.empty() ? "None" : python_string(f); }
+
+// The script's code: everything it needs comes from RUN above it.
+const char* const script_body = R"py(
+import argparse
+import math
+import os
+import sys
+
+import paraview.simple
+from paraview.simple import *  # noqa: F401,F403 (ParaView's own scripting API)
+
+
+def _folder():
+    """The folder that holds this script and the run's files."""
+    if os.environ.get("OROGEN_RUN_FOLDER"):
+        return os.environ["OROGEN_RUN_FOLDER"]
+    try:
+        return os.path.dirname(os.path.abspath(__file__))
+    except NameError:  # a ParaView that runs state scripts without __file__: the working folder
+        return os.getcwd()
+
+
+HERE = _folder()
+
+
+def _file(name):
+    path = os.path.join(HERE, name)
+    if not os.path.isfile(path):
+        raise SystemExit("orogen state: cannot find %s in %s; keep the run's files together (move the whole "
+                         "folder), or set OROGEN_RUN_FOLDER to the folder that holds them" % (name, HERE))
+    return path
+
+
+def _options():
+    parser = argparse.ArgumentParser(
+        prog="pvbatch " + RUN["script"],
+        description="Opens an orogen run in ParaView; with pvbatch, saves pictures of it.")
+    parser.add_argument("--screenshot", metavar="PNG", help="save a picture of the view")
+    parser.add_argument("--animation", metavar="PNG", help="save one picture per time step (NAME.0000.png ...)")
+    parser.add_argument("--size", default="1600x900", help="picture size, WIDTHxHEIGHT (default 1600x900)")
+    parser.add_argument("--time", type=float, help="show this time step (default: the first)")
+    parser.add_argument("--save-state", metavar="PVSM", help="save the state as a .pvsm (absolute paths: on Load "
+                        "State choose 'Search files under specified directory' after moving the folder)")
+    # Known options only: inside the ParaView GUI (Load State, --script) sys.argv
+    # holds the application's own arguments, which are not ours to refuse.
+    args, _ = parser.parse_known_args(getattr(sys, "argv", [])[1:])
+    try:
+        width, height = (int(v) for v in args.size.lower().split("x"))
+    except ValueError:
+        parser.error("--size must be WIDTHxHEIGHT, e.g. 1600x900, not %r" % args.size)
+    args.size = [width, height]
+    return args
+
+
+def _apply_colours(lut, colours):
+    """The run's colour map for one array (categorical, diverging or sequential)."""
+    lut.AutomaticRescaleRangeMode = "Never"
+    if colours["kind"] == "categorical":
+        lut.InterpretValuesAsCategories = 1
+        lut.AnnotationsInitialized = 1
+        annotations, indexed = [], []
+        for value, name, rgb in colours["categories"]:
+            annotations += [str(value), name]
+            indexed += rgb
+        lut.Annotations = annotations
+        lut.IndexedColors = indexed
+        return
+    lut.InterpretValuesAsCategories = 0
+    low, high = colours["range"]
+    ramp = colours["ramp"]
+    points = []
+    for i, rgb in enumerate(ramp):
+        points += [low + (high - low) * i / (len(ramp) - 1)] + rgb
+    lut.RGBPoints = points
+    lut.ColorSpace = "Diverging" if colours["kind"] == "diverging" else "Lab"
+    lut.NanColor = [0.5, 0.5, 0.5]
+    lut.RescaleTransferFunction(low, high)
+
+
+def _colour_by(display, view, association, array, colours, bar=True, separate=False):
+    # The table first, then the array: ColorBy() would rescale to the data,
+    # which is empty at some time steps (no collisions yet) and is not wanted.
+    # `separate`: a table of this display's own, so plates or particles
+    # sharing an array name with a terrain layer keep their own colours.
+    display.UseSeparateColorMap = 1 if separate else 0
+    lut = GetColorTransferFunction(array, display, separate=separate)
+    _apply_colours(lut, colours)
+    display.LookupTable = lut
+    display.ColorArrayName = [association, array]
+    display.SetScalarBarVisibility(view, bar)
+    if bar:
+        scalar_bar = GetScalarBar(lut, view)
+        scalar_bar.Title = colours["title"]
+        scalar_bar.ComponentTitle = ""
+        scalar_bar.WindowLocation = "Lower Right Corner"
+        scalar_bar.ScalarBarLength = 0.4
+    return lut
+
+
+def open_run():
+    """Builds the pipeline, colours and camera; returns the render view."""
+    # Keep the camera set below (ParaView's own state scripts do the same):
+    # the first Render() would otherwise reset it to a default view.
+    paraview.simple._DisableFirstRenderCameraReset()
+    view = GetActiveViewOrCreate("RenderView")
+    exaggeration = RUN["exaggeration"]
+    low, high = RUN["heights"]
+
+    # The terrain: image data in the XY plane (Z up), raised by its height.
+    terrain = XMLImageDataReader(registrationName=RUN["terrain"], FileName=[_file(RUN["terrain"])])
+    warped = WarpByScalar(registrationName="warped x%g" % exaggeration, Input=terrain)
+    warped.Scalars = ["POINTS", "height"]
+    warped.ScaleFactor = exaggeration
+    warped.Normal = [0.0, 0.0, 1.0]
+    warped.UseNormal = 1
+    surface = ExtractSurface(registrationName="surface", Input=warped)
+    shaded = GenerateSurfaceNormals(registrationName="terrain", Input=surface)
+    shaded.Splitting = 0  # smooth shading across ridges
+    display = Show(shaded, view)
+    display.Representation = "Surface"
+    _colour_by(display, view, "POINTS", RUN["layer"], RUN["colours"])
+
+    # Plates: their outlines (one colour per plate, so the terrain's colours
+    # stay readable) and the collisions since the previous snapshot, just
+    # above the highest peak.
+    lift = (high + 0.01 * max(RUN["size"])) * exaggeration
+    if RUN["plates"]:
+        plates = PVDReader(registrationName=RUN["plates"], FileName=_file(RUN["plates"]))
+        raised = Transform(registrationName="plates (raised)", Input=plates)
+        raised.Transform.Translate = [0.0, 0.0, lift]
+        shown = Show(raised, view)
+        shown.Representation = "Wireframe"
+        shown.LineWidth = 2.0
+        shown.Ambient = 1.0
+        shown.Diffuse = 0.0
+        _colour_by(shown, view, "CELLS", "plate", RUN["plate_colours"], bar=False, separate=True)
+    if RUN["collisions"]:
+        collisions = PVDReader(registrationName=RUN["collisions"], FileName=_file(RUN["collisions"]))
+        raised = Transform(registrationName="collisions (raised)", Input=collisions)
+        raised.Transform.Translate = [0.0, 0.0, lift * 1.001 + 1.0]
+        shown = Show(raised, view)
+        shown.LineWidth = 4.0
+        _colour_by(shown, view, "CELLS", "kind", RUN["collision_colours"], bar=False, separate=True)
+
+    # Particles: positions in metres, stretched with the terrain.
+    if RUN["particles"]:
+        particles = PVDReader(registrationName=RUN["particles"], FileName=_file(RUN["particles"]))
+        stretched = Transform(registrationName="particles (stretched)", Input=particles)
+        stretched.Transform.Scale = [1.0, 1.0, exaggeration]
+        shown = Show(stretched, view)
+        shown.SetRepresentationType("Point Gaussian")
+        shown.GaussianRadius = 0.0035 * max(RUN["size"])
+        if RUN["particle_colour"]:  # one range over every frame, so colours compare across time
+            lut = _colour_by(shown, view, "POINTS", RUN["particle_colour"], RUN["particle_colours"], bar=False,
+                             separate=True)
+            lut.VectorMode = "Magnitude"
+        else:
+            ColorBy(shown, None)
+            shown.AmbientColor = shown.DiffuseColor = [0.2, 0.45, 0.9]
+
+    # Time: every series' steps, snapped to (Play in the toolbar runs them).
+    scene = GetAnimationScene()
+    scene.UpdateAnimationUsingDataTimeSteps()
+    scene.PlayMode = "Snap To TimeSteps"
+
+    # An oblique camera: from the azimuth (clockwise from north) and elevation
+    # above the horizon, far enough to see the whole terrain.
+    size_x, size_y = RUN["size"]
+    centre = [size_x / 2.0, -size_y / 2.0, (low + high) / 2.0 * exaggeration]
+    azimuth, elevation = (math.radians(a) for a in RUN["camera"])
+    direction = [math.sin(azimuth) * math.cos(elevation), math.cos(azimuth) * math.cos(elevation), math.sin(elevation)]
+    radius = 0.5 * math.sqrt(size_x ** 2 + size_y ** 2 + ((high - low) * exaggeration) ** 2)
+    distance = 0.8 * radius / math.tan(math.radians(30.0) / 2.0)  # the terrain's diagonal just fits
+    view.CameraViewAngle = 30.0
+    view.CameraFocalPoint = centre
+    view.CameraPosition = [c + distance * d for c, d in zip(centre, direction)]
+    view.CameraViewUp = [0.0, 0.0, 1.0]
+    view.CenterOfRotation = centre
+    view.OrientationAxesVisibility = 1
+    SetActiveSource(shaded)
+    Render(view)
+    return view
+
+
+def main():
+    args = _options()
+    view = open_run()
+    if args.screenshot or args.animation:
+        view.ViewSize = args.size  # text and bars at their own size, not magnified
+    if args.time is not None:
+        GetAnimationScene().AnimationTime = args.time
+    if args.screenshot:
+        SaveScreenshot(args.screenshot, view, ImageResolution=args.size)
+    if args.animation:
+        SaveAnimation(args.animation, view, ImageResolution=args.size)
+    if args.save_state:
+        SaveState(args.save_state)
+
+
+main()
+)py";
+
+}  // namespace
+
+std::string state_script(const StateScript& s) {
+    std::ostringstream o;
+    o << "# " << s.script_name << ": a ParaView state written by orogen's export:paraview-state.\n"
+      << "# It opens this run: the terrain warped by its height, coloured by '" << s.layer << "',\n"
+      << "# plates and particles over time, an oblique camera. Its files are found beside it\n"
+      << "# (relative paths): move the whole folder, not the script alone.\n"
+      << "#\n"
+      << "#   ParaView:  File > Load State... > " << s.script_name << "   (or: paraview --script=" << s.script_name
+      << ")\n"
+      << "#   Batch:     pvbatch " << s.script_name << " --screenshot view.png [--size 1600x900] [--time T]\n"
+      << "#              pvbatch " << s.script_name << " --animation frames.png     (a picture per time step)\n"
+      << "#              pvbatch " << s.script_name << " --save-state view.pvsm\n"
+      << "#   (Debian's pvbatch draws through X: on a machine without a display, prefix xvfb-run -a.)\n"
+      << "# Frame: X east, Y north, Z up, metres; origin at the north-west corner sample.\n"
+      << "\n"
+      << "RUN = {\n"
+      << "    \"script\": " << python_string(s.script_name) << ",\n"
+      << "    \"terrain\": " << python_string(s.terrain) << ",\n"
+      << "    \"plates\": " << optional_file(s.plates) << ",\n"
+      << "    \"collisions\": " << optional_file(s.collisions) << ",\n"
+      << "    \"particles\": " << optional_file(s.particles) << ",\n"
+      << "    \"layer\": " << python_string(s.layer) << ",\n"
+      << "    \"colours\": " << colours_python(s.colours) << ",\n"
+      << "    \"plate_colours\": " << colours_python(s.plates_colours) << ",\n"
+      << "    \"collision_colours\": "
+      << colours_python(colours_for("boundary", std::vector<float>{1.0f, 2.0f, 3.0f})) << ",\n"
+      << "    \"particle_colour\": " << optional_file(s.particle_colour) << ",\n"
+      << "    \"particle_colours\": " << colours_python(s.particle_colours) << ",\n"
+      << "    \"exaggeration\": " << number(s.exaggeration) << ",  # vertical, applied by Warp By Scalar\n"
+      << "    \"heights\": [" << number(s.height_min) << ", " << number(s.height_max) << "],  # m\n"
+      << "    \"size\": [" << number(s.size_x) << ", " << number(s.size_y) << "],  # m, east and north\n"
+      << "    \"camera\": [" << number(s.azimuth) << ", " << number(s.elevation)
+      << "],  # azimuth clockwise from north, elevation, degrees\n"
+      << "}\n"
+      << script_body;
+    return o.str();
+}
+
+}  // namespace orogen::paraview
