@@ -250,6 +250,16 @@ TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
     EXPECT_EQ(manifest_hashes(f.dir / "warm"), reference);
     EXPECT_EQ(disk_hashes(f.dir / "warm"), reference);  // the files themselves, not only what the manifest says
     EXPECT_EQ(slurp(f.dir / "warm" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
+
+    // Into the folder of the cold run, whose files are already the right bytes: they are left in place
+    // (not staged and renamed over themselves) and still listed, so the manifest is again the same bytes.
+    // A file changed since is put back.
+    std::ofstream(f.dir / "cold" / "scree.png", std::ios::binary) << "edited by hand";
+    const RunResult again = f.cached("cold");
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find("wrote 5 files"), std::string::npos) << again.out;
+    EXPECT_EQ(slurp(f.dir / "cold" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
+    EXPECT_EQ(disk_hashes(f.dir / "cold"), reference);
 }
 
 TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
