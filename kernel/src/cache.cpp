@@ -29,13 +29,17 @@ namespace {
 
 constexpr char magic[8] = {'O', 'R', 'G', 'N', 'C', 'A', 'C', 'H'};
 constexpr std::uint32_t format_version = 1;
-constexpr std::size_t header_size = 128;  // a multiple of 64, so arrays aligned in the payload are aligned in the file
+constexpr std::size_t header_size = 192;  // a multiple of 64, so arrays aligned in the payload are aligned in the file
+constexpr std::size_t max_message_bytes = std::size_t(1) << 20;
 constexpr std::size_t array_alignment = 64;
 constexpr std::size_t hash_block = std::size_t(1) << 20;  // bytes per block of the payload hash
 
 // Header layout (little-endian):
 //   0 magic[8]  8 u32 format  12 u32 header size  16 char orogen version[32]  48 u64 payload size
-//   56 u8 payload hash[32]  88 u8 key[32]  120 u32 messages  124 u32 files
+//   56 u8 payload hash[32]  88 u8 key[32]  120 u32 messages  124 u32 files  128 u64 message bytes
+//   136 u8 messages' SHA-256[32]  168 reserved (zero) to 192
+// then the messages block (u32 count, strings), zero-padded to a multiple of 64, then the payload. The
+// messages have their own hash so that a cached node's messages are replayed without reading its payload.
 struct Header {
     std::uint32_t format = 0;
     std::string version;
@@ -43,7 +47,12 @@ struct Header {
     Digest payload_hash{};
     Digest key{};
     std::uint32_t messages = 0, files = 0;
+    std::uint64_t message_bytes = 0;
+    Digest message_hash{};
+    std::uint64_t payload_offset() const { return header_size + (message_bytes + 63) / 64 * 64; }
 };
+
+void copy_bytes(void* dst, const void* src, std::size_t n);
 
 template <typename T>
 T get(const std::uint8_t* p) {
@@ -70,6 +79,9 @@ Header read_header(std::span<const std::uint8_t> bytes) {
     std::memcpy(h.key.data(), bytes.data() + 88, 32);
     h.messages = get<std::uint32_t>(bytes.data() + 120);
     h.files = get<std::uint32_t>(bytes.data() + 124);
+    h.message_bytes = get<std::uint64_t>(bytes.data() + 128);
+    std::memcpy(h.message_hash.data(), bytes.data() + 136, 32);
+    if (h.message_bytes > max_message_bytes) throw CorruptEntry("its header is damaged (message size)");
     return h;
 }
 
@@ -156,13 +168,13 @@ public:
     void array(std::vector<T>& out) {
         const auto s = array_span<T>();
         out.resize(s.size());
-        if (!s.empty()) std::memcpy(out.data(), s.data(), s.size_bytes());
+        copy_bytes(out.data(), s.data(), s.size_bytes());
     }
     /// An array of exactly `n` elements copied into `dst`.
     void floats_into(float* dst, std::size_t n) {
         const auto s = array_span<float>();
         if (s.size() != n) throw CorruptEntry("a layer's size does not match its heightmap");
-        if (n) std::memcpy(dst, s.data(), n * sizeof(float));
+        copy_bytes(dst, s.data(), n * sizeof(float));
     }
     /// A count that must be followed by at least `min_bytes_each` bytes per element (so a damaged count
     /// cannot make us allocate gigabytes).
@@ -270,7 +282,7 @@ Value read_value(Reader& r) {
             if (heights.size() != std::size_t(width) * std::size_t(height))
                 throw CorruptEntry("a heightmap's size does not match its heights");
             *hm = Heightmap(width, height, cell);
-            if (!heights.empty()) std::memcpy(hm->heights().data(), heights.data(), heights.size_bytes());
+            copy_bytes(hm->heights().data(), heights.data(), heights.size_bytes());
             const std::uint32_t layers = r.u32();
             for (std::uint32_t i = 0; i < layers; ++i) {
                 const std::string name = r.str();
@@ -379,8 +391,19 @@ void write_payload(Writer& w, const Contents& c) {
         w.str(path);
         w.array(bytes);
     }
-    w.u32(std::uint32_t(c.messages.size()));
-    for (const auto& m : c.messages) w.str(m);
+}
+
+std::vector<std::string> read_messages(std::span<const std::uint8_t> block, const Header& h) {
+    Digest d{};
+    unsigned int len = 0;
+    EVP_Digest(block.data(), block.size(), d.data(), &len, EVP_sha256(), nullptr);
+    if (d != h.message_hash) throw CorruptEntry("its messages do not match their SHA-256");
+    Reader r(block, 0);
+    std::vector<std::string> out;
+    const std::uint32_t n = r.u32();
+    for (std::uint32_t i = 0; i < n; ++i) out.push_back(r.str());
+    if (!r.at_end() || n != h.messages) throw CorruptEntry("its messages are damaged");
+    return out;
 }
 
 /// A read-only mapping of a whole file.
@@ -412,6 +435,19 @@ private:
     const std::uint8_t* data_ = nullptr;
     std::size_t size_ = 0;
 };
+
+/// memcpy, on every core for large arrays (the copy out of the mapping is half the cost of a read).
+void copy_bytes(void* dst, const void* src, std::size_t n) {
+    constexpr std::size_t chunk = std::size_t(1) << 20;
+    if (n < 4 * chunk) {
+        if (n) std::memcpy(dst, src, n);
+        return;
+    }
+    tbb::parallel_for(std::size_t(0), (n + chunk - 1) / chunk, [&](std::size_t c) {
+        const std::size_t at = c * chunk;
+        std::memcpy(static_cast<std::uint8_t*>(dst) + at, static_cast<const std::uint8_t*>(src) + at, std::min(chunk, n - at));
+    });
+}
 
 std::string errno_text(int e) { return std::generic_category().message(e); }
 
@@ -527,9 +563,15 @@ std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
     for (const auto& m : contents.messages) reserve += m.size() + 8;
     Writer w(reserve);
     w.buffer().resize(header_size, 0);
+    w.u32(std::uint32_t(contents.messages.size()));
+    for (const auto& m : contents.messages) w.str(m);
+    const std::size_t message_bytes = w.buffer().size() - header_size;
+    if (message_bytes > max_message_bytes) throw Error("the node printed more than 1 MiB of messages");
+    w.buffer().resize((w.buffer().size() + 63) / 64 * 64, 0);
+    const std::size_t payload_offset = w.buffer().size();
     write_payload(w, contents);
     std::vector<std::uint8_t>& buf = w.buffer();
-    const std::span<const std::uint8_t> payload(buf.data() + header_size, buf.size() - header_size);
+    const std::span<const std::uint8_t> payload(buf.data() + payload_offset, buf.size() - payload_offset);
     std::uint8_t* h = buf.data();
     std::memcpy(h, magic, sizeof magic);
     put<std::uint32_t>(h + 8, format_version);
@@ -541,6 +583,9 @@ std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
     std::memcpy(h + 88, key.data(), 32);
     put<std::uint32_t>(h + 120, std::uint32_t(contents.messages.size()));
     put<std::uint32_t>(h + 124, std::uint32_t(contents.files.size()));
+    put<std::uint64_t>(h + 128, message_bytes);
+    unsigned int len = 0;
+    EVP_Digest(buf.data() + header_size, message_bytes, h + 136, &len, EVP_sha256(), nullptr);
     return std::move(buf);
 }
 
@@ -548,13 +593,14 @@ Contents decode(std::span<const std::uint8_t> entry, const Digest& key) {
     const Header h = read_header(entry);
     check_version(h);
     if (h.key != key) throw CorruptEntry("it holds another key (" + hex(h.key).substr(0, 12) + "...)");
-    if (h.payload_size != entry.size() - header_size)
-        throw CorruptEntry("truncated: " + std::to_string(entry.size() - header_size) + " of " +
-                           std::to_string(h.payload_size) + " payload bytes");
-    const auto payload = entry.subspan(header_size);
+    if (entry.size() < h.payload_offset() || h.payload_size != entry.size() - h.payload_offset())
+        throw CorruptEntry("truncated: " + std::to_string(entry.size()) + " bytes, its header says " +
+                           std::to_string(h.payload_offset() + h.payload_size));
+    const auto payload = entry.subspan(h.payload_offset());
     if (payload_hash(payload) != h.payload_hash) throw CorruptEntry("its payload does not match its SHA-256");
-    Reader r(entry, header_size);
     Contents c;
+    c.messages = read_messages(entry.subspan(header_size, h.message_bytes), h);
+    Reader r(entry, h.payload_offset());
     const std::uint32_t values = r.u32();
     for (std::uint32_t i = 0; i < values; ++i) {
         std::string name = r.str();
@@ -567,8 +613,6 @@ Contents decode(std::span<const std::uint8_t> entry, const Digest& key) {
         r.array(bytes);
         c.files.emplace_back(std::move(path), std::move(bytes));
     }
-    const std::uint32_t messages = r.u32();
-    for (std::uint32_t i = 0; i < messages; ++i) c.messages.push_back(r.str());
     if (!r.at_end()) throw CorruptEntry("bytes left over after its contents");
     return c;
 }
@@ -653,10 +697,19 @@ std::optional<EntryInfo> Store::probe(const Digest& key, const std::string& what
     try {
         const Header h = read_header({buf, std::size_t(std::max<ssize_t>(got, 0))});
         check_version(h);
-        if (!stat_ok || h.payload_size != std::uint64_t(st.st_size) - header_size)
+        if (!stat_ok || std::uint64_t(st.st_size) != h.payload_offset() + h.payload_size)
             throw CorruptEntry("truncated: " + std::to_string(std::uint64_t(st.st_size)) + " bytes, its header says " +
-                               std::to_string(h.payload_size + header_size));
-        return EntryInfo{std::uint64_t(st.st_size), h.messages, h.files};
+                               std::to_string(h.payload_offset() + h.payload_size));
+        EntryInfo info{std::uint64_t(st.st_size), h.messages, h.files, {}};
+        if (h.message_bytes > 0) {  // a few hundred bytes, checked by their own hash
+            std::vector<std::uint8_t> block(h.message_bytes);
+            const int mfd = ::open(p.c_str(), O_RDONLY | O_CLOEXEC);
+            const ssize_t n = mfd < 0 ? -1 : ::pread(mfd, block.data(), block.size(), off_t(header_size));
+            if (mfd >= 0) ::close(mfd);
+            if (n != ssize_t(block.size())) throw CorruptEntry("cannot read its messages");
+            info.texts = read_messages(block, h);
+        }
+        return info;
     } catch (const OtherVersion& e) {
         warn_("orogen: note: ignoring the cache entry of '" + what + "': " + e.what());
         return std::nullopt;

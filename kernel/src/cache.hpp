@@ -9,9 +9,9 @@
 // cached node whose result no node that runs needs is never even read.
 //
 // An entry is one file, `<folder>/<key hex>.orc`: a fixed header (magic,
-// format version, orogen version, payload size, payload hash, the key) and a
-// payload of raw little-endian arrays (the values, the files an export wrote,
-// the node's messages). It is read with one mmap, its hash checked before
+// format version, orogen version, payload size, payload hash, the key), the
+// node's messages (with their own hash) and a payload of raw little-endian
+// arrays (the values, the files an export wrote). It is read with one mmap, its hash checked before
 // anything is used, and written atomically (temporary name + rename), so a
 // concurrent run never sees half an entry. LRU: a hit touches the entry's
 // modification time; when the folder outgrows its limit the oldest entries go.
@@ -106,6 +106,7 @@ struct EntryInfo {
     std::uint64_t bytes = 0;     ///< whole file
     std::uint32_t messages = 0;  ///< messages the node printed
     std::uint32_t files = 0;     ///< files it wrote
+    std::vector<std::string> texts;  ///< the messages (read and checked with the header: no payload needed)
 };
 
 struct Settings {

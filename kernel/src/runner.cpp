@@ -278,10 +278,10 @@ public:
             if (s.key && !s.rerun) {
                 if (const auto info = store_->probe(*s.key, node.label)) {
                     // Files and messages are this node's effects: they are put back now. Values wait for a reader.
-                    if (info->files == 0 && info->messages == 0) {
-                        mark_cached(i, "cached");
+                    if (info->files == 0) {
+                        mark_cached(i, "cached", info->texts);
                     } else if (restore(i)) {
-                        mark_cached(i, "cached (files restored)");
+                        mark_cached(i, "cached (files restored)", info->texts);
                     }
                 } else if (node.output_files.empty() && (node.node->output_series || node.mapped_input >= 0)) {
                     // A series is made on demand and never kept: make it only if a node that runs reads it.
@@ -344,8 +344,10 @@ private:
             value_keys_[node.value_name + "." + side.name] = cache::output_key(*s.key, side.name);
     }
 
-    void mark_cached(std::size_t i, const std::string& why) {
+    void mark_cached(std::size_t i, const std::string& why, const std::vector<std::string>& said) {
         const PlannedNode& node = plan_.nodes[i];
+        if (options_.progress)
+            for (const auto& line : said) options_.progress->message(line);
         states_[i].status = Status::cached;
         result_.timings[states_[i].row].cached = true;
         if (options_.progress)
@@ -397,8 +399,6 @@ private:
         } catch (const std::exception& e) {
             throw NodeFailed{1, node_error(node, std::string("cannot put back its cached files: ") + e.what())};
         }
-        for (const auto& line : contents->messages)
-            if (options_.progress) options_.progress->message(line);
         for (auto& [name, v] : contents->values) keep(name.empty() ? node.value_name : node.value_name + "." + name, std::move(v));
         result_.timings[states_[j].row].seconds += seconds_since(t0);
         return true;
