@@ -434,3 +434,53 @@ TEST(CacheRun, TheDefaultFolderFollowsXdgCacheHomeAndTheEnvironmentCanTurnItOff)
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_NE(bad.err.find("--cache-size needs a size"), std::string::npos) << bad.err;
 }
+
+TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
+    TempDir dir;
+    const auto make_png = [&](int seed) {
+        dir.write("gen.orogen", "orogen 1\ngrid 65 cell=10\nh = generate:diamond-square(amplitude=300)\n"
+                                "export:png(h, path=\"in.png\", bits=16)\n");
+        const RunResult r = run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        fs::copy_file(dir / "png" / "in.png", dir / "in.png", fs::copy_options::overwrite_existing);
+    };
+    make_png(1);
+    dir.write("use.orogen", "orogen 1\ngrid 65 cell=10\nh = import:png(path=\"in.png\", low=0, high=300)\n"
+                            "s = erode:thermal(h, talus=30, iterations=5)\nexport:png(s, path=\"s.png\", bits=16)\n");
+    const std::string cache = " --cache " + q(dir / "cache");
+    ASSERT_EQ(run_orogen("run use.orogen --out a" + cache, "", dir.path()).exit_code, 0);
+    const RunResult same = run_orogen("run use.orogen --out b" + cache, "", dir.path());
+    ASSERT_EQ(same.exit_code, 0) << same.err;
+    auto rows = cache_column(same.out);
+    EXPECT_EQ(row(rows, "h"), "") << same.out;  // the file may have changed: it is read again
+    EXPECT_EQ(row(rows, "s"), "cached") << same.out;  // it had not: the rest is reused
+    EXPECT_EQ(slurp(dir / "b" / "s.png"), slurp(dir / "a" / "s.png"));
+
+    make_png(2);  // the same path, other heights
+    const RunResult changed = run_orogen("run use.orogen --out c" + cache, "", dir.path());
+    ASSERT_EQ(changed.exit_code, 0) << changed.err;
+    rows = cache_column(changed.out);
+    EXPECT_EQ(row(rows, "s"), "") << changed.out;
+    EXPECT_EQ(count_rows(rows, ""), 3) << changed.out;
+    const RunResult plain = run_orogen("run use.orogen --out plain --no-cache", "", dir.path());
+    EXPECT_EQ(slurp(dir / "c" / "s.png"), slurp(dir / "plain" / "s.png"));
+    EXPECT_NE(slurp(dir / "c" / "s.png"), slurp(dir / "a" / "s.png"));
+}
+
+TEST(CacheRun, WhatACachedNodeSaidIsSaidAgainWithoutReadingItsValues) {
+    TempDir dir;
+    dir.write("p.orogen", "orogen 1\nseed 5\ngrid 65 cell=100\ncrust = generate:diamond-square(amplitude=100)\n"
+                          "plates = tectonics:plates(crust, plates=3, steps=20)\n"
+                          "export:png(plates, path=\"p.png\", bits=16)\n");
+    const std::string cache = " --cache " + q(dir / "cache");
+    const RunResult first = run_orogen("run p.orogen --out a" + cache, "", dir.path());
+    ASSERT_EQ(first.exit_code, 0) << first.err;
+    const auto said = first.err.find("plates: ");
+    ASSERT_NE(said, std::string::npos) << first.err;
+    const std::string line = first.err.substr(said, first.err.find('\n', said) - said);
+    const RunResult again = run_orogen("run p.orogen --out b" + cache, "", dir.path());
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.err.find(line + "\n"), std::string::npos) << again.err;
+    const auto rows = cache_column(again.out);
+    EXPECT_EQ(row(rows, "plates"), "cached") << again.out;  // not ", read": the messages have their own hash
+}
