@@ -709,6 +709,9 @@ std::optional<EntryInfo> Store::probe(const Digest& key, const std::string& what
             if (n != ssize_t(block.size())) throw CorruptEntry("cannot read its messages");
             info.texts = read_messages(block, h);
         }
+        // LRU: a hit is a use, whether or not its values are read later (a cached node nobody reads is
+        // still what makes the run fast).
+        ::utimensat(AT_FDCWD, p.c_str(), nullptr, 0);
         return info;
     } catch (const OtherVersion& e) {
         warn_("orogen: note: ignoring the cache entry of '" + what + "': " + e.what());
