@@ -44,7 +44,7 @@ TSAN_ONLY  ?= /plugins/[^/]+/[^/]+$$|/tests/plugins/(thermal|hydraulic|pipe|plat
 # targets and the plugins the kernel's tests run specs through (the whole-tree run is not yet measured
 # on a 2-core CI machine; see docs/hardening.md).
 ASAN_ONLY  ?=
-ASAN_CI     = /tests/(kernel|fuzz)|/plugins/(generate/(diamond-square|fault|rmp)|export/(png|raw|gltf)|import/(png|raw)|erode/thermal|tectonics/plates)
+ASAN_CI     = /tests/(kernel|fuzz|cache)|/plugins/(generate/(diamond-square|fault|rmp)|export/(png|raw|gltf)|import/(png|raw)|erode/thermal|tectonics/plates)
 FUZZ_SECONDS ?= 20
 FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000

@@ -41,7 +41,7 @@ extern "C" void on_interrupt(int sig) {
 const char* usage_text =
     "usage:\n"
     "  orogen run SPEC [--out DIR] [--seed N] [--threads N] [--set NAME.PARAM=VALUE]... [--quiet]\n"
-    "                  [--allow-outside-out]\n"
+    "                  [--allow-outside-out] [--cache DIR | --no-cache] [--cache-size SIZE]\n"
     "  orogen check SPEC [--out DIR] [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
     "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
@@ -49,6 +49,10 @@ const char* usage_text =
     "\n"
     "Output paths in a spec are relative to --out (default: out/) and must stay inside it unless\n"
     "--allow-outside-out is given. A run's outputs appear together, the manifest last, or not at all.\n"
+    "Each node's result is kept in a cache folder (default: $XDG_CACHE_HOME/orogen or ~/.cache/orogen;\n"
+    "--cache DIR picks another, --no-cache or OROGEN_NO_CACHE=1 turns it off) of at most --cache-size\n"
+    "(default 2G; K, M, G, T suffixes), least recently used entries evicted: a re-run recomputes only\n"
+    "what changed.\n"
     "Plugins are loaded from\n"
     "<prefix>/lib/orogen/plugins and from OROGEN_PLUGIN_PATH (folders or .so files, ':'-separated).\n";
 
@@ -76,6 +80,9 @@ struct Args {
     bool quiet = false;
     bool allow_outside_out = false;
     std::vector<std::string> overrides;
+    std::optional<std::string> cache_dir;  ///< --cache DIR
+    bool no_cache = false;                 ///< --no-cache
+    std::uint64_t cache_size = cache::Settings{}.max_bytes;
 };
 
 std::optional<std::uint64_t> parse_u64(const std::string& s) {
@@ -120,6 +127,17 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
             auto v = value("--set");
             if (!v) return usage_error("--set needs NAME.PARAM=VALUE");
             a.overrides.push_back(*v);
+        } else if (is("--cache-size")) {
+            auto v = value("--cache-size");
+            auto n = v ? cache::parse_size(*v) : std::nullopt;
+            if (!n) return usage_error("--cache-size needs a size such as 2G, 500M or 1073741824" + (v ? ", got '" + *v + "'" : std::string()));
+            a.cache_size = *n;
+        } else if (is("--cache")) {
+            auto v = value("--cache");
+            if (!v || v->empty()) return usage_error("--cache needs a folder");
+            a.cache_dir = *v;
+        } else if (arg == "--no-cache") {
+            a.no_cache = true;
         } else if (arg == "--allow-outside-out") {
             a.allow_outside_out = true;
         } else if (arg == "--quiet" || arg == "-q") {
@@ -130,7 +148,27 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
             a.positional.push_back(arg);
         }
     }
+    if (a.no_cache && a.cache_dir) return usage_error("--cache and --no-cache contradict each other; give one");
     return std::nullopt;
+}
+
+/// The cache a run uses (nullopt: none), from --cache, --no-cache, OROGEN_NO_CACHE and the user's cache folder.
+std::optional<cache::Settings> cache_settings(const Args& args) {
+    if (args.no_cache) return std::nullopt;
+    cache::Settings s;
+    s.max_bytes = args.cache_size;
+    if (args.cache_dir) {  // the command line wins over the environment
+        s.folder = *args.cache_dir;
+        return s;
+    }
+    if (const char* off = std::getenv("OROGEN_NO_CACHE"); off && *off && std::string(off) != "0") return std::nullopt;
+    s.folder = cache::default_folder();
+    if (s.folder.empty()) {
+        std::fprintf(stderr, "orogen: warning: neither XDG_CACHE_HOME nor HOME is set, so there is no cache folder; "
+                             "running without the cache (give one with --cache DIR)\n");
+        return std::nullopt;
+    }
+    return s;
 }
 
 /// Read, parse and check a spec. Prints diagnostics; returns nullopt on error.
@@ -199,6 +237,12 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
     options.cancel = &g_cancel;
     options.cancel_signal = &g_signal;
     options.on_note = [](const std::string& note) { std::fprintf(stderr, "orogen: %s\n", note.c_str()); };
+    options.cache = cache_settings(args);
+    for (const auto* n : plugins.registry().nodes()) {  // which plugin (name, version) makes each node: part of its cache key
+        const std::string file = plugins.registry().provider(n->qualified_name());
+        for (const auto& p : options.plugins)
+            if (p.file == file) options.node_plugins[n->qualified_name()] = p;
+    }
     RunResult result = run(*plan, options);
     if (result.exit_code != 0) {
         std::fputs(result.error.c_str(), stderr);

@@ -73,6 +73,15 @@ void ProgressDisplay::finish(double seconds) {
     std::fflush(out_);
 }
 
+void ProgressDisplay::skipped(int index, int total, const std::string& label, const std::string& node,
+                              const std::string& why) {
+    if (quiet_) return;
+    std::lock_guard lock(mutex_);
+    if (terminal_) clear_bar();
+    std::fprintf(out_, "[%d/%d] %s (%s) %s\n", index, total, label.c_str(), node.c_str(), why.c_str());
+    std::fflush(out_);
+}
+
 void ProgressDisplay::message(const std::string& text) {
     std::lock_guard lock(mutex_);
     if (terminal_) clear_bar();

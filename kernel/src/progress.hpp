@@ -18,6 +18,8 @@ public:
     void start(int index, int total, const std::string& label, const std::string& node);
     void update(double fraction);
     void finish(double seconds);
+    /// A node that does not run: "[3/9] summit (generate:rmp) cached".
+    void skipped(int index, int total, const std::string& label, const std::string& node, const std::string& why);
     void message(const std::string& text);  ///< a log line, keeping the bar intact
 
 private:

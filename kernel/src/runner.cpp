@@ -9,7 +9,13 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
+#include <cstring>
+#include <fstream>
+#include <fcntl.h>
+#include <unistd.h>
 #include <csignal>
 #include <optional>
 #include <cstdio>
@@ -95,17 +101,21 @@ public:
     void check_cancelled() override {
         if (options_.cancel && options_.cancel->load()) throw Cancelled();
     }
-    void info(std::string_view message) override {
-        if (options_.progress) options_.progress->message(node_.label + ": " + std::string(message));
-    }
-    void warn(std::string_view message) override {
-        if (options_.progress) options_.progress->message(node_.label + ": warning: " + std::string(message));
-    }
+    void info(std::string_view message) override { say(node_.label + ": " + std::string(message)); }
+    void warn(std::string_view message) override { say(node_.label + ": warning: " + std::string(message)); }
+    /// What the node said, for the cache to replay when its result is reused.
+    const std::vector<std::string>& said() const { return said_; }
 
 private:
+    void say(std::string line) {
+        if (options_.progress) options_.progress->message(line);
+        if (!for_entry_) said_.push_back(std::move(line));
+    }
+
     const Plan& plan_;
     const PlannedNode& node_;
     std::vector<Value> inputs_;
+    std::vector<std::string> said_;
     const RunOptions& options_;
     const Staging& staging_;
     std::vector<fs::path>& outside_;
@@ -157,7 +167,8 @@ std::string node_error(const PlannedNode& node, const std::string& message) {
 /// manifest.json into the staging folder: `staged` are the run's files relative to --out (and to the
 /// staging folder), `outside` those written outside --out.
 void write_manifest(const Plan& plan, const RunOptions& options, const Staging& staging,
-                    const std::vector<fs::path>& staged, const std::vector<fs::path>& outside) {
+                    const std::vector<fs::path>& staged, const std::vector<fs::path>& outside,
+                    const std::vector<fs::path>& kept = {}) {
     JsonWriter j;
     j.begin_object();
     j.key("orogen").value(OROGEN_VERSION);
@@ -199,7 +210,13 @@ void write_manifest(const Plan& plan, const RunOptions& options, const Staging& 
         j.key("sha256").value(sha256_file(file));
         j.end_object();
     };
-    for (const auto& f : staged) entry(f, staging.folder() / f);
+    // In one sorted list with the files a cached export found already in place (kept), so the manifest
+    // is the same bytes whichever way a file got there.
+    std::vector<std::pair<fs::path, fs::path>> listed;
+    for (const auto& f : staged) listed.emplace_back(f, staging.folder() / f);
+    for (const auto& f : kept) listed.emplace_back(f, options.out_dir / f);
+    std::sort(listed.begin(), listed.end());
+    for (const auto& [shown, file] : listed) entry(shown, file);
     for (const auto& f : outside)
         if (std::error_code ec; fs::exists(f, ec)) entry(f, f);
     j.end_array();
@@ -218,6 +235,345 @@ void cancelled(RunResult& result, std::string message) {
     result.exit_code = 130;
     result.error = std::move(message);
 }
+
+
+/// A node failed; the message is formatted (node_error), on its way out of nested evaluation.
+struct NodeFailed {
+    int exit_code;
+    std::string message;
+};
+
+/// Runs a plan's nodes in spec order, with the node cache (docs/cache.md) when there is one: a node whose
+/// key has an entry does not run; its values are read from the entry only when a node that does run needs
+/// them (so a cached upstream is never read when everything downstream is cached too), and the files it
+/// wrote are put back into the staging folder at its turn. A damaged entry is recomputed: evaluation is by
+/// demand, so a node runs whenever a value it makes is needed and not at hand.
+class Evaluation {
+public:
+    Evaluation(const Plan& plan, const RunOptions& options, const Staging& staging, std::vector<fs::path>& outside,
+               RunResult& result)
+        : plan_(plan), options_(options), staging_(staging), outside_(outside), result_(result),
+          states_(plan.nodes.size()) {
+        for (std::size_t j = 0; j < plan.nodes.size(); ++j) {
+            const PlannedNode& n = plan.nodes[j];
+            if (n.value_name.empty()) continue;
+            producer_[n.value_name] = {j, ""};
+            for (const auto& side : n.node->side_outputs) producer_[n.value_name + "." + side.name] = {j, side.name};
+        }
+        if (options.cache) {
+            store_.emplace(*options.cache, [this](const std::string& line) { warn(line); });
+            if (!store_->usable()) store_.reset();
+        }
+    }
+
+    /// Throws NodeFailed.
+    void run_all() {
+        for (std::size_t i = 0; i < plan_.nodes.size(); ++i) {
+            current_ = i;
+            const PlannedNode& node = plan_.nodes[i];
+            State& s = states_[i];
+            s.row = result_.timings.size();
+            result_.timings.push_back({node.label, node.node->qualified_name(), node.where.line, 0.0, false, false});
+            compute_key(i);
+            if (s.key && !s.rerun) {
+                if (const auto info = store_->probe(*s.key, node.label)) {
+                    // Files and messages are this node's effects: they are put back now. Values wait for a reader.
+                    if (info->files == 0) {
+                        mark_cached(i, "cached", info->texts);
+                    } else if (restore(i)) {
+                        mark_cached(i, "cached (files restored)", info->texts);
+                    }
+                } else if (node.output_files.empty() && (node.node->output_series || node.mapped_input >= 0)) {
+                    // A series is made on demand and never kept: make it only if a node that runs reads it.
+                    s.status = Status::deferred;
+                    result_.timings[s.row].cached = true;
+                }
+            }
+            if (s.status == Status::pending) execute(i);
+            else release_inputs(i);
+        }
+    }
+
+    int reused() const {
+        int n = 0;
+        for (const auto& t : result_.timings) n += t.cached ? 1 : 0;
+        return n;
+    }
+    const std::optional<cache::Store>& store() const { return store_; }
+    /// Files of cached exports that were already in --out with the same bytes (relative to --out).
+    const std::vector<fs::path>& kept() const { return kept_; }
+
+private:
+    enum class Status { pending, ran, cached, deferred };
+    struct State {
+        std::optional<cache::Digest> key;  ///< nullopt: not cached (no cache, a series' producer unknown...)
+        bool rerun = false;                ///< always runs; its outputs are keyed by their contents
+        Status status = Status::pending;
+        std::size_t row = 0;  ///< in result_.timings
+    };
+
+    void warn(const std::string& line) {
+        if (options_.on_warning) options_.on_warning(line);
+        else if (options_.progress) options_.progress->message(line);
+    }
+
+    void compute_key(std::size_t i) {
+        const PlannedNode& node = plan_.nodes[i];
+        State& s = states_[i];
+        s.rerun = node.node->cache == CachePolicy::rerun;
+        for (const auto& p : node.node->params)
+            if (p.type == ParamType::path && p.path_role == PathRole::input) s.rerun = true;
+        if (!store_) return;
+        const auto plugin = options_.node_plugins.find(node.node->qualified_name());
+        if (plugin == options_.node_plugins.end()) return;
+        std::vector<std::optional<cache::Digest>> inputs;
+        for (const auto& k : node.inputs) {
+            if (k.empty()) {
+                inputs.emplace_back();
+                continue;
+            }
+            const auto it = value_keys_.find(k);
+            if (it == value_keys_.end() || !it->second) return;  // made by a node whose result has no key
+            inputs.push_back(it->second);
+        }
+        s.key = cache::node_key(plan_, node, inputs, plugin->second.name, plugin->second.version,
+                                node_seed(plan_.seed, node.label));
+        if (s.rerun || node.value_name.empty()) return;
+        value_keys_[node.value_name] = cache::output_key(*s.key, "");
+        for (const auto& side : node.node->side_outputs)
+            value_keys_[node.value_name + "." + side.name] = cache::output_key(*s.key, side.name);
+    }
+
+    void mark_cached(std::size_t i, const std::string& why, const std::vector<std::string>& said) {
+        const PlannedNode& node = plan_.nodes[i];
+        if (options_.progress)
+            for (const auto& line : said) options_.progress->message(line);
+        states_[i].status = Status::cached;
+        result_.timings[states_[i].row].cached = true;
+        if (options_.progress)
+            options_.progress->skipped(int(i) + 1, int(plan_.nodes.size()), node.label, node.node->qualified_name(), why);
+        release_inputs(i);
+    }
+
+    /// Values read for the last time by node i are dropped (so a node that runs may modify its input in place).
+    void release_inputs(std::size_t i) {
+        for (const auto& key : plan_.nodes[i].inputs) {
+            auto it = plan_.last_use.find(key);
+            if (!key.empty() && it != plan_.last_use.end() && it->second == i) values_.erase(key);
+        }
+    }
+
+    /// Keep value `key` if a node from the current one on reads it.
+    void keep(const std::string& key, Value v) {
+        const auto it = plan_.last_use.find(key);
+        if (it != plan_.last_use.end() && it->second >= current_) values_[key] = std::move(v);
+    }
+
+    /// Put node j's files back into the staging folder and its values at hand; false if its entry failed.
+    bool restore(std::size_t j) {
+        const PlannedNode& node = plan_.nodes[j];
+        const auto t0 = std::chrono::steady_clock::now();
+        auto contents = store_->load(*states_[j].key, node.label);
+        if (!contents) return false;
+        try {
+            int written = 0;
+            for (const auto& [relative, bytes] : contents->files) {
+                const fs::path rel(relative);
+                if (rel.empty() || rel.is_absolute() || std::any_of(rel.begin(), rel.end(), [](const fs::path& p) { return p == ".."; }))
+                    throw Error("a cached file has a bad path: " + relative);
+                if (already_in_place(rel, bytes)) {  // nothing to stage or move: it is listed as it is
+                    kept_.push_back(rel);
+                    continue;
+                }
+                const fs::path full = staging_.folder() / rel;
+                fs::create_directories(full.parent_path());
+                write_plain(full, bytes);
+                ++written;
+            }
+            // One flush for all of them (an fsync each costs ~8 ms: 123 files of plates/ took a second).
+            const int fd = written ? ::open(staging_.folder().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC) : -1;
+            if (fd >= 0) {
+                ::syncfs(fd);
+                ::close(fd);
+            }
+        } catch (const std::exception& e) {
+            throw NodeFailed{1, node_error(node, std::string("cannot put back its cached files: ") + e.what())};
+        }
+        for (auto& [name, v] : contents->values) keep(name.empty() ? node.value_name : node.value_name + "." + name, std::move(v));
+        result_.timings[states_[j].row].seconds += seconds_since(t0);
+        return true;
+    }
+
+    /// True if `--out/rel` is a regular file inside --out holding exactly `bytes` (a re-run whose export
+    /// is cached: its file is left alone rather than staged and renamed over itself).
+    bool already_in_place(const fs::path& rel, std::span<const std::uint8_t> bytes) const {
+        const OutputPlace place = place_output(options_.out_dir, rel.string());
+        if (!place.inside) return false;
+        const fs::path target = options_.out_dir / place.relative;
+        std::error_code ec;
+        if (!fs::is_regular_file(fs::symlink_status(target, ec)) || fs::file_size(target, ec) != bytes.size() || ec)
+            return false;
+        std::ifstream in(target, std::ios::binary);
+        std::vector<char> buf(std::size_t(1) << 20);
+        std::size_t at = 0;
+        while (at < bytes.size()) {
+            const std::size_t n = std::min(buf.size(), bytes.size() - at);
+            if (!in.read(buf.data(), std::streamsize(n)) || std::memcmp(buf.data(), bytes.data() + at, n) != 0) return false;
+            at += n;
+        }
+        return true;
+    }
+
+    /// Write a file into the private staging folder (no other process looks there; the commit moves it).
+    static void write_plain(const fs::path& path, std::span<const std::uint8_t> bytes) {
+        const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        if (fd < 0) throw Error("cannot write " + path.string() + ": " + std::strerror(errno));
+        std::size_t done = 0;
+        while (done < bytes.size()) {
+            const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+            if (n < 0 && errno == EINTR) continue;
+            if (n < 0) {
+                const int err = errno;
+                ::close(fd);
+                throw Error("cannot write " + path.string() + ": " + std::strerror(err));
+            }
+            done += std::size_t(n);
+        }
+        if (::close(fd) != 0) throw Error("cannot write " + path.string() + ": " + std::strerror(errno));
+    }
+
+    static double seconds_since(std::chrono::steady_clock::time_point t0) {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    }
+
+    /// Value `key` for the current node: at hand, read from node j's cache entry, or made by running node j.
+    Value ensure(const std::string& key) {
+        if (auto it = values_.find(key); it != values_.end()) return it->second;
+        const auto [j, output] = producer_.at(key);
+        State& s = states_[j];
+        const PlannedNode& node = plan_.nodes[j];
+        if (store_ && s.key && !s.rerun && s.status != Status::deferred) {
+            const auto t0 = std::chrono::steady_clock::now();
+            // A node that ran this time kept its entry (or could not); one marked cached was probed at its turn.
+            if (s.status == Status::cached || store_->probe(*s.key, node.label)) {
+                if (auto contents = store_->load(*s.key, node.label)) {
+                    result_.timings[s.row].seconds += seconds_since(t0);
+                    result_.timings[s.row].read = true;
+                    Value wanted;
+                    for (auto& [name, v] : contents->values) {
+                        const std::string k = name.empty() ? node.value_name : node.value_name + "." + name;
+                        if (k == key) wanted = v;
+                        keep(k, std::move(v));
+                    }
+                    if (wanted) return wanted;
+                }
+            }
+        }
+        NodeOutputs out = execute(j);
+        Value wanted = output.empty() ? out.main : out.side[output];
+        if (!wanted) throw NodeFailed{1, node_error(node, "internal error: it did not make its value '" + key + "'")};
+        return wanted;
+    }
+
+    /// Run node j (its inputs made or read first), keep its values and its cache entry.
+    NodeOutputs execute(std::size_t j) {
+        const PlannedNode& node = plan_.nodes[j];
+        State& s = states_[j];
+        std::vector<Value> inputs;
+        for (const auto& key : node.inputs) inputs.push_back(key.empty() ? Value() : ensure(key));
+        if (j == current_) release_inputs(j);
+        const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
+        Context ctx(plan_, node, std::move(inputs), options_, staging_, outside_);
+        const bool writes_files = !node.output_files.empty();
+        const std::vector<fs::path> files_before = writes_files && s.key ? staging_.files() : std::vector<fs::path>{};
+        const std::size_t outside_before = outside_.size();
+        if (options_.progress) options_.progress->start(int(j) + 1, int(plan_.nodes.size()), node.label, node.node->qualified_name());
+        const auto start = std::chrono::steady_clock::now();
+        NodeOutputs out;
+        try {
+            ctx.check_cancelled();
+            if (node.mapped_input >= 0)  // entries are made when a later node pulls them
+                out = NodeOutputs(map_over_series(plan_, node, mapped_inputs, std::size_t(node.mapped_input), options_,
+                                                  staging_, outside_));
+            else
+                out = node.node->run(ctx);
+        } catch (const Cancelled&) {
+            throw NodeFailed{130, node_error(node, cancel_reason(options_))};
+        } catch (const Error& e) {
+            throw NodeFailed{e.kind() == Error::Kind::bad_input ? 2 : 1, node_error(node, e.what())};
+        } catch (const std::bad_alloc&) {
+            throw NodeFailed{1, node_error(node, "out of memory; try a smaller grid")};
+        } catch (const std::exception& e) {
+            throw NodeFailed{1, node_error(node, e.what())};
+        } catch (...) {
+            throw NodeFailed{1, node_error(node, "unknown exception")};
+        }
+        const double seconds = seconds_since(start);
+        if (options_.progress) options_.progress->finish(seconds);
+        NodeTiming& row = result_.timings[s.row];
+        row.seconds += seconds;
+        row.cached = row.read = false;
+        s.status = Status::ran;
+
+        const bool series_out = node.node->output_series || node.mapped_input >= 0;
+        const ValueType returned_entry = out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
+        if ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output)
+            throw NodeFailed{1, node_error(node, "internal error: it returned a " +
+                                                     (returned_entry == ValueType::none
+                                                          ? std::string("nothing")
+                                                          : describe_type(returned_entry, out.main.type() == ValueType::series)) +
+                                                     " but declares a " + describe_type(node.node->output, series_out))};
+        if (!node.value_name.empty()) {
+            if (s.rerun && s.key) {  // what it made decides the keys of the nodes after it
+                auto content_key = [&](const std::string& name, const Value& v) -> std::optional<cache::Digest> {
+                    if (!cache::storable(v.type())) return std::nullopt;
+                    return cache::content_key(*s.key, name, cache::value_hash(v));
+                };
+                value_keys_[node.value_name] = content_key("", out.main);
+                for (const auto& [side, v] : out.side) value_keys_[node.value_name + "." + side] = content_key(side, v);
+            }
+            keep(node.value_name, out.main);
+            for (const auto& [side, v] : out.side) keep(node.value_name + "." + side, v);
+        }
+        if (store_ && s.key && !s.rerun && out.main.type() != ValueType::series && outside_.size() == outside_before)
+            save(j, out, ctx.said(), files_before);
+        return out;
+    }
+
+    void save(std::size_t j, const NodeOutputs& out, const std::vector<std::string>& said,
+              const std::vector<fs::path>& files_before) {
+        const PlannedNode& node = plan_.nodes[j];
+        try {
+            cache::Contents c;
+            if (cache::storable(out.main.type())) c.values.emplace_back("", out.main);
+            for (const auto& [side, v] : out.side)
+                if (cache::storable(v.type())) c.values.emplace_back(side, v);
+            if (!node.output_files.empty()) {
+                const std::vector<fs::path> after = staging_.files();
+                for (const auto& f : after)
+                    if (!std::binary_search(files_before.begin(), files_before.end(), f))
+                        c.files.emplace_back(f.generic_string(), read_file(staging_.folder() / f));
+            }
+            c.messages = said;
+            store_->save(*states_[j].key, c);
+        } catch (const std::exception& e) {
+            warn("orogen: warning: could not keep the result of '" + node.label + "' in the cache (" + e.what() + ")");
+        }
+    }
+
+    const Plan& plan_;
+    const RunOptions& options_;
+    const Staging& staging_;
+    std::vector<fs::path>& outside_;
+    RunResult& result_;
+    std::vector<State> states_;
+    std::size_t current_ = 0;
+    std::optional<cache::Store> store_;
+    std::vector<fs::path> kept_;
+    std::map<std::string, Value, std::less<>> values_;
+    std::map<std::string, std::optional<cache::Digest>, std::less<>> value_keys_;
+    std::map<std::string, std::pair<std::size_t, std::string>, std::less<>> producer_;  ///< value key → node, output
+};
 
 }  // namespace
 
@@ -249,71 +605,18 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     }
     std::vector<fs::path> outside;  // outputs written outside --out (allowed with --allow-outside-out)
 
-    std::map<std::string, Value, std::less<>> values;
-    const int total = int(plan.nodes.size());
-    for (std::size_t i = 0; i < plan.nodes.size(); ++i) {
-        const PlannedNode& node = plan.nodes[i];
-        std::vector<Value> inputs;
-        for (const auto& key : node.inputs) inputs.push_back(key.empty() ? Value() : values.at(key));
-        // Values read for the last time are released now, so a node may modify its input in place.
-        for (const auto& key : node.inputs) {
-            auto it = plan.last_use.find(key);
-            if (!key.empty() && it != plan.last_use.end() && it->second == i) values.erase(key);
-        }
-        const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
-        Context ctx(plan, node, std::move(inputs), options, *staging, outside);
-        if (options.progress) options.progress->start(int(i) + 1, total, node.label, node.node->qualified_name());
-        const auto start = std::chrono::steady_clock::now();
-        NodeOutputs out;
-        try {
-            ctx.check_cancelled();
-            if (node.mapped_input >= 0)  // entries are made when a later node pulls them
-                out = NodeOutputs(map_over_series(plan, node, mapped_inputs, std::size_t(node.mapped_input), options,
-                                                  *staging, outside));
-            else
-                out = node.node->run(ctx);
-        } catch (const Cancelled&) {
-            cancelled(result, node_error(node, cancel_reason(options)));
-            break;
-        } catch (const Error& e) {
-            result.exit_code = e.kind() == Error::Kind::bad_input ? 2 : 1;
-            result.error = node_error(node, e.what());
-            break;
-        } catch (const std::bad_alloc&) {
-            result.exit_code = 1;
-            result.error = node_error(node, "out of memory; try a smaller grid");
-            break;
-        } catch (const std::exception& e) {
-            result.exit_code = 1;
-            result.error = node_error(node, e.what());
-            break;
-        } catch (...) {
-            result.exit_code = 1;
-            result.error = node_error(node, "unknown exception");
-            break;
-        }
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (options.progress) options.progress->finish(seconds);
-        result.timings.push_back({node.label, node.node->qualified_name(), node.where.line, seconds});
-
-        const bool series_out = node.node->output_series || node.mapped_input >= 0;
-        const ValueType returned_entry = out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
-        if ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output) {
-            result.exit_code = 1;
-            result.error = node_error(node, "internal error: it returned a " +
-                                                (returned_entry == ValueType::none
-                                                     ? std::string("nothing")
-                                                     : describe_type(returned_entry, out.main.type() == ValueType::series)) +
-                                                " but declares a " + describe_type(node.node->output, series_out));
-            break;
-        }
-        if (!node.value_name.empty()) {
-            if (plan.last_use.count(node.value_name)) values[node.value_name] = std::move(out.main);
-            for (auto& [side, v] : out.side) {
-                const std::string key = node.value_name + "." + side;
-                if (plan.last_use.count(key)) values[key] = std::move(v);
-            }
-        }
+    Evaluation evaluation(plan, options, *staging, outside, result);
+    try {
+        evaluation.run_all();
+    } catch (const NodeFailed& f) {
+        result.exit_code = f.exit_code;
+        result.error = f.message;
+    }
+    if (const auto& store = evaluation.store()) {
+        result.cache_summary = "cache: " + std::to_string(evaluation.reused()) + " of " + std::to_string(plan.nodes.size()) +
+                               " nodes reused from " + store->folder().string() + " (" +
+                               human_bytes(double(store->total_bytes())) + " of " +
+                               human_bytes(double(options.cache->max_bytes)) + ")";
     }
     result.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (result.exit_code == 0 && options.cancel && options.cancel->load())  // stopped after the last node
@@ -322,9 +625,12 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         // All or nothing: the manifest is staged with the rest and moves into place last.
         try {
             const std::vector<fs::path> staged = staging->files();
-            write_manifest(plan, options, *staging, staged, outside);
+            write_manifest(plan, options, *staging, staged, outside, evaluation.kept());
             staging->commit("manifest.json");
-            for (const auto& f : staged) result.outputs.push_back(options.out_dir / f);
+            std::vector<fs::path> all = staged;
+            all.insert(all.end(), evaluation.kept().begin(), evaluation.kept().end());
+            std::sort(all.begin(), all.end());
+            for (const auto& f : all) result.outputs.push_back(options.out_dir / f);
             for (const auto& f : outside) result.outputs.push_back(f);
             result.outputs.push_back(options.out_dir / "manifest.json");
         } catch (const std::exception& e) {
@@ -341,12 +647,14 @@ std::string format_timings(const RunResult& result) {
     std::snprintf(line, sizeof line, "%-16s %-26s %5s %10s %6s\n", "node", "kind:name", "line", "seconds", "share");
     out << line;
     for (const auto& t : result.timings) {
-        std::snprintf(line, sizeof line, "%-16s %-26s %5d %10.3f %5.1f%%\n", t.label.c_str(), t.node.c_str(), t.line,
-                      t.seconds, result.total_seconds > 0 ? 100.0 * t.seconds / result.total_seconds : 0.0);
+        std::snprintf(line, sizeof line, "%-16s %-26s %5d %10.3f %5.1f%%%s\n", t.label.c_str(), t.node.c_str(), t.line,
+                      t.seconds, result.total_seconds > 0 ? 100.0 * t.seconds / result.total_seconds : 0.0,
+                      t.cached ? (t.read ? "  cached, read" : "  cached") : "");
         out << line;
     }
     std::snprintf(line, sizeof line, "%-16s %-26s %5s %10.3f\n", "total", "", "", result.total_seconds);
     out << line;
+    if (!result.cache_summary.empty()) out << result.cache_summary << "\n";
     return out.str();
 }
 

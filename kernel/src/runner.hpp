@@ -2,12 +2,15 @@
 // next, each node timed, every error stopped at the node boundary.
 #pragma once
 
+#include "cache.hpp"
 #include "plan.hpp"
 #include "progress.hpp"
 
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,12 +30,21 @@ struct RunOptions {
     const std::atomic<int>* cancel_signal = nullptr;
     /// Told at once of each piece of debris of killed runs removed before this run (else kept in RunResult::notes).
     std::function<void(const std::string&)> on_note;
+    /// The node cache (docs/cache.md); nullopt: every node runs.
+    std::optional<cache::Settings> cache;
+    /// kind:name → the plugin that provides it (its name and version go into cache keys; a node not
+    /// listed is never cached).
+    std::map<std::string, PluginRecord, std::less<>> node_plugins;
+    /// One-line warnings that do not stop the run (a damaged cache entry...); default: the progress display.
+    std::function<void(const std::string&)> on_warning;
 };
 
 struct NodeTiming {
     std::string label, node;
     int line = 0;
     double seconds = 0.0;
+    bool cached = false;  ///< it did not run: its result came from the cache (or nothing that ran needed it)
+    bool read = false;    ///< cached, and its values were read from the cache for a node that ran
 };
 
 struct RunResult {
@@ -42,6 +54,8 @@ struct RunResult {
     std::vector<std::filesystem::path> outputs;  ///< files written (staged ones sorted), the manifest last
     std::vector<std::string> notes;              ///< debris of killed runs removed before this one, one line each
     double total_seconds = 0.0;
+    /// "cache: 9 of 14 nodes reused from DIR (312 MiB of 2 GiB)"; empty without the cache.
+    std::string cache_summary;
 };
 
 /// The seed a node gets: a hash of the spec's seed and the node's label.

@@ -61,13 +61,15 @@ inline std::string slurp(const fs::path& p) {
 /// Run `orogen ARGS` (a shell-quoted argument string) with optional extra
 /// environment assignments ("OROGEN_PLUGIN_PATH=/x") in folder `cwd` (default:
 /// the current one), capturing both streams. OROGEN_PLUGIN_PATH is cleared
-/// unless `env` sets it, so the caller's environment cannot change a result.
+/// unless `env` sets it, so the caller's environment cannot change a result;
+/// the node cache is off (OROGEN_NO_CACHE=1) unless ARGS pass --cache DIR, so a
+/// test neither writes to ~/.cache nor depends on what an earlier run left there.
 inline RunResult run_orogen(const std::string& args, const std::string& env = "", const fs::path& cwd = {}) {
     static int counter = 0;
     const fs::path dir = fs::path(OROGEN_BINARY_DIR) / "test-tmp" / "cli";
     fs::create_directories(dir);
     const std::string stem = (dir / (std::to_string(::getpid()) + "-" + std::to_string(counter++))).string();
-    const std::string cmd = (cwd.empty() ? "" : "cd '" + cwd.string() + "' && ") + "env OROGEN_PLUGIN_PATH= " + env +
+    const std::string cmd = (cwd.empty() ? "" : "cd '" + cwd.string() + "' && ") + "env OROGEN_PLUGIN_PATH= OROGEN_NO_CACHE=1 " + env +
                             " " + std::string(OROGEN_CLI) + " " + args +
                             " >" + stem + ".out 2>" + stem + ".err </dev/null";
     const int status = std::system(cmd.c_str());

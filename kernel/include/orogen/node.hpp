@@ -244,6 +244,19 @@ struct NodeOutputs {
 
 // -------------------------------------------------------------- descriptor
 
+/// How `orogen run`'s node cache (docs/cache.md) treats a node.
+enum class CachePolicy {
+    /// The result is a pure function of the parameters, inputs, seed, grid and plugin version: it is kept
+    /// (with the files the node wrote through output_path and what it said through info/warn) and reused
+    /// while none of them changes.
+    store,
+    /// Always run: the node reads something the spec does not name (a file's contents, a clock, a device)
+    /// or has effects besides its values and output files. The nodes after it are keyed by what it
+    /// produced, so an unchanged result still lets them come from the cache. The kernel treats every node
+    /// with an input path parameter (the importers) this way whatever it declares.
+    rerun,
+};
+
 struct NodeDescriptor {
     std::string kind;     ///< generate | erode | tectonics | render | export | import
     std::string name;     ///< kebab-case, unique within the kind
@@ -260,6 +273,8 @@ struct NodeDescriptor {
     /// Optional cross-parameter and input checks, run at check time.
     std::function<void(CheckContext&)> check;
     std::function<NodeOutputs(NodeContext&)> run;
+    /// Whether its result may come from the cache (plugin API 3).
+    CachePolicy cache = CachePolicy::store;
 
     std::string qualified_name() const { return kind + ":" + name; }
     const Param* find_param(std::string_view n) const;
