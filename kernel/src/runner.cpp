@@ -2,6 +2,7 @@
 
 #include "json.hpp"
 #include "outputs.hpp"
+#include "tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -100,6 +101,9 @@ public:
     }
     void warn(std::string_view message) override {
         if (options_.progress) options_.progress->message(node_.label + ": warning: " + std::string(message));
+    }
+    Tiling* tiling() override {
+        return options_.tiled && !for_entry_ && TiledRun::runs_tiled(node_) ? options_.tiled : nullptr;
     }
 
 private:
@@ -214,6 +218,15 @@ std::string cancel_reason(const RunOptions& options) {
     return sig == SIGTERM ? "stopped by SIGTERM" : "cancelled by the user";
 }
 
+/// Collective in a tiled run: every rank learns the worst exit code; only the lowest failing rank keeps its message.
+void agree_across_ranks(TiledRun& tiled, RunResult& result) {
+    const int mine = result.exit_code;
+    int reporter = 0;
+    const int worst = tiled.agree(mine, &reporter);
+    if (worst != 0 && (mine == 0 || reporter != tiled.rank())) result.error.clear();
+    result.exit_code = worst;
+}
+
 void cancelled(RunResult& result, std::string message) {
     result.exit_code = 130;
     result.error = std::move(message);
@@ -233,10 +246,15 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         result.exit_code = 1;
         result.error = "orogen: error: cannot create the output folder " + options.out_dir.string() + " (" +
                        (ec ? ec.message() : std::string("a file of that name exists")) + "); pick another with --out\n";
-        return result;
     }
-    // Debris of earlier runs that were killed, then a staging folder of our own.
-    result.notes = clean_debris(options.out_dir);
+    // In a tiled run every rank learns of a failure on any (and only the first failing rank reports it).
+    if (options.tiled) agree_across_ranks(*options.tiled, result);
+    if (result.exit_code != 0) return result;
+    // Debris of earlier runs that were killed, then a staging folder of our own. In a tiled run rank 0
+    // cleans up before the other ranks make theirs (it would see their fresh folders as debris).
+    const bool rank0 = !options.tiled || options.tiled->rank() == 0;
+    if (rank0) result.notes = clean_debris(options.out_dir);
+    if (options.tiled) options.tiled->agree(0);
     if (options.on_note)
         for (const auto& note : result.notes) options.on_note(note);
     std::optional<Staging> staging;
@@ -245,8 +263,9 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     } catch (const Error& e) {
         result.exit_code = 1;
         result.error = std::string("orogen: error: ") + e.what() + "\n";
-        return result;
     }
+    if (options.tiled) agree_across_ranks(*options.tiled, result);
+    if (result.exit_code != 0) return result;
     std::vector<fs::path> outside;  // outputs written outside --out (allowed with --allow-outside-out)
 
     std::map<std::string, Value, std::less<>> values;
@@ -260,45 +279,54 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             auto it = plan.last_use.find(key);
             if (!key.empty() && it != plan.last_use.end() && it->second == i) values.erase(key);
         }
-        const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
-        Context ctx(plan, node, std::move(inputs), options, *staging, outside);
         if (options.progress) options.progress->start(int(i) + 1, total, node.label, node.node->qualified_name());
         const auto start = std::chrono::steady_clock::now();
         NodeOutputs out;
+        bool runs_here = true;
+        bool agreed = false;  // a tiled node found another rank's failure (PeerFailed): already agreed on
         try {
+            // A tiled run: tiles for a tiled node, the whole values on rank 0 for the others (collective).
+            if (options.tiled) runs_here = options.tiled->prepare_inputs(node, inputs);
+            const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
+            Context ctx(plan, node, std::move(inputs), options, *staging, outside);
             ctx.check_cancelled();
-            if (node.mapped_input >= 0)  // entries are made when a later node pulls them
+            if (!runs_here)
+                ;  // rank 0 runs it
+            else if (node.mapped_input >= 0)  // entries are made when a later node pulls them
                 out = NodeOutputs(map_over_series(plan, node, mapped_inputs, std::size_t(node.mapped_input), options,
                                                   *staging, outside));
             else
                 out = node.node->run(ctx);
         } catch (const Cancelled&) {
             cancelled(result, node_error(node, cancel_reason(options)));
-            break;
+        } catch (const PeerFailed& e) {
+            result.exit_code = e.exit_code();
+            result.error.clear();  // the rank that failed says why
+            agreed = true;
         } catch (const Error& e) {
             result.exit_code = e.kind() == Error::Kind::bad_input ? 2 : 1;
             result.error = node_error(node, e.what());
-            break;
         } catch (const std::bad_alloc&) {
             result.exit_code = 1;
             result.error = node_error(node, "out of memory; try a smaller grid");
-            break;
         } catch (const std::exception& e) {
             result.exit_code = 1;
             result.error = node_error(node, e.what());
-            break;
         } catch (...) {
             result.exit_code = 1;
             result.error = node_error(node, "unknown exception");
-            break;
         }
+        // A tiled run goes on only if every rank finished the node; one rank (the lowest that failed) reports.
+        if (options.tiled && !agreed) agree_across_ranks(*options.tiled, result);
+        if (result.exit_code != 0) break;
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         if (options.progress) options.progress->finish(seconds);
         result.timings.push_back({node.label, node.node->qualified_name(), node.where.line, seconds});
 
+        if (options.tiled) options.tiled->produced(node);
         const bool series_out = node.node->output_series || node.mapped_input >= 0;
         const ValueType returned_entry = out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
-        if ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output) {
+        if (runs_here && ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output)) {
             result.exit_code = 1;
             result.error = node_error(node, "internal error: it returned a " +
                                                 (returned_entry == ValueType::none
@@ -318,7 +346,10 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     result.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (result.exit_code == 0 && options.cancel && options.cancel->load())  // stopped after the last node
         cancelled(result, "orogen: error: " + cancel_reason(options) + " before the outputs were moved into place\n");
-    if (result.exit_code == 0) {
+    if (result.exit_code == 0 && !rank0) {
+        // Another rank of a tiled run: it wrote nothing, rank 0 commits (and says whether that worked).
+        agree_across_ranks(*options.tiled, result);
+    } else if (result.exit_code == 0) {
         // All or nothing: the manifest is staged with the rest and moves into place last.
         try {
             const std::vector<fs::path> staged = staging->files();
@@ -331,6 +362,7 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             result.exit_code = 1;
             result.error = std::string("orogen: error: ") + e.what() + "\n";
         }
+        if (options.tiled) agree_across_ranks(*options.tiled, result);
     }
     return result;  // on failure `staging` goes out of scope and takes every staged file with it
 }

@@ -13,6 +13,8 @@
 
 namespace orogen {
 
+class TiledRun;  // tiles.hpp
+
 struct PluginRecord {
     std::string name, version, file;
 };
@@ -27,6 +29,8 @@ struct RunOptions {
     const std::atomic<int>* cancel_signal = nullptr;
     /// Told at once of each piece of debris of killed runs removed before this run (else kept in RunResult::notes).
     std::function<void(const std::string&)> on_note;
+    /// A tiled run under MPI (tiles.hpp): this rank's side of it; nullptr for a single process.
+    TiledRun* tiled = nullptr;
 };
 
 struct NodeTiming {
@@ -37,7 +41,7 @@ struct NodeTiming {
 
 struct RunResult {
     int exit_code = 0;        ///< 0 ok, 1 failed run, 2 bad input, 130 cancelled
-    std::string error;        ///< formatted diagnostic when exit_code != 0
+    std::string error;        ///< formatted diagnostic when exit_code != 0 ("" on a rank that only saw another fail)
     std::vector<NodeTiming> timings;
     std::vector<std::filesystem::path> outputs;  ///< files written (staged ones sorted), the manifest last
     std::vector<std::string> notes;              ///< debris of killed runs removed before this one, one line each

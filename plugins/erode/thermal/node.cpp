@@ -16,6 +16,70 @@ namespace {
 
 using namespace orogen;
 
+/// A step changes a vertex from the 5 × 5 vertices around it (F of a
+/// neighbour looks one vertex further), so a sweep of kStepsPerSweep steps
+/// needs this many vertices of the neighbouring tiles.
+constexpr int kTileHalo = 2 * thermal::kStepsPerSweep;
+
+/// Adds the layers run() adds (eroded, and hardness for Hardness::height) from the heights before and after.
+void add_layers(Heightmap& hm, const float* before, const float* after, const thermal::Settings& s) {
+    GridView eroded = hm.layer("eroded", 0.0f);
+    for (std::size_t i = 0; i < hm.size(); ++i) eroded.data[i] += after[i] - before[i];
+    if (s.hardness == thermal::Hardness::height) {
+        GridView k = hm.layer("hardness", 0.0f);
+        for (std::size_t i = 0; i < hm.size(); ++i)
+            k.data[i] = thermal::height_hardness(after[i], s.height_min, s.height_max);
+    }
+}
+
+/// One rank's tile of a tiled run (orogen/tiles.hpp). The rank works on its
+/// tile grown by kTileHalo vertices: before each sweep of kStepsPerSweep
+/// steps the halo is refilled from the neighbours; the sweep treats the edge
+/// of the grown tile as a wall, whose wrong effect travels 2 vertices a step,
+/// so after the sweep the owned vertices are exactly the whole grid's (the
+/// same operations on the same inputs, bit for bit), and only the halo is stale.
+NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap> hm, const thermal::Settings& s,
+                      const float* layer) {
+    const TileRect own = tiles.owned(), grown = tiles.grown(kTileHalo);
+    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
+    auto copy_in = [&](const float* tile, std::vector<float>& held) {
+        held.assign(std::size_t(grown.width) * std::size_t(grown.height), 0.0f);
+        for (int y = 0; y < own.height; ++y)
+            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
+                      held.begin() + std::ptrdiff_t(std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox)));
+    };
+    std::vector<float> held, held_layer;
+    copy_in(hm->heights().data(), held);
+    GridView view{held.data(), grown.width, grown.height, hm->cell()};
+    if (layer) {  // the hardness of the halo too, once: it does not change
+        copy_in(layer, held_layer);
+        tiles.exchange_halo({held_layer.data(), grown.width, grown.height, hm->cell()}, kTileHalo);
+    }
+    const std::int64_t iterations = ctx.integer("iterations");
+    for (std::int64_t i = 0; i < iterations;) {
+        const int k = int(std::min<std::int64_t>(thermal::kStepsPerSweep, iterations - i));
+        tiles.exchange_halo(view, kTileHalo);
+        thermal::steps(view, view, k, s, layer ? held_layer.data() : nullptr);
+        i += k;
+        ctx.check_cancelled();
+        if (i % 64 == 0 || i == iterations) {  // as run() does
+            for (int y = 0; y < own.height; ++y)
+                ctx.check_finite(std::span<const float>(view.row(y + oy) + ox, std::size_t(own.width)), "height", i);
+            ctx.progress(double(i) / double(iterations));
+        }
+    }
+    held_layer = {};
+    // The owned part back into the tile; the tile's old heights are `before` for the layers.
+    std::vector<float> after(hm->size());
+    for (int y = 0; y < own.height; ++y)
+        std::copy(view.row(y + oy) + ox, view.row(y + oy) + ox + own.width,
+                  after.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(own.width)));
+    held = {};
+    add_layers(*hm, hm->heights().data(), after.data(), s);
+    hm->heights() = std::move(after);
+    return hm;
+}
+
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
     thermal::Settings s;
@@ -32,6 +96,7 @@ NodeOutputs run(NodeContext& ctx) {
         const auto [lo, hi] = std::minmax_element(hm->heights().begin(), hm->heights().end());
         s.height_min = hm->heights().empty() ? 0.0f : *lo;
         s.height_max = hm->heights().empty() ? 1.0f : *hi;
+        if (Tiling* tiles = ctx.tiling()) tiles->min_max(s.height_min, s.height_max);  // the whole grid's range
     } else {
         s.hardness = thermal::Hardness::layer;
         if (!hm->has_layer(hardness))
@@ -39,6 +104,7 @@ NodeOutputs run(NodeContext& ctx) {
         layer = std::as_const(*hm).layer(hardness).data;
     }
 
+    if (Tiling* tiles = ctx.tiling()) return run_tiled(ctx, *tiles, std::move(hm), s, layer);
     const std::vector<float> before = hm->heights();
     const std::int64_t iterations = ctx.integer("iterations");
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0);  // time = step count
@@ -53,14 +119,7 @@ NodeOutputs run(NodeContext& ctx) {
     });
 
     // eroded: net change in metres, added to an earlier eroder's if present.
-    GridView eroded = hm->layer("eroded", 0.0f);
-    const std::vector<float>& after = hm->heights();
-    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
-    if (s.hardness == thermal::Hardness::height) {
-        GridView k = hm->layer("hardness", 0.0f);
-        for (std::size_t i = 0; i < after.size(); ++i)
-            k.data[i] = thermal::height_hardness(after[i], s.height_min, s.height_max);
-    }
+    add_layers(*hm, before.data(), hm->heights().data(), s);
     lapse.finish(iterations, *hm);
     NodeOutputs out(hm);
     if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
@@ -123,6 +182,7 @@ OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"eroded"},
+        .tile_halo = kTileHalo,
         .check = check,
         .run = run,
     });

@@ -80,14 +80,20 @@ void count_sides(std::vector<std::int32_t>& counts, int width, int height, const
 }
 
 void apply(GridView terrain, int iterations, double displacement, std::uint64_t seed) {
-    const std::vector<Line> lines = random_lines(terrain.width, terrain.height, iterations, seed);
+    apply_tile(terrain, terrain.width, terrain.height, 0, 0, iterations, displacement, seed);
+}
+
+void apply_tile(GridView tile, int grid_width, int grid_height, int x0, int y0, int iterations, double displacement,
+                std::uint64_t seed) {
+    const std::vector<Line> lines = random_lines(grid_width, grid_height, iterations, seed);
     const float d = float(displacement);
-    parallel_for(0, terrain.height, 16, [&](std::int64_t y0, std::int64_t y1) {
-        std::vector<std::int32_t> diff(std::size_t(terrain.width) + 1), row(std::size_t(terrain.width));
-        for (std::int64_t y = y0; y < y1; ++y) {
-            count_row(row.data(), diff, terrain.width, int(y), lines);
-            float* out = terrain.row(int(y));
-            for (int x = 0; x < terrain.width; ++x) out[x] += d * float(row[std::size_t(x)]);
+    parallel_for(0, tile.height, 16, [&](std::int64_t t0, std::int64_t t1) {
+        // A row's counts come from a running sum from column 0: the whole grid's row is counted.
+        std::vector<std::int32_t> diff(std::size_t(grid_width) + 1), row(static_cast<std::size_t>(grid_width));
+        for (std::int64_t t = t0; t < t1; ++t) {
+            count_row(row.data(), diff, grid_width, y0 + int(t), lines);
+            float* out = tile.row(int(t));
+            for (int x = 0; x < tile.width; ++x) out[x] += d * float(row[std::size_t(x0 + x)]);
         }
     });
 }
