@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -64,7 +65,15 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         ctx.check_cancelled();
         if (i % 64 == 0 || i == iterations) {  // as run() does
             for (int y = 0; y < own.height; ++y)
-                ctx.check_finite(std::span<const float>(view.row(y + oy) + ox, std::size_t(own.width)), "height", i);
+                for (int x = 0; x < own.width; ++x)
+                    if (const float v = view.row(y + oy)[ox + x]; !std::isfinite(v)) {
+                        // check_finite()'s message, with the sample's index in the whole grid.
+                        std::ostringstream msg;
+                        msg << "non-finite height (" << v << ") at sample "
+                            << std::int64_t(own.y0 + y) * tiles.grid_width() + (own.x0 + x) << " after step " << i
+                            << "; the simulation became unstable";
+                        throw Error(msg.str());
+                    }
             ctx.progress(double(i) / double(iterations));
         }
     }
