@@ -6,6 +6,7 @@
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -57,10 +58,16 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         tiles.exchange_halo({held_layer.data(), grown.width, grown.height, hm->cell()}, kTileHalo);
     }
     const std::int64_t iterations = ctx.integer("iterations");
+    using clock = std::chrono::steady_clock;
+    clock::duration exchanging{}, sweeping{};  // for the figure in the info line (docs/benchmarks.md)
     for (std::int64_t i = 0; i < iterations;) {
         const int k = int(std::min<std::int64_t>(thermal::kStepsPerSweep, iterations - i));
+        const auto t0 = clock::now();
         tiles.exchange_halo(view, kTileHalo);
+        const auto t1 = clock::now();
         thermal::steps(view, view, k, s, layer ? held_layer.data() : nullptr);
+        exchanging += t1 - t0;
+        sweeping += clock::now() - t1;
         i += k;
         ctx.check_cancelled();
         if (i % 64 == 0 || i == iterations) {  // as run() does
@@ -77,13 +84,20 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
             ctx.progress(double(i) / double(iterations));
         }
     }
-    held_layer = {};
+    const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
+    std::ostringstream note;
+    note.precision(3);
+    note << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height << " at ("
+         << own.x0 << ", " << own.y0 << "), " << iterations << " steps: sweeps " << sw << " s, halo exchange " << ex
+         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %)";
+    ctx.info(note.str());
+    std::vector<float>().swap(held_layer);  // freed now (assigning {} would keep the capacity)
     // The owned part back into the tile; the tile's old heights are `before` for the layers.
     std::vector<float> after(hm->size());
     for (int y = 0; y < own.height; ++y)
         std::copy(view.row(y + oy) + ox, view.row(y + oy) + ox + own.width,
                   after.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(own.width)));
-    held = {};
+    std::vector<float>().swap(held);
     add_layers(*hm, hm->heights().data(), after.data(), s);
     hm->heights() = std::move(after);
     return hm;
