@@ -30,7 +30,7 @@ namespace {
 class Context : public NodeContext {
 public:
     Context(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs, const RunOptions& options,
-            const Staging& staging, std::vector<fs::path>& outside, bool for_entry = false)
+            const fs::path& staging, std::vector<fs::path>& outside, bool for_entry = false)
         : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), staging_(staging),
           outside_(outside), seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
 
@@ -64,7 +64,7 @@ public:
             throw Error("internal error: " + node_.node->qualified_name() +
                         " writes files, so it cannot be mapped over a series");
         const OutputPlace place = place_output(options_.out_dir, relative);
-        const fs::path full = place.inside ? staging_.folder() / place.relative : place.resolved;
+        const fs::path full = place.inside ? staging_ / place.relative : place.resolved;
         std::error_code ec;
         if (place.inside) {  // where it will go must be free: fail now, naming the node, not at the commit
             const fs::path target = options_.out_dir / place.relative;
@@ -111,7 +111,7 @@ private:
     const PlannedNode& node_;
     std::vector<Value> inputs_;
     const RunOptions& options_;
-    const Staging& staging_;
+    const fs::path& staging_;  ///< the staging folder (in a tiled run, rank 0's: every rank writes into it)
     std::vector<fs::path>& outside_;
     std::uint64_t seed_;
     bool for_entry_;
@@ -122,7 +122,7 @@ private:
 /// consumer asks for it. It runs inside run(), which keeps plan, node and
 /// options alive for as long as any node can pull an entry.
 std::shared_ptr<Series> map_over_series(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs,
-                                        std::size_t mapped, const RunOptions& options, const Staging& staging,
+                                        std::size_t mapped, const RunOptions& options, const fs::path& staging,
                                         std::vector<fs::path>& outside) {
     const std::shared_ptr<const Series> source = inputs[mapped].series();
     auto result = std::make_shared<Series>();
@@ -257,15 +257,26 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     if (options.tiled) options.tiled->agree(0);
     if (options.on_note)
         for (const auto& note : result.notes) options.on_note(note);
+    // A tiled run stages in rank 0's folder alone: every rank writes its files there, and rank 0 moves them
+    // into place with its own, the manifest (which lists and hashes them all) last, or removes them all.
     std::optional<Staging> staging;
+    fs::path staging_folder;
     try {
-        staging.emplace(options.out_dir);
+        if (rank0) {
+            staging.emplace(options.out_dir);
+            staging_folder = staging->folder();
+        }
     } catch (const Error& e) {
         result.exit_code = 1;
         result.error = std::string("orogen: error: ") + e.what() + "\n";
     }
     if (options.tiled) agree_across_ranks(*options.tiled, result);
     if (result.exit_code != 0) return result;
+    if (options.tiled) {
+        std::string folder = staging_folder.string();
+        options.tiled->broadcast(folder);
+        staging_folder = folder;
+    }
     std::vector<fs::path> outside;  // outputs written outside --out (allowed with --allow-outside-out)
 
     std::map<std::string, Value, std::less<>> values;
@@ -288,13 +299,13 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             // A tiled run: tiles for a tiled node, the whole values on rank 0 for the others (collective).
             if (options.tiled) runs_here = options.tiled->prepare_inputs(node, inputs);
             const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
-            Context ctx(plan, node, std::move(inputs), options, *staging, outside);
+            Context ctx(plan, node, std::move(inputs), options, staging_folder, outside);
             ctx.check_cancelled();
             if (!runs_here)
                 ;  // rank 0 runs it
             else if (node.mapped_input >= 0)  // entries are made when a later node pulls them
                 out = NodeOutputs(map_over_series(plan, node, mapped_inputs, std::size_t(node.mapped_input), options,
-                                                  *staging, outside));
+                                                  staging_folder, outside));
             else
                 out = node.node->run(ctx);
         } catch (const Cancelled&) {
@@ -347,7 +358,8 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     if (result.exit_code == 0 && options.cancel && options.cancel->load())  // stopped after the last node
         cancelled(result, "orogen: error: " + cancel_reason(options) + " before the outputs were moved into place\n");
     if (result.exit_code == 0 && !rank0) {
-        // Another rank of a tiled run: it wrote nothing, rank 0 commits (and says whether that worked).
+        // Another rank of a tiled run: its files are in rank 0's staging folder; rank 0 commits them (and says
+        // whether that worked).
         agree_across_ranks(*options.tiled, result);
     } else if (result.exit_code == 0) {
         // All or nothing: the manifest is staged with the rest and moves into place last.

@@ -190,6 +190,8 @@ void TiledRun::exchange_halo(GridView held, int halo) {
     rows(oy + o.height - halo, south, oy - halo, north, kTagSouth);
 }
 
+void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
+
 void TiledRun::min_max(float& lo, float& hi) {
     if (const int code = agree(0)) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
     mpi::min_max_all(lo, hi);

@@ -62,6 +62,7 @@ public:
     int grid_width() const override { return split_.grid_width; }
     int grid_height() const override { return split_.grid_height; }
     TileRect owned() const override { return split_.tile(rank_); }
+    TileRect tile(int rank) const override { return split_.tile(rank); }
     void exchange_halo(GridView held, int halo) override;
     void min_max(float& lo, float& hi) override;
 
@@ -81,6 +82,9 @@ public:
     std::shared_ptr<Heightmap> gather(const Heightmap* tile);
     /// Collective: rank 0's whole heightmap `whole`, cut into tiles; this rank's tile.
     std::shared_ptr<Heightmap> scatter(const Heightmap* whole);
+
+    /// Collective: rank 0's `text` on every rank.
+    void broadcast(std::string& text);
 
     const TileSplit& split() const { return split_; }
 

@@ -51,6 +51,8 @@ public:
     virtual int grid_height() const = 0;
     /// This rank's tile: what its heightmaps hold.
     virtual TileRect owned() const = 0;
+    /// Rank `rank`'s tile (0 ≤ rank < ranks()).
+    virtual TileRect tile(int rank) const = 0;
     /// `owned` grown by `halo` vertices on every side, clipped to the grid.
     TileRect grown(int halo) const;
 
