@@ -27,7 +27,9 @@ one() {  # label, command...
     t=$(awk '$2=="erode:thermal"{print $4}' "$work/log")
     ex=$(grep -o 'sweeps [0-9.e-]* s, halo exchange [0-9.e-]* s ([0-9.e-]* %)' "$work/log" | head -1 || true)
     rss=$(grep 'Maximum resident' "$work/log" | awk '{printf "%d ", $6/1024}')
-    echo "$label rep $r: thermal ${t} s; ${ex:-single process}; peak RSS MiB per rank: $rss"
+    # CPU seconds (user + system) summed over the ranks: what the run costs whatever the machine's load.
+    cpu=$(awk '/User time/{u+=$4} /System time/{s+=$4} END{printf "%.2f", u+s}' "$work/log")
+    echo "$label rep $r: thermal ${t} s; ${ex:-single process}; peak RSS MiB per rank: $rss; CPU s (all ranks, whole run): $cpu"
   done
 }
 one "1 process (no mpirun)" /usr/bin/time -v "$orogen"
