@@ -6,6 +6,7 @@
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cstring>
 #include <sstream>
@@ -154,7 +155,10 @@ void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, 
 }  // namespace
 
 void TiledRun::exchange_halo(GridView held, int halo) {
-    if (const int code = agree(0)) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
+    const auto t0 = std::chrono::steady_clock::now();
+    const int code = agree(0);
+    waiting_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (code) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
     const TileRect o = owned(), g = grown(halo);
     if (held.width != g.width || held.height != g.height)
         throw Error("internal error: exchange_halo got a " + std::to_string(held.width) + "x" +

@@ -65,6 +65,7 @@ public:
     TileRect tile(int rank) const override { return split_.tile(rank); }
     void exchange_halo(GridView held, int halo) override;
     void min_max(float& lo, float& hi) override;
+    double seconds_waiting() const override { return waiting_; }
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
     static bool runs_tiled(const PlannedNode& node);
@@ -92,6 +93,7 @@ private:
     enum class Place { tiles, rank0 };
     TileSplit split_;
     int rank_;
+    double waiting_ = 0.0;
     std::map<std::string, Place, std::less<>> places_;
 };
 

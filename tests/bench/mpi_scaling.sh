@@ -25,7 +25,7 @@ one() {  # label, command...
     "$@" run "$work/thermal.orogen" --out "$work/out" --threads 1 >"$work/log" 2>&1
     local t ex rss
     t=$(awk '$2=="erode:thermal"{print $4}' "$work/log")
-    ex=$(grep -o 'sweeps [0-9.e-]* s, halo exchange [0-9.e-]* s ([0-9.e-]* %)' "$work/log" | head -1 || true)
+    ex=$(grep -o 'sweeps [0-9.e-]* s, halo exchange [0-9.e-]* s ([0-9.e-]* %), of which waiting for the other ranks [0-9.e-]* s' "$work/log" | head -1 || true)
     rss=$(grep 'Maximum resident' "$work/log" | awk '{printf "%d ", $6/1024}')
     # CPU seconds (user + system) summed over the ranks: what the run costs whatever the machine's load.
     cpu=$(awk '/User time/{u+=$4} /System time/{s+=$4} END{printf "%.2f", u+s}' "$work/log")

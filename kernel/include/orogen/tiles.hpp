@@ -63,6 +63,10 @@ public:
     /// high (the kernel checks this at check time against the node's
     /// tile_halo). Throws PeerFailed if another rank failed before the call.
     virtual void exchange_halo(GridView held, int halo) = 0;
+    /// Seconds spent so far in exchange_halo() waiting for every rank to arrive
+    /// (its opening agreement), as opposed to moving the halo: under load or
+    /// with uneven tiles, most of an exchange's time is this wait.
+    virtual double seconds_waiting() const = 0;
     /// Collective: the least and greatest of each rank's `lo`/`hi` (exact).
     virtual void min_max(float& lo, float& hi) = 0;
 };

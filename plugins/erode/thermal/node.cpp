@@ -60,6 +60,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     const std::int64_t iterations = ctx.integer("iterations");
     using clock = std::chrono::steady_clock;
     clock::duration exchanging{}, sweeping{};  // for the figure in the info line (docs/benchmarks.md)
+    const double waited_before = tiles.seconds_waiting();
     for (std::int64_t i = 0; i < iterations;) {
         const int k = int(std::min<std::int64_t>(thermal::kStepsPerSweep, iterations - i));
         const auto t0 = clock::now();
@@ -89,7 +90,8 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     note.precision(3);
     note << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height << " at ("
          << own.x0 << ", " << own.y0 << "), " << iterations << " steps: sweeps " << sw << " s, halo exchange " << ex
-         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %)";
+         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %), of which waiting for the other ranks "
+         << tiles.seconds_waiting() - waited_before << " s";
     ctx.info(note.str());
     std::vector<float>().swap(held_layer);  // freed now (assigning {} would keep the capacity)
     // The owned part back into the tile; the tile's old heights are `before` for the layers.
