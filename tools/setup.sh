@@ -12,6 +12,7 @@ packages=(
   libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev
   clang-14 libclang-rt-14-dev
+  openmpi-bin libopenmpi-dev
 )
 
 # ParaView's pvbatch (the export:paraview-state test) is not installed here:

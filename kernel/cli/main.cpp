@@ -2,17 +2,21 @@
 // Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
 // usage), 130 interrupted (SIGINT), 143 terminated (SIGTERM).
 #include "../src/loader.hpp"
+#include "../src/mpi_comm.hpp"
 #include "../src/plan.hpp"
 #include "../src/progress.hpp"
 #include "../src/runner.hpp"
 #include "../src/spec.hpp"
+#include "../src/tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iostream>
 #include <sstream>
@@ -41,7 +45,7 @@ extern "C" void on_interrupt(int sig) {
 const char* usage_text =
     "usage:\n"
     "  orogen run SPEC [--out DIR] [--seed N] [--threads N] [--set NAME.PARAM=VALUE]... [--quiet]\n"
-    "                  [--allow-outside-out] [--cache DIR | --no-cache] [--cache-size SIZE]\n"
+    "                  [--allow-outside-out] [--cache DIR | --no-cache] [--cache-size SIZE] [--tiles RxC]\n"
     "  orogen check SPEC [--out DIR] [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
     "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
@@ -53,6 +57,8 @@ const char* usage_text =
     "--cache DIR picks another, --no-cache or OROGEN_NO_CACHE=1 turns it off) of at most --cache-size\n"
     "(default 2G; K, M, G, T suffixes), least recently used entries evicted: a re-run recomputes only\n"
     "what changed.\n"
+    "Under mpirun (`mpirun -n N orogen run SPEC`), the grid is cut into one tile per rank, R rows by\n"
+    "C columns (--tiles RxC, default: as square as N allows); see docs/mpi.md.\n"
     "Plugins are loaded from\n"
     "<prefix>/lib/orogen/plugins and from OROGEN_PLUGIN_PATH (folders or .so files, ':'-separated).\n";
 
@@ -83,7 +89,15 @@ struct Args {
     std::optional<std::string> cache_dir;  ///< --cache DIR
     bool no_cache = false;                 ///< --no-cache
     std::uint64_t cache_size = cache::Settings{}.max_bytes;
+    std::optional<std::pair<int, int>> tiles;  ///< --tiles RxC
+    std::string tiles_text;
 };
+
+/// The MPI side of this process: set when mpirun started it.
+struct MpiRun {
+    int rank = 0, size = 1;
+};
+std::optional<MpiRun> g_mpi;
 
 std::optional<std::uint64_t> parse_u64(const std::string& s) {
     if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 20) return std::nullopt;
@@ -138,6 +152,12 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
             a.cache_dir = *v;
         } else if (arg == "--no-cache") {
             a.no_cache = true;
+        } else if (is("--tiles")) {
+            auto v = value("--tiles");
+            a.tiles = v ? parse_tiles(*v) : std::nullopt;
+            if (!a.tiles)
+                return usage_error("--tiles needs ROWSxCOLUMNS, e.g. 2x3" + (v ? ", got '" + *v + "'" : std::string()));
+            a.tiles_text = *v;
         } else if (arg == "--allow-outside-out") {
             a.allow_outside_out = true;
         } else if (arg == "--quiet" || arg == "-q") {
@@ -169,6 +189,29 @@ std::optional<cache::Settings> cache_settings(const Args& args) {
         return std::nullopt;
     }
     return s;
+}
+
+/// The tiles of a run under mpirun: --tiles or automatic.
+TileSplit tiled_split(const Plan& plan, const Args& args) {
+    const auto [rows, cols] = args.tiles ? *args.tiles : automatic_tiles(g_mpi->size, plan.grid.width, plan.grid.height);
+    return split_grid(plan.grid.width, plan.grid.height, rows, cols);
+}
+
+/// The problem with --tiles for this many ranks, or "".
+std::string tiles_problem(const Args& args, int ranks) {
+    if (!args.tiles) return "";
+    const auto [rows, cols] = *args.tiles;
+    const long long tiles = (long long)rows * cols;
+    if (tiles == ranks) return "";
+    if (tiles < ranks)
+        return "--tiles " + args.tiles_text + " makes " + std::to_string(tiles) + " tile" + (tiles == 1 ? "" : "s") +
+               " for " + std::to_string(ranks) + " ranks (more ranks than tiles): give --tiles with " +
+               std::to_string(ranks) + " tiles, or start " + std::to_string(tiles) + " rank" + (tiles == 1 ? "" : "s") +
+               " (mpirun -n " + std::to_string(tiles) + ")";
+    return "--tiles " + args.tiles_text + " makes " + std::to_string(tiles) + " tiles for " + std::to_string(ranks) +
+           " rank" + (ranks == 1 ? "" : "s") + ", and each rank holds one tile: give --tiles with " +
+           std::to_string(ranks) + " tiles, or start " + std::to_string(tiles) + " ranks (mpirun -n " +
+           std::to_string(tiles) + ")";
 }
 
 /// Read, parse and check a spec. Prints diagnostics; returns nullopt on error.
@@ -203,7 +246,23 @@ std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins,
     options.seed = args.seed;
     options.out_dir = args.out;
     options.allow_outside_out = args.allow_outside_out;
+    if (g_mpi) {
+        // Tiled: each heightmap of a tiled node is one tile, and the ranks on this machine share its memory.
+        const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
+        const int on_this_machine = std::clamp(local ? std::atoi(local) : g_mpi->size, 1, g_mpi->size);
+        options.heightmap_memory_limit = heightmap_memory_limit() / std::uint64_t(on_this_machine) *
+                                         std::uint64_t(g_mpi->size);
+    }
     Plan plan = check(parsed, plugins.registry(), path, options, diags);
+    if (g_mpi && !diags.has_errors()) {
+        TiledCheckOptions tiled;
+        tiled.ranks = g_mpi->size;
+        tiled.tiles_given = args.tiles.has_value();
+        tiled.whole_grid_limit = heightmap_memory_limit();
+        check_tiled(plan, tiled_split(plan, args), tiled, diags);
+    }
+    // Under mpirun every rank checks the same plan; rank 0 alone prints.
+    if (g_mpi && g_mpi->rank != 0) return diags.has_errors() ? std::nullopt : std::optional<Plan>(std::move(plan));
     if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
     if (diags.has_errors()) {
         std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s", path.c_str());
@@ -216,6 +275,7 @@ int cmd_check(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() != 1) return usage_error("check needs one spec file");
     auto plan = load_spec(args.positional[0], plugins, args);
     if (!plan) return exit_bad_input;
+    if (g_mpi && g_mpi->rank != 0) return exit_ok;
     std::printf("%s: ok (%zu node%s, grid %dx%d, cell %g m, seed %llu)\n", args.positional[0].c_str(),
                 plan->nodes.size(), plan->nodes.size() == 1 ? "" : "s", plan->grid.width, plan->grid.height,
                 plan->grid.cell, static_cast<unsigned long long>(plan->seed));
@@ -228,8 +288,12 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
     if (!plan) return exit_bad_input;
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
-    ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, args.quiet);
+    const bool speaks = !g_mpi || g_mpi->rank == 0;  // under mpirun, rank 0 shows progress and the summary
+    ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, args.quiet || !speaks);
+    std::optional<TiledRun> tiled;
+    if (g_mpi) tiled.emplace(tiled_split(*plan, args), g_mpi->rank);
     RunOptions options;
+    options.tiled = tiled ? &*tiled : nullptr;
     options.out_dir = args.out;
     options.threads = args.threads;
     options.progress = &progress;
@@ -237,7 +301,8 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
     options.cancel = &g_cancel;
     options.cancel_signal = &g_signal;
     options.on_note = [](const std::string& note) { std::fprintf(stderr, "orogen: %s\n", note.c_str()); };
-    options.cache = cache_settings(args);
+    // A tiled run keeps no cache: its values are tiles, which the cache's keys do not describe (docs/cache.md).
+    options.cache = g_mpi ? std::nullopt : cache_settings(args);
     for (const auto* n : plugins.registry().nodes()) {  // which plugin (name, version) makes each node: part of its cache key
         const std::string file = plugins.registry().provider(n->qualified_name());
         for (const auto& p : options.plugins)
@@ -249,7 +314,12 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
         if (result.exit_code == 130 && g_signal.load() == SIGTERM) return 143;
         return result.exit_code;
     }
-    if (!args.quiet) {
+    if (!args.quiet && speaks) {
+        if (g_mpi) {
+            const TileSplit& split = tiled->split();
+            std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size, g_mpi->size == 1 ? "" : "s",
+                        split.grid_width, split.grid_height, split.rows, split.cols);
+        }
         std::printf("wrote %zu file%s to %s:\n", result.outputs.size(), result.outputs.size() == 1 ? "" : "s",
                     args.out.c_str());
         for (const auto& f : result.outputs) std::printf("  %s\n", f.string().c_str());
@@ -386,6 +456,25 @@ int main(int argc, char** argv) {
         return usage_error(msg);
     }
     if (auto rc = parse_args(argc, argv, args)) return *rc;
+
+    // Started by mpirun: MPI for the life of main, one tile per rank.
+    std::optional<mpi::Session> mpi_session;
+    if (mpi::launched_size() > 0 && (args.command == "run" || args.command == "check")) {
+        try {
+            mpi_session.emplace(argc, argv);
+        } catch (const Error& e) {
+            std::fprintf(stderr, "orogen: error: %s\n", e.what());
+            return exit_failed;
+        }
+        g_mpi = MpiRun{mpi_session->rank(), mpi_session->size()};
+        if (const std::string problem = tiles_problem(args, g_mpi->size); !problem.empty()) {
+            if (g_mpi->rank == 0) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
+            return exit_bad_input;
+        }
+    } else if (args.tiles) {
+        return usage_error("--tiles splits a run under mpirun (mpirun -n N orogen run SPEC --tiles RxC); "
+                           "this orogen was not started by mpirun");
+    }
 
     PluginSet plugins;
     plugins.load_all(self_path(argv[0]));

@@ -2,6 +2,7 @@
 
 #include "json.hpp"
 #include "outputs.hpp"
+#include "tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -35,7 +36,7 @@ namespace {
 class Context : public NodeContext {
 public:
     Context(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs, const RunOptions& options,
-            const Staging& staging, std::vector<fs::path>& outside, bool for_entry = false)
+            const fs::path& staging, std::vector<fs::path>& outside, bool for_entry = false)
         : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), staging_(staging),
           outside_(outside), seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
 
@@ -69,7 +70,7 @@ public:
             throw Error("internal error: " + node_.node->qualified_name() +
                         " writes files, so it cannot be mapped over a series");
         const OutputPlace place = place_output(options_.out_dir, relative);
-        const fs::path full = place.inside ? staging_.folder() / place.relative : place.resolved;
+        const fs::path full = place.inside ? staging_ / place.relative : place.resolved;
         std::error_code ec;
         if (place.inside) {  // where it will go must be free: fail now, naming the node, not at the commit
             const fs::path target = options_.out_dir / place.relative;
@@ -105,6 +106,9 @@ public:
     void warn(std::string_view message) override { say(node_.label + ": warning: " + std::string(message)); }
     /// What the node said, for the cache to replay when its result is reused.
     const std::vector<std::string>& said() const { return said_; }
+    Tiling* tiling() override {
+        return options_.tiled && !for_entry_ && TiledRun::runs_tiled(node_) ? options_.tiled : nullptr;
+    }
 
 private:
     void say(std::string line) {
@@ -117,7 +121,7 @@ private:
     std::vector<Value> inputs_;
     std::vector<std::string> said_;
     const RunOptions& options_;
-    const Staging& staging_;
+    const fs::path& staging_;  ///< the staging folder (in a tiled run, rank 0's: every rank writes into it)
     std::vector<fs::path>& outside_;
     std::uint64_t seed_;
     bool for_entry_;
@@ -128,7 +132,7 @@ private:
 /// consumer asks for it. It runs inside run(), which keeps plan, node and
 /// options alive for as long as any node can pull an entry.
 std::shared_ptr<Series> map_over_series(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs,
-                                        std::size_t mapped, const RunOptions& options, const Staging& staging,
+                                        std::size_t mapped, const RunOptions& options, const fs::path& staging,
                                         std::vector<fs::path>& outside) {
     const std::shared_ptr<const Series> source = inputs[mapped].series();
     auto result = std::make_shared<Series>();
@@ -231,6 +235,15 @@ std::string cancel_reason(const RunOptions& options) {
     return sig == SIGTERM ? "stopped by SIGTERM" : "cancelled by the user";
 }
 
+/// Collective in a tiled run: every rank learns the worst exit code; only the lowest failing rank keeps its message.
+void agree_across_ranks(TiledRun& tiled, RunResult& result) {
+    const int mine = result.exit_code;
+    int reporter = 0;
+    const int worst = tiled.agree(mine, &reporter);
+    if (worst != 0 && (mine == 0 || reporter != tiled.rank())) result.error.clear();
+    result.exit_code = worst;
+}
+
 void cancelled(RunResult& result, std::string message) {
     result.exit_code = 130;
     result.error = std::move(message);
@@ -250,17 +263,19 @@ struct NodeFailed {
 /// demand, so a node runs whenever a value it makes is needed and not at hand.
 class Evaluation {
 public:
-    Evaluation(const Plan& plan, const RunOptions& options, const Staging& staging, std::vector<fs::path>& outside,
-               RunResult& result)
-        : plan_(plan), options_(options), staging_(staging), outside_(outside), result_(result),
-          states_(plan.nodes.size()) {
+    /// `staging`: this process's staging folder, or nullptr on a rank of a tiled run other than 0, which
+    /// writes into rank 0's (`staging_folder`) and keeps no cache.
+    Evaluation(const Plan& plan, const RunOptions& options, const Staging* staging, fs::path staging_folder,
+               std::vector<fs::path>& outside, RunResult& result)
+        : plan_(plan), options_(options), staging_(staging), staging_folder_(std::move(staging_folder)),
+          outside_(outside), result_(result), states_(plan.nodes.size()) {
         for (std::size_t j = 0; j < plan.nodes.size(); ++j) {
             const PlannedNode& n = plan.nodes[j];
             if (n.value_name.empty()) continue;
             producer_[n.value_name] = {j, ""};
             for (const auto& side : n.node->side_outputs) producer_[n.value_name + "." + side.name] = {j, side.name};
         }
-        if (options.cache) {
+        if (options.cache && staging_ && !options.tiled) {
             store_.emplace(*options.cache, [this](const std::string& line) { warn(line); });
             if (!store_->usable()) store_.reset();
         }
@@ -385,13 +400,13 @@ private:
                     kept_.push_back(rel);
                     continue;
                 }
-                const fs::path full = staging_.folder() / rel;
+                const fs::path full = staging_folder_ / rel;
                 fs::create_directories(full.parent_path());
                 write_plain(full, bytes);
                 ++written;
             }
             // One flush for all of them (an fsync each costs ~8 ms: 123 files of plates/ took a second).
-            const int fd = written ? ::open(staging_.folder().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC) : -1;
+            const int fd = written ? ::open(staging_folder_.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC) : -1;
             if (fd >= 0) {
                 ::syncfs(fd);
                 ::close(fd);
@@ -482,32 +497,52 @@ private:
         std::vector<Value> inputs;
         for (const auto& key : node.inputs) inputs.push_back(key.empty() ? Value() : ensure(key));
         if (j == current_) release_inputs(j);
-        const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
-        Context ctx(plan_, node, std::move(inputs), options_, staging_, outside_);
         const bool writes_files = !node.output_files.empty();
-        const std::vector<fs::path> files_before = writes_files && s.key ? staging_.files() : std::vector<fs::path>{};
+        const std::vector<fs::path> files_before =
+            writes_files && s.key && staging_ ? staging_->files() : std::vector<fs::path>{};
         const std::size_t outside_before = outside_.size();
         if (options_.progress) options_.progress->start(int(j) + 1, int(plan_.nodes.size()), node.label, node.node->qualified_name());
         const auto start = std::chrono::steady_clock::now();
         NodeOutputs out;
+        std::optional<Context> ctx;
+        RunResult failure;        // exit code and message if the node failed here
+        bool agreed = false;      // a tiled node learnt of another rank's failure (PeerFailed): already agreed on
+        bool runs_here = true;    // false on ranks other than 0 for a node that is not tiled
         try {
-            ctx.check_cancelled();
-            if (node.mapped_input >= 0)  // entries are made when a later node pulls them
+            // A tiled run: tiles for a tiled node, the whole values on rank 0 for the others (collective).
+            if (options_.tiled) runs_here = options_.tiled->prepare_inputs(node, inputs);
+            const std::vector<Value> mapped_inputs = node.mapped_input >= 0 ? inputs : std::vector<Value>{};
+            ctx.emplace(plan_, node, std::move(inputs), options_, staging_folder_, outside_);
+            ctx->check_cancelled();
+            if (!runs_here)
+                ;  // rank 0 runs it
+            else if (node.mapped_input >= 0)  // entries are made when a later node pulls them
                 out = NodeOutputs(map_over_series(plan_, node, mapped_inputs, std::size_t(node.mapped_input), options_,
-                                                  staging_, outside_));
+                                                  staging_folder_, outside_));
             else
-                out = node.node->run(ctx);
+                out = node.node->run(*ctx);
         } catch (const Cancelled&) {
-            throw NodeFailed{130, node_error(node, cancel_reason(options_))};
+            cancelled(failure, node_error(node, cancel_reason(options_)));
+        } catch (const PeerFailed& e) {
+            failure.exit_code = e.exit_code();  // the rank that failed says why
+            agreed = true;
         } catch (const Error& e) {
-            throw NodeFailed{e.kind() == Error::Kind::bad_input ? 2 : 1, node_error(node, e.what())};
+            failure.exit_code = e.kind() == Error::Kind::bad_input ? 2 : 1;
+            failure.error = node_error(node, e.what());
         } catch (const std::bad_alloc&) {
-            throw NodeFailed{1, node_error(node, "out of memory; try a smaller grid")};
+            failure.exit_code = 1;
+            failure.error = node_error(node, "out of memory; try a smaller grid");
         } catch (const std::exception& e) {
-            throw NodeFailed{1, node_error(node, e.what())};
+            failure.exit_code = 1;
+            failure.error = node_error(node, e.what());
         } catch (...) {
-            throw NodeFailed{1, node_error(node, "unknown exception")};
+            failure.exit_code = 1;
+            failure.error = node_error(node, "unknown exception");
         }
+        // A tiled run goes on only if every rank finished the node; one rank (the lowest that failed) reports.
+        if (options_.tiled && !agreed) agree_across_ranks(*options_.tiled, failure);
+        if (failure.exit_code != 0) throw NodeFailed{failure.exit_code, failure.error};
+        if (options_.tiled) options_.tiled->produced(node);
         const double seconds = seconds_since(start);
         if (options_.progress) options_.progress->finish(seconds);
         NodeTiming& row = result_.timings[s.row];
@@ -517,7 +552,7 @@ private:
 
         const bool series_out = node.node->output_series || node.mapped_input >= 0;
         const ValueType returned_entry = out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
-        if ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output)
+        if (runs_here && ((out.main.type() == ValueType::series) != series_out || returned_entry != node.node->output))
             throw NodeFailed{1, node_error(node, "internal error: it returned a " +
                                                      (returned_entry == ValueType::none
                                                           ? std::string("nothing")
@@ -536,7 +571,7 @@ private:
             for (const auto& [side, v] : out.side) keep(node.value_name + "." + side, v);
         }
         if (store_ && s.key && !s.rerun && out.main.type() != ValueType::series && outside_.size() == outside_before)
-            save(j, out, ctx.said(), files_before);
+            save(j, out, ctx->said(), files_before);
         return out;
     }
 
@@ -549,10 +584,10 @@ private:
             for (const auto& [side, v] : out.side)
                 if (cache::storable(v.type())) c.values.emplace_back(side, v);
             if (!node.output_files.empty()) {
-                const std::vector<fs::path> after = staging_.files();
+                const std::vector<fs::path> after = staging_->files();
                 for (const auto& f : after)
                     if (!std::binary_search(files_before.begin(), files_before.end(), f))
-                        c.files.emplace_back(f.generic_string(), read_file(staging_.folder() / f));
+                        c.files.emplace_back(f.generic_string(), read_file(staging_folder_ / f));
             }
             c.messages = said;
             store_->save(*states_[j].key, c);
@@ -563,7 +598,8 @@ private:
 
     const Plan& plan_;
     const RunOptions& options_;
-    const Staging& staging_;
+    const Staging* staging_;
+    fs::path staging_folder_;
     std::vector<fs::path>& outside_;
     RunResult& result_;
     std::vector<State> states_;
@@ -589,23 +625,40 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         result.exit_code = 1;
         result.error = "orogen: error: cannot create the output folder " + options.out_dir.string() + " (" +
                        (ec ? ec.message() : std::string("a file of that name exists")) + "); pick another with --out\n";
-        return result;
     }
-    // Debris of earlier runs that were killed, then a staging folder of our own.
-    result.notes = clean_debris(options.out_dir);
+    // In a tiled run every rank learns of a failure on any (and only the first failing rank reports it).
+    if (options.tiled) agree_across_ranks(*options.tiled, result);
+    if (result.exit_code != 0) return result;
+    // Debris of earlier runs that were killed, then a staging folder of our own. In a tiled run rank 0
+    // cleans up before the other ranks make theirs (it would see their fresh folders as debris).
+    const bool rank0 = !options.tiled || options.tiled->rank() == 0;
+    if (rank0) result.notes = clean_debris(options.out_dir);
+    if (options.tiled) options.tiled->agree(0);
     if (options.on_note)
         for (const auto& note : result.notes) options.on_note(note);
+    // A tiled run stages in rank 0's folder alone: every rank writes its files there, and rank 0 moves them
+    // into place with its own, the manifest (which lists and hashes them all) last, or removes them all.
     std::optional<Staging> staging;
+    fs::path staging_folder;
     try {
-        staging.emplace(options.out_dir);
+        if (rank0) {
+            staging.emplace(options.out_dir);
+            staging_folder = staging->folder();
+        }
     } catch (const Error& e) {
         result.exit_code = 1;
         result.error = std::string("orogen: error: ") + e.what() + "\n";
-        return result;
+    }
+    if (options.tiled) agree_across_ranks(*options.tiled, result);
+    if (result.exit_code != 0) return result;
+    if (options.tiled) {
+        std::string folder = staging_folder.string();
+        options.tiled->broadcast(folder);
+        staging_folder = folder;
     }
     std::vector<fs::path> outside;  // outputs written outside --out (allowed with --allow-outside-out)
 
-    Evaluation evaluation(plan, options, *staging, outside, result);
+    Evaluation evaluation(plan, options, staging ? &*staging : nullptr, staging_folder, outside, result);
     try {
         evaluation.run_all();
     } catch (const NodeFailed& f) {
@@ -621,7 +674,11 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     result.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (result.exit_code == 0 && options.cancel && options.cancel->load())  // stopped after the last node
         cancelled(result, "orogen: error: " + cancel_reason(options) + " before the outputs were moved into place\n");
-    if (result.exit_code == 0) {
+    if (result.exit_code == 0 && !rank0) {
+        // Another rank of a tiled run: its files are in rank 0's staging folder; rank 0 commits them (and says
+        // whether that worked).
+        agree_across_ranks(*options.tiled, result);
+    } else if (result.exit_code == 0) {
         // All or nothing: the manifest is staged with the rest and moves into place last.
         try {
             const std::vector<fs::path> staged = staging->files();
@@ -637,6 +694,7 @@ RunResult run(const Plan& plan, const RunOptions& options) {
             result.exit_code = 1;
             result.error = std::string("orogen: error: ") + e.what() + "\n";
         }
+        if (options.tiled) agree_across_ranks(*options.tiled, result);
     }
     return result;  // on failure `staging` goes out of scope and takes every staged file with it
 }

@@ -16,6 +16,8 @@
 
 namespace orogen {
 
+class TiledRun;  // tiles.hpp
+
 struct PluginRecord {
     std::string name, version, file;
 };
@@ -37,6 +39,8 @@ struct RunOptions {
     std::map<std::string, PluginRecord, std::less<>> node_plugins;
     /// One-line warnings that do not stop the run (a damaged cache entry...); default: the progress display.
     std::function<void(const std::string&)> on_warning;
+    /// A tiled run under MPI (tiles.hpp): this rank's side of it; nullptr for a single process.
+    TiledRun* tiled = nullptr;
 };
 
 struct NodeTiming {
@@ -49,7 +53,7 @@ struct NodeTiming {
 
 struct RunResult {
     int exit_code = 0;        ///< 0 ok, 1 failed run, 2 bad input, 130 cancelled
-    std::string error;        ///< formatted diagnostic when exit_code != 0
+    std::string error;        ///< formatted diagnostic when exit_code != 0 ("" on a rank that only saw another fail)
     std::vector<NodeTiming> timings;
     std::vector<std::filesystem::path> outputs;  ///< files written (staged ones sorted), the manifest last
     std::vector<std::string> notes;              ///< debris of killed runs removed before this one, one line each

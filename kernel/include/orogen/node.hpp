@@ -18,6 +18,7 @@
 //   });
 #pragma once
 
+#include <orogen/tiles.hpp>
 #include <orogen/values.hpp>
 
 #include <cstdint>
@@ -229,6 +230,11 @@ public:
     /// Throws orogen::Error naming the node, `what`, the step and the first bad
     /// sample if `data` holds a NaN or infinity.
     void check_finite(std::span<const float> data, std::string_view what, std::int64_t step) const;
+
+    /// In a tiled (MPI) run, for a node with tile_halo >= 0: the split, this
+    /// rank's tile and the halo exchange (orogen/tiles.hpp). nullptr otherwise:
+    /// the node then sees the whole grid, as always.
+    virtual Tiling* tiling() { return nullptr; }
 };
 
 /// What a node produced: a main value (empty for pure exporters) and side
@@ -270,6 +276,11 @@ struct NodeDescriptor {
     std::vector<Param> params;
     /// Heightmap layers this node adds to its output (for the checker and help).
     std::vector<std::string> adds_layers;
+    /// Whether the node runs tiled under MPI (orogen/tiles.hpp): -1 it cannot
+    /// (it runs on rank 0 over the whole grid, gathered there); h >= 0 it runs
+    /// on every rank's tile and needs a halo of h vertices from each neighbour
+    /// (so every tile must be at least h vertices wide and high).
+    int tile_halo = -1;
     /// Optional cross-parameter and input checks, run at check time.
     std::function<void(CheckContext&)> check;
     std::function<NodeOutputs(NodeContext&)> run;

@@ -26,7 +26,7 @@
 
 /// Bumped whenever a public header changes in a way that breaks plugins built
 /// against the previous one (layout of a shared type, a virtual function...).
-/// 3: NodeDescriptor::cache (the node cache).
+/// 3: NodeDescriptor::cache (the node cache), NodeDescriptor::tile_halo and NodeContext::tiling() (MPI tiles).
 #define OROGEN_PLUGIN_API_VERSION 3
 
 namespace orogen {

@@ -6,8 +6,10 @@
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +17,93 @@
 namespace {
 
 using namespace orogen;
+
+/// A step changes a vertex from the 5 × 5 vertices around it (F of a
+/// neighbour looks one vertex further), so a sweep of kStepsPerSweep steps
+/// needs this many vertices of the neighbouring tiles.
+constexpr int kTileHalo = 2 * thermal::kStepsPerSweep;
+
+/// Adds the layers run() adds (eroded, and hardness for Hardness::height) from the heights before and after.
+void add_layers(Heightmap& hm, const float* before, const float* after, const thermal::Settings& s) {
+    GridView eroded = hm.layer("eroded", 0.0f);
+    for (std::size_t i = 0; i < hm.size(); ++i) eroded.data[i] += after[i] - before[i];
+    if (s.hardness == thermal::Hardness::height) {
+        GridView k = hm.layer("hardness", 0.0f);
+        for (std::size_t i = 0; i < hm.size(); ++i)
+            k.data[i] = thermal::height_hardness(after[i], s.height_min, s.height_max);
+    }
+}
+
+/// One rank's tile of a tiled run (orogen/tiles.hpp). The rank works on its
+/// tile grown by kTileHalo vertices: before each sweep of kStepsPerSweep
+/// steps the halo is refilled from the neighbours; the sweep treats the edge
+/// of the grown tile as a wall, whose wrong effect travels 2 vertices a step,
+/// so after the sweep the owned vertices are exactly the whole grid's (the
+/// same operations on the same inputs, bit for bit), and only the halo is stale.
+NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap> hm, const thermal::Settings& s,
+                      const float* layer) {
+    const TileRect own = tiles.owned(), grown = tiles.grown(kTileHalo);
+    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
+    auto copy_in = [&](const float* tile, std::vector<float>& held) {
+        held.assign(std::size_t(grown.width) * std::size_t(grown.height), 0.0f);
+        for (int y = 0; y < own.height; ++y)
+            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
+                      held.begin() + std::ptrdiff_t(std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox)));
+    };
+    std::vector<float> held, held_layer;
+    copy_in(hm->heights().data(), held);
+    GridView view{held.data(), grown.width, grown.height, hm->cell()};
+    if (layer) {  // the hardness of the halo too, once: it does not change
+        copy_in(layer, held_layer);
+        tiles.exchange_halo({held_layer.data(), grown.width, grown.height, hm->cell()}, kTileHalo);
+    }
+    const std::int64_t iterations = ctx.integer("iterations");
+    using clock = std::chrono::steady_clock;
+    clock::duration exchanging{}, sweeping{};  // for the figure in the info line (docs/benchmarks.md)
+    const double waited_before = tiles.seconds_waiting();
+    for (std::int64_t i = 0; i < iterations;) {
+        const int k = int(std::min<std::int64_t>(thermal::kStepsPerSweep, iterations - i));
+        const auto t0 = clock::now();
+        tiles.exchange_halo(view, kTileHalo);
+        const auto t1 = clock::now();
+        thermal::steps(view, view, k, s, layer ? held_layer.data() : nullptr);
+        exchanging += t1 - t0;
+        sweeping += clock::now() - t1;
+        i += k;
+        ctx.check_cancelled();
+        if (i % 64 == 0 || i == iterations) {  // as run() does
+            for (int y = 0; y < own.height; ++y)
+                for (int x = 0; x < own.width; ++x)
+                    if (const float v = view.row(y + oy)[ox + x]; !std::isfinite(v)) {
+                        // check_finite()'s message, with the sample's index in the whole grid.
+                        std::ostringstream msg;
+                        msg << "non-finite height (" << v << ") at sample "
+                            << std::int64_t(own.y0 + y) * tiles.grid_width() + (own.x0 + x) << " after step " << i
+                            << "; the simulation became unstable";
+                        throw Error(msg.str());
+                    }
+            ctx.progress(double(i) / double(iterations));
+        }
+    }
+    const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
+    std::ostringstream note;
+    note.precision(3);
+    note << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height << " at ("
+         << own.x0 << ", " << own.y0 << "), " << iterations << " steps: sweeps " << sw << " s, halo exchange " << ex
+         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %), of which waiting for the other ranks "
+         << tiles.seconds_waiting() - waited_before << " s";
+    ctx.info(note.str());
+    std::vector<float>().swap(held_layer);  // freed now (assigning {} would keep the capacity)
+    // The owned part back into the tile; the tile's old heights are `before` for the layers.
+    std::vector<float> after(hm->size());
+    for (int y = 0; y < own.height; ++y)
+        std::copy(view.row(y + oy) + ox, view.row(y + oy) + ox + own.width,
+                  after.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(own.width)));
+    std::vector<float>().swap(held);
+    add_layers(*hm, hm->heights().data(), after.data(), s);
+    hm->heights() = std::move(after);
+    return hm;
+}
 
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
@@ -32,6 +121,7 @@ NodeOutputs run(NodeContext& ctx) {
         const auto [lo, hi] = std::minmax_element(hm->heights().begin(), hm->heights().end());
         s.height_min = hm->heights().empty() ? 0.0f : *lo;
         s.height_max = hm->heights().empty() ? 1.0f : *hi;
+        if (Tiling* tiles = ctx.tiling()) tiles->min_max(s.height_min, s.height_max);  // the whole grid's range
     } else {
         s.hardness = thermal::Hardness::layer;
         if (!hm->has_layer(hardness))
@@ -39,6 +129,7 @@ NodeOutputs run(NodeContext& ctx) {
         layer = std::as_const(*hm).layer(hardness).data;
     }
 
+    if (Tiling* tiles = ctx.tiling()) return run_tiled(ctx, *tiles, std::move(hm), s, layer);
     const std::vector<float> before = hm->heights();
     const std::int64_t iterations = ctx.integer("iterations");
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0);  // time = step count
@@ -53,14 +144,7 @@ NodeOutputs run(NodeContext& ctx) {
     });
 
     // eroded: net change in metres, added to an earlier eroder's if present.
-    GridView eroded = hm->layer("eroded", 0.0f);
-    const std::vector<float>& after = hm->heights();
-    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - before[i];
-    if (s.hardness == thermal::Hardness::height) {
-        GridView k = hm->layer("hardness", 0.0f);
-        for (std::size_t i = 0; i < after.size(); ++i)
-            k.data[i] = thermal::height_hardness(after[i], s.height_min, s.height_max);
-    }
+    add_layers(*hm, before.data(), hm->heights().data(), s);
     lapse.finish(iterations, *hm);
     NodeOutputs out(hm);
     if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
@@ -123,6 +207,7 @@ OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"eroded"},
+        .tile_halo = kTileHalo,
         .check = check,
         .run = run,
     });

@@ -4,7 +4,11 @@
 #include "vtk_writer.hpp"
 
 #include <orogen/error.hpp>
+#include <orogen/io.hpp>
 #include <orogen/plugin.hpp>
+
+#include <algorithm>
+#include <filesystem>
 
 namespace {
 
@@ -58,6 +62,69 @@ NodeOutputs run_plates(NodeContext& ctx) {
     return {};
 }
 
+/// export:vtk-tiles: a .pvti over one .vti piece per tile (per rank under
+/// mpirun; one piece for a single process). Each rank writes its own piece:
+/// its tile plus the first column east and the first row south of it (from the
+/// neighbours, by a one-vertex halo exchange), so neighbouring pieces share
+/// those points bit for bit, as ParaView's parallel reader expects. Rank 0
+/// writes the .pvti. The files are staged with the run's others.
+NodeOutputs run_tiles(NodeContext& ctx) {
+    const Heightmap& hm = *ctx.input(0).heightmap();
+    Tiling* tiles = ctx.tiling();
+    const int width = tiles ? tiles->grid_width() : hm.width(), height = tiles ? tiles->grid_height() : hm.height();
+    const int rank = tiles ? tiles->rank() : 0, ranks = tiles ? tiles->ranks() : 1;
+    auto tile_of = [&](int r) { return tiles ? tiles->tile(r) : TileRect{0, 0, width, height}; };
+    // A piece: the tile and one more column and row where a neighbour has them.
+    auto piece_of = [&](int r) {
+        const TileRect t = tile_of(r);
+        return TileRect{t.x0, t.y0, std::min(t.x1() + 1, width) - t.x0, std::min(t.y1() + 1, height) - t.y0};
+    };
+    const TileRect own = tile_of(rank), piece = piece_of(rank);
+    const TileRect grown = tiles ? tiles->grown(1) : own;
+    // Each grid (heights, then the layers by name) grown by the halo, exchanged, cut to the piece.
+    auto piece_grid = [&](const float* tile) {
+        std::vector<float> held(std::size_t(grown.width) * std::size_t(grown.height));
+        for (int y = 0; y < own.height; ++y)
+            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
+                      held.begin() + std::ptrdiff_t(std::size_t(y + own.y0 - grown.y0) * std::size_t(grown.width) +
+                                                    std::size_t(own.x0 - grown.x0)));
+        if (tiles) tiles->exchange_halo({held.data(), grown.width, grown.height, hm.cell()}, 1);
+        std::vector<float> out(std::size_t(piece.width) * std::size_t(piece.height));
+        for (int y = 0; y < piece.height; ++y) {
+            const float* src = held.data() + std::size_t(piece.y0 - grown.y0 + y) * std::size_t(grown.width) +
+                               std::size_t(piece.x0 - grown.x0);
+            std::copy(src, src + piece.width, out.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(piece.width)));
+        }
+        return out;
+    };
+    const std::vector<std::string> names = hm.layer_names();
+    std::vector<std::vector<float>> grids;
+    grids.push_back(piece_grid(hm.heights().data()));
+    for (const auto& n : names) grids.push_back(piece_grid(hm.layer(n).data));
+    std::vector<vtk::NamedGrid> layers;
+    for (std::size_t i = 0; i < names.size(); ++i)
+        layers.push_back({names[i], {grids[i + 1].data(), piece.width, piece.height, hm.cell()}});
+    vtk::Options o;
+    o.compress = ctx.flag("compress");
+
+    const std::filesystem::path pvti = ctx.text("path");
+    auto piece_file = [&](int r) { return pvti.stem().string() + "_" + std::to_string(r) + ".vti"; };
+    vtk::write_heightmap_piece({grids[0].data(), piece.width, piece.height, hm.cell()}, layers, piece.x0, piece.y0,
+                               ctx.output_path((pvti.parent_path() / piece_file(rank)).string()), o);
+    if (rank == 0) {
+        std::vector<vtk::PvtiPiece> pieces;
+        for (int r = 0; r < ranks; ++r) {
+            const TileRect p = piece_of(r);
+            pieces.push_back({piece_file(r), p.x0, p.x1() - 1, p.y0, p.y1() - 1});
+        }
+        const std::string text = vtk::pvti_text(width, height, hm.cell(), names, pieces);
+        write_file_atomically(ctx.output_path(pvti.string()),
+                              {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    }
+    ctx.info("wrote " + pvti.string() + " over " + std::to_string(ranks) + " piece(s)");
+    return {};
+}
+
 Param up_param() {
     return Param::choice("up", {"z", "y"}, "z")
         .help("which axis points up: z (X east, Y north, Z up: ParaView's and GIS's convention, the terrain in the "
@@ -95,6 +162,25 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
             },
         .check = check_heightmap,
         .run = run_heightmap,
+    });
+    registry.add({
+        .kind = "export",
+        .name = "vtk-tiles",
+        .summary = "write the heightmap and its layers as a ParaView .pvti over one .vti piece per tile (MPI rank)",
+        .description =
+            "The same points and arrays as export:vtk's .vti, cut into pieces: under mpirun each rank writes its own "
+            "tile as NAME_RANK.vti (with the first column and row of its east and south neighbours, so the pieces "
+            "meet without a gap), rank 0 the .pvti that lists them; a single process writes one piece. Open the "
+            ".pvti in ParaView (or read it with vtkXMLPImageDataReader).",
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to write"}},
+        .output = ValueType::none,
+        .params =
+            {
+                Param::path("path", PathRole::output, {".pvti"}).help("output .pvti; the pieces NAME_RANK.vti go beside it"),
+                compress_param(),
+            },
+        .tile_halo = 1,
+        .run = run_tiles,
     });
     registry.add({
         .kind = "export",

@@ -171,6 +171,42 @@ std::string pvd_text(std::span<const PvdEntry> entries) {
 
 // ---------------------------------------------------------------- heightmap
 
+void write_heightmap_piece(ConstGridView piece, std::span<const NamedGrid> layers, int x0, int y0,
+                           const fs::path& target, const Options& o) {
+    check_layers(piece, layers);
+    AtomicFile file(target);
+    vtkNew<vtkImageData> image;
+    // X east, Z south: sample order as stored; the extent places the piece in the whole grid.
+    image->SetExtent(x0, x0 + piece.width - 1, 0, 0, y0, y0 + piece.height - 1);
+    image->SetSpacing(piece.cell, 1.0, piece.cell);
+    image->SetOrigin(0, 0, 0);
+    image->GetPointData()->AddArray(wrap("height", piece.data, piece.size(), 1));
+    image->GetPointData()->SetActiveScalars("height");
+    for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
+    mark_frame(image, Up::y);  // pieces are Y-up (X east, Z south) until export:vtk-tiles learns up=z
+    write_with<vtkXMLImageDataWriter>(image, file, o);
+    file.commit();
+}
+
+std::string pvti_text(int width, int height, double cell, std::span<const std::string> layer_names,
+                      std::span<const PvtiPiece> pieces) {
+    std::ostringstream s;
+    s << "<?xml version=\"1.0\"?>\n"
+      << "<VTKFile type=\"PImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
+      << "  <PImageData WholeExtent=\"0 " << width - 1 << " 0 0 0 " << height - 1
+      << "\" GhostLevel=\"0\" Origin=\"0 0 0\" Spacing=\"" << number(cell) << " 1 " << number(cell) << "\">\n"
+      << "    <PPointData Scalars=\"height\">\n"
+      << "      <PDataArray type=\"Float32\" Name=\"height\"/>\n";
+    for (const auto& n : layer_names) s << "      <PDataArray type=\"Float32\" Name=\"" << n << "\"/>\n";
+    s << "    </PPointData>\n";
+    for (const auto& p : pieces)
+        s << "    <Piece Extent=\"" << p.x0 << " " << p.x1 << " 0 0 " << p.y0 << " " << p.y1 << "\" Source=\"" << p.file
+          << "\"/>\n";
+    s << "  </PImageData>\n"
+      << "</VTKFile>\n";
+    return s.str();
+}
+
 void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, const fs::path& target,
                      const Options& o) {
     const std::string ext = target.extension().string();
@@ -178,9 +214,9 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
         throw BadInput("export:vtk writes a heightmap as .vti or .vtp; '" + target.filename().string() +
                        "' has another extension");
     check_layers(heights, layers);
-    AtomicFile file(target);
     if (ext == ".vti") {
         if (o.decimate != 1) throw BadInput("decimate applies to .vtp meshes only; .vti keeps every sample");
+        AtomicFile file(target);
         vtkNew<vtkImageData> image;
         if (o.up == Up::z) {
             // X east, Y north: VTK's j runs north, so the south row comes first (a copy of each array).
@@ -202,6 +238,7 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
         file.commit();
         return;
     }
+    AtomicFile file(target);
 
     const terrain::TerrainMesh mesh = terrain::plan_mesh(heights, o.decimate, 1, o.vertical_scale);
     const terrain::MeshChunk& chunk = mesh.chunks.at(0);

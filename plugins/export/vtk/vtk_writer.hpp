@@ -65,6 +65,23 @@ struct Options {
 void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, const std::filesystem::path& target,
                      const Options& options = {});
 
+/// One piece of a tiled heightmap as a .vti whose extent is the piece's place in
+/// the whole grid: columns x0 .. x0+width−1, rows y0 .. y0+height−1 (the
+/// .vti a whole grid gives, cut there). Pieces listed in a .pvti (pvti_text)
+/// overlap by one row or column, as ParaView's parallel image data wants.
+void write_heightmap_piece(ConstGridView piece, std::span<const NamedGrid> layers, int x0, int y0,
+                           const std::filesystem::path& target, const Options& options = {});
+
+/// A .pvti piece: its file (relative to the .pvti) and extent in the whole grid (first and last column, row).
+struct PvtiPiece {
+    std::string file;
+    int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+/// The .pvti text over `pieces` of a width × height grid, `cell` metres apart, with the point arrays
+/// "height" and `layer_names` (all Float32), in that order.
+std::string pvti_text(int width, int height, double cell, std::span<const std::string> layer_names,
+                      std::span<const PvtiPiece> pieces);
+
 /// Particle frames: `target` .pvd (one <stem>_NNNNNN.vtp per frame beside it) or
 /// .vtp (a single frame). Returns the number of files written.
 std::size_t write_particles(const ParticleSeries& series, const std::filesystem::path& target,

@@ -45,26 +45,32 @@ int first_lowered(const Line& l, double y, int width) {
     return x;
 }
 
-void count_row(std::int32_t* out, std::vector<std::int32_t>& diff, int width, int y, const std::vector<Line>& lines) {
-    std::fill(diff.begin(), diff.end(), 0);
-    std::int32_t start = 0;  // sign at column 0, summed over lines
+/// The counts of row y at columns x0 .. x0+count−1 of a `width`-wide grid,
+/// into out[0..count): the sign at column x0 summed over the lines, then a
+/// difference array over the columns after it. O(lines + count) a row, so a
+/// tile pays only for its own columns.
+void count_row(std::int32_t* out, std::vector<std::int32_t>& diff, int width, int x0, int count, int y,
+               const std::vector<Line>& lines) {
+    std::fill(diff.begin(), diff.begin() + std::ptrdiff_t(count) + 1, 0);
+    std::int32_t start = 0;  // sign at column x0, summed over lines
+    const int x1 = x0 + count;
     for (const Line& l : lines) {
         if (l.dy > 0.0) {  // lowered on [0, x), raised on [x, width)
             const int x = first_raised(l, y, width);
-            start += x > 0 ? -1 : 1;
-            if (x > 0 && x < width) diff[std::size_t(x)] += 2;
+            start += x > x0 ? -1 : 1;
+            if (x > x0 && x < x1) diff[std::size_t(x - x0)] += 2;
         } else if (l.dy < 0.0) {  // raised on [0, x), lowered after
             const int x = first_lowered(l, y, width);
-            start += x > 0 ? 1 : -1;
-            if (x > 0 && x < width) diff[std::size_t(x)] -= 2;
+            start += x > x0 ? 1 : -1;
+            if (x > x0 && x < x1) diff[std::size_t(x - x0)] -= 2;
         } else {
             start += raised(l, 0, y) ? 1 : -1;  // horizontal: the whole row on one side
         }
     }
     std::int32_t running = start;
-    for (int x = 0; x < width; ++x) {
-        running += diff[std::size_t(x)];
-        out[x] = running;
+    for (int i = 0; i < count; ++i) {
+        running += diff[std::size_t(i)];
+        out[i] = running;
     }
 }
 
@@ -75,19 +81,24 @@ void count_sides(std::vector<std::int32_t>& counts, int width, int height, const
     parallel_for(0, height, 16, [&](std::int64_t y0, std::int64_t y1) {
         std::vector<std::int32_t> diff(std::size_t(width) + 1);
         for (std::int64_t y = y0; y < y1; ++y)
-            count_row(counts.data() + std::size_t(y) * std::size_t(width), diff, width, int(y), lines);
+            count_row(counts.data() + std::size_t(y) * std::size_t(width), diff, width, 0, width, int(y), lines);
     });
 }
 
 void apply(GridView terrain, int iterations, double displacement, std::uint64_t seed) {
-    const std::vector<Line> lines = random_lines(terrain.width, terrain.height, iterations, seed);
+    apply_tile(terrain, terrain.width, terrain.height, 0, 0, iterations, displacement, seed);
+}
+
+void apply_tile(GridView tile, int grid_width, int grid_height, int x0, int y0, int iterations, double displacement,
+                std::uint64_t seed) {
+    const std::vector<Line> lines = random_lines(grid_width, grid_height, iterations, seed);
     const float d = float(displacement);
-    parallel_for(0, terrain.height, 16, [&](std::int64_t y0, std::int64_t y1) {
-        std::vector<std::int32_t> diff(std::size_t(terrain.width) + 1), row(std::size_t(terrain.width));
-        for (std::int64_t y = y0; y < y1; ++y) {
-            count_row(row.data(), diff, terrain.width, int(y), lines);
-            float* out = terrain.row(int(y));
-            for (int x = 0; x < terrain.width; ++x) out[x] += d * float(row[std::size_t(x)]);
+    parallel_for(0, tile.height, 16, [&](std::int64_t t0, std::int64_t t1) {
+        std::vector<std::int32_t> diff(std::size_t(tile.width) + 1), row(static_cast<std::size_t>(tile.width));
+        for (std::int64_t t = t0; t < t1; ++t) {
+            count_row(row.data(), diff, grid_width, x0, tile.width, y0 + int(t), lines);
+            float* out = tile.row(int(t));
+            for (int x = 0; x < tile.width; ++x) out[x] += d * float(row[std::size_t(x)]);
         }
     });
 }

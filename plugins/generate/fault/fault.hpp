@@ -38,4 +38,10 @@ void count_sides(std::vector<std::int32_t>& counts, int width, int height, const
 /// Add displacement × count_sides(...) to `terrain` (metres).
 void apply(GridView terrain, int iterations, double displacement, std::uint64_t seed);
 
+/// apply() on one tile of a grid_width × grid_height grid: `tile` holds the
+/// vertices from column x0 and row y0 on. The lines are the whole grid's, so
+/// every vertex gets the very bits apply() gives it on the whole grid.
+void apply_tile(GridView tile, int grid_width, int grid_height, int x0, int y0, int iterations, double displacement,
+                std::uint64_t seed);
+
 }  // namespace orogen::fault

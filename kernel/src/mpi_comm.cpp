@@ -1,0 +1,154 @@
+#include "mpi_comm.hpp"
+
+#include <orogen/error.hpp>
+
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#ifdef OROGEN_HAVE_MPI
+// The C API only: Open MPI's deprecated C++ bindings would need libmpi_cxx.
+#define OMPI_SKIP_MPICXX 1
+#define MPICH_SKIP_MPICXX 1
+#include <mpi.h>
+#endif
+
+namespace orogen::mpi {
+
+int launched_size() {
+    for (const char* name : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_SIZE"})
+        if (const char* v = std::getenv(name); v && *v) {
+            const int n = std::atoi(v);
+            if (n > 0) return n;
+        }
+    return 0;
+}
+
+#ifdef OROGEN_HAVE_MPI
+
+bool built_with_mpi() { return true; }
+
+namespace {
+// MPI counts are ints: large messages go in pieces of at most 1 GiB.
+constexpr std::size_t kPiece = std::size_t(1) << 30;
+
+void check(int rc, const char* what) {
+    if (rc == MPI_SUCCESS) return;
+    char text[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    MPI_Error_string(rc, text, &len);
+    throw Error(std::string("MPI ") + what + " failed: " + std::string(text, std::size_t(len)));
+}
+}  // namespace
+
+Session::Session(int& argc, char**& argv) {
+    int provided = 0;
+    check(MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init");
+    // Errors come back as codes and become orogen::Error (not MPI's default abort).
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+Session::~Session() { MPI_Finalize(); }
+
+void max_all(int* values, int count) {
+    check(MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_INT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
+}
+
+void min_max_all(float& lo, float& hi) {
+    float a = lo, b = hi;
+    check(MPI_Allreduce(&a, &lo, 1, MPI_FLOAT, MPI_MIN, MPI_COMM_WORLD), "MPI_Allreduce");
+    check(MPI_Allreduce(&b, &hi, 1, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
+}
+
+double sum_all(double value) {
+    // Gathered and added in rank order on every rank, so the sum does not depend on MPI's reduction tree.
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    std::vector<double> all(static_cast<std::size_t>(size));
+    check(MPI_Allgather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD), "MPI_Allgather");
+    double s = 0.0;
+    for (double v : all) s += v;
+    return s;
+}
+
+void barrier() { check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier"); }
+
+void sendrecv(const void* send_data, std::size_t send_bytes, int to, void* recv_data, std::size_t recv_bytes, int from,
+              int tag) {
+    const int dest = to < 0 ? MPI_PROC_NULL : to, source = from < 0 ? MPI_PROC_NULL : from;
+    if (to < 0) send_bytes = 0;
+    if (from < 0) recv_bytes = 0;
+    std::size_t done_s = 0, done_r = 0;
+    do {  // both sides cut their messages into the same pieces (the sizes match pairwise)
+        const std::size_t s = std::min(kPiece, send_bytes - done_s), r = std::min(kPiece, recv_bytes - done_r);
+        check(MPI_Sendrecv(static_cast<const char*>(send_data) + done_s, int(s), MPI_BYTE, dest, tag,
+                           static_cast<char*>(recv_data) + done_r, int(r), MPI_BYTE, source, tag, MPI_COMM_WORLD,
+                           MPI_STATUS_IGNORE),
+              "MPI_Sendrecv");
+        done_s += s;
+        done_r += r;
+    } while (done_s < send_bytes || done_r < recv_bytes);
+}
+
+void send(const void* data, std::size_t bytes, int to, int tag) {
+    std::size_t done = 0;
+    do {
+        const std::size_t n = std::min(kPiece, bytes - done);
+        check(MPI_Send(static_cast<const char*>(data) + done, int(n), MPI_BYTE, to, tag, MPI_COMM_WORLD), "MPI_Send");
+        done += n;
+    } while (done < bytes);
+}
+
+void recv(void* data, std::size_t bytes, int from, int tag) {
+    std::size_t done = 0;
+    do {
+        const std::size_t n = std::min(kPiece, bytes - done);
+        check(MPI_Recv(static_cast<char*>(data) + done, int(n), MPI_BYTE, from, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE),
+              "MPI_Recv");
+        done += n;
+    } while (done < bytes);
+}
+
+void broadcast(std::string& text) {
+    unsigned long long n = text.size();
+    check(MPI_Bcast(&n, 1, MPI_UNSIGNED_LONG_LONG, 0, MPI_COMM_WORLD), "MPI_Bcast");
+    text.resize(std::size_t(n));
+    if (n) check(MPI_Bcast(text.data(), int(n), MPI_CHAR, 0, MPI_COMM_WORLD), "MPI_Bcast");
+}
+
+void abort_all(int exit_code) {
+    MPI_Abort(MPI_COMM_WORLD, exit_code);
+    std::_Exit(exit_code);
+}
+
+#else  // built without MPI
+
+bool built_with_mpi() { return false; }
+
+namespace {
+[[noreturn]] void unavailable() { throw Error("this orogen was built without MPI"); }
+}  // namespace
+
+Session::Session(int&, char**&) {
+    throw Error("started by mpirun, but this orogen was built without MPI: install Open MPI "
+                "(apt-get install openmpi-bin libopenmpi-dev), configure again and rebuild, or run without mpirun");
+}
+Session::~Session() = default;
+void max_all(int*, int) {}
+void min_max_all(float&, float&) {}
+double sum_all(double value) { return value; }
+void barrier() {}
+void sendrecv(const void*, std::size_t, int to, void*, std::size_t, int from, int) {
+    if (to >= 0 || from >= 0) unavailable();
+}
+void send(const void*, std::size_t, int, int) { unavailable(); }
+void recv(void*, std::size_t, int, int) { unavailable(); }
+void broadcast(std::string&) {}
+void abort_all(int exit_code) { std::_Exit(exit_code); }
+
+#endif
+
+}  // namespace orogen::mpi

@@ -1,0 +1,307 @@
+#include "tiles.hpp"
+
+#include "mpi_comm.hpp"
+
+#include <orogen/io.hpp>
+#include <orogen/timelapse.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <climits>
+#include <cstring>
+#include <sstream>
+
+namespace orogen {
+
+TileRect Tiling::grown(int halo) const {
+    const TileRect o = owned();
+    const int x0 = std::max(0, o.x0 - halo), y0 = std::max(0, o.y0 - halo);
+    const int x1 = std::min(grid_width(), o.x1() + halo), y1 = std::min(grid_height(), o.y1() + halo);
+    return {x0, y0, x1 - x0, y1 - y0};
+}
+
+// ------------------------------------------------------------------ the split
+
+TileRect TileSplit::tile(int index) const {
+    const int r = index / cols, c = index % cols;
+    return {xs[std::size_t(c)], ys[std::size_t(r)], xs[std::size_t(c) + 1] - xs[std::size_t(c)],
+            ys[std::size_t(r) + 1] - ys[std::size_t(r)]};
+}
+
+int TileSplit::smallest_width() const {
+    int w = INT_MAX;
+    for (int c = 0; c < cols; ++c) w = std::min(w, xs[std::size_t(c) + 1] - xs[std::size_t(c)]);
+    return w;
+}
+
+int TileSplit::smallest_height() const {
+    int h = INT_MAX;
+    for (int r = 0; r < rows; ++r) h = std::min(h, ys[std::size_t(r) + 1] - ys[std::size_t(r)]);
+    return h;
+}
+
+TileSplit split_grid(int width, int height, int rows, int cols) {
+    TileSplit s;
+    s.grid_width = width;
+    s.grid_height = height;
+    s.rows = rows;
+    s.cols = cols;
+    for (int c = 0; c <= cols; ++c) s.xs.push_back(int(std::int64_t(c) * width / cols));
+    for (int r = 0; r <= rows; ++r) s.ys.push_back(int(std::int64_t(r) * height / rows));
+    return s;
+}
+
+std::optional<std::pair<int, int>> parse_tiles(std::string_view text) {
+    const auto x = text.find_first_of("xX");
+    if (x == std::string_view::npos || x == 0 || x + 1 == text.size()) return std::nullopt;
+    auto number = [](std::string_view t) -> std::optional<int> {
+        if (t.empty() || t.size() > 6 || t.find_first_not_of("0123456789") != std::string_view::npos) return std::nullopt;
+        const int v = std::stoi(std::string(t));
+        return v >= 1 ? std::optional<int>(v) : std::nullopt;
+    };
+    const auto r = number(text.substr(0, x)), c = number(text.substr(x + 1));
+    if (!r || !c) return std::nullopt;
+    return std::pair{*r, *c};
+}
+
+std::pair<int, int> automatic_tiles(int ranks, int width, int height) {
+    // The factor pair whose tiles are closest to square (ties: more rows, so
+    // each tile's rows stay long and contiguous in memory).
+    std::pair<int, int> best{ranks, 1};
+    double best_score = 1e300;
+    for (int rows = 1; rows <= ranks; ++rows) {
+        if (ranks % rows) continue;
+        const int cols = ranks / rows;
+        const double tw = double(width) / cols, th = double(height) / rows;
+        const double score = std::max(tw, th) / std::min(tw, th);
+        if (score < best_score - 1e-12 || (std::abs(score - best_score) <= 1e-12 && rows > best.first)) {
+            best = {rows, cols};
+            best_score = score;
+        }
+    }
+    return best;
+}
+
+void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptions& options, spec::Diagnostics& diags) {
+    const std::string how = (options.tiles_given ? "--tiles " : "the automatic split ") + std::to_string(split.rows) +
+                            "x" + std::to_string(split.cols);
+    const std::string grid = std::to_string(split.grid_width) + "x" + std::to_string(split.grid_height);
+    if (split.cols > split.grid_width || split.rows > split.grid_height) {
+        diags.error(spec::Location{plan.source, 1, 1, 1},
+                    how + " cuts the " + grid + " grid into more " + (split.cols > split.grid_width ? "columns" : "rows") +
+                        " than it has vertices; use fewer ranks or --tiles with fewer " +
+                        (split.cols > split.grid_width ? "columns" : "rows"));
+        return;
+    }
+    for (const PlannedNode& node : plan.nodes) {
+        const std::string who = "'" + node.label + "' (" + node.node->qualified_name() + ")";
+        if (!TiledRun::runs_tiled(node)) {
+            const std::string problem =
+                heightmap_memory_problem(split.grid_width, split.grid_height, options.whole_grid_limit);
+            if (!problem.empty())
+                diags.error(node.where, who + " cannot be tiled, so it runs on rank 0 over the whole " + grid +
+                                            " grid, which " + problem +
+                                            "; remove it from this spec (run it on the result, in a smaller spec) "
+                                            "or use a smaller grid");
+            continue;
+        }
+        const int halo = node.node->tile_halo;
+        const bool narrow = split.cols > 1 && split.smallest_width() < halo;
+        const bool low = split.rows > 1 && split.smallest_height() < halo;
+        if (narrow || low)
+            diags.error(node.where,
+                        who + " exchanges a halo of " + std::to_string(halo) +
+                            " vertices with each neighbouring tile, so tiles must be at least " + std::to_string(halo) +
+                            " vertices " + (narrow ? "wide" : "high") + ", but " + how + " cuts the " + grid +
+                            " grid into tiles " +
+                            std::to_string(narrow ? split.smallest_width() : split.smallest_height()) + " " +
+                            (narrow ? "wide" : "high") + "; use fewer " + (narrow ? "columns" : "rows") +
+                            " (--tiles), fewer ranks or a larger grid");
+        if (auto it = node.params.find(timelapse_param().name); it != node.params.end())
+            if (const auto* every = std::get_if<std::int64_t>(&it->second); every && *every > 0)
+                diags.error(node.where, who + ": time-lapses are not recorded in a tiled run yet; set " +
+                                            timelapse_param().name + "=0 or run without mpirun");
+    }
+}
+
+// ------------------------------------------------------------------ one rank
+
+bool TiledRun::runs_tiled(const PlannedNode& node) { return node.node->tile_halo >= 0 && node.mapped_input < 0; }
+
+int TiledRun::agree(int exit_code, int* reporter) {
+    // One shape of collective for every agreement, so a rank that failed
+    // inside a node meets the others at the agreement inside their next
+    // exchange: {worst exit code, lowest failing rank (negated, for MAX)}.
+    int v[2] = {exit_code, exit_code != 0 ? -rank_ : INT_MIN};
+    mpi::max_all(v, 2);
+    if (reporter) *reporter = v[1] == INT_MIN ? -1 : -v[1];
+    return v[0];
+}
+
+namespace {
+
+constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagTile = 20;
+
+/// Copy the rectangle (x, y, w, h) of `grid` (row length `stride`) into `out`, or back with `to_grid`.
+void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, bool to_grid) {
+    for (int r = 0; r < h; ++r) {
+        float* g = grid + std::size_t(y + r) * std::size_t(stride) + std::size_t(x);
+        float* o = out + std::size_t(r) * std::size_t(w);
+        if (to_grid) std::memcpy(g, o, std::size_t(w) * sizeof(float));
+        else std::memcpy(o, g, std::size_t(w) * sizeof(float));
+    }
+}
+
+}  // namespace
+
+void TiledRun::exchange_halo(GridView held, int halo) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const int code = agree(0);
+    waiting_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (code) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
+    const TileRect o = owned(), g = grown(halo);
+    if (held.width != g.width || held.height != g.height)
+        throw Error("internal error: exchange_halo got a " + std::to_string(held.width) + "x" +
+                    std::to_string(held.height) + " grid for a grown tile of " + std::to_string(g.width) + "x" +
+                    std::to_string(g.height));
+    if (halo == 0 || ranks() == 1) return;
+    const int r = rank_ / split_.cols, c = rank_ % split_.cols;
+    const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
+    const int north = r > 0 ? rank_ - split_.cols : -1, south = r + 1 < split_.rows ? rank_ + split_.cols : -1;
+    const int ox = o.x0 - g.x0, oy = o.y0 - g.y0;  // the owned part inside `held`
+    std::vector<float> out, in;
+    // East and west: the owned rows only (the corners come with the rows below).
+    auto columns = [&](int send_x, int to, int recv_x, int from, int tag) {
+        out.resize(std::size_t(halo) * std::size_t(o.height));
+        in.resize(out.size());
+        if (to >= 0) copy_rect(held.data, held.width, send_x, oy, halo, o.height, out.data(), false);
+        mpi::sendrecv(out.data(), out.size() * sizeof(float), to, in.data(), in.size() * sizeof(float), from, tag);
+        if (from >= 0) copy_rect(held.data, held.width, recv_x, oy, halo, o.height, in.data(), true);
+    };
+    columns(ox, west, ox + o.width, east, kTagWest);        // my first columns go west, the east's come in
+    columns(ox + o.width - halo, east, ox - halo, west, kTagEast);
+    // North and south: whole rows of `held`, halo columns included (the same
+    // columns for both, as tiles in one column of the split share their cuts).
+    auto rows = [&](int send_y, int to, int recv_y, int from, int tag) {
+        const std::size_t n = std::size_t(halo) * std::size_t(held.width);
+        if (to >= 0) out.assign(held.row(send_y), held.row(send_y) + n);
+        else out.clear();
+        in.resize(from >= 0 ? n : 0);
+        mpi::sendrecv(out.data(), out.size() * sizeof(float), to, in.data(), in.size() * sizeof(float), from, tag);
+        if (from >= 0) std::memcpy(held.row(recv_y), in.data(), n * sizeof(float));
+    };
+    rows(oy, north, oy + o.height, south, kTagNorth);
+    rows(oy + o.height - halo, south, oy - halo, north, kTagSouth);
+}
+
+void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
+
+void TiledRun::min_max(float& lo, float& hi) {
+    if (const int code = agree(0)) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
+    mpi::min_max_all(lo, hi);
+}
+
+std::shared_ptr<Heightmap> TiledRun::gather(const Heightmap* tile) {
+    const TileRect mine = owned();
+    if (!tile || tile->width() != mine.width || tile->height() != mine.height)
+        throw Error("internal error: gather got no tile or one of the wrong size");
+    const std::vector<std::string> names = tile->layer_names();
+    if (rank_ != 0) {
+        mpi::send(tile->heights().data(), tile->size() * sizeof(float), 0, kTagTile);
+        for (const auto& n : names) mpi::send(tile->layer(n).data, tile->size() * sizeof(float), 0, kTagTile);
+        return nullptr;
+    }
+    auto whole = std::make_shared<Heightmap>(split_.grid_width, split_.grid_height, tile->cell());
+    std::vector<GridView> grids{whole->view()};
+    for (const auto& n : names) grids.push_back(whole->layer(n, 0.0f));
+    std::vector<float> buffer;
+    for (int r = 0; r < ranks(); ++r) {
+        const TileRect t = split_.tile(r);
+        buffer.resize(std::size_t(t.width) * std::size_t(t.height));
+        for (std::size_t k = 0; k < grids.size(); ++k) {
+            if (r == 0) {
+                const float* src = k == 0 ? tile->heights().data() : tile->layer(names[k - 1]).data;
+                std::copy(src, src + buffer.size(), buffer.begin());
+            } else {
+                mpi::recv(buffer.data(), buffer.size() * sizeof(float), r, kTagTile);
+            }
+            copy_rect(grids[k].data, grids[k].width, t.x0, t.y0, t.width, t.height, buffer.data(), true);
+        }
+    }
+    return whole;
+}
+
+std::shared_ptr<Heightmap> TiledRun::scatter(const Heightmap* whole) {
+    // Rank 0 says what it holds: size, cell, layers (one line each).
+    std::string header;
+    if (rank_ == 0) {
+        std::ostringstream h;
+        h.precision(17);
+        if (!whole) h << "none\n";
+        else {
+            h << whole->width() << ' ' << whole->height() << ' ' << whole->cell() << '\n';
+            for (const auto& n : whole->layer_names()) h << n << '\n';
+        }
+        header = h.str();
+    }
+    mpi::broadcast(header);
+    std::istringstream h(header);
+    std::string first;
+    std::getline(h, first);
+    if (first == "none") throw Error("internal error: scatter of a value rank 0 does not hold");
+    int w = 0, hg = 0;
+    double cell = 1.0;
+    std::istringstream(first) >> w >> hg >> cell;
+    if (w != split_.grid_width || hg != split_.grid_height)
+        throw BadInput("a tiled node was given a " + std::to_string(w) + "x" + std::to_string(hg) +
+                       " heightmap, but the tiles cut the spec's " + std::to_string(split_.grid_width) + "x" +
+                       std::to_string(split_.grid_height) + " grid; give the spec a grid of the input's size");
+    std::vector<std::string> names;
+    for (std::string n; std::getline(h, n);) names.push_back(n);
+    const TileRect mine = owned();
+    auto tile = std::make_shared<Heightmap>(mine.width, mine.height, cell);
+    std::vector<GridView> mine_grids{tile->view()};
+    for (const auto& n : names) mine_grids.push_back(tile->layer(n, 0.0f));
+    if (rank_ != 0) {
+        for (auto& g : mine_grids) mpi::recv(g.data, g.size() * sizeof(float), 0, kTagTile);
+        return tile;
+    }
+    std::vector<float> buffer;
+    for (int r = 0; r < ranks(); ++r) {
+        const TileRect t = split_.tile(r);
+        buffer.resize(std::size_t(t.width) * std::size_t(t.height));
+        for (std::size_t k = 0; k <= names.size(); ++k) {
+            const float* src = k == 0 ? whole->heights().data() : whole->layer(names[k - 1]).data;
+            copy_rect(const_cast<float*>(src), w, t.x0, t.y0, t.width, t.height, buffer.data(), false);
+            if (r == 0) std::copy(buffer.begin(), buffer.end(), mine_grids[k].data);
+            else mpi::send(buffer.data(), buffer.size() * sizeof(float), r, kTagTile);
+        }
+    }
+    return tile;
+}
+
+bool TiledRun::prepare_inputs(const PlannedNode& node, std::vector<Value>& inputs) {
+    const bool tiled = runs_tiled(node);
+    for (std::size_t i = 0; i < inputs.size() && i < node.inputs.size(); ++i) {
+        const std::string& key = node.inputs[i];
+        if (key.empty()) continue;
+        auto it = places_.find(key);
+        const Place place = it == places_.end() ? Place::rank0 : it->second;
+        if (tiled && place == Place::rank0) {
+            inputs[i] = Value(scatter(rank_ == 0 ? inputs[i].heightmap().get() : nullptr));
+        } else if (!tiled && place == Place::tiles) {
+            auto whole = gather(inputs[i].heightmap().get());
+            inputs[i] = whole ? Value(std::move(whole)) : Value();
+        }
+    }
+    return tiled || rank_ == 0;
+}
+
+void TiledRun::produced(const PlannedNode& node) {
+    if (node.value_name.empty()) return;
+    const Place p = runs_tiled(node) ? Place::tiles : Place::rank0;
+    places_[node.value_name] = p;
+    for (const auto& side : node.node->side_outputs) places_[node.value_name + "." + side.name] = p;
+}
+
+}  // namespace orogen

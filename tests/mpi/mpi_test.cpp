@@ -1,0 +1,259 @@
+// Tiled runs under mpirun: the real `orogen` binary on 1-4 ranks against the
+// same spec run as one process. Seam tests compare the output files byte for
+// byte: a tile that stopped eroding at its edge, a halo one vertex short or a
+// cut in the wrong place changes bytes near the seams.
+#include "orogen_test.hpp"
+
+#include <gtest/gtest.h>
+
+#include <vtkDataArray.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkXMLImageDataReader.h>
+#include <vtkXMLPImageDataReader.h>
+
+#include <algorithm>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace orogen::test;
+
+/// `mpirun -n RANKS orogen ARGS`, one machine, ranks allowed to outnumber cores and to run as root (CI).
+RunResult run_mpi(int ranks, const std::string& args) {
+    const std::string launcher = std::string(OROGEN_MPIEXEC) + " --oversubscribe --allow-run-as-root -n " +
+                                 std::to_string(ranks) + " ";
+    // run_orogen puts the binary after the environment: mpirun starts it from there.
+    return run_orogen(args, "OMPI_MCA_rmaps_base_oversubscribe=1 " + launcher);
+}
+
+/// Fault, then thermal (height-aware, then hardness from a layer, with a last
+/// sweep shorter than the others), each written whole: RAW heights and a VTK
+/// image with every layer (eroded, hardness).
+const char* kTiledSpec = R"(orogen 1
+seed 7
+grid 97x61 cell=2
+
+f  = generate:fault(iterations=300, displacement=0.5)
+t1 = erode:thermal(f, talus=20, rate=0.5, iterations=37, hardness=height)
+t2 = erode:thermal(t1, talus=15, rate=0.3, iterations=9, hardness="hardness", neighbourhood=von-neumann)
+export:raw(f, path="f.r32")
+export:raw(t2, path="t.r32")
+export:vtk(t2, path="t.vti")
+)";
+
+/// A node that is not tiled (Diamond-Square runs on rank 0) before a tiled one: its value is cut into tiles and sent.
+const char* kScatterSpec = R"(orogen 1
+seed 3
+grid 65 cell=1
+
+d = generate:diamond-square(amplitude=40)
+t = erode:thermal(d, talus=25, iterations=12, neighbourhood=moore)
+export:raw(t, path="t.r32")
+)";
+
+struct Case {
+    int ranks;
+    std::string tiles;  // "" automatic
+    friend void PrintTo(const Case& c, std::ostream* os) { *os << c.ranks << " ranks, tiles " << (c.tiles.empty() ? "automatic" : c.tiles); }
+};
+
+class Seam : public ::testing::TestWithParam<Case> {};
+
+void expect_same_outputs(const std::string& spec_text, const std::vector<std::string>& files, const Case& c) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", spec_text);
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q");
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    const RunResult many = run_mpi(c.ranks, "run " + q(spec) + " --out " + q(dir / "many") +
+                                                (c.tiles.empty() ? "" : " --tiles " + c.tiles));
+    ASSERT_EQ(many.exit_code, 0) << many.err;
+    EXPECT_NE(many.out.find("tiled run: " + std::to_string(c.ranks) + " rank"), std::string::npos) << many.out;
+    for (const auto& f : files) {
+        const std::string a = slurp(dir / "one" / f), b = slurp(dir / "many" / f);
+        ASSERT_FALSE(a.empty()) << f;
+        EXPECT_TRUE(a == b) << f << " differs between one process and " << c.ranks << " ranks"
+                            << (c.tiles.empty() ? "" : " (--tiles " + c.tiles + ")");
+    }
+}
+
+TEST_P(Seam, FaultAndThermalEqualOneProcess) {
+    expect_same_outputs(kTiledSpec, {"f.r32", "t.r32", "t.vti"}, GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(Ranks, Seam,
+                         ::testing::Values(Case{1, ""}, Case{2, ""}, Case{3, ""}, Case{4, ""}, Case{2, "2x1"},
+                                           Case{3, "3x1"}, Case{4, "1x4"}),
+                         [](const auto& info) {
+                             std::string t = info.param.tiles.empty() ? "auto" : info.param.tiles;
+                             return std::to_string(info.param.ranks) + "_ranks_" + t;
+                         });
+
+TEST(Mpi, WholeValueFromRankZeroIsCutIntoTiles) { expect_same_outputs(kScatterSpec, {"t.r32"}, {3, "3x1"}); }
+
+TEST(Mpi, MoreRanksThanTilesIsRefused) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", kScatterSpec);
+    const RunResult r = run_mpi(3, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 2x1");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--tiles 2x1 makes 2 tiles for 3 ranks (more ranks than tiles)"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "o" / "t.r32"));
+}
+
+TEST(Mpi, TilesNarrowerThanTheHaloAreRefusedAtTheNode) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 28x20\nf = generate:fault()\nt = erode:thermal(f)\n"
+                                            "export:raw(t, path=\"t.r32\")\n");
+    const RunResult r = run_mpi(4, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 1x4");
+    EXPECT_EQ(r.exit_code, 2);
+    // Once (rank 0 speaks), at the thermal node's line, naming the halo, the tile width and what to change.
+    EXPECT_NE(r.err.find("s.orogen:4:5: error: 't' (erode:thermal) exchanges a halo of 8 vertices"), std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("--tiles 1x4 cuts the 28x20 grid into tiles 7 wide"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("error: 't'"), r.err.rfind("error: 't'")) << r.err;
+    const RunResult ok = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 1x2");
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;  // tiles 14 wide: fine
+}
+
+TEST(Mpi, TilesWithoutMpirunIsAUsageError) {
+    const RunResult r = run_orogen("run nothing.orogen --tiles 2x2");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("this orogen was not started by mpirun"), std::string::npos) << r.err;
+}
+
+/// A .r32 (and sidecar) of width × height with heights 0, but ±3e38 on two
+/// neighbouring vertices at the east edge: their drop overflows to infinity
+/// and thermal erosion turns it into NaN there, in the east tile only at first.
+fs::path write_poisoned_raw(const TempDir& dir, int width, int height) {
+    std::vector<float> h(std::size_t(width) * std::size_t(height), 0.0f);
+    h[std::size_t(height / 2) * std::size_t(width) + std::size_t(width - 1)] = 3e38f;
+    h[std::size_t(height / 2) * std::size_t(width) + std::size_t(width - 2)] = -3e38f;
+    dir.write("p.r32", std::string(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(float)));
+    dir.write("p.r32.json", "{\"format\": \"r32\", \"sample_type\": \"float32\", \"byte_order\": \"little-endian\", "
+                            "\"width\": " + std::to_string(width) + ", \"height\": " + std::to_string(height) +
+                                ", \"cell_size\": 1, \"height_min\": -3e38, \"height_max\": 3e38, \"units\": \"m\", "
+                                "\"layout\": \"rows north to south, samples west to east, no header\"}");
+    return dir / "p.r32";
+}
+
+TEST(Mpi, ARankThatFailsEndsEveryRankWithOneErrorAndNoOutputs) {
+    TempDir dir;
+    write_poisoned_raw(dir, 400, 16);
+    // Staged before the failure: export:raw of the input. The NaN shows at the check after step 64, when it
+    // has spread ~128 vertices: only in the east tile of 1x2, so rank 1 fails while rank 0 goes on.
+    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 400x16\np = import:raw(path=\"p.r32\")\n"
+                                            "export:raw(p, path=\"before.r32\")\n"
+                                            "t = erode:thermal(p, iterations=100)\nexport:raw(t, path=\"t.r32\")\n");
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one"));
+    ASSERT_EQ(one.exit_code, 1) << one.err;
+    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "many") + " --tiles 1x2");
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    // One report, the same as one process gives (the node, its line, the step).
+    const auto line = [](const std::string& err) {
+        const auto at = err.find("error: node 't'");
+        return at == std::string::npos ? std::string() : err.substr(at, err.find('\n', at) - at);
+    };
+    EXPECT_NE(line(one.err).find("failed: non-finite height"), std::string::npos) << one.err;
+    EXPECT_NE(line(one.err).find("after step 64"), std::string::npos) << one.err;
+    EXPECT_EQ(line(r.err), line(one.err)) << r.err;
+    EXPECT_EQ(r.err.find("error:"), r.err.rfind("error:")) << r.err;  // once, not once per rank
+    // Nothing in --out on any rank: no outputs, no manifest, no staging folder left behind.
+    std::vector<std::string> left;
+    for (const auto& e : fs::directory_iterator(dir / "many")) left.push_back(e.path().filename().string());
+    EXPECT_TRUE(left.empty()) << left.size() << " entries left, first " << (left.empty() ? "" : left[0]);
+}
+
+TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 33\nf = generate:fault()\nt = erode:thermal(f, iterations=4)\n"
+                                            "export:raw(f, path=\"f.r32\")\nexport:raw(t, path=\"t.r32\")\n");
+    fs::create_directories(dir / "o" / "t.r32");  // a folder where the file should go
+    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "o"));
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find("a folder has that name"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "o" / "f.r32"));
+    EXPECT_FALSE(fs::exists(dir / "o" / "manifest.json"));
+}
+
+/// Every point array of `image` by name, as floats.
+std::map<std::string, std::vector<float>> arrays_of(vtkImageData* image) {
+    std::map<std::string, std::vector<float>> out;
+    vtkPointData* pd = image->GetPointData();
+    for (int i = 0; i < pd->GetNumberOfArrays(); ++i) {
+        vtkDataArray* a = pd->GetArray(i);
+        auto& v = out[a->GetName()];
+        for (vtkIdType k = 0; k < a->GetNumberOfTuples(); ++k) v.push_back(float(a->GetComponent(k, 0)));
+    }
+    return out;
+}
+
+TEST(Mpi, PvtiPiecesFromEveryRankReadBackAsTheSingleVti) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", R"(orogen 1
+seed 5
+grid 50x37 cell=3
+
+f = generate:fault(iterations=200, displacement=0.5)
+t = erode:thermal(f, iterations=10, hardness=height)
+export:vtk(t, path="t.vti", up="y")   # the tiles are Y-up for now
+export:vtk-tiles(t, path="tiles/t.pvti")
+)");
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q");
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    const RunResult many = run_mpi(4, "run " + q(spec) + " --out " + q(dir / "many") + " --tiles 2x2");
+    ASSERT_EQ(many.exit_code, 0) << many.err;
+
+    vtkNew<vtkXMLImageDataReader> single;
+    single->SetFileName((dir / "one" / "t.vti").c_str());
+    single->Update();
+    vtkNew<vtkXMLPImageDataReader> parallel;
+    parallel->SetFileName((dir / "many" / "tiles" / "t.pvti").c_str());
+    parallel->Update();
+    vtkImageData* a = single->GetOutput();
+    vtkImageData* b = parallel->GetOutput();
+    int ea[6], eb[6];
+    a->GetExtent(ea);
+    b->GetExtent(eb);
+    for (int i = 0; i < 6; ++i) EXPECT_EQ(ea[i], eb[i]) << "extent " << i;
+    EXPECT_EQ(ea[1], 49);
+    EXPECT_EQ(ea[5], 36);
+    double sa[3], sb[3];
+    a->GetSpacing(sa);
+    b->GetSpacing(sb);
+    for (int i = 0; i < 3; ++i) EXPECT_EQ(sa[i], sb[i]);
+    const auto va = arrays_of(a), vb = arrays_of(b);
+    ASSERT_EQ(va.size(), 3u);  // height, eroded, hardness
+    ASSERT_EQ(vb.size(), va.size());
+    for (const auto& [name, values] : va) {
+        ASSERT_TRUE(vb.count(name)) << name;
+        EXPECT_TRUE(values == vb.at(name)) << name << " differs between the .vti and the .pvti";
+    }
+    // Each rank wrote its own piece; pieces 0 and 1 (west, east) share a column, bit for bit.
+    vtkNew<vtkXMLImageDataReader> west, east;
+    west->SetFileName((dir / "many" / "tiles" / "t_0.vti").c_str());
+    east->SetFileName((dir / "many" / "tiles" / "t_1.vti").c_str());
+    west->Update();
+    east->Update();
+    int ew[6], ee[6];
+    west->GetOutput()->GetExtent(ew);
+    east->GetOutput()->GetExtent(ee);
+    EXPECT_EQ(ew[1], ee[0]);  // the seam column belongs to both
+    EXPECT_GT(ee[0], 0);
+    const auto hw = arrays_of(west->GetOutput()).at("height"), he = arrays_of(east->GetOutput()).at("height");
+    const int ww = ew[1] - ew[0] + 1, we = ee[1] - ee[0] + 1;
+    for (int y = 0; y <= std::min(ew[5], ee[5]); ++y)
+        EXPECT_EQ(hw[std::size_t(y * ww + ww - 1)], he[std::size_t(y * we)]) << "row " << y;
+    // The manifest (rank 0) lists every piece with its hash.
+    const std::string manifest = slurp(dir / "many" / "manifest.json");
+    for (int r = 0; r < 4; ++r) {
+        const std::string piece = "tiles/t_" + std::to_string(r) + ".vti";
+        const auto at = manifest.find("\"" + piece + "\"");
+        ASSERT_NE(at, std::string::npos) << piece;
+        EXPECT_NE(manifest.find(orogen::sha256_file(dir / "many" / piece), at), std::string::npos) << piece;
+    }
+}
+
+}  // namespace
