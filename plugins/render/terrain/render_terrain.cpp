@@ -93,6 +93,11 @@ struct TerrainRenderer::Impl {
     int stride = 1;
     GLuint shadow_fbo = 0, shadow_depth = 0;
     int shadow_size = 0;
+    // What the shadow map holds: drawn for this light and mesh, it is kept for the next frame (a turntable's
+    // sun turns with the terrain, so every frame would draw the same map).
+    bool shadow_ready = false, shadow_drawn = false;
+    glm::dmat4 shadow_light{0.0};
+    int shadow_stride = 0;
     GLuint particle_vbo = 0, particle_vao = 0;
 
     ~Impl() {
@@ -353,6 +358,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         if (m.shadow_fbo) glDeleteFramebuffers(1, &m.shadow_fbo);
         if (m.shadow_depth) glDeleteTextures(1, &m.shadow_depth);
         m.shadow_size = st.shadow_size;
+        m.shadow_ready = false;
         glGenTextures(1, &m.shadow_depth);
         glBindTexture(GL_TEXTURE_2D, m.shadow_depth);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, m.shadow_size, m.shadow_size, 0, GL_DEPTH_COMPONENT,
@@ -388,10 +394,14 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         light_vp = glm::ortho(lo.x, hi.x, lo.y, hi.y, -hi.z - 1.0, -lo.z + 1.0) * light_view;
     }
     const bool shaded = st.output == Style::Output::beauty;
+    const bool draw_shadows = shaded && st.sun_elevation > 0;
+    const bool shadow_kept = m.shadow_ready && m.shadow_light == light_vp && m.shadow_stride == m.stride &&
+                             m.shadow_drawn == draw_shadows;
+    if (!shadow_kept) {
     glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
     glViewport(0, 0, m.shadow_size, m.shadow_size);
     glClear(GL_DEPTH_BUFFER_BIT);
-    if (shaded && st.sun_elevation > 0) {
+    if (draw_shadows) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glDepthMask(GL_TRUE);
@@ -406,6 +416,11 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glBindVertexArray(m.vao);
         glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
         glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+    m.shadow_ready = true;
+    m.shadow_drawn = draw_shadows;
+    m.shadow_light = light_vp;
+    m.shadow_stride = m.stride;
     }
     mark(&Timings::shadow);
 

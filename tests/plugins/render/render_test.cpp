@@ -219,6 +219,29 @@ TEST(Reflection, TheSeaMirrorsWhatStandsAboveItAndNothingBelow) {
     EXPECT_GT(my, column_top + 5) << "the mirror image lies below the column's top";
 }
 
+TEST(Shadows, AKeptShadowMapGivesTheFrameAFreshOneWould) {
+    // The renderer keeps its shadow map between frames of the same light (a turntable's): a second view from
+    // a renderer that kept it equals the same view from a fresh renderer, byte for byte.
+    auto hm = grid(65, 10.0, 0.0f);
+    for (int y = 28; y <= 36; ++y)
+        for (int x = 28; x <= 36; ++x) hm->view().at(x, y) = 250.0f;
+    Style s;
+    s.sun_azimuth = 120;
+    s.sun_elevation = 25;
+    Camera a, b;
+    a.azimuth = 200;
+    b.azimuth = 290;
+    TerrainRenderer kept(hm, s);
+    (void)kept.render(96, 64, a);
+    const Image second = kept.render(96, 64, b);
+    TerrainRenderer fresh(hm, s);
+    EXPECT_TRUE(fresh.render(96, 64, b).rgba32f == second.rgba32f);
+    // And a changed light draws a new map: the same view with the sun elsewhere differs.
+    s.sun_azimuth = 300;
+    TerrainRenderer moved(hm, s);
+    EXPECT_FALSE(moved.render(96, 64, b).rgba32f == second.rgba32f);
+}
+
 TEST(Camera, BadCamerasAreRefusedWithTheReason) {
     auto hm = grid(33, 10.0, 100.0f);
     TerrainRenderer r(hm, Style{});
