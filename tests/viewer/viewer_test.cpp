@@ -8,6 +8,7 @@
 #include <orogen/values.hpp>
 
 #include <gtest/gtest.h>
+#include "../support/test_picture.hpp"
 #include <png.h>
 
 #include <array>
@@ -26,6 +27,9 @@
 
 namespace fs = std::filesystem;
 using namespace orogen;
+using orogen::test::Picture;
+using orogen::test::read_picture;
+using orogen::test::differing_pixels;
 
 namespace {
 
@@ -74,31 +78,6 @@ protected:
     }
 };
 
-struct Picture {
-    int width = 0, height = 0;
-    std::vector<std::uint8_t> rgb;
-    std::array<int, 3> at(int x, int y) const {
-        const std::uint8_t* p = &rgb[(std::size_t(y) * width + x) * 3];
-        return {p[0], p[1], p[2]};
-    }
-};
-
-Picture read_png(const fs::path& file) {
-    png_image image{};
-    image.version = PNG_IMAGE_VERSION;
-    Picture p;
-    if (!png_image_begin_read_from_file(&image, file.c_str())) {
-        ADD_FAILURE() << "cannot read " << file;
-        return p;
-    }
-    image.format = PNG_FORMAT_RGB;
-    p.width = int(image.width);
-    p.height = int(image.height);
-    p.rgb.resize(PNG_IMAGE_SIZE(image));
-    png_image_finish_read(&image, nullptr, p.rgb.data(), 0, nullptr);
-    return p;
-}
-
 /// Mean colour of a 9 × 9 patch.
 std::array<double, 3> patch(const Picture& p, int cx, int cy) {
     std::array<double, 3> m{};
@@ -113,13 +92,6 @@ double distance(const std::array<double, 3>& a, const std::array<std::uint8_t, 3
 }
 double distance(const std::array<double, 3>& a, const std::array<double, 3>& b) {
     return std::sqrt(std::pow(a[0] - b[0], 2) + std::pow(a[1] - b[1], 2) + std::pow(a[2] - b[2], 2));
-}
-
-std::size_t differing_pixels(const Picture& a, const Picture& b) {
-    std::size_t n = 0;
-    for (std::size_t i = 0; i + 2 < a.rgb.size() && i + 2 < b.rgb.size(); i += 3)
-        n += std::abs(a.rgb[i] - b.rgb[i]) + std::abs(a.rgb[i + 1] - b.rgb[i + 1]) + std::abs(a.rgb[i + 2] - b.rgb[i + 2]) > 30;
-    return n;
 }
 
 /// A 65 × 65 terrain: a flat plain at 0 m (west), a slope, a flat plateau at 100 m (east).
@@ -139,7 +111,7 @@ TEST_F(Viewer, ScreenshotShowsTheSplatColoursWhereExpected) {
     const Result r = view("t.vti --screenshot shot.png " + top_view);
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err, "");
-    const Picture p = read_png(dir / "shot.png");
+    const Picture p = read_picture(dir / "shot.png");
     ASSERT_EQ(p.width, 320);
     ASSERT_EQ(p.height, 320);
     // Looking down, north up: the plain (lowest band: sand) on the left, the
@@ -168,8 +140,8 @@ TEST_F(Viewer, ColouringByALayerChangesThePixelsAndUsesItsColourMap) {
     ASSERT_EQ(r.code, 0) << r.err;
     ASSERT_EQ(view("t.vti --screenshot plate.png --layer plate " + top_view).code, 0);
     ASSERT_EQ(view("t.vti --screenshot eroded.png --layer eroded " + top_view).code, 0);
-    const Picture splat = read_png(dir / "splat.png"), fl = read_png(dir / "flow.png"), pl = read_png(dir / "plate.png"),
-                  er = read_png(dir / "eroded.png");
+    const Picture splat = read_picture(dir / "splat.png"), fl = read_picture(dir / "flow.png"), pl = read_picture(dir / "plate.png"),
+                  er = read_picture(dir / "eroded.png");
     EXPECT_GT(differing_pixels(splat, fl), 20000u);
     // Flow rises west to east: the colour map's ends differ.
     EXPECT_GT(distance(patch(fl, 70, 160), patch(fl, 250, 160)), 80);
@@ -211,8 +183,8 @@ TEST_F(Viewer, VtpRawAndPngTerrainsShowTheSameSplat) {
     ASSERT_EQ(r.code, 0) << r.err;
     r = view("t.png --screenshot d.png " + top_view);
     ASSERT_EQ(r.code, 0) << r.err;
-    const Picture a = read_png(dir / "a.png"), b = read_png(dir / "b.png"), c = read_png(dir / "c.png"),
-                  d = read_png(dir / "d.png");
+    const Picture a = read_picture(dir / "a.png"), b = read_picture(dir / "b.png"), c = read_picture(dir / "c.png"),
+                  d = read_picture(dir / "d.png");
     for (const Picture* p : {&b, &c, &d}) {
         EXPECT_LT(distance(patch(a, 70, 160), patch(*p, 70, 160)), 10);
         EXPECT_LT(distance(patch(a, 250, 160), patch(*p, 250, 160)), 10);
@@ -248,13 +220,13 @@ TEST_F(Viewer, PlatesSeriesFramesDifferOverTime) {
     }
     // The folder opens the same: its terrain and its series.
     ASSERT_EQ(view(". --screenshot folder.png --time 0 " + top_view).code, 0);
-    const Picture p0 = read_png(dir / "p0.png"), p1 = read_png(dir / "p1.png"), p2 = read_png(dir / "p2.png");
-    EXPECT_LT(differing_pixels(p0, read_png(dir / "folder.png")), 50u);
+    const Picture p0 = read_picture(dir / "p0.png"), p1 = read_picture(dir / "p1.png"), p2 = read_picture(dir / "p2.png");
+    EXPECT_LT(differing_pixels(p0, read_picture(dir / "folder.png")), 50u);
     EXPECT_GT(differing_pixels(p0, p1), 1000u);
     EXPECT_GT(differing_pixels(p1, p2), 1000u);
     // The plates tint the terrain: without them (m toggles, here: no .pvd) the picture differs.
     ASSERT_EQ(view("t.vti --screenshot bare.png " + top_view).code, 0);
-    EXPECT_GT(differing_pixels(read_png(dir / "bare.png"), p0), 20000u);
+    EXPECT_GT(differing_pixels(read_picture(dir / "bare.png"), p0), 20000u);
 }
 
 TEST_F(Viewer, ParticleSeriesFramesShowMovingColouredParticles) {
@@ -277,7 +249,7 @@ TEST_F(Viewer, ParticleSeriesFramesShowMovingColouredParticles) {
     ASSERT_EQ(view("t.vti p.pvd --screenshot a.png --time 0 " + top_view).code, 0);
     ASSERT_EQ(view("t.vti p.pvd --screenshot b.png --time 0.5 " + top_view).code, 0);
     ASSERT_EQ(view("t.vti --screenshot c.png " + top_view).code, 0);
-    const Picture a = read_png(dir / "a.png"), b = read_png(dir / "b.png"), c = read_png(dir / "c.png");
+    const Picture a = read_picture(dir / "a.png"), b = read_picture(dir / "b.png"), c = read_picture(dir / "c.png");
     EXPECT_GT(differing_pixels(a, c), 500u);   // particles drawn
     EXPECT_GT(differing_pixels(a, b), 500u);   // and they moved
 }
@@ -313,12 +285,12 @@ TEST_F(Viewer, ZUpAndYUpFilesShowTheSamePicture) {
         }
     }
     for (const char* input : {"t.vti", "m.vtp"}) {
-        const Picture z = read_png(dir / (std::string("z_") + input + ".png")),
-                      y = read_png(dir / (std::string("y_") + input + ".png"));
+        const Picture z = read_picture(dir / (std::string("z_") + input + ".png")),
+                      y = read_picture(dir / (std::string("y_") + input + ".png"));
         EXPECT_LT(differing_pixels(z, y), 50u) << input;
     }
     // The layer is not mirrored: the top of the picture (north) is low on the ramp, the bottom high.
-    const Picture z = read_png(dir / "z_t.vti.png");
+    const Picture z = read_picture(dir / "z_t.vti.png");
     EXPECT_GT(distance(patch(z, 160, 40), patch(z, 160, 280)), 30.0);
 }
 
@@ -425,8 +397,8 @@ TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) 
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;  // exits cleanly after the 4th load
     const std::string out = slurp(dir / "stdout");
     EXPECT_NE(out.find("w.orogen:4:"), std::string::npos) << out;  // file:line:col of the syntax error
-    const Picture p1 = read_png(dir / "shot-1.png"), p2 = read_png(dir / "shot-2.png"), p3 = read_png(dir / "shot-3.png"),
-                  p4 = read_png(dir / "shot-4.png");
+    const Picture p1 = read_picture(dir / "shot-1.png"), p2 = read_picture(dir / "shot-2.png"), p3 = read_picture(dir / "shot-3.png"),
+                  p4 = read_picture(dir / "shot-4.png");
     EXPECT_GT(differing_pixels(p1, p2), 2000u);  // the parameter change shows
     EXPECT_GT(differing_pixels(p2, p3), 200u);   // the error text shows
     // ... over the last good terrain: the lower right quarter is unchanged.
@@ -492,7 +464,7 @@ TEST_F(Viewer, GltfFromTheExporterOpens) {
     ASSERT_EQ(std::system(run.c_str()), 0);
     const Result r = view("t.glb --screenshot g.png " + top_view);
     ASSERT_EQ(r.code, 0) << r.err;
-    const Picture p = read_png(dir / "g.png");
+    const Picture p = read_picture(dir / "g.png");
     EXPECT_GT(distance(patch(p, 160, 160), patch(p, 6, 6)), 20);
     std::ofstream(dir / "bad.glb") << "not a glb";
     const Result bad = view("bad.glb --screenshot b.png");

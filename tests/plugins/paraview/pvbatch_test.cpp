@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include "test_picture.hpp"
 #include <png.h>
 
 #include <algorithm>
@@ -18,31 +19,6 @@ using namespace orogen::test;
 namespace fs = std::filesystem;
 
 namespace {
-
-struct Picture {
-    int width = 0, height = 0;
-    std::vector<std::uint8_t> rgb;
-    std::array<int, 3> at(int x, int y) const {
-        const std::uint8_t* p = &rgb[(std::size_t(y) * width + x) * 3];
-        return {p[0], p[1], p[2]};
-    }
-};
-
-Picture read_png(const fs::path& file) {
-    png_image image{};
-    image.version = PNG_IMAGE_VERSION;
-    Picture p;
-    if (!png_image_begin_read_from_file(&image, file.c_str())) {
-        ADD_FAILURE() << "cannot read " << file;
-        return p;
-    }
-    image.format = PNG_FORMAT_RGB;
-    p.width = int(image.width);
-    p.height = int(image.height);
-    p.rgb.resize(PNG_IMAGE_SIZE(image));
-    png_image_finish_read(&image, nullptr, p.rgb.data(), 0, nullptr);
-    return p;
-}
 
 int distance(const std::array<int, 3>& a, const std::array<int, 3>& b) {
     return std::abs(a[0] - b[0]) + std::abs(a[1] - b[1]) + std::abs(a[2] - b[2]);
@@ -67,13 +43,6 @@ std::size_t foreground_colours(const Picture& p) {
             if (distance(c, background) > 24) colours.insert((c[0] >> 4) << 8 | (c[1] >> 4) << 4 | (c[2] >> 4));
         }
     return colours.size();
-}
-
-std::size_t differing_pixels(const Picture& a, const Picture& b) {
-    std::size_t n = 0;
-    for (int y = 0; y < std::min(a.height, b.height); ++y)
-        for (int x = 0; x < std::min(a.width, b.width); ++x) n += distance(a.at(x, y), b.at(x, y)) > 30;
-    return n;
 }
 
 /// pvbatch from tools/paraview.sh, or a skip naming why the download was impossible.
@@ -186,13 +155,13 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     EXPECT_NE(pvsm.find((dir / "moved" / "run.vti").string()), std::string::npos);
 
     // The picture shows something: a large share of non-background pixels in many colours.
-    const Picture first = read_png(dir / "pictures" / "first.png");
+    const Picture first = read_picture(dir / "pictures" / "first.png");
     ASSERT_EQ(first.width, 640);
     ASSERT_EQ(first.height, 400);
     EXPECT_GT(foreground_fraction(first), 0.2);
     EXPECT_GT(foreground_colours(first), 40u);
     // And the last time step differs from the first (plates and particles moved).
-    const Picture last = read_png(dir / "pictures" / "last.png");
+    const Picture last = read_picture(dir / "pictures" / "last.png");
     EXPECT_GT(differing_pixels(first, last), 500u);
 }
 
@@ -215,6 +184,6 @@ TEST_F(Pvbatch, ThePlateLayerIsColouredByCategory) {
     ASSERT_GE(annotations.size(), 4u);  // value, name pairs: at least two plates
     EXPECT_EQ(annotations[1].rfind("plate ", 0) == 0 || annotations[1] == "no plate", true) << annotations[1];
     EXPECT_TRUE(report["times"].empty());  // no series: nothing to play
-    const Picture first = read_png(dir / "pictures" / "first.png");
+    const Picture first = read_picture(dir / "pictures" / "first.png");
     EXPECT_GT(foreground_fraction(first), 0.2);
 }
