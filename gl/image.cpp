@@ -11,6 +11,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -41,26 +42,26 @@ Texture upload(const Image& image) {
     Texture t;
     t.width = image.width;
     t.height = image.height;
-    const std::size_t row = std::size_t(image.width) * 4;
-    std::vector<float> flipped(row * std::size_t(image.height));
+    const std::size_t size = std::size_t(image.width) * 4 * std::size_t(image.height);
+    std::vector<float> decoded;  // only for 8-bit images: a float image goes up as it is, without a copy
+    const float* pixels = image.rgba32f.data();
     if (image.format == Image::Format::rgba32f) {
-        if (image.rgba32f.size() != flipped.size()) throw Error("internal error: image data does not match its size");
-        for (int y = 0; y < image.height; ++y)
-            std::memcpy(&flipped[std::size_t(image.height - 1 - y) * row], &image.rgba32f[std::size_t(y) * row],
-                        row * sizeof(float));
+        if (image.rgba32f.size() != size) throw Error("internal error: image data does not match its size");
     } else {
-        if (image.rgba8.size() != flipped.size()) throw Error("internal error: image data does not match its size");
+        if (image.rgba8.size() != size) throw Error("internal error: image data does not match its size");
         float table[256];
         for (int i = 0; i < 256; ++i) table[i] = srgb_to_linear(std::uint8_t(i));
-        for (int y = 0; y < image.height; ++y)
-            for (std::size_t i = 0; i < row; ++i) {
-                const std::uint8_t v = image.rgba8[std::size_t(y) * row + i];
-                flipped[std::size_t(image.height - 1 - y) * row + i] = i % 4 == 3 ? v / 255.0f : table[v];
-            }
+        decoded.resize(size);
+        parallel_for(0, std::int64_t(size / 4), 1 << 16, [&](std::int64_t p0, std::int64_t p1) {
+            for (std::size_t i = std::size_t(p0) * 4; i < std::size_t(p1) * 4; ++i)
+                decoded[i] = i % 4 == 3 ? image.rgba8[i] / 255.0f : table[image.rgba8[i]];
+        });
+        pixels = decoded.data();
     }
     glGenTextures(1, &t.id);
     glBindTexture(GL_TEXTURE_2D, t.id);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, image.width, image.height, 0, GL_RGBA, GL_FLOAT, flipped.data());
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, image.width, image.height, 0, GL_RGBA, GL_FLOAT, pixels);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -115,20 +116,23 @@ void Target::bind() const {
     glViewport(0, 0, width(), height());
 }
 
-Image read_rgba32f(int width, int height) {
+Image read_rgba32f(int width, int height, Rows rows) {
     Image out;
     out.width = width;
     out.height = height;
     out.format = Image::Format::rgba32f;
     const std::size_t row = std::size_t(width) * 4;
-    std::vector<float> raw(row * std::size_t(height));
+    out.rgba32f.resize(row * std::size_t(height));
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, raw.data());
-    out.rgba32f.resize(raw.size());
-    parallel_for(0, height, 64, [&](std::int64_t y0, std::int64_t y1) {
-        for (std::int64_t y = y0; y < y1; ++y)
-            std::memcpy(&out.rgba32f[std::size_t(y) * row], &raw[std::size_t(height - 1 - y) * row], row * sizeof(float));
-    });
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, out.rgba32f.data());
+    if (rows == Rows::flip) {
+        parallel_for(0, height / 2, 32, [&](std::int64_t y0, std::int64_t y1) {
+            for (std::int64_t y = y0; y < y1; ++y)
+                std::swap_ranges(out.rgba32f.begin() + std::ptrdiff_t(std::size_t(y) * row),
+                                 out.rgba32f.begin() + std::ptrdiff_t(std::size_t(y + 1) * row),
+                                 out.rgba32f.begin() + std::ptrdiff_t(std::size_t(height - 1 - y) * row));
+        });
+    }
     return out;
 }
 

@@ -17,8 +17,8 @@ uniform float floor_height;   // m, exaggerated
 uniform vec4 clip_plane;      // world-space plane (a, b, c, d): kept where a·x + b·y + c·z + d ≥ 0
 out vec3 world;
 flat out vec3 wall_normal;
-// The depth pre-pass and the colour pass run this shader in two programs: their depths must be equal bit for bit.
-invariant gl_Position;    // (0, 0, 0) on the surface
+
+
 void main() {
     ivec2 s;
     wall_normal = vec3(0.0);

@@ -83,6 +83,28 @@ void BM_Frame1080p(benchmark::State& state) {
 }
 BENCHMARK(BM_Frame1080p)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// A lone 1080p frame, as one `render:terrain` + `render:bloom` of a pipeline makes it: a new renderer each time
+// (the heights uploaded, the shadow map drawn), where BM_Frame1080p's renderer keeps its shadow map from one
+// frame to the next as a turntable's does.
+void BM_LoneFrame1080p(benchmark::State& state) {
+    render::bloom(render::TerrainRenderer(terrain_1025(), {}).render(1920, 1080, {}), {});  // shader compiles
+    const double cpu0 = process_cpu();
+    render::Timings total;
+    for (auto _ : state) {
+        render::TerrainRenderer renderer(terrain_1025(), {});
+        render::Timings t;
+        Image out = render::bloom(renderer.render(1920, 1080, {}, nullptr, &t), {});
+        benchmark::DoNotOptimize(out.rgba32f.data());
+        total.shadow += t.shadow;
+        total.scene += t.scene;
+    }
+    const double n = double(state.iterations());
+    state.counters["cpu_all_threads_s"] = (process_cpu() - cpu0) / n;
+    state.counters["shadow_s"] = total.shadow / n;
+    state.counters["scene_s"] = total.scene / n;
+}
+BENCHMARK(BM_LoneFrame1080p)->Unit(benchmark::kMillisecond)->UseRealTime();
+
 // The bloom alone (bright pass, blur x, blur y, combine) on a 1080p frame.
 void BM_Bloom1080p(benchmark::State& state) {
     render::TerrainRenderer renderer(terrain_1025(), {});

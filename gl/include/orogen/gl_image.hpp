@@ -19,9 +19,12 @@ struct Texture {
     ~Texture();
 };
 
-/// Upload an image as an RGBA32F texture (rows top to bottom become GL's
-/// bottom-up rows flipped, so texel (x, 0) is the bottom row). 8-bit sRGB
-/// images are decoded to linear first. Filtering: linear, clamped to edge.
+/// Upload an image as an RGBA32F texture, its rows in the order they are
+/// stored (image row y is texel row y: the image's top is GL's bottom). The
+/// image-space passes (bloom, blur) neither know nor care, so an image goes up
+/// and, read back with Rows::as_stored, comes down without being flipped or
+/// copied. 8-bit sRGB images are decoded to linear first. Filtering: linear,
+/// clamped to edge.
 Texture upload(const Image& image);
 
 /// An offscreen RGBA32F colour target, with a 32-bit float depth buffer if asked.
@@ -42,9 +45,13 @@ struct Target {
     void bind() const;  ///< as the draw framebuffer, viewport covering it
 };
 
-/// Read the currently bound read framebuffer's colour as a linear float image
-/// (rows top to bottom).
-Image read_rgba32f(int width, int height);
+/// How read_rgba32f orders the rows: as_stored keeps GL's row y as image row
+/// y (for a target drawn from an uploaded image); flip turns a scene drawn
+/// with GL's usual bottom-up window into an image with its top row first.
+enum class Rows { as_stored, flip };
+
+/// Read the currently bound read framebuffer's colour as a linear float image.
+Image read_rgba32f(int width, int height, Rows rows);
 
 /// Draw the full-screen triangle (shaders/fullscreen.vert) with the bound program.
 void draw_fullscreen();

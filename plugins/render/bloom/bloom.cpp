@@ -96,7 +96,7 @@ gl::Target combine_gl(const gl::Texture& original, const gl::Texture& bloom, dou
 
 Image read(const gl::Target& t, const char* who) {
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t.framebuffer);
-    Image out = gl::read_rgba32f(t.width(), t.height());
+    Image out = gl::read_rgba32f(t.width(), t.height(), gl::Rows::as_stored);
     gl::check_errors(who, "drawing");
     return out;
 }

@@ -17,6 +17,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -87,8 +88,10 @@ struct TerrainRenderer::Impl {
     int width = 0, height = 0;  // samples
     float lo = 0, hi = 0;       // height range, m
     bool has_water = false;
-    GLuint heights = 0, surface = 0, indices = 0, vao = 0;
-    GLsizei index_count = 0;
+    GLuint heights = 0, surface = 0, vao = 0;
+    // The grid's triangle strips in four drawing orders (Order), each built on first use: drawn nearest rows
+    // first, the depth test rejects most hidden fragments before the splatting shader runs for them.
+    std::array<GLuint, 4> indices{};
     glm::ivec2 kept{0, 0};
     int stride = 1;
     GLuint shadow_fbo = 0, shadow_depth = 0;
@@ -105,33 +108,69 @@ struct TerrainRenderer::Impl {
         GLuint textures[] = {heights, surface, shadow_depth};
         for (GLuint t : textures)
             if (t) glDeleteTextures(1, &t);
-        if (indices) glDeleteBuffers(1, &indices);
+        for (GLuint b : indices)
+            if (b) glDeleteBuffers(1, &b);
         if (particle_vbo) glDeleteBuffers(1, &particle_vbo);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (particle_vao) glDeleteVertexArrays(1, &particle_vao);
         if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
     }
 
-    /// The grid as one triangle strip per row (every stride-th sample), joined by primitive restart.
+    /// The order the grid's strips are drawn in: rows from north to south or back, columns from west to
+    /// east or back. Every order keeps the triangles' winding (counter-clockwise seen from above).
+    enum Order { rows_southward = 0, rows_northward = 1, columns_eastward = 2, columns_westward = 3 };
+
+    /// Keep every stride-th sample; the index buffers are rebuilt on first use.
     void build_mesh(int new_stride) {
-        if (new_stride == stride && indices) return;
+        if (new_stride == stride && kept.x > 0) return;
         stride = new_stride;
         kept = {(width - 1 + stride - 1) / stride + 1, (height - 1 + stride - 1) / stride + 1};
-        std::vector<std::uint32_t> index;
-        index.reserve(std::size_t(kept.y - 1) * (2 * std::size_t(kept.x) + 1));
-        for (int y = 0; y + 1 < kept.y; ++y) {
-            for (int x = 0; x < kept.x; ++x) {
-                index.push_back(std::uint32_t(y * kept.x + x));
-                index.push_back(std::uint32_t((y + 1) * kept.x + x));
+        for (GLuint& b : indices)
+            if (b) {
+                glDeleteBuffers(1, &b);
+                b = 0;
             }
-            index.push_back(0xFFFFFFFFu);
-        }
-        index_count = GLsizei(index.size());
+    }
+
+    /// Binds the strips in `order` to the vertex array (one strip per row or column of quads, joined by
+    /// primitive restart), building them on first use. Returns the number of indices.
+    GLsizei bind_order(Order order) {
+        GLuint& buffer = indices[order];
+        const bool columns = order == columns_eastward || order == columns_westward;
+        const bool reverse = order == rows_northward || order == columns_westward;
+        const int strips = columns ? kept.x - 1 : kept.y - 1, along = columns ? kept.y : kept.x;
+        const GLsizei count = GLsizei(strips) * (2 * along + 1);
         glBindVertexArray(vao);
-        if (!indices) glGenBuffers(1, &indices);
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, indices);
-        glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(index.size() * 4), index.data(), GL_STATIC_DRAW);
-        glBindVertexArray(0);
+        if (!buffer) {
+            std::vector<std::uint32_t> index;
+            index.reserve(std::size_t(count));
+            for (int k = 0; k < strips; ++k) {
+                const int strip = reverse ? strips - 1 - k : k;
+                for (int i = 0; i < along; ++i) {
+                    if (columns) {  // (x + 1, y) then (x, y): counter-clockwise from above, as the rows
+                        index.push_back(std::uint32_t(i * kept.x + strip + 1));
+                        index.push_back(std::uint32_t(i * kept.x + strip));
+                    } else {
+                        index.push_back(std::uint32_t(strip * kept.x + i));
+                        index.push_back(std::uint32_t((strip + 1) * kept.x + i));
+                    }
+                }
+                index.push_back(0xFFFFFFFFu);
+            }
+            glGenBuffers(1, &buffer);
+            glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffer);
+            glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(index.size() * 4), index.data(), GL_STATIC_DRAW);
+        } else {
+            glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, buffer);
+        }
+        return count;
+    }
+
+    /// Nearest strips first, seen from `eye` (world space): along whichever grid axis the view runs more.
+    Order front_to_back(const glm::dvec3& eye) const {
+        const double dx = eye.x - 0.5 * extent_x(), dz = eye.z - 0.5 * extent_z();
+        if (std::abs(dz) >= std::abs(dx)) return dz > 0 ? rows_northward : rows_southward;
+        return dx > 0 ? columns_westward : columns_eastward;
     }
 
     double extent_x() const { return double(width - 1) * terrain->cell(); }
@@ -413,8 +452,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.shadow, "heights", 0);
         set_grid(prog.shadow, glm::mat4(light_vp));
         set(prog.shadow, "skirt_edge", -1);
-        glBindVertexArray(m.vao);
-        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+        glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(Impl::rows_southward), GL_UNSIGNED_INT, nullptr);
         glDisable(GL_POLYGON_OFFSET_FILL);
     }
     m.shadow_ready = true;
@@ -457,42 +495,20 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     gl::draw_fullscreen();
 
     // Terrain.
-    // The surface, then the skirt down to below the lowest point (and below the sea), with `program`.
-    auto draw_surface_and_skirt = [&](GLuint program) {
-        glBindVertexArray(m.vao);
-        set(program, "skirt_edge", -1);
-        glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
-        set(program, "floor_height", float(floor_height * exag));
-        for (int edge = 0; edge < 4; ++edge) {
-            set(program, "skirt_edge", edge);
-            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
-        }
-    };
-    auto draw_terrain = [&](const glm::mat4& matrix, int mode) {
+    // The surface, nearest strips first and its back faces culled (a heightfield seen from above the ground
+    // only ever shows its front faces), then the skirt down to below the lowest point (and below the sea).
+    // `mirrored`: the matrix mirrors the world (the sea's reflection), which turns the winding over.
+    auto draw_terrain = [&](const glm::mat4& matrix, int mode, bool mirrored) {
         glEnable(GL_DEPTH_TEST);
-        glDisable(GL_BLEND);
-        glBindVertexArray(m.vao);
-        // Depth pre-pass: the surface and skirt into depth only (the shadow pass's empty fragment shader, the
-        // same vertex shader, whose gl_Position is invariant), so the splatting shader below (noise, five
-        // shadow taps) runs once per pixel instead of once per overlapping triangle: on llvmpipe the
-        // fragment work is the frame's cost, and an oblique view of a range overdraws it 2-3 times.
-        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glDepthFunc(GL_LESS);
         glDepthMask(GL_TRUE);
-        glUseProgram(prog.shadow);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, m.heights);
-        set(prog.shadow, "heights", 0);
-        set_grid(prog.shadow, matrix);
-        draw_surface_and_skirt(prog.shadow);
-        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-        glDepthFunc(GL_LEQUAL);
-        glDepthMask(GL_FALSE);
+        glDisable(GL_BLEND);
         glUseProgram(prog.terrain);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, m.heights);
         glActiveTexture(GL_TEXTURE1);
         glBindTexture(GL_TEXTURE_2D, m.shadow_depth);
+        glActiveTexture(GL_TEXTURE0);
         set(prog.terrain, "heights", 0);
         set(prog.terrain, "shadow_map", 1);
         set_grid(prog.terrain, matrix);
@@ -513,11 +529,20 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.terrain, "output_mode", mode);
         set(prog.terrain, "light_view_projection", glm::mat4(light_vp));
         set(prog.terrain, "shadow_texel", 1.0f / float(m.shadow_size));
-        draw_surface_and_skirt(prog.terrain);
-        glDepthMask(GL_TRUE);
-        glDepthFunc(GL_LESS);
+        glEnable(GL_CULL_FACE);
+        glCullFace(GL_BACK);
+        glFrontFace(mirrored ? GL_CW : GL_CCW);
+        set(prog.terrain, "skirt_edge", -1);
+        glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(m.front_to_back(eye)), GL_UNSIGNED_INT, nullptr);
+        glDisable(GL_CULL_FACE);
+        glFrontFace(GL_CCW);
+        set(prog.terrain, "floor_height", float(floor_height * exag));
+        for (int edge = 0; edge < 4; ++edge) {
+            set(prog.terrain, "skirt_edge", edge);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
+        }
     };
-    draw_terrain(vp, int(st.output));
+    draw_terrain(vp, int(st.output), false);
 
     // Particles: lit spheres (points).
     if (shaded && particles && particles->count() > 0) {
@@ -568,7 +593,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glEnable(GL_CLIP_DISTANCE0);
         for (GLuint p : {prog.shadow, prog.terrain})
             glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
-        draw_terrain(glm::mat4(view_projection * mirror), int(st.output));
+        draw_terrain(glm::mat4(view_projection * mirror), int(st.output), true);
         glDisable(GL_CLIP_DISTANCE0);
         for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
         light_eye = eye;
@@ -604,8 +629,10 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         set(prog.water, "sea_level", float(st.sea_level));
         glBindVertexArray(m.vao);
         if (m.has_water) {
+            // Farthest strips first: the water is blended, and where it overlaps itself the nearer must come last.
             set(prog.water, "sea_plane", 0);
-            glDrawElements(GL_TRIANGLE_STRIP, m.index_count, GL_UNSIGNED_INT, nullptr);
+            const auto back_to_front = Impl::Order(int(m.front_to_back(eye)) ^ 1);
+            glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(back_to_front), GL_UNSIGNED_INT, nullptr);
         }
         if (st.sea) {
             const double reach = radius * 38.0;
@@ -627,7 +654,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved.framebuffer);
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved.framebuffer);
-    Image image = gl::read_rgba32f(width, height);
+    Image image = gl::read_rgba32f(width, height, gl::Rows::flip);
     gl::check_errors("render:terrain", "drawing the frame");
     mark(&Timings::resolve_and_read);
     return image;
