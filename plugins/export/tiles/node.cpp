@@ -1,0 +1,152 @@
+// export:tiles — registers the tiled heightmap writer (tiles.hpp) with the kernel.
+#include "tiles.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+#include <orogen/parallel.hpp>
+#include <orogen/plugin.hpp>
+
+#include <cstring>
+#include <filesystem>
+
+namespace {
+
+using namespace orogen;
+using namespace orogen::tiles_export;
+
+void check(CheckContext& ctx) {
+    const bool low = ctx.given("low"), high = ctx.given("high");
+    if (low != high) {
+        ctx.error(low ? "low" : "high", "give both low and high (the heights written as 0 and 65535), or neither "
+                                        "to use the terrain's own lowest and highest point");
+        return;
+    }
+    if (low && !(ctx.real("high") > ctx.real("low"))) ctx.error("high", "high must be above low");
+    if (low && ctx.text("format") == "r32")
+        ctx.error("low", "low and high set the 16-bit scale; format=r32 writes metres as they are");
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    const Heightmap& hm = *ctx.input(0).heightmap();
+    const ConstGridView grid = hm.view();
+    const Format format = format_named(ctx.text("format"));
+    const int tile_size = int(ctx.integer("tile_size"));
+    const std::filesystem::path index_path = ctx.text("path");
+    const std::string stem = index_path.stem().string();
+    const std::filesystem::path folder = index_path.parent_path();
+
+    Index index;
+    index.format = format;
+    index.width = hm.width();
+    index.height = hm.height();
+    index.tile_size = tile_size;
+    index.cell = hm.cell();
+    index.range = ctx.real("low") != 0.0 || ctx.real("high") != 0.0 ? raw::Range{ctx.real("low"), ctx.real("high")}
+                                                                      : raw::min_max(grid);
+    index.tiles = layout(hm.width(), hm.height(), tile_size, stem, format);
+    const Tile& last = index.tiles.back();
+    if (last.width != tile_size || last.height != tile_size)
+        ctx.warn("the last tiles are " + std::to_string(last.width) + " × " + std::to_string(last.height) +
+                 " samples where the others are " + std::to_string(tile_size) + "; for equal tiles use a grid of k·" +
+                 std::to_string(tile_size - 1) + " + 1 samples a side");
+
+    // Where each file goes (the kernel's bookkeeping, on this thread), then the tiles encoded and written in
+    // parallel: each tile's bytes depend on its samples only, so the files are the same on any thread count.
+    std::vector<std::filesystem::path> targets;
+    for (const Tile& t : index.tiles) targets.push_back(ctx.output_path((folder / t.file).string()));
+    const bool vrt = ctx.flag("vrt");
+    std::vector<std::filesystem::path> raw_vrts;
+    if (vrt && format != Format::png16)
+        for (const Tile& t : index.tiles) raw_vrts.push_back(ctx.output_path((folder / (t.file + ".vrt")).string()));
+    const int level = int(ctx.integer("compression"));
+    std::vector<std::size_t> clamped(index.tiles.size(), 0);
+    std::size_t done = 0;
+    for (std::size_t first = 0; first < index.tiles.size(); first += 8) {  // in groups, for progress and Ctrl-C
+        ctx.check_cancelled();
+        const std::size_t end = std::min(first + 8, index.tiles.size());
+        parallel_for(std::int64_t(first), std::int64_t(end), 1, [&](std::int64_t i0, std::int64_t i1) {
+            for (std::int64_t i = i0; i < i1; ++i) {
+                const Tile& t = index.tiles[std::size_t(i)];
+                const std::vector<float> samples = cut(grid, t);
+                const ConstGridView view{samples.data(), t.width, t.height, hm.cell()};
+                AtomicFile file(targets[std::size_t(i)]);
+                if (format == Format::r32) {
+                    std::vector<std::uint8_t> bytes(samples.size() * 4);
+                    std::memcpy(bytes.data(), samples.data(), bytes.size());  // little-endian x86-64 and ARM
+                    file.write(bytes);
+                } else {
+                    const std::vector<std::uint16_t> q = raw::quantize16(view, index.range, &clamped[std::size_t(i)]);
+                    if (format == Format::png16) {
+                        write_gray_png(file.stream(), t.width, t.height, 16, q, level);
+                    } else {
+                        std::vector<std::uint8_t> bytes(q.size() * 2);
+                        for (std::size_t k = 0; k < q.size(); ++k) {
+                            bytes[2 * k] = std::uint8_t(q[k] & 0xFF);
+                            bytes[2 * k + 1] = std::uint8_t(q[k] >> 8);
+                        }
+                        file.write(bytes);
+                    }
+                }
+                file.commit();
+            }
+        });
+        done = end;
+        ctx.progress(double(done) / double(index.tiles.size()));
+    }
+    std::size_t outside = 0;
+    for (std::size_t c : clamped) outside += c;
+    if (outside > 0)
+        ctx.warn(std::to_string(outside) + " samples lie outside low..high and were clamped to its ends");
+
+    for (std::size_t i = 0; i < raw_vrts.size(); ++i) {
+        const std::string text = raw_tile_vrt(index, index.tiles[i]);
+        write_file_atomically(raw_vrts[i], {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    }
+    if (vrt) {
+        const std::string text = mosaic_vrt(index);
+        write_file_atomically(ctx.output_path((folder / (stem + ".vrt")).string()),
+                              {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
+    }
+    const std::string json = index_json(index);
+    write_file_atomically(ctx.output_path(index_path.string()),
+                          {reinterpret_cast<const std::uint8_t*>(json.data()), json.size()});
+    ctx.info("wrote " + std::to_string(index.tiles.size()) + " tiles of " + std::to_string(tile_size) + " samples (" +
+             std::to_string(last.column + 1) + " × " + std::to_string(last.row + 1) + "), " + index_path.string() +
+             (vrt ? " and " + (folder / (stem + ".vrt")).string() : std::string()));
+    return {};
+}
+
+}  // namespace
+
+OROGEN_PLUGIN("export-tiles", "0.1.0", registry) {
+    registry.add({
+        .kind = "export",
+        .name = "tiles",
+        .summary = "cut the heightmap into engine tiles (16-bit PNG or RAW) that share their edges, with a JSON index "
+                   "and a GDAL VRT",
+        .description =
+            "Tiles of tile_size samples a side start every tile_size - 1 samples, so neighbours share their edge row "
+            "or column bit for bit (no seams in Unreal's World Partition or Unity's terrain tiles). Every tile uses "
+            "one height scale (low..high, default the terrain's own range). Files <stem>_x<column>_y<row>.png "
+            "(.r16, .r32) beside the index <stem>.json (sizes, cell, height scale, Unreal and Unity scale settings, "
+            "every tile's place) and, with vrt=true, <stem>.vrt, which GDAL and QGIS open as the whole terrain "
+            "(metres, through its offset and scale). Unreal sizes: 127, 253, 505, 1009, 2017, 4033; Unity: 2^n + 1.",
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to cut"}},
+        .output = ValueType::none,
+        .params =
+            {
+                Param::path("path", PathRole::output, {".json"}).help("the index; the tiles go beside it"),
+                Param::choice("format", {"png16", "r16", "r32"}, "png16")
+                    .help("png16: 16-bit grayscale PNG; r16: RAW unsigned 16-bit little-endian; r32: RAW float metres"),
+                Param::integer("tile_size", 505).min(2).max(65537).unit("samples").help(
+                    "samples per tile side, the shared edge included (Unreal: 127, 253, 505, 1009, 2017, 4033)"),
+                Param::real("low", 0.0).unit("m").help("height written as 0 (with high; both 0 = the terrain's lowest)"),
+                Param::real("high", 0.0).unit("m").help(
+                    "height written as 65535 (with low; both 0 = the terrain's highest)"),
+                Param::boolean("vrt", true).help("also write <stem>.vrt, the tiles as one GDAL raster"),
+                Param::integer("compression", 6).min(0).max(12).help("png16: deflate level (libdeflate), 0 to 12"),
+            },
+        .check = check,
+        .run = run,
+    });
+}
