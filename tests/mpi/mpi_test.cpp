@@ -198,61 +198,77 @@ grid 50x37 cell=3
 
 f = generate:fault(iterations=200, displacement=0.5)
 t = erode:thermal(f, iterations=10, hardness=height)
-export:vtk(t, path="t.vti", up="y")   # the tiles are Y-up for now
+export:vtk(t, path="t.vti")
 export:vtk-tiles(t, path="tiles/t.pvti")
+export:vtk(t, path="y/t.vti", up="y")
+export:vtk-tiles(t, path="ytiles/t.pvti", up="y")
 )");
     const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q");
     ASSERT_EQ(one.exit_code, 0) << one.err;
     const RunResult many = run_mpi(4, "run " + q(spec) + " --out " + q(dir / "many") + " --tiles 2x2");
     ASSERT_EQ(many.exit_code, 0) << many.err;
 
-    vtkNew<vtkXMLImageDataReader> single;
-    single->SetFileName((dir / "one" / "t.vti").c_str());
-    single->Update();
-    vtkNew<vtkXMLPImageDataReader> parallel;
-    parallel->SetFileName((dir / "many" / "tiles" / "t.pvti").c_str());
-    parallel->Update();
-    vtkImageData* a = single->GetOutput();
-    vtkImageData* b = parallel->GetOutput();
-    int ea[6], eb[6];
-    a->GetExtent(ea);
-    b->GetExtent(eb);
-    for (int i = 0; i < 6; ++i) EXPECT_EQ(ea[i], eb[i]) << "extent " << i;
-    EXPECT_EQ(ea[1], 49);
-    EXPECT_EQ(ea[5], 36);
-    double sa[3], sb[3];
-    a->GetSpacing(sa);
-    b->GetSpacing(sb);
-    for (int i = 0; i < 3; ++i) EXPECT_EQ(sa[i], sb[i]);
-    const auto va = arrays_of(a), vb = arrays_of(b);
-    ASSERT_EQ(va.size(), 3u);  // height, eroded, hardness
-    ASSERT_EQ(vb.size(), va.size());
-    for (const auto& [name, values] : va) {
-        ASSERT_TRUE(vb.count(name)) << name;
-        EXPECT_TRUE(values == vb.at(name)) << name << " differs between the .vti and the .pvti";
-    }
-    // Each rank wrote its own piece; pieces 0 and 1 (west, east) share a column, bit for bit.
-    vtkNew<vtkXMLImageDataReader> west, east;
-    west->SetFileName((dir / "many" / "tiles" / "t_0.vti").c_str());
-    east->SetFileName((dir / "many" / "tiles" / "t_1.vti").c_str());
-    west->Update();
-    east->Update();
-    int ew[6], ee[6];
-    west->GetOutput()->GetExtent(ew);
-    east->GetOutput()->GetExtent(ee);
-    EXPECT_EQ(ew[1], ee[0]);  // the seam column belongs to both
-    EXPECT_GT(ee[0], 0);
-    const auto hw = arrays_of(west->GetOutput()).at("height"), he = arrays_of(east->GetOutput()).at("height");
-    const int ww = ew[1] - ew[0] + 1, we = ee[1] - ee[0] + 1;
-    for (int y = 0; y <= std::min(ew[5], ee[5]); ++y)
-        EXPECT_EQ(hw[std::size_t(y * ww + ww - 1)], he[std::size_t(y * we)]) << "row " << y;
-    // The manifest (rank 0) lists every piece with its hash.
-    const std::string manifest = slurp(dir / "many" / "manifest.json");
-    for (int r = 0; r < 4; ++r) {
-        const std::string piece = "tiles/t_" + std::to_string(r) + ".vti";
-        const auto at = manifest.find("\"" + piece + "\"");
-        ASSERT_NE(at, std::string::npos) << piece;
-        EXPECT_NE(manifest.find(orogen::sha256_file(dir / "many" / piece), at), std::string::npos) << piece;
+    // Z-up (the default: X east, Y north, rows counted from the south) and Y-up (X east, Z south).
+    for (const bool z_up : {true, false}) {
+        SCOPED_TRACE(z_up ? "up=z" : "up=y");
+        const fs::path vti = dir / "one" / (z_up ? "t.vti" : "y/t.vti");
+        const fs::path tiles = dir / "many" / (z_up ? "tiles" : "ytiles");
+        vtkNew<vtkXMLImageDataReader> single;
+        single->SetFileName(vti.c_str());
+        single->Update();
+        vtkNew<vtkXMLPImageDataReader> parallel;
+        parallel->SetFileName((tiles / "t.pvti").c_str());
+        parallel->Update();
+        vtkImageData* a = single->GetOutput();
+        vtkImageData* b = parallel->GetOutput();
+        int ea[6], eb[6];
+        a->GetExtent(ea);
+        b->GetExtent(eb);
+        for (int i = 0; i < 6; ++i) EXPECT_EQ(ea[i], eb[i]) << "extent " << i;
+        EXPECT_EQ(ea[1], 49);
+        EXPECT_EQ(z_up ? ea[3] : ea[5], 36);
+        double sa[3], sb[3], oa[3], ob[3];
+        a->GetSpacing(sa);
+        b->GetSpacing(sb);
+        a->GetOrigin(oa);
+        b->GetOrigin(ob);
+        for (int i = 0; i < 3; ++i) {
+            EXPECT_EQ(sa[i], sb[i]);
+            EXPECT_EQ(oa[i], ob[i]);
+        }
+        const auto va = arrays_of(a), vb = arrays_of(b);
+        ASSERT_EQ(va.size(), 3u);  // height, eroded, hardness
+        ASSERT_EQ(vb.size(), va.size());
+        for (const auto& [name, values] : va) {
+            ASSERT_TRUE(vb.count(name)) << name;
+            EXPECT_TRUE(values == vb.at(name)) << name << " differs between the .vti and the .pvti";
+        }
+        // Each rank wrote its own piece; pieces 0 and 1 (west, east) share a column, bit for bit.
+        vtkNew<vtkXMLImageDataReader> west, east;
+        west->SetFileName((tiles / "t_0.vti").c_str());
+        east->SetFileName((tiles / "t_1.vti").c_str());
+        west->Update();
+        east->Update();
+        int ew[6], ee[6];
+        west->GetOutput()->GetExtent(ew);
+        east->GetOutput()->GetExtent(ee);
+        EXPECT_EQ(ew[1], ee[0]);  // the seam column belongs to both
+        EXPECT_GT(ee[0], 0);
+        const int rows = z_up ? ew[3] - ew[2] + 1 : ew[5] - ew[4] + 1;
+        EXPECT_EQ(rows, z_up ? ee[3] - ee[2] + 1 : ee[5] - ee[4] + 1);
+        EXPECT_GT(rows, 1);
+        const auto hw = arrays_of(west->GetOutput()).at("height"), he = arrays_of(east->GetOutput()).at("height");
+        const int ww = ew[1] - ew[0] + 1, we = ee[1] - ee[0] + 1;
+        for (int y = 0; y < rows; ++y)
+            EXPECT_EQ(hw[std::size_t(y * ww + ww - 1)], he[std::size_t(y * we)]) << "row " << y;
+        // The manifest (rank 0) lists every piece with its hash.
+        const std::string manifest = slurp(dir / "many" / "manifest.json");
+        for (int r = 0; r < 4; ++r) {
+            const std::string piece = std::string(z_up ? "tiles" : "ytiles") + "/t_" + std::to_string(r) + ".vti";
+            const auto at = manifest.find("\"" + piece + "\"");
+            ASSERT_NE(at, std::string::npos) << piece;
+            EXPECT_NE(manifest.find(orogen::sha256_file(dir / "many" / piece), at), std::string::npos) << piece;
+        }
     }
 }
 

@@ -106,18 +106,19 @@ NodeOutputs run_tiles(NodeContext& ctx) {
         layers.push_back({names[i], {grids[i + 1].data(), piece.width, piece.height, hm.cell()}});
     vtk::Options o;
     o.compress = ctx.flag("compress");
+    o.up = vtk::up_from_name(ctx.text("up"));
 
     const std::filesystem::path pvti = ctx.text("path");
     auto piece_file = [&](int r) { return pvti.stem().string() + "_" + std::to_string(r) + ".vti"; };
     vtk::write_heightmap_piece({grids[0].data(), piece.width, piece.height, hm.cell()}, layers, piece.x0, piece.y0,
-                               ctx.output_path((pvti.parent_path() / piece_file(rank)).string()), o);
+                               height, ctx.output_path((pvti.parent_path() / piece_file(rank)).string()), o);
     if (rank == 0) {
         std::vector<vtk::PvtiPiece> pieces;
         for (int r = 0; r < ranks; ++r) {
             const TileRect p = piece_of(r);
             pieces.push_back({piece_file(r), p.x0, p.x1() - 1, p.y0, p.y1() - 1});
         }
-        const std::string text = vtk::pvti_text(width, height, hm.cell(), names, pieces);
+        const std::string text = vtk::pvti_text(width, height, hm.cell(), names, pieces, o.up);
         write_file_atomically(ctx.output_path(pvti.string()),
                               {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
     }
@@ -177,6 +178,7 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
         .params =
             {
                 Param::path("path", PathRole::output, {".pvti"}).help("output .pvti; the pieces NAME_RANK.vti go beside it"),
+                up_param(),
                 compress_param(),
             },
         .tile_halo = 1,

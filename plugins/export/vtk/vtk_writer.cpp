@@ -171,37 +171,54 @@ std::string pvd_text(std::span<const PvdEntry> entries) {
 
 // ---------------------------------------------------------------- heightmap
 
-void write_heightmap_piece(ConstGridView piece, std::span<const NamedGrid> layers, int x0, int y0,
+void write_heightmap_piece(ConstGridView piece, std::span<const NamedGrid> layers, int x0, int y0, int whole_height,
                            const fs::path& target, const Options& o) {
     check_layers(piece, layers);
     AtomicFile file(target);
     vtkNew<vtkImageData> image;
-    // X east, Z south: sample order as stored; the extent places the piece in the whole grid.
-    image->SetExtent(x0, x0 + piece.width - 1, 0, 0, y0, y0 + piece.height - 1);
-    image->SetSpacing(piece.cell, 1.0, piece.cell);
-    image->SetOrigin(0, 0, 0);
-    image->GetPointData()->AddArray(wrap("height", piece.data, piece.size(), 1));
+    if (o.up == Up::z) {
+        // X east, Y north, as export:vtk's up=z .vti: j counts rows from the south, so the piece's rows are
+        // turned (a copy) and its extent counted from the whole grid's south edge.
+        const int j0 = whole_height - y0 - piece.height;
+        image->SetExtent(x0, x0 + piece.width - 1, j0, j0 + piece.height - 1, 0, 0);
+        image->SetSpacing(piece.cell, piece.cell, 1.0);
+        image->SetOrigin(0, -(whole_height - 1) * piece.cell + 0.0, 0);
+        image->GetPointData()->AddArray(flipped("height", piece));
+        for (const auto& l : layers) image->GetPointData()->AddArray(flipped(l.name, l.grid));
+    } else {
+        // X east, Z south: sample order as stored; the extent places the piece in the whole grid.
+        image->SetExtent(x0, x0 + piece.width - 1, 0, 0, y0, y0 + piece.height - 1);
+        image->SetSpacing(piece.cell, 1.0, piece.cell);
+        image->SetOrigin(0, 0, 0);
+        image->GetPointData()->AddArray(wrap("height", piece.data, piece.size(), 1));
+        for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
+    }
     image->GetPointData()->SetActiveScalars("height");
-    for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
-    mark_frame(image, Up::y);  // pieces are Y-up (X east, Z south) until export:vtk-tiles learns up=z
+    mark_frame(image, o.up);
     write_with<vtkXMLImageDataWriter>(image, file, o);
     file.commit();
 }
 
 std::string pvti_text(int width, int height, double cell, std::span<const std::string> layer_names,
-                      std::span<const PvtiPiece> pieces) {
+                      std::span<const PvtiPiece> pieces, Up up) {
     std::ostringstream s;
+    const bool z = up == Up::z;
     s << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"PImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-      << "  <PImageData WholeExtent=\"0 " << width - 1 << " 0 0 0 " << height - 1
-      << "\" GhostLevel=\"0\" Origin=\"0 0 0\" Spacing=\"" << number(cell) << " 1 " << number(cell) << "\">\n"
+      << "  <PImageData WholeExtent=\"0 " << width - 1 << (z ? " 0 " + std::to_string(height - 1) + " 0 0"
+                                                              : " 0 0 0 " + std::to_string(height - 1))
+      << "\" GhostLevel=\"0\" Origin=\"0 " << (z ? number(-(height - 1) * cell + 0.0) : std::string("0")) << " 0\" Spacing=\""
+      << number(cell) << (z ? " " + number(cell) + " 1" : " 1 " + number(cell)) << "\">\n"
       << "    <PPointData Scalars=\"height\">\n"
       << "      <PDataArray type=\"Float32\" Name=\"height\"/>\n";
     for (const auto& n : layer_names) s << "      <PDataArray type=\"Float32\" Name=\"" << n << "\"/>\n";
     s << "    </PPointData>\n";
-    for (const auto& p : pieces)
-        s << "    <Piece Extent=\"" << p.x0 << " " << p.x1 << " 0 0 " << p.y0 << " " << p.y1 << "\" Source=\"" << p.file
-          << "\"/>\n";
+    for (const auto& p : pieces) {
+        s << "    <Piece Extent=\"" << p.x0 << " " << p.x1;
+        if (z) s << " " << height - 1 - p.y1 << " " << height - 1 - p.y0 << " 0 0";
+        else s << " 0 0 " << p.y0 << " " << p.y1;
+        s << "\" Source=\"" << p.file << "\"/>\n";
+    }
     s << "  </PImageData>\n"
       << "</VTKFile>\n";
     return s.str();

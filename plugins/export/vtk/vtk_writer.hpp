@@ -69,7 +69,8 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
 /// the whole grid: columns x0 .. x0+width−1, rows y0 .. y0+height−1 (the
 /// .vti a whole grid gives, cut there). Pieces listed in a .pvti (pvti_text)
 /// overlap by one row or column, as ParaView's parallel image data wants.
-void write_heightmap_piece(ConstGridView piece, std::span<const NamedGrid> layers, int x0, int y0,
+/// `whole_height`: rows of the whole grid (up=z places the piece counting rows from the south).
+void write_heightmap_piece(ConstGridView piece, std::span<const NamedGrid> layers, int x0, int y0, int whole_height,
                            const std::filesystem::path& target, const Options& options = {});
 
 /// A .pvti piece: its file (relative to the .pvti) and extent in the whole grid (first and last column, row).
@@ -79,8 +80,9 @@ struct PvtiPiece {
 };
 /// The .pvti text over `pieces` of a width × height grid, `cell` metres apart, with the point arrays
 /// "height" and `layer_names` (all Float32), in that order.
+/// The pieces' extents are given in orogen's rows (north to south); up=z turns them as the pieces are.
 std::string pvti_text(int width, int height, double cell, std::span<const std::string> layer_names,
-                      std::span<const PvtiPiece> pieces);
+                      std::span<const PvtiPiece> pieces, Up up = Up::y);
 
 /// Particle frames: `target` .pvd (one <stem>_NNNNNN.vtp per frame beside it) or
 /// .vtp (a single frame). Returns the number of files written.
