@@ -248,7 +248,8 @@ TEST(Thermal, ErodeInPlaceEqualsSingleSteps) {
 // for every rule and hardness mode: O = rate·softness·max(0, max_i(d_i − T_i))
 // leaves a cell, shared in proportion to d_i among the neighbours with d_i > T_i.
 TEST(Thermal, StepMatchesAPlainReferenceOnEveryCell) {
-    for (const auto [w, h] : {std::pair{23, 17}, std::pair{3, 40}, std::pair{64, 2}, std::pair{2, 7}, std::pair{1, 5}}) {
+    for (const auto& size : {std::pair{23, 17}, std::pair{3, 40}, std::pair{64, 2}, std::pair{2, 7}, std::pair{1, 5}}) {
+        const int w = size.first, h = size.second;  // plain names: clang 14 cannot capture structured bindings
         const auto v = noise_terrain(w, h, 51, 30.0f);
         std::vector<float> hard(v.size());
         for (std::size_t i = 0; i < hard.size(); ++i) hard[i] = float(random::uniform(52, i)) * 1.2f - 0.1f;
