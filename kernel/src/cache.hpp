@@ -68,9 +68,14 @@ Digest output_key(const Digest& node, std::string_view name);
 /// The key of an output of a node that always runs: what it produced decides, not how.
 Digest content_key(const Digest& node, std::string_view name, const Digest& content);
 
-/// The hash that seals an entry's payload: SHA-256 over the SHA-256 of each
-/// 1 MiB block and the payload's length, so that every core checks a part.
+/// The content hash of a payload (value_hash): SHA-256 over the SHA-256 of each 1 MiB block and the
+/// payload's length, so that every core hashes a part.
 Digest payload_hash(std::span<const std::uint8_t> payload);
+/// The checksum that seals an entry's payload against damage (docs/cache.md): XXH3-128 of each 1 MiB block,
+/// then of the payload's length and those block checksums; in the first 16 bytes, the rest zero. Not a
+/// cryptographic hash, and need not be: it sits in the same file as what it checks, so it catches damage
+/// (a flipped bit, a torn write), not forgery, which SHA-256 in that place would not stop either.
+Digest payload_checksum(std::span<const std::uint8_t> payload);
 
 /// What a cached node produced.
 struct Contents {
