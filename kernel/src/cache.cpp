@@ -768,6 +768,31 @@ Contents decode(std::span<const std::uint8_t> entry, const Digest& key) {
     return c;
 }
 
+void reseal(std::vector<std::uint8_t>& entry, const Digest& key) {
+    if (entry.size() < header_size) entry.resize(header_size, 0);
+    std::uint8_t* h = entry.data();
+    std::memcpy(h, magic, sizeof magic);
+    put<std::uint32_t>(h + 8, format_version);
+    put<std::uint32_t>(h + 12, header_size);
+    std::memset(h + 16, 0, 32);
+    std::strncpy(reinterpret_cast<char*>(h + 16), OROGEN_VERSION, 31);
+    std::memcpy(h + 88, key.data(), 32);
+    // The messages block: as long as the header says, within the limit and within the entry.
+    std::uint64_t message_bytes = get<std::uint64_t>(h + 128);
+    message_bytes = std::min<std::uint64_t>({message_bytes, max_message_bytes, entry.size() - header_size});
+    std::uint64_t payload_offset = header_size + (message_bytes + 63) / 64 * 64;
+    if (payload_offset > entry.size()) entry.resize(payload_offset, 0);
+    h = entry.data();
+    put<std::uint64_t>(h + 128, message_bytes);
+    put<std::uint32_t>(h + 120, message_bytes >= 4 ? get<std::uint32_t>(h + header_size) : 0);
+    unsigned int len = 0;
+    EVP_Digest(h + header_size, message_bytes, h + 136, &len, EVP_sha256(), nullptr);
+    const std::span<const std::uint8_t> payload(entry.data() + payload_offset, entry.size() - payload_offset);
+    put<std::uint64_t>(h + 48, payload.size());
+    const Digest sum = payload_checksum(payload);
+    std::memcpy(h + 56, sum.data(), 32);
+}
+
 Digest value_hash(const Value& value) {
     Writer w(estimate(value));
     write_value(w, value);

@@ -11,6 +11,8 @@
 
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <algorithm>
 #include <map>
 #include <regex>
 #include <set>
@@ -209,6 +211,129 @@ TEST(CacheEntry, AnyFlippedByteOrCutIsCaughtAndAnotherVersionOrKeyRefused) {
     EXPECT_THROW(cache::decode(other, key), cache::OtherVersion);
     cache::Hasher kh2;
     EXPECT_THROW(cache::decode(good, kh2.text("other").finish()), cache::CorruptEntry);
+}
+
+TEST(CacheEntry, LargeValuesRoundTripThroughTheParallelCopies) {
+    // Arrays of 256 KiB and more are copied after parsing, on every core beside the checksum, and from 4 MiB
+    // into huge pages: a 1025² heightmap (4.2 MB a layer) with three layers, a large image and a large file.
+    const int n = 1025;
+    auto hm = std::make_shared<Heightmap>(n, n, 7.5, 0.0f);
+    for (std::size_t i = 0; i < hm->size(); ++i) hm->heights()[i] = float(i % 8191) * 0.5f - 100.0f;
+    for (const char* name : {"water", "sediment", "flow"}) {
+        GridView l = hm->layer(name);
+        for (std::size_t i = 0; i < l.size(); ++i) l.data[i] = float((i * 31 + std::strlen(name)) % 977);
+    }
+    auto img = std::make_shared<Image>();
+    img->width = 400;
+    img->height = 300;
+    img->rgba8.resize(400 * 300 * 4);
+    for (std::size_t i = 0; i < img->rgba8.size(); ++i) img->rgba8[i] = std::uint8_t(i * 13);
+    std::vector<std::uint8_t> file(3u << 20);
+    for (std::size_t i = 0; i < file.size(); ++i) file[i] = std::uint8_t(i ^ (i >> 9));
+    cache::Contents c;
+    c.values = {{"", Value(hm)}, {"img", Value(img)}};
+    c.files = {{"big.bin", file}, {"small.txt", {1, 2}}};
+    cache::Hasher kh;
+    const cache::Digest key = kh.text("big").finish();
+    const std::vector<std::uint8_t> bytes = cache::encode(key, c);
+    const cache::Contents d = cache::decode(bytes, key);
+    ASSERT_EQ(d.values.size(), 2u);
+    const Heightmap& h2 = *d.values[0].second.heightmap();
+    EXPECT_EQ(h2.width(), n);
+    EXPECT_EQ(h2.cell(), 7.5);
+    EXPECT_EQ(h2.heights(), hm->heights());
+    ASSERT_EQ(h2.layer_names(), hm->layer_names());
+    for (const auto& name : hm->layer_names())
+        EXPECT_EQ(std::memcmp(h2.layer(name).data, hm->layer(name).data, hm->size() * 4), 0) << name;
+    EXPECT_EQ(d.values[1].second.image()->rgba8, img->rgba8);
+    EXPECT_EQ(d.files, c.files);
+    EXPECT_EQ(cache::encode(key, d), bytes);
+    // One flipped bit in the last layer: refused, whichever core copied or checked that part.
+    auto bad = bytes;
+    bad[bytes.size() - (3u << 20) - 4096] ^= 0x04;
+    EXPECT_THROW(cache::decode(bad, key), cache::CorruptEntry);
+}
+
+namespace {
+/// An entry of one value whose payload passes the checksum but was written wrong on purpose: `edit` changes
+/// the encoded bytes of `c` (found by searching them), then the entry is resealed.
+std::string refusal(const cache::Contents& c, const std::function<void(std::vector<std::uint8_t>&)>& edit) {
+    cache::Hasher kh;
+    const cache::Digest key = kh.text("sealed").finish();
+    auto bytes = cache::encode(key, c);
+    edit(bytes);
+    cache::reseal(bytes, key);
+    try {
+        cache::decode(bytes, key);
+    } catch (const cache::CorruptEntry& e) {
+        return e.what();
+    }
+    return "accepted";
+}
+
+/// Replace the first occurrence of `from` in `bytes` by `to` (the same length).
+void replace_bytes(std::vector<std::uint8_t>& bytes, const std::vector<std::uint8_t>& from, const std::vector<std::uint8_t>& to) {
+    const auto it = std::search(bytes.begin(), bytes.end(), from.begin(), from.end());
+    ASSERT_NE(it, bytes.end());
+    std::copy(to.begin(), to.end(), it);
+}
+
+template <typename T>
+std::vector<std::uint8_t> le(T v) {
+    std::vector<std::uint8_t> b(sizeof v);
+    std::memcpy(b.data(), &v, sizeof v);
+    return b;
+}
+}  // namespace
+
+TEST(CacheEntry, ASealedButInvalidPayloadIsRefusedNamingWhatIsWrong) {
+    // What the checksum cannot catch (an entry written wrong, by another program or by hand) must still never
+    // reach a node: sizes that disagree, a path out of --out, an unknown kind.
+    auto img = std::make_shared<Image>();
+    img->width = 0x1234;
+    img->height = 1;
+    img->rgba8.assign(0x1234 * 4, 9);
+    cache::Contents ci;
+    ci.values = {{"", Value(img)}};
+    EXPECT_EQ(refusal(ci, [](auto&) {}), "accepted");
+    EXPECT_EQ(refusal(ci, [](auto& b) { replace_bytes(b, le<std::int32_t>(0x1234), le<std::int32_t>(0x1235)); }),
+              "an image's pixels do not match its size and format");
+
+    cache::Contents cf;
+    cf.files = {{"abc/x.png", {1, 2, 3}}};
+    const auto path = [](const std::string& p) {
+        return [p](std::vector<std::uint8_t>& b) {
+            replace_bytes(b, std::vector<std::uint8_t>{'a', 'b', 'c', '/', 'x', '.', 'p', 'n', 'g'},
+                          std::vector<std::uint8_t>(p.begin(), p.end()));
+        };
+    };
+    EXPECT_EQ(refusal(cf, path("abc/x.png")), "accepted");
+    EXPECT_EQ(refusal(cf, path("../../x.p")), "a kept file has a bad path ('../../x.p')");
+    EXPECT_EQ(refusal(cf, path("/etc/x.pn")), "a kept file has a bad path ('/etc/x.pn')");
+
+    auto hm = std::make_shared<Heightmap>(3, 2, 4.0, 1.0f);
+    hm->layer("water");
+    cache::Contents ch;
+    ch.values = {{"", Value(hm)}};
+    EXPECT_EQ(refusal(ch, [](auto& b) { replace_bytes(b, le<double>(4.0), le<double>(-4.0)); }),
+              "a heightmap whose cell size is not a positive number");
+    EXPECT_EQ(refusal(ch, [](auto& b) { replace_bytes(b, le<std::int32_t>(3), le<std::int32_t>(2)); }),
+              "a heightmap's size does not match its heights");
+
+    auto ps = std::make_shared<ParticleSeries>();
+    ps->frames.resize(1);
+    ps->frames[0].attributes["position"] = {3, {1, 2, 3, 4, 5, 6}};
+    ps->frames[0].attributes["zdensity"] = {1, {7, 8, 9}};  // one particle too many
+    cache::Contents cp;
+    cp.values = {{"", Value(ps)}};
+    EXPECT_EQ(refusal(cp, [](auto&) {}), "a particle attribute's size does not match the frame's particles");
+
+    auto ph = std::make_shared<PlateHistory>();
+    ph->collisions.push_back({4, 7, 8, {1, 2}, {3, 4}, BoundaryKind::transform, 0.125});
+    cache::Contents cpl;
+    cpl.values = {{"", Value(ph)}};
+    EXPECT_EQ(refusal(cpl, [](auto& b) { replace_bytes(b, le<std::int32_t>(3), le<std::int32_t>(9)); }),
+              "a collision of unknown kind 9");
 }
 
 TEST(CacheEntry, SizesParseWithUnits) {
