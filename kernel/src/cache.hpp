@@ -58,11 +58,21 @@ private:
     void* ctx_;
 };
 
-/// A node's key: its kind and name, its plugin's name and version, the orogen version and the cache
-/// format, every resolved parameter, its seed, the grid, which input it is mapped over, and the keys of
-/// its inputs (nullopt for an optional input not given). `inputs` must all be known.
+/// The identity of the loaded binary (executable or shared library) whose code holds `address`: its GNU
+/// build-id ("build-id:<hex>", read from the ELF note in memory: free, and it changes whenever the linked
+/// code does), else the SHA-256 of its file ("sha256:<hex>", computed once per binary and process); "" if
+/// neither can be had (no such binary, or its file is gone).
+std::string binary_identity(const void* address);
+/// The identity of the orogen kernel library itself (binary_identity of its code), once per process.
+const std::string& kernel_identity();
+
+/// A node's key: its kind and name, its plugin's name, version and binary identity, the orogen version,
+/// the kernel's binary identity and the cache format, every resolved parameter, its seed, the grid, which
+/// input it is mapped over, and the keys of its inputs (nullopt for an optional input not given). `inputs`
+/// must all be known.
 Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std::optional<Digest>>& inputs,
-                std::string_view plugin_name, std::string_view plugin_version, std::uint64_t seed);
+                std::string_view plugin_name, std::string_view plugin_version, std::string_view plugin_identity,
+                std::uint64_t seed);
 /// The key of output `name` ("" the main value) of a node with key `node`.
 Digest output_key(const Digest& node, std::string_view name);
 /// The key of an output of a node that always runs: what it produced decides, not how.

@@ -2,6 +2,7 @@
 // test with its own cache folder, looking at the files it leaves and at the
 // timing table ("cached" / "cached, read" rows).
 #include "cache.hpp"
+#include "loader.hpp"
 
 #include <orogen/io.hpp>
 
@@ -94,15 +95,28 @@ std::uint64_t entry_bytes(const fs::path& cache) {
     return n;
 }
 
+/// The GNU build-id of an ELF file as binutils' readelf prints it ("" if it has none).
+std::string read_build_id(const fs::path& file) {
+    const std::string cmd = "readelf -n " + q(file) + " 2>/dev/null";
+    std::FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) return {};
+    std::string text;
+    char buf[4096];
+    while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) text.append(buf, n);
+    ::pclose(p);
+    std::smatch m;
+    return std::regex_search(text, m, std::regex("Build ID: ([0-9a-f]+)")) ? m[1].str() : std::string();
+}
+
 struct Fixture {
     TempDir dir;
     fs::path spec = dir.write("t.orogen", spec_text);
     fs::path cache = dir / "cache";
 
-    RunResult run(const std::string& out, const std::string& extra = "", const std::string& env = "") const {
+    test::RunResult run(const std::string& out, const std::string& extra = "", const std::string& env = "") const {
         return run_orogen("run " + q(spec) + " --out " + q(dir / out) + " " + extra, env);
     }
-    RunResult cached(const std::string& out, const std::string& extra = "") const {
+    test::RunResult cached(const std::string& out, const std::string& extra = "") const {
         return run(out, "--cache " + q(cache) + " " + extra);
     }
 };
@@ -336,6 +350,65 @@ TEST(CacheEntry, ASealedButInvalidPayloadIsRefusedNamingWhatIsWrong) {
               "a collision of unknown kind 9");
 }
 
+TEST(CacheKey, ThePluginsAndTheKernelsBinaryIdentityAreInTheKey) {
+    NodeDescriptor desc{.kind = "generate", .name = "x"};
+    PlannedNode node;
+    node.node = &desc;
+    node.label = "x";
+    Plan plan;
+    const auto key = [&](std::string_view identity) { return cache::node_key(plan, node, {}, "p", "0.1.0", identity, 7); };
+    EXPECT_EQ(key("build-id:aa11"), key("build-id:aa11"));
+    EXPECT_NE(key("build-id:aa11"), key("build-id:aa12"));
+    EXPECT_NE(key("build-id:aa11"), key("sha256:aa11"));
+    // The kernel's own identity is its build-id as binutils reads it from the file.
+    const std::string kernel = read_build_id(fs::path(OROGEN_BINARY_DIR) / "lib" / "liborogen.so");
+    ASSERT_FALSE(kernel.empty());
+    EXPECT_EQ(cache::kernel_identity(), "build-id:" + kernel);
+}
+
+TEST(CacheKey, ALoadedPluginsIdentityIsItsBuildIdAndTwoBuildsDiffer) {
+    std::vector<std::string> identities;
+    for (const char* variant : {"1", "2"}) {
+        const fs::path file = fs::path(OROGEN_STALE_PLUGIN_DIR + std::string(variant)) / "stale.so";
+        PluginSet set;
+        set.load(file);
+        ASSERT_EQ(set.plugins().size(), 1u) << file;
+        const std::string id = read_build_id(file);
+        ASSERT_FALSE(id.empty()) << file;
+        EXPECT_EQ(set.plugins()[0].identity, "build-id:" + id);
+        identities.push_back(set.plugins()[0].identity);
+    }
+    EXPECT_NE(identities[0], identities[1]);
+    // Code with no loaded binary around it has no identity.
+    int on_the_stack = 0;
+    EXPECT_EQ(cache::binary_identity(&on_the_stack), "");
+}
+
+TEST(CacheRun, ARebuiltPluginWithTheSameVersionDoesNotFindTheOldBuildsResults) {
+    TempDir dir;
+    const fs::path spec = dir.write("s.orogen", "orogen 1\ngrid 9 cell=1\nh = generate:test-stale()\nexport:raw(h, path=\"h.r32\")\n");
+    const auto run = [&](const char* variant, const std::string& out) {
+        return run_orogen("run " + q(spec) + " --out " + q(dir / out) + " --cache " + q(dir / "cache"),
+                          "OROGEN_PLUGIN_PATH=" + q(OROGEN_STALE_PLUGIN_DIR + std::string(variant)));
+    };
+    const auto first_height = [&](const std::string& out) {
+        const auto bytes = read_file(dir / out / "h.r32");
+        float v = -1;
+        if (bytes.size() >= 4) std::memcpy(&v, bytes.data(), 4);
+        return v;
+    };
+    const test::RunResult a = run("1", "a");
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    EXPECT_EQ(first_height("a"), 1.0f);
+    const test::RunResult again = run("1", "again");  // the same build: everything reused
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_EQ(count_rows(cache_column(again.out), "cached"), 2) << again.out;
+    const test::RunResult b = run("2", "b");  // rebuilt with other code, same name and version "0.1.0"
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    EXPECT_EQ(row(cache_column(b.out), "h"), "") << b.out;  // ran
+    EXPECT_EQ(first_height("b"), 2.0f);
+}
+
 TEST(CacheEntry, SizesParseWithUnits) {
     EXPECT_EQ(cache::parse_size("2G"), std::uint64_t(2) << 30);
     EXPECT_EQ(cache::parse_size("500M"), std::uint64_t(500) << 20);
@@ -351,14 +424,14 @@ TEST(CacheEntry, SizesParseWithUnits) {
 
 TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
     Fixture f;
-    const RunResult plain = f.run("plain", "--no-cache");
+    const test::RunResult plain = f.run("plain", "--no-cache");
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     EXPECT_FALSE(fs::exists(f.cache));
-    const RunResult cold = f.cached("cold");
+    const test::RunResult cold = f.cached("cold");
     ASSERT_EQ(cold.exit_code, 0) << cold.err;
     EXPECT_EQ(count_rows(cache_column(cold.out), ""), 6) << cold.out;
     EXPECT_EQ(entries(f.cache).size(), 6u);  // three heightmaps, three exports' files
-    const RunResult warm = f.cached("warm");
+    const test::RunResult warm = f.cached("warm");
     ASSERT_EQ(warm.exit_code, 0) << warm.err;
 
     // Every node came from the cache; the exports' files were put back from their entries, and the
@@ -380,7 +453,7 @@ TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
     // (not staged and renamed over themselves) and still listed, so the manifest is again the same bytes.
     // A file changed since is put back.
     std::ofstream(f.dir / "cold" / "scree.png", std::ios::binary) << "edited by hand";
-    const RunResult again = f.cached("cold");
+    const test::RunResult again = f.cached("cold");
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_NE(again.out.find("wrote 5 files"), std::string::npos) << again.out;
     EXPECT_EQ(slurp(f.dir / "cold" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
@@ -390,7 +463,7 @@ TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
 TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
     Fixture f;
     ASSERT_EQ(f.cached("a").exit_code, 0);
-    const RunResult r = f.cached("b", "--set scree.talus=30");
+    const test::RunResult r = f.cached("b", "--set scree.talus=30");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto rows = cache_column(r.out);
     EXPECT_EQ(row(rows, "base"), "cached") << r.out;         // not even read: nothing that ran needed it
@@ -399,7 +472,7 @@ TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
     EXPECT_EQ(count_rows(rows, ""), 3) << r.out;             // with the two exports of scree
     EXPECT_EQ(count_rows(rows, "cached"), 2) << r.out;       // export:png(base) put back from the cache
 
-    const RunResult plain = f.run("plain", "--no-cache --set scree.talus=30");
+    const test::RunResult plain = f.run("plain", "--no-cache --set scree.talus=30");
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     EXPECT_EQ(manifest_hashes(f.dir / "b"), manifest_hashes(f.dir / "plain"));
     EXPECT_NE(manifest_hashes(f.dir / "b"), manifest_hashes(f.dir / "a"));
@@ -408,19 +481,19 @@ TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
 TEST(CacheRun, ANewSeedOrUpstreamParameterRecomputesEverythingAfterIt) {
     Fixture f;
     ASSERT_EQ(f.cached("a").exit_code, 0);
-    const RunResult seed = f.cached("seed", "--seed 4");
+    const test::RunResult seed = f.cached("seed", "--seed 4");
     ASSERT_EQ(seed.exit_code, 0) << seed.err;
     EXPECT_EQ(count_rows(cache_column(seed.out), ""), 6) << seed.out;
     EXPECT_NE(manifest_hashes(f.dir / "seed"), manifest_hashes(f.dir / "a"));
 
-    const RunResult up = f.cached("up", "--set cut.iterations=41");
+    const test::RunResult up = f.cached("up", "--set cut.iterations=41");
     ASSERT_EQ(up.exit_code, 0) << up.err;
     const auto rows = cache_column(up.out);
     EXPECT_EQ(row(rows, "base"), "cached, read") << up.out;  // the new cut starts from it
     EXPECT_EQ(row(rows, "cut"), "") << up.out;
     EXPECT_EQ(row(rows, "scree"), "") << up.out;
     EXPECT_EQ(count_rows(rows, ""), 4) << up.out;  // cut, scree and scree's two exports
-    const RunResult plain = f.run("plain", "--no-cache --set cut.iterations=41");
+    const test::RunResult plain = f.run("plain", "--no-cache --set cut.iterations=41");
     EXPECT_EQ(manifest_hashes(f.dir / "up"), manifest_hashes(f.dir / "plain"));
 }
 
@@ -447,7 +520,7 @@ TEST(CacheRun, DamagedOrTruncatedEntriesAreRecomputedWithAWarningNeverUsed) {
     }
     // Change the last exporter's file name so the heightmap entries must be read, not only the exports'.
     f.dir.write("t.orogen", std::string(spec_text) + "export:png(scree, path=\"again.png\")\n");
-    const RunResult r = f.cached("b");
+    const test::RunResult r = f.cached("b");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::regex warning("orogen: warning: the cache entry of '[^']+' \\([0-9a-f]{64}\\.orc\\) is damaged \\([^\\n]*\\); recomputing it\\n");
     const auto n = std::distance(std::sregex_iterator(r.err.begin(), r.err.end(), warning), std::sregex_iterator());
@@ -461,7 +534,7 @@ TEST(CacheRun, DamagedOrTruncatedEntriesAreRecomputedWithAWarningNeverUsed) {
     EXPECT_EQ(got, expected);
     EXPECT_EQ(disk_hashes(f.dir / "b").at("scree.png"), expected.at("scree.png"));
     // The damaged entries were replaced by good ones: the next run reuses everything, silently.
-    const RunResult again = f.cached("c");
+    const test::RunResult again = f.cached("c");
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_EQ(again.err.find("warning"), std::string::npos) << again.err;
     EXPECT_EQ(count_rows(cache_column(again.out), ""), 0) << again.out;
@@ -476,7 +549,7 @@ TEST(CacheRun, AnEntryWrittenByAnotherVersionIsIgnored) {
         const char other[32] = "0.0.1-elsewhere";
         io.write(other, 32);
     }
-    const RunResult r = f.cached("b");
+    const test::RunResult r = f.cached("b");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("orogen: note: ignoring the cache entry of 'scree': written by orogen 0.0.1-elsewhere"),
               std::string::npos) << r.err;
@@ -487,7 +560,7 @@ TEST(CacheRun, AnEntryWrittenByAnotherVersionIsIgnored) {
 TEST(CacheRun, AFolderThatCannotBeWrittenGivesAWarningAndTheRunGoesOn) {
     Fixture f;
     const fs::path file = f.dir.write("not-a-folder", "x");
-    const RunResult r = f.run("a", "--cache " + q(file / "cache"));
+    const test::RunResult r = f.run("a", "--cache " + q(file / "cache"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("orogen: warning: cache folder " + (file / "cache").string() + ": cannot create it"), std::string::npos)
         << r.err;
@@ -505,15 +578,15 @@ TEST(CacheRun, EvictionKeepsTheFolderUnderItsLimitAndKeepsTheRecentEntries) {
     // Room for about two runs' entries.
     const std::uint64_t limit = one_run * 2 + one_run / 2;
     for (int seed = 10; seed < 15; ++seed) {
-        const RunResult r = f.cached("s" + std::to_string(seed), "--seed " + std::to_string(seed) +
+        const test::RunResult r = f.cached("s" + std::to_string(seed), "--seed " + std::to_string(seed) +
                                                                      " --cache-size " + std::to_string(limit));
         ASSERT_EQ(r.exit_code, 0) << r.err;
         EXPECT_LE(entry_bytes(f.cache), limit) << "after seed " << seed;
     }
     // The last seed's results are all there; the first seed's are gone.
-    const RunResult last = f.cached("again14", "--seed 14 --cache-size " + std::to_string(limit));
+    const test::RunResult last = f.cached("again14", "--seed 14 --cache-size " + std::to_string(limit));
     EXPECT_EQ(count_rows(cache_column(last.out), ""), 0) << last.out;
-    const RunResult first = f.cached("again10", "--seed 10 --cache-size " + std::to_string(limit));
+    const test::RunResult first = f.cached("again10", "--seed 10 --cache-size " + std::to_string(limit));
     EXPECT_EQ(count_rows(cache_column(first.out), ""), 6) << first.out;
 }
 
@@ -525,18 +598,18 @@ TEST(CacheRun, SeriesAreMadeOnlyWhenANodeThatRunsNeedsThem) {
                           "export:test-series(g, path=\"s.txt\")\n");
     const std::string env = "OROGEN_PLUGIN_PATH=" + std::string(OROGEN_FAKE_PLUGIN_DIR);
     const std::string cache = " --cache " + q(dir / "cache");
-    const RunResult plain = run_orogen("run s.orogen --out plain --no-cache", env, dir.path());
+    const test::RunResult plain = run_orogen("run s.orogen --out plain --no-cache", env, dir.path());
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     ASSERT_EQ(run_orogen("run s.orogen --out a" + cache, env, dir.path()).exit_code, 0);
-    const RunResult warm = run_orogen("run s.orogen --out b" + cache, env, dir.path());
+    const test::RunResult warm = run_orogen("run s.orogen --out b" + cache, env, dir.path());
     ASSERT_EQ(warm.exit_code, 0) << warm.err;
     EXPECT_EQ(count_rows(cache_column(warm.out), "cached"), 3) << warm.out;
     EXPECT_EQ(slurp(dir / "b" / "s.txt"), slurp(dir / "plain" / "s.txt"));
     // A changed exporter pulls the series again, through the mapped node.
-    const RunResult sums = run_orogen("run s.orogen --out c --set g.amount=3" + cache, env, dir.path());
+    const test::RunResult sums = run_orogen("run s.orogen --out c --set g.amount=3" + cache, env, dir.path());
     ASSERT_EQ(sums.exit_code, 0) << sums.err;
     EXPECT_EQ(count_rows(cache_column(sums.out), ""), 3) << sums.out;  // the export, g, and f (series are never kept)
-    const RunResult plain3 = run_orogen("run s.orogen --out plain3 --no-cache --set g.amount=3", env, dir.path());
+    const test::RunResult plain3 = run_orogen("run s.orogen --out plain3 --no-cache --set g.amount=3", env, dir.path());
     EXPECT_EQ(slurp(dir / "c" / "s.txt"), slurp(dir / "plain3" / "s.txt"));
     EXPECT_NE(slurp(dir / "c" / "s.txt"), slurp(dir / "b" / "s.txt"));
 }
@@ -544,7 +617,7 @@ TEST(CacheRun, SeriesAreMadeOnlyWhenANodeThatRunsNeedsThem) {
 TEST(CacheRun, TheDefaultFolderFollowsXdgCacheHomeAndTheEnvironmentCanTurnItOff) {
     Fixture f;
     const fs::path xdg = f.dir / "xdg";
-    const RunResult r = f.run("a", "", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg));
+    const test::RunResult r = f.run("a", "", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(entries(xdg / "orogen").size(), 6u);
     EXPECT_NE(r.out.find("nodes reused from " + (xdg / "orogen").string()), std::string::npos) << r.out;
@@ -553,9 +626,9 @@ TEST(CacheRun, TheDefaultFolderFollowsXdgCacheHomeAndTheEnvironmentCanTurnItOff)
     EXPECT_FALSE(fs::exists(xdg2));
     ASSERT_EQ(f.run("c", "--no-cache", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg2)).exit_code, 0);
     EXPECT_FALSE(fs::exists(xdg2));
-    const RunResult both = f.run("d", "--no-cache --cache " + q(xdg2));
+    const test::RunResult both = f.run("d", "--no-cache --cache " + q(xdg2));
     EXPECT_EQ(both.exit_code, 2);
-    const RunResult bad = f.run("d", "--cache-size lots");
+    const test::RunResult bad = f.run("d", "--cache-size lots");
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_NE(bad.err.find("--cache-size needs a size"), std::string::npos) << bad.err;
 }
@@ -565,7 +638,7 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
     const auto make_png = [&](int seed) {
         dir.write("gen.orogen", "orogen 1\ngrid 65 cell=10\nh = generate:diamond-square(amplitude=300)\n"
                                 "export:png(h, path=\"in.png\", bits=16)\n");
-        const RunResult r = run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
+        const test::RunResult r = run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
         ASSERT_EQ(r.exit_code, 0) << r.err;
         fs::copy_file(dir / "png" / "in.png", dir / "in.png", fs::copy_options::overwrite_existing);
     };
@@ -574,7 +647,7 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
                             "s = erode:thermal(h, talus=30, iterations=5)\nexport:png(s, path=\"s.png\", bits=16)\n");
     const std::string cache = " --cache " + q(dir / "cache");
     ASSERT_EQ(run_orogen("run use.orogen --out a" + cache, "", dir.path()).exit_code, 0);
-    const RunResult same = run_orogen("run use.orogen --out b" + cache, "", dir.path());
+    const test::RunResult same = run_orogen("run use.orogen --out b" + cache, "", dir.path());
     ASSERT_EQ(same.exit_code, 0) << same.err;
     auto rows = cache_column(same.out);
     EXPECT_EQ(row(rows, "h"), "") << same.out;  // the file may have changed: it is read again
@@ -582,12 +655,12 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
     EXPECT_EQ(slurp(dir / "b" / "s.png"), slurp(dir / "a" / "s.png"));
 
     make_png(2);  // the same path, other heights
-    const RunResult changed = run_orogen("run use.orogen --out c" + cache, "", dir.path());
+    const test::RunResult changed = run_orogen("run use.orogen --out c" + cache, "", dir.path());
     ASSERT_EQ(changed.exit_code, 0) << changed.err;
     rows = cache_column(changed.out);
     EXPECT_EQ(row(rows, "s"), "") << changed.out;
     EXPECT_EQ(count_rows(rows, ""), 3) << changed.out;
-    const RunResult plain = run_orogen("run use.orogen --out plain --no-cache", "", dir.path());
+    const test::RunResult plain = run_orogen("run use.orogen --out plain --no-cache", "", dir.path());
     EXPECT_EQ(slurp(dir / "c" / "s.png"), slurp(dir / "plain" / "s.png"));
     EXPECT_NE(slurp(dir / "c" / "s.png"), slurp(dir / "a" / "s.png"));
 }
@@ -598,12 +671,12 @@ TEST(CacheRun, WhatACachedNodeSaidIsSaidAgainWithoutReadingItsValues) {
                           "plates = tectonics:plates(crust, plates=3, steps=20)\n"
                           "export:png(plates, path=\"p.png\", bits=16)\n");
     const std::string cache = " --cache " + q(dir / "cache");
-    const RunResult first = run_orogen("run p.orogen --out a" + cache, "", dir.path());
+    const test::RunResult first = run_orogen("run p.orogen --out a" + cache, "", dir.path());
     ASSERT_EQ(first.exit_code, 0) << first.err;
     const auto said = first.err.find("plates: ");
     ASSERT_NE(said, std::string::npos) << first.err;
     const std::string line = first.err.substr(said, first.err.find('\n', said) - said);
-    const RunResult again = run_orogen("run p.orogen --out b" + cache, "", dir.path());
+    const test::RunResult again = run_orogen("run p.orogen --out b" + cache, "", dir.path());
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_NE(again.err.find(line + "\n"), std::string::npos) << again.err;
     const auto rows = cache_column(again.out);
