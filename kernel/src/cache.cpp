@@ -1096,6 +1096,54 @@ std::vector<FileFact> list_entries(const fs::path& folder, bool remove_stale_tem
 }
 }  // namespace
 
+namespace {
+void check_listable(const fs::path& folder) {
+    std::error_code ec;
+    const auto st = fs::status(folder, ec);
+    if (!fs::is_directory(st)) throw BadInput(folder.string() + " is not a folder; give the cache folder with --cache DIR");
+    fs::directory_iterator it(folder, ec);
+    if (ec) throw BadInput("cannot list the cache folder " + folder.string() + " (" + ec.message() + ")");
+}
+}  // namespace
+
+FolderFacts folder_facts(const fs::path& folder) {
+    FolderFacts f;
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(folder, ec))) return f;
+    check_listable(folder);
+    f.exists = true;
+    for (const auto& e : list_entries(folder, false)) {
+        f.oldest_ns = f.entries == 0 ? e.mtime_ns : std::min(f.oldest_ns, e.mtime_ns);
+        f.newest_ns = f.entries == 0 ? e.mtime_ns : std::max(f.newest_ns, e.mtime_ns);
+        ++f.entries;
+        f.bytes += e.bytes;
+    }
+    for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+        struct stat st{};
+        if (it->path().filename().string().rfind(".tmp-", 0) == 0 && ::lstat(it->path().c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+            ++f.temporaries;
+            f.temporary_bytes += std::uint64_t(st.st_size);
+        }
+    }
+    return f;
+}
+
+Cleared clear_folder(const fs::path& folder) {
+    Cleared c;
+    std::error_code ec;
+    if (!fs::exists(fs::symlink_status(folder, ec))) return c;
+    check_listable(folder);
+    for (const auto& e : list_entries(folder, true)) {  // true: killed runs' temporaries go too
+        if (::unlink(e.path.c_str()) == 0) {
+            ++c.entries;
+            c.bytes += e.bytes;
+        } else if (errno != ENOENT) {
+            c.failures.push_back(e.path.string() + ": " + errno_text(errno));
+        }
+    }
+    return c;
+}
+
 std::uint64_t Store::total_bytes() const {
     std::uint64_t total = 0;
     for (const auto& f : list_entries(settings_.folder, false)) total += f.bytes;

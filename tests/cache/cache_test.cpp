@@ -14,6 +14,8 @@
 #include <fstream>
 #include <functional>
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <map>
 #include <regex>
 #include <set>
@@ -631,6 +633,93 @@ TEST(CacheRun, TheDefaultFolderFollowsXdgCacheHomeAndTheEnvironmentCanTurnItOff)
     const test::RunResult bad = f.run("d", "--cache-size lots");
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_NE(bad.err.find("--cache-size needs a size"), std::string::npos) << bad.err;
+}
+
+TEST(CacheCommand, InfoCountsTheEntriesAndClearRemovesThemAndNothingElse) {
+    Fixture f;
+    ASSERT_EQ(f.cached("a").exit_code, 0);
+    const auto all = entries(f.cache);
+    ASSERT_EQ(all.size(), 6u);
+    std::uint64_t bytes = 0;
+    for (const auto& e : all) bytes += fs::file_size(e);
+    // The least and most recently used entries, set apart by an hour each way.
+    const auto now = fs::file_time_type::clock::now();
+    fs::last_write_time(all[0], now - std::chrono::hours(30));
+    fs::last_write_time(all[1], now + std::chrono::hours(2));
+    const auto utc = [](fs::file_time_type t) {
+        const std::time_t s = std::chrono::system_clock::to_time_t(std::chrono::file_clock::to_sys(t));
+        std::tm tm{};
+        ::gmtime_r(&s, &tm);
+        char buf[64];
+        std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+        return std::string(buf);
+    };
+    const std::string oldest = utc(fs::last_write_time(all[0])), newest = utc(fs::last_write_time(all[1]));
+    // Something of the user's in the folder, and a run's temporary.
+    const fs::path mine = f.cache / "notes.txt";
+    std::ofstream(mine) << "keep me";
+    std::ofstream(f.cache / ".tmp-0123456789abcdef-1-0") << "half an entry";
+
+    const test::RunResult info = run_orogen("cache info --cache " + q(f.cache) + " --cache-size 1M");
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("cache folder: " + f.cache.string() + "\n"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("entries:      6 ("), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("limit:        1.0 MiB (--cache-size)"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("oldest:       " + oldest), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("newest:       " + newest), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("temporaries:  1 (13 bytes)"), std::string::npos) << info.out;
+    // The size, to the byte when small enough, else to a tenth of the unit.
+    char expected_size[64];
+    std::snprintf(expected_size, sizeof expected_size, bytes < 1024 ? "%.0f bytes" : bytes < (1u << 20) ? "%.1f KiB" : "%.1f MiB",
+                  bytes < 1024 ? double(bytes) : bytes < (1u << 20) ? double(bytes) / 1024 : double(bytes) / (1 << 20));
+    EXPECT_NE(info.out.find(std::string("entries:      6 (") + expected_size + ")"), std::string::npos) << info.out;
+
+    const test::RunResult clear = run_orogen("cache clear --cache " + q(f.cache));
+    ASSERT_EQ(clear.exit_code, 0) << clear.err;
+    EXPECT_NE(clear.out.find("removed 6 cache entries (" + std::string(expected_size) + ")"), std::string::npos) << clear.out;
+    EXPECT_TRUE(entries(f.cache).empty());
+    EXPECT_TRUE(fs::exists(mine));                                       // not an entry: left alone
+    EXPECT_TRUE(fs::exists(f.cache / ".tmp-0123456789abcdef-1-0"));  // a run in progress may be writing it
+    const test::RunResult after = run_orogen("cache info --cache " + q(f.cache));
+    EXPECT_NE(after.out.find("entries:      0 (0 bytes)"), std::string::npos) << after.out;
+    EXPECT_EQ(after.out.find("oldest"), std::string::npos) << after.out;
+    EXPECT_NE(after.out.find("limit:        2.0 GiB (the default"), std::string::npos) << after.out;
+    // Cleared means recomputed: the next run reuses nothing.
+    const test::RunResult again = f.cached("b");
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_EQ(count_rows(cache_column(again.out), ""), 6) << again.out;
+}
+
+TEST(CacheCommand, TheDefaultFolderAndBadUsage) {
+    Fixture f;
+    const fs::path xdg = f.dir / "xdg";
+    ASSERT_EQ(f.run("a", "", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg)).exit_code, 0);
+    // Without --cache: the user's cache folder, even where OROGEN_NO_CACHE turns caching off for runs.
+    const test::RunResult info = run_orogen("cache info", "XDG_CACHE_HOME=" + q(xdg));
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("cache folder: " + (xdg / "orogen").string()), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("entries:      6 ("), std::string::npos) << info.out;
+    EXPECT_EQ(run_orogen("cache clear", "XDG_CACHE_HOME=" + q(xdg)).exit_code, 0);
+    EXPECT_TRUE(entries(xdg / "orogen").empty());
+
+    const test::RunResult missing = run_orogen("cache info --cache " + q(f.dir / "none"));
+    EXPECT_EQ(missing.exit_code, 0) << missing.err;
+    EXPECT_NE(missing.out.find("does not exist yet"), std::string::npos) << missing.out;
+    EXPECT_FALSE(fs::exists(f.dir / "none"));  // looking creates nothing
+    EXPECT_EQ(run_orogen("cache clear --cache " + q(f.dir / "none")).exit_code, 0);
+
+    const test::RunResult file = run_orogen("cache info --cache " + q(f.spec));
+    EXPECT_EQ(file.exit_code, 2);
+    EXPECT_NE(file.err.find("is not a folder"), std::string::npos) << file.err;
+    const test::RunResult no_verb = run_orogen("cache");
+    EXPECT_EQ(no_verb.exit_code, 2);
+    EXPECT_NE(no_verb.err.find("cache needs 'info' or 'clear'"), std::string::npos) << no_verb.err;
+    const test::RunResult bad_verb = run_orogen("cache purge");
+    EXPECT_EQ(bad_verb.exit_code, 2);
+    EXPECT_NE(bad_verb.err.find("got 'purge'"), std::string::npos) << bad_verb.err;
+    EXPECT_EQ(run_orogen("cache info --no-cache").exit_code, 2);
+    const test::RunResult help = run_orogen("--help");
+    EXPECT_NE(help.out.find("orogen cache clear [--cache DIR]"), std::string::npos) << help.out;
 }
 
 TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
