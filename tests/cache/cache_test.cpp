@@ -411,6 +411,31 @@ TEST(CacheRun, ARebuiltPluginWithTheSameVersionDoesNotFindTheOldBuildsResults) {
     EXPECT_EQ(first_height("b"), 2.0f);
 }
 
+TEST(CacheEntry, TheFuzzCorpusHoldsRealEntriesThatDecodeOnceResealed) {
+    // tests/fuzz/corpus/cache: entries of a real run (and a few made here), so the fuzzer starts from valid
+    // payloads of every kind. Resealed (the version and checksums of this build), each must decode: a corpus
+    // the decoder refuses would leave the fuzzer at the door.
+    const fs::path corpus = fs::path(OROGEN_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / "cache";
+    std::set<int> kinds;
+    int decoded = 0;
+    for (const auto& e : fs::directory_iterator(corpus)) {
+        const std::string name = e.path().filename().string();
+        if (e.path().extension() != ".orc" || name.rfind("truncated", 0) == 0) continue;
+        auto bytes = read_file(e.path());
+        ASSERT_GE(bytes.size(), 192u) << name;
+        cache::Digest key{};
+        std::memcpy(key.data(), bytes.data() + 88, key.size());
+        cache::reseal(bytes, key);
+        const cache::Contents c = cache::decode(bytes, key);
+        for (const auto& [_, v] : c.values) kinds.insert(int(v.type()));
+        if (!c.files.empty()) kinds.insert(100);
+        ++decoded;
+    }
+    EXPECT_GE(decoded, 8);
+    EXPECT_EQ(kinds, (std::set<int>{int(ValueType::heightmap), int(ValueType::image), int(ValueType::particles),
+                                    int(ValueType::plates), 100}));
+}
+
 TEST(CacheEntry, SizesParseWithUnits) {
     EXPECT_EQ(cache::parse_size("2G"), std::uint64_t(2) << 30);
     EXPECT_EQ(cache::parse_size("500M"), std::uint64_t(500) << 20);
