@@ -331,7 +331,7 @@ Value read_value(Reader& r) {
             if (!std::isfinite(cell) || cell <= 0) throw CorruptEntry("a heightmap whose cell size is not a positive number");
             const std::size_t size = std::size_t(width) * std::size_t(height);
             // Heights first, then each layer: fresh vectors filled from the mapping (deferred: on every core, beside
-            // the hash), then adopted by the Heightmap, so no byte of it is written twice.
+            // the checksum), then adopted by the Heightmap, so no byte of it is written twice.
             auto hm = std::make_shared<Heightmap>();
             const auto heights = r.array_span<float>();
             if (heights.size() != size) throw CorruptEntry("a heightmap's size does not match its heights");
@@ -500,7 +500,7 @@ public:
         if (!S_ISREG(st.st_mode)) throw CorruptEntry("not a regular file");
         size_ = std::size_t(st.st_size);
         if (size_ == 0) return;
-        void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | (std::getenv("NOPOP") ? 0 : MAP_POPULATE), fd_, 0);
+        void* p = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd_, 0);
         if (p == MAP_FAILED) throw std::system_error(errno, std::generic_category());
         data_ = static_cast<const std::uint8_t*>(p);
     }
