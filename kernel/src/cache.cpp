@@ -816,7 +816,7 @@ namespace {
 /// Parse the payload into `c`, leaving the large copies in `deferred`.
 void parse_payload(std::span<const std::uint8_t> entry, std::size_t offset, Contents& c, Deferred& deferred) {
     Reader r(entry, offset, &deferred);
-    const std::uint32_t values = r.count32(2);  // a name's length and a type at least (the count bounds the reserve)
+    const std::uint32_t values = r.count32(9);  // a name's length and a type at least (the count bounds the reserve)
     c.values.reserve(values);
     for (std::uint32_t i = 0; i < values; ++i) {
         std::string name = r.str();
@@ -848,8 +848,8 @@ Contents decode(std::span<const std::uint8_t> entry, const Digest& key) {
     c.messages = read_messages(entry.subspan(header_size, h.message_bytes), h);
     // Parse first (every size checked against the payload, so a damaged entry cannot make us read outside it
     // or allocate more than its size), leaving the large copies for later; then the copies into fresh vectors
-    // and the payload hash run together on every core, each byte of a value written once; only if the hash
-    // matches are the values assembled and returned. So nothing of a damaged entry is ever used.
+    // and the payload checksum run together on every core, each byte of a value written once; only if the
+    // checksum matches are the values assembled and returned. So nothing of a damaged entry is ever used.
     Deferred deferred;
     try {
         parse_payload(entry, h.payload_offset(), c, deferred);
