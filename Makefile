@@ -48,7 +48,7 @@ ASAN_CI     = /tests/(kernel|fuzz|cache)|/plugins/(generate/(diamond-square|faul
 FUZZ_SECONDS ?= 20
 FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000
-FUZZ_TARGETS  = spec overrides png sidecar
+FUZZ_TARGETS  = spec overrides png sidecar cache
 # Extra cmake arguments for the sanitizer builds, e.g. SAN_CMAKE=-DCMAKE_CXX_COMPILER_LAUNCHER=ccache
 SAN_CMAKE    ?=
 export ASAN_OPTIONS  ?= detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1

@@ -1,4 +1,4 @@
-// The `orogen` command: run | check | list | help | version.
+// The `orogen` command: run | check | list | help | version | cache.
 // Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
 // usage), 130 interrupted (SIGINT), 143 terminated (SIGTERM).
 #include "../src/loader.hpp"
@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <iostream>
 #include <sstream>
 #include <unistd.h>
@@ -50,6 +51,9 @@ const char* usage_text =
     "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
     "  orogen version                                  kernel, plugin API and plugin versions\n"
+    "  orogen cache info [--cache DIR] [--cache-size SIZE]   what the cache folder holds: entries, size, limit,\n"
+    "                                                  least and most recently used\n"
+    "  orogen cache clear [--cache DIR]                remove every cache entry (nothing else in the folder)\n"
     "\n"
     "Output paths in a spec are relative to --out (default: out/) and must stay inside it unless\n"
     "--allow-outside-out is given. A run's outputs appear together, the manifest last, or not at all.\n"
@@ -189,6 +193,66 @@ std::optional<cache::Settings> cache_settings(const Args& args) {
         return std::nullopt;
     }
     return s;
+}
+
+std::string human_bytes(std::uint64_t n) {
+    const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+    double v = double(n);
+    int u = 0;
+    while (v >= 1024 && u < 4) {
+        v /= 1024;
+        ++u;
+    }
+    char buf[64];
+    if (u == 0) std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(n));
+    else std::snprintf(buf, sizeof buf, "%.1f %s", v, units[u]);
+    return buf;
+}
+
+std::string utc_time(std::int64_t ns) {
+    const std::time_t t = std::time_t(ns / 1'000'000'000);
+    std::tm tm{};
+    ::gmtime_r(&t, &tm);
+    char buf[64];
+    std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+    return buf;
+}
+
+/// `orogen cache info|clear`: the folder a run would use (--cache DIR, else the user's cache folder; not
+/// turned off by OROGEN_NO_CACHE, which is about runs).
+int cmd_cache(const Args& args) {
+    if (args.positional.size() != 1 || (args.positional[0] != "info" && args.positional[0] != "clear"))
+        return usage_error(args.positional.empty() ? "cache needs 'info' or 'clear'"
+                                                   : "cache takes 'info' or 'clear', got '" + args.positional[0] + "'");
+    if (args.no_cache) return usage_error("--no-cache means no cache folder; give the folder with --cache DIR");
+    const fs::path folder = args.cache_dir ? fs::path(*args.cache_dir) : cache::default_folder();
+    if (folder.empty()) {
+        std::fprintf(stderr, "orogen: error: neither XDG_CACHE_HOME nor HOME is set, so there is no default cache "
+                             "folder; give one with --cache DIR\n");
+        return exit_bad_input;
+    }
+    if (args.positional[0] == "clear") {
+        const cache::Cleared c = cache::clear_folder(folder);
+        for (const auto& f : c.failures) std::fprintf(stderr, "orogen: error: cannot remove %s\n", f.c_str());
+        std::printf("removed %llu cache entr%s (%s) from %s\n", static_cast<unsigned long long>(c.entries),
+                    c.entries == 1 ? "y" : "ies", human_bytes(c.bytes).c_str(), folder.c_str());
+        return c.failures.empty() ? exit_ok : exit_failed;
+    }
+    const cache::FolderFacts f = cache::folder_facts(folder);
+    std::printf("cache folder: %s%s\n", folder.c_str(), f.exists ? "" : " (does not exist yet: nothing kept)");
+    std::printf("entries:      %llu (%s)\n", static_cast<unsigned long long>(f.entries), human_bytes(f.bytes).c_str());
+    std::printf("limit:        %s%s\n", human_bytes(args.cache_size).c_str(),
+                args.cache_size == cache::Settings{}.max_bytes ? " (the default; a run's --cache-size sets its own)" : " (--cache-size)");
+    if (f.entries > 0) {
+        std::printf("oldest:       %s (least recently used)\n", utc_time(f.oldest_ns).c_str());
+        std::printf("newest:       %s (most recently used)\n", utc_time(f.newest_ns).c_str());
+    }
+    if (f.temporaries > 0)
+        std::printf("temporaries:  %llu (%s) being written by a run, or left by a killed one (removed after an hour)\n",
+                    static_cast<unsigned long long>(f.temporaries), human_bytes(f.temporary_bytes).c_str());
+    if (f.bytes > args.cache_size)
+        std::printf("over the limit: the next run that keeps a result evicts the least recently used entries\n");
+    return exit_ok;
 }
 
 /// The tiles of a run under mpirun: --tiles or automatic.
@@ -448,7 +512,7 @@ int main(int argc, char** argv) {
         return exit_ok;
     }
     if (args.command == "--version") args.command = "version";
-    static const std::vector<std::string> commands = {"run", "check", "list", "help", "version"};
+    static const std::vector<std::string> commands = {"run", "check", "list", "help", "version", "cache"};
     if (std::find(commands.begin(), commands.end(), args.command) == commands.end()) {
         std::string msg = "unknown command '" + args.command + "'";
         const std::string guess = spec::closest(args.command, commands);
@@ -474,6 +538,15 @@ int main(int argc, char** argv) {
     } else if (args.tiles) {
         return usage_error("--tiles splits a run under mpirun (mpirun -n N orogen run SPEC --tiles RxC); "
                            "this orogen was not started by mpirun");
+    }
+
+    if (args.command == "cache") {  // no plugins needed
+        try {
+            return cmd_cache(args);
+        } catch (const Error& e) {
+            std::fprintf(stderr, "orogen: error: %s\n", e.what());
+            return e.kind() == Error::Kind::bad_input ? exit_bad_input : exit_failed;
+        }
     }
 
     PluginSet plugins;

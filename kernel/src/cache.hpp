@@ -58,19 +58,34 @@ private:
     void* ctx_;
 };
 
-/// A node's key: its kind and name, its plugin's name and version, the orogen version and the cache
-/// format, every resolved parameter, its seed, the grid, which input it is mapped over, and the keys of
-/// its inputs (nullopt for an optional input not given). `inputs` must all be known.
+/// The identity of the loaded binary (executable or shared library) whose code holds `address`: its GNU
+/// build-id ("build-id:<hex>", read from the ELF note in memory: free, and it changes whenever the linked
+/// code does), else the SHA-256 of its file ("sha256:<hex>", computed once per binary and process); "" if
+/// neither can be had (no such binary, or its file is gone).
+std::string binary_identity(const void* address);
+/// The identity of the orogen kernel library itself (binary_identity of its code), once per process.
+const std::string& kernel_identity();
+
+/// A node's key: its kind and name, its plugin's name, version and binary identity, the orogen version,
+/// the kernel's binary identity and the cache format, every resolved parameter, its seed, the grid, which
+/// input it is mapped over, and the keys of its inputs (nullopt for an optional input not given). `inputs`
+/// must all be known.
 Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std::optional<Digest>>& inputs,
-                std::string_view plugin_name, std::string_view plugin_version, std::uint64_t seed);
+                std::string_view plugin_name, std::string_view plugin_version, std::string_view plugin_identity,
+                std::uint64_t seed);
 /// The key of output `name` ("" the main value) of a node with key `node`.
 Digest output_key(const Digest& node, std::string_view name);
 /// The key of an output of a node that always runs: what it produced decides, not how.
 Digest content_key(const Digest& node, std::string_view name, const Digest& content);
 
-/// The hash that seals an entry's payload: SHA-256 over the SHA-256 of each
-/// 1 MiB block and the payload's length, so that every core checks a part.
+/// The content hash of a payload (value_hash): SHA-256 over the SHA-256 of each 1 MiB block and the
+/// payload's length, so that every core hashes a part.
 Digest payload_hash(std::span<const std::uint8_t> payload);
+/// The checksum that seals an entry's payload against damage (docs/cache.md): XXH3-128 of each 1 MiB block,
+/// then of the payload's length and those block checksums; in the first 16 bytes, the rest zero. Not a
+/// cryptographic hash, and need not be: it sits in the same file as what it checks, so it catches damage
+/// (a flipped bit, a torn write), not forgery, which SHA-256 in that place would not stop either.
+Digest payload_checksum(std::span<const std::uint8_t> payload);
 
 /// What a cached node produced.
 struct Contents {
@@ -90,6 +105,12 @@ bool storable(ValueType type);
 std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents);
 /// Parse a whole entry. Throws CorruptEntry (damaged, truncated, wrong hash) or OtherVersion.
 Contents decode(std::span<const std::uint8_t> entry, const Digest& key);
+
+/// Make `entry` pass every check of decode() under `key` but the payload's own validity: set the magic,
+/// format, version and key, clamp the messages block to what is there, and recompute the sizes, the messages'
+/// hash and the payload checksum. For the tests and the fuzz target (tests/fuzz/fuzz_cache.cpp), so that
+/// hand-made or mutated payloads reach the parser instead of stopping at the checksum.
+void reseal(std::vector<std::uint8_t>& entry, const Digest& key);
 
 /// The content hash of one value (its payload's hash), for values made by nodes that always run.
 Digest value_hash(const Value& value);
@@ -118,6 +139,28 @@ struct Settings {
 std::filesystem::path default_folder();
 /// "2G", "500M", "64MiB", "1e9", "123456" → bytes; nullopt if it is not a size.
 std::optional<std::uint64_t> parse_size(std::string_view text);
+
+/// What a cache folder holds (`orogen cache info`).
+struct FolderFacts {
+    bool exists = false;            ///< false: no such folder (nothing kept yet)
+    std::uint64_t entries = 0;      ///< `<key>.orc` files
+    std::uint64_t bytes = 0;        ///< their size
+    std::int64_t oldest_ns = 0;     ///< least recently used entry's modification time (ns since 1970), if any
+    std::int64_t newest_ns = 0;     ///< most recently used
+    std::uint64_t temporaries = 0;  ///< half-written entries of runs in progress or killed
+    std::uint64_t temporary_bytes = 0;
+};
+/// Throws orogen::BadInput if `folder` exists but is not a folder or cannot be listed.
+FolderFacts folder_facts(const std::filesystem::path& folder);
+
+struct Cleared {
+    std::uint64_t entries = 0, bytes = 0;  ///< removed
+    std::vector<std::string> failures;     ///< "file: why", one per entry that could not be removed
+};
+/// Remove every entry of `folder` and the temporaries of killed runs (older than an hour; a run in progress
+/// keeps its own). Nothing else in the folder is touched, so pointing --cache at a wrong folder loses no
+/// files of the user's. Throws orogen::BadInput as folder_facts does.
+Cleared clear_folder(const std::filesystem::path& folder);
 
 /// A cache folder in use. Every problem is one line to `warn`, never an error:
 /// the run goes on, without the cache if the folder cannot be used.

@@ -1,5 +1,7 @@
 #include "loader.hpp"
 
+#include "cache.hpp"
+
 #include <boost/dll/shared_library.hpp>
 
 #include <algorithm>
@@ -52,8 +54,11 @@ void PluginSet::load(const fs::path& file) {
         return;
     }
     OrogenPluginInfo info{};
+    std::string identity;
     try {
-        info = lib.get<OrogenPluginInfo()>(OROGEN_PLUGIN_ENTRY_SYMBOL)();
+        auto& entry = lib.get<OrogenPluginInfo()>(OROGEN_PLUGIN_ENTRY_SYMBOL);
+        identity = cache::binary_identity(reinterpret_cast<const void*>(&entry));  // the code its nodes run
+        info = entry();
     } catch (const std::exception& e) {
         impl_->problems.push_back(name + ": its entry point failed (" + e.what() + "); skipped");
         return;
@@ -89,7 +94,7 @@ void PluginSet::load(const fs::path& file) {
                                   "' failed while registering its nodes (unknown exception)");
     }
     impl_->registry.set_current_plugin("", "");
-    impl_->plugins.push_back({plugin_name, plugin_version, name});
+    impl_->plugins.push_back({plugin_name, plugin_version, name, identity});
     impl_->libraries.push_back(std::move(lib));
 }
 

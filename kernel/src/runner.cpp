@@ -340,7 +340,7 @@ private:
             if (p.type == ParamType::path && p.path_role == PathRole::input) s.rerun = true;
         if (!store_) return;
         const auto plugin = options_.node_plugins.find(node.node->qualified_name());
-        if (plugin == options_.node_plugins.end()) return;
+        if (plugin == options_.node_plugins.end() || plugin->second.identity.empty()) return;
         std::vector<std::optional<cache::Digest>> inputs;
         for (const auto& k : node.inputs) {
             if (k.empty()) {
@@ -351,7 +351,7 @@ private:
             if (it == value_keys_.end() || !it->second) return;  // made by a node whose result has no key
             inputs.push_back(it->second);
         }
-        s.key = cache::node_key(plan_, node, inputs, plugin->second.name, plugin->second.version,
+        s.key = cache::node_key(plan_, node, inputs, plugin->second.name, plugin->second.version, plugin->second.identity,
                                 node_seed(plan_.seed, node.label));
         if (s.rerun || node.value_name.empty()) return;
         value_keys_[node.value_name] = cache::output_key(*s.key, "");

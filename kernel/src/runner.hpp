@@ -20,6 +20,10 @@ class TiledRun;  // tiles.hpp
 
 struct PluginRecord {
     std::string name, version, file;
+    /// The loaded library's binary identity (cache::binary_identity: "build-id:<hex>" or "sha256:<hex>"), part
+    /// of every cache key of its nodes, so a rebuilt plugin whose code changed never finds the old results
+    /// even if its version string did not change. "": unknown, and its nodes are not cached.
+    std::string identity;
 };
 
 struct RunOptions {

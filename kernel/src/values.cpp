@@ -20,12 +20,28 @@ std::string_view to_string(ValueType type) {
 Heightmap::Heightmap(int width, int height, double cell, float elevation)
     : width_(width), height_(height), cell_(cell), heights_(std::size_t(width) * std::size_t(height), elevation) {}
 
+Heightmap::Heightmap(int width, int height, double cell, std::vector<float> heights)
+    : width_(width), height_(height), cell_(cell), heights_(std::move(heights)) {
+    if (width < 0 || height < 0 || heights_.size() != size())
+        throw Error("internal error: a " + std::to_string(width) + " x " + std::to_string(height) +
+                    " heightmap given " + std::to_string(heights_.size()) + " heights");
+}
+
 bool Heightmap::has_layer(std::string_view name) const { return layers_.find(name) != layers_.end(); }
 
 GridView Heightmap::layer(std::string_view name, float fill) {
     auto it = layers_.find(name);
     if (it == layers_.end()) it = layers_.emplace(std::string(name), std::vector<float>(size(), fill)).first;
     return {it->second.data(), width_, height_, cell_};
+}
+
+void Heightmap::set_layer(std::string_view name, std::vector<float> values) {
+    if (values.size() != size())
+        throw Error("internal error: layer '" + std::string(name) + "' of " + std::to_string(values.size()) +
+                    " values for a heightmap of " + std::to_string(size()) + " vertices");
+    auto it = layers_.find(name);
+    if (it == layers_.end()) layers_.emplace(std::string(name), std::move(values));
+    else it->second = std::move(values);
 }
 
 ConstGridView Heightmap::layer(std::string_view name) const {

@@ -2,6 +2,7 @@
 // test with its own cache folder, looking at the files it leaves and at the
 // timing table ("cached" / "cached, read" rows).
 #include "cache.hpp"
+#include "loader.hpp"
 
 #include <orogen/io.hpp>
 
@@ -11,6 +12,10 @@
 
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <map>
 #include <regex>
 #include <set>
@@ -92,15 +97,28 @@ std::uint64_t entry_bytes(const fs::path& cache) {
     return n;
 }
 
+/// The GNU build-id of an ELF file as binutils' readelf prints it ("" if it has none).
+std::string read_build_id(const fs::path& file) {
+    const std::string cmd = "readelf -n " + q(file) + " 2>/dev/null";
+    std::FILE* p = ::popen(cmd.c_str(), "r");
+    if (!p) return {};
+    std::string text;
+    char buf[4096];
+    while (std::size_t n = std::fread(buf, 1, sizeof buf, p)) text.append(buf, n);
+    ::pclose(p);
+    std::smatch m;
+    return std::regex_search(text, m, std::regex("Build ID: ([0-9a-f]+)")) ? m[1].str() : std::string();
+}
+
 struct Fixture {
     TempDir dir;
     fs::path spec = dir.write("t.orogen", spec_text);
     fs::path cache = dir / "cache";
 
-    RunResult run(const std::string& out, const std::string& extra = "", const std::string& env = "") const {
+    test::RunResult run(const std::string& out, const std::string& extra = "", const std::string& env = "") const {
         return run_orogen("run " + q(spec) + " --out " + q(dir / out) + " " + extra, env);
     }
-    RunResult cached(const std::string& out, const std::string& extra = "") const {
+    test::RunResult cached(const std::string& out, const std::string& extra = "") const {
         return run(out, "--cache " + q(cache) + " " + extra);
     }
 };
@@ -211,6 +229,213 @@ TEST(CacheEntry, AnyFlippedByteOrCutIsCaughtAndAnotherVersionOrKeyRefused) {
     EXPECT_THROW(cache::decode(good, kh2.text("other").finish()), cache::CorruptEntry);
 }
 
+TEST(CacheEntry, LargeValuesRoundTripThroughTheParallelCopies) {
+    // Arrays of 256 KiB and more are copied after parsing, on every core beside the checksum, and from 4 MiB
+    // into huge pages: a 1025² heightmap (4.2 MB a layer) with three layers, a large image and a large file.
+    const int n = 1025;
+    auto hm = std::make_shared<Heightmap>(n, n, 7.5, 0.0f);
+    for (std::size_t i = 0; i < hm->size(); ++i) hm->heights()[i] = float(i % 8191) * 0.5f - 100.0f;
+    for (const char* name : {"water", "sediment", "flow"}) {
+        GridView l = hm->layer(name);
+        for (std::size_t i = 0; i < l.size(); ++i) l.data[i] = float((i * 31 + std::strlen(name)) % 977);
+    }
+    auto img = std::make_shared<Image>();
+    img->width = 400;
+    img->height = 300;
+    img->rgba8.resize(400 * 300 * 4);
+    for (std::size_t i = 0; i < img->rgba8.size(); ++i) img->rgba8[i] = std::uint8_t(i * 13);
+    std::vector<std::uint8_t> file(3u << 20);
+    for (std::size_t i = 0; i < file.size(); ++i) file[i] = std::uint8_t(i ^ (i >> 9));
+    cache::Contents c;
+    c.values = {{"", Value(hm)}, {"img", Value(img)}};
+    c.files = {{"big.bin", file}, {"small.txt", {1, 2}}};
+    cache::Hasher kh;
+    const cache::Digest key = kh.text("big").finish();
+    const std::vector<std::uint8_t> bytes = cache::encode(key, c);
+    const cache::Contents d = cache::decode(bytes, key);
+    ASSERT_EQ(d.values.size(), 2u);
+    const Heightmap& h2 = *d.values[0].second.heightmap();
+    EXPECT_EQ(h2.width(), n);
+    EXPECT_EQ(h2.cell(), 7.5);
+    EXPECT_EQ(h2.heights(), hm->heights());
+    ASSERT_EQ(h2.layer_names(), hm->layer_names());
+    for (const auto& name : hm->layer_names())
+        EXPECT_EQ(std::memcmp(h2.layer(name).data, hm->layer(name).data, hm->size() * 4), 0) << name;
+    EXPECT_EQ(d.values[1].second.image()->rgba8, img->rgba8);
+    EXPECT_EQ(d.files, c.files);
+    EXPECT_EQ(cache::encode(key, d), bytes);
+    // One flipped bit in the last layer: refused, whichever core copied or checked that part.
+    auto bad = bytes;
+    bad[bytes.size() - (3u << 20) - 4096] ^= 0x04;
+    EXPECT_THROW(cache::decode(bad, key), cache::CorruptEntry);
+}
+
+namespace {
+/// An entry of one value whose payload passes the checksum but was written wrong on purpose: `edit` changes
+/// the encoded bytes of `c` (found by searching them), then the entry is resealed.
+std::string refusal(const cache::Contents& c, const std::function<void(std::vector<std::uint8_t>&)>& edit) {
+    cache::Hasher kh;
+    const cache::Digest key = kh.text("sealed").finish();
+    auto bytes = cache::encode(key, c);
+    edit(bytes);
+    cache::reseal(bytes, key);
+    try {
+        cache::decode(bytes, key);
+    } catch (const cache::CorruptEntry& e) {
+        return e.what();
+    }
+    return "accepted";
+}
+
+/// Replace the first occurrence of `from` in `bytes` by `to` (the same length).
+void replace_bytes(std::vector<std::uint8_t>& bytes, const std::vector<std::uint8_t>& from, const std::vector<std::uint8_t>& to) {
+    const auto it = std::search(bytes.begin(), bytes.end(), from.begin(), from.end());
+    ASSERT_NE(it, bytes.end());
+    std::copy(to.begin(), to.end(), it);
+}
+
+template <typename T>
+std::vector<std::uint8_t> le(T v) {
+    std::vector<std::uint8_t> b(sizeof v);
+    std::memcpy(b.data(), &v, sizeof v);
+    return b;
+}
+}  // namespace
+
+TEST(CacheEntry, ASealedButInvalidPayloadIsRefusedNamingWhatIsWrong) {
+    // What the checksum cannot catch (an entry written wrong, by another program or by hand) must still never
+    // reach a node: sizes that disagree, a path out of --out, an unknown kind.
+    auto img = std::make_shared<Image>();
+    img->width = 0x1234;
+    img->height = 1;
+    img->rgba8.assign(0x1234 * 4, 9);
+    cache::Contents ci;
+    ci.values = {{"", Value(img)}};
+    EXPECT_EQ(refusal(ci, [](auto&) {}), "accepted");
+    EXPECT_EQ(refusal(ci, [](auto& b) { replace_bytes(b, le<std::int32_t>(0x1234), le<std::int32_t>(0x1235)); }),
+              "an image's pixels do not match its size and format");
+
+    cache::Contents cf;
+    cf.files = {{"abc/x.png", {1, 2, 3}}};
+    const auto path = [](const std::string& p) {
+        return [p](std::vector<std::uint8_t>& b) {
+            replace_bytes(b, std::vector<std::uint8_t>{'a', 'b', 'c', '/', 'x', '.', 'p', 'n', 'g'},
+                          std::vector<std::uint8_t>(p.begin(), p.end()));
+        };
+    };
+    EXPECT_EQ(refusal(cf, path("abc/x.png")), "accepted");
+    EXPECT_EQ(refusal(cf, path("../../x.p")), "a kept file has a bad path ('../../x.p')");
+    EXPECT_EQ(refusal(cf, path("/etc/x.pn")), "a kept file has a bad path ('/etc/x.pn')");
+
+    auto hm = std::make_shared<Heightmap>(3, 2, 4.0, 1.0f);
+    hm->layer("water");
+    cache::Contents ch;
+    ch.values = {{"", Value(hm)}};
+    EXPECT_EQ(refusal(ch, [](auto& b) { replace_bytes(b, le<double>(4.0), le<double>(-4.0)); }),
+              "a heightmap whose cell size is not a positive number");
+    EXPECT_EQ(refusal(ch, [](auto& b) { replace_bytes(b, le<std::int32_t>(3), le<std::int32_t>(2)); }),
+              "a heightmap's size does not match its heights");
+
+    auto ps = std::make_shared<ParticleSeries>();
+    ps->frames.resize(1);
+    ps->frames[0].attributes["position"] = {3, {1, 2, 3, 4, 5, 6}};
+    ps->frames[0].attributes["zdensity"] = {1, {7, 8, 9}};  // one particle too many
+    cache::Contents cp;
+    cp.values = {{"", Value(ps)}};
+    EXPECT_EQ(refusal(cp, [](auto&) {}), "a particle attribute's size does not match the frame's particles");
+
+    auto ph = std::make_shared<PlateHistory>();
+    ph->collisions.push_back({4, 7, 8, {1, 2}, {3, 4}, BoundaryKind::transform, 0.125});
+    cache::Contents cpl;
+    cpl.values = {{"", Value(ph)}};
+    EXPECT_EQ(refusal(cpl, [](auto& b) { replace_bytes(b, le<std::int32_t>(3), le<std::int32_t>(9)); }),
+              "a collision of unknown kind 9");
+}
+
+TEST(CacheKey, ThePluginsAndTheKernelsBinaryIdentityAreInTheKey) {
+    NodeDescriptor desc{.kind = "generate", .name = "x"};
+    PlannedNode node;
+    node.node = &desc;
+    node.label = "x";
+    Plan plan;
+    const auto key = [&](std::string_view identity) { return cache::node_key(plan, node, {}, "p", "0.1.0", identity, 7); };
+    EXPECT_EQ(key("build-id:aa11"), key("build-id:aa11"));
+    EXPECT_NE(key("build-id:aa11"), key("build-id:aa12"));
+    EXPECT_NE(key("build-id:aa11"), key("sha256:aa11"));
+    // The kernel's own identity is its build-id as binutils reads it from the file.
+    const std::string kernel = read_build_id(fs::path(OROGEN_BINARY_DIR) / "lib" / "liborogen.so");
+    ASSERT_FALSE(kernel.empty());
+    EXPECT_EQ(cache::kernel_identity(), "build-id:" + kernel);
+}
+
+TEST(CacheKey, ALoadedPluginsIdentityIsItsBuildIdAndTwoBuildsDiffer) {
+    std::vector<std::string> identities;
+    for (const char* variant : {"1", "2"}) {
+        const fs::path file = fs::path(OROGEN_STALE_PLUGIN_DIR + std::string(variant)) / "stale.so";
+        PluginSet set;
+        set.load(file);
+        ASSERT_EQ(set.plugins().size(), 1u) << file;
+        const std::string id = read_build_id(file);
+        ASSERT_FALSE(id.empty()) << file;
+        EXPECT_EQ(set.plugins()[0].identity, "build-id:" + id);
+        identities.push_back(set.plugins()[0].identity);
+    }
+    EXPECT_NE(identities[0], identities[1]);
+    // Code with no loaded binary around it has no identity.
+    int on_the_stack = 0;
+    EXPECT_EQ(cache::binary_identity(&on_the_stack), "");
+}
+
+TEST(CacheRun, ARebuiltPluginWithTheSameVersionDoesNotFindTheOldBuildsResults) {
+    TempDir dir;
+    const fs::path spec = dir.write("s.orogen", "orogen 1\ngrid 9 cell=1\nh = generate:test-stale()\nexport:raw(h, path=\"h.r32\")\n");
+    const auto run = [&](const char* variant, const std::string& out) {
+        return run_orogen("run " + q(spec) + " --out " + q(dir / out) + " --cache " + q(dir / "cache"),
+                          "OROGEN_PLUGIN_PATH=" + q(OROGEN_STALE_PLUGIN_DIR + std::string(variant)));
+    };
+    const auto first_height = [&](const std::string& out) {
+        const auto bytes = read_file(dir / out / "h.r32");
+        float v = -1;
+        if (bytes.size() >= 4) std::memcpy(&v, bytes.data(), 4);
+        return v;
+    };
+    const test::RunResult a = run("1", "a");
+    ASSERT_EQ(a.exit_code, 0) << a.err;
+    EXPECT_EQ(first_height("a"), 1.0f);
+    const test::RunResult again = run("1", "again");  // the same build: everything reused
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_EQ(count_rows(cache_column(again.out), "cached"), 2) << again.out;
+    const test::RunResult b = run("2", "b");  // rebuilt with other code, same name and version "0.1.0"
+    ASSERT_EQ(b.exit_code, 0) << b.err;
+    EXPECT_EQ(row(cache_column(b.out), "h"), "") << b.out;  // ran
+    EXPECT_EQ(first_height("b"), 2.0f);
+}
+
+TEST(CacheEntry, TheFuzzCorpusHoldsRealEntriesThatDecodeOnceResealed) {
+    // tests/fuzz/corpus/cache: entries of a real run (and a few made here), so the fuzzer starts from valid
+    // payloads of every kind. Resealed (the version and checksums of this build), each must decode: a corpus
+    // the decoder refuses would leave the fuzzer at the door.
+    const fs::path corpus = fs::path(OROGEN_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / "cache";
+    std::set<int> kinds;
+    int decoded = 0;
+    for (const auto& e : fs::directory_iterator(corpus)) {
+        const std::string name = e.path().filename().string();
+        if (e.path().extension() != ".orc" || name.rfind("truncated", 0) == 0) continue;
+        auto bytes = read_file(e.path());
+        ASSERT_GE(bytes.size(), 192u) << name;
+        cache::Digest key{};
+        std::memcpy(key.data(), bytes.data() + 88, key.size());
+        cache::reseal(bytes, key);
+        const cache::Contents c = cache::decode(bytes, key);
+        for (const auto& [_, v] : c.values) kinds.insert(int(v.type()));
+        if (!c.files.empty()) kinds.insert(100);
+        ++decoded;
+    }
+    EXPECT_GE(decoded, 8);
+    EXPECT_EQ(kinds, (std::set<int>{int(ValueType::heightmap), int(ValueType::image), int(ValueType::particles),
+                                    int(ValueType::plates), 100}));
+}
+
 TEST(CacheEntry, SizesParseWithUnits) {
     EXPECT_EQ(cache::parse_size("2G"), std::uint64_t(2) << 30);
     EXPECT_EQ(cache::parse_size("500M"), std::uint64_t(500) << 20);
@@ -226,14 +451,14 @@ TEST(CacheEntry, SizesParseWithUnits) {
 
 TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
     Fixture f;
-    const RunResult plain = f.run("plain", "--no-cache");
+    const test::RunResult plain = f.run("plain", "--no-cache");
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     EXPECT_FALSE(fs::exists(f.cache));
-    const RunResult cold = f.cached("cold");
+    const test::RunResult cold = f.cached("cold");
     ASSERT_EQ(cold.exit_code, 0) << cold.err;
     EXPECT_EQ(count_rows(cache_column(cold.out), ""), 6) << cold.out;
     EXPECT_EQ(entries(f.cache).size(), 6u);  // three heightmaps, three exports' files
-    const RunResult warm = f.cached("warm");
+    const test::RunResult warm = f.cached("warm");
     ASSERT_EQ(warm.exit_code, 0) << warm.err;
 
     // Every node came from the cache; the exports' files were put back from their entries, and the
@@ -255,7 +480,7 @@ TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
     // (not staged and renamed over themselves) and still listed, so the manifest is again the same bytes.
     // A file changed since is put back.
     std::ofstream(f.dir / "cold" / "scree.png", std::ios::binary) << "edited by hand";
-    const RunResult again = f.cached("cold");
+    const test::RunResult again = f.cached("cold");
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_NE(again.out.find("wrote 5 files"), std::string::npos) << again.out;
     EXPECT_EQ(slurp(f.dir / "cold" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
@@ -265,7 +490,7 @@ TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
 TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
     Fixture f;
     ASSERT_EQ(f.cached("a").exit_code, 0);
-    const RunResult r = f.cached("b", "--set scree.talus=30");
+    const test::RunResult r = f.cached("b", "--set scree.talus=30");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto rows = cache_column(r.out);
     EXPECT_EQ(row(rows, "base"), "cached") << r.out;         // not even read: nothing that ran needed it
@@ -274,7 +499,7 @@ TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
     EXPECT_EQ(count_rows(rows, ""), 3) << r.out;             // with the two exports of scree
     EXPECT_EQ(count_rows(rows, "cached"), 2) << r.out;       // export:png(base) put back from the cache
 
-    const RunResult plain = f.run("plain", "--no-cache --set scree.talus=30");
+    const test::RunResult plain = f.run("plain", "--no-cache --set scree.talus=30");
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     EXPECT_EQ(manifest_hashes(f.dir / "b"), manifest_hashes(f.dir / "plain"));
     EXPECT_NE(manifest_hashes(f.dir / "b"), manifest_hashes(f.dir / "a"));
@@ -283,19 +508,19 @@ TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
 TEST(CacheRun, ANewSeedOrUpstreamParameterRecomputesEverythingAfterIt) {
     Fixture f;
     ASSERT_EQ(f.cached("a").exit_code, 0);
-    const RunResult seed = f.cached("seed", "--seed 4");
+    const test::RunResult seed = f.cached("seed", "--seed 4");
     ASSERT_EQ(seed.exit_code, 0) << seed.err;
     EXPECT_EQ(count_rows(cache_column(seed.out), ""), 6) << seed.out;
     EXPECT_NE(manifest_hashes(f.dir / "seed"), manifest_hashes(f.dir / "a"));
 
-    const RunResult up = f.cached("up", "--set cut.iterations=41");
+    const test::RunResult up = f.cached("up", "--set cut.iterations=41");
     ASSERT_EQ(up.exit_code, 0) << up.err;
     const auto rows = cache_column(up.out);
     EXPECT_EQ(row(rows, "base"), "cached, read") << up.out;  // the new cut starts from it
     EXPECT_EQ(row(rows, "cut"), "") << up.out;
     EXPECT_EQ(row(rows, "scree"), "") << up.out;
     EXPECT_EQ(count_rows(rows, ""), 4) << up.out;  // cut, scree and scree's two exports
-    const RunResult plain = f.run("plain", "--no-cache --set cut.iterations=41");
+    const test::RunResult plain = f.run("plain", "--no-cache --set cut.iterations=41");
     EXPECT_EQ(manifest_hashes(f.dir / "up"), manifest_hashes(f.dir / "plain"));
 }
 
@@ -322,13 +547,13 @@ TEST(CacheRun, DamagedOrTruncatedEntriesAreRecomputedWithAWarningNeverUsed) {
     }
     // Change the last exporter's file name so the heightmap entries must be read, not only the exports'.
     f.dir.write("t.orogen", std::string(spec_text) + "export:png(scree, path=\"again.png\")\n");
-    const RunResult r = f.cached("b");
+    const test::RunResult r = f.cached("b");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::regex warning("orogen: warning: the cache entry of '[^']+' \\([0-9a-f]{64}\\.orc\\) is damaged \\([^\\n]*\\); recomputing it\\n");
     const auto n = std::distance(std::sregex_iterator(r.err.begin(), r.err.end(), warning), std::sregex_iterator());
     EXPECT_EQ(n, 6) << r.err;
     EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("does not match its SHA-256"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("does not match its checksum"), std::string::npos) << r.err;
     auto expected = manifest_hashes(f.dir / "plain");
     auto got = manifest_hashes(f.dir / "b");
     ASSERT_EQ(got.count("again.png"), 1u);
@@ -336,7 +561,7 @@ TEST(CacheRun, DamagedOrTruncatedEntriesAreRecomputedWithAWarningNeverUsed) {
     EXPECT_EQ(got, expected);
     EXPECT_EQ(disk_hashes(f.dir / "b").at("scree.png"), expected.at("scree.png"));
     // The damaged entries were replaced by good ones: the next run reuses everything, silently.
-    const RunResult again = f.cached("c");
+    const test::RunResult again = f.cached("c");
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_EQ(again.err.find("warning"), std::string::npos) << again.err;
     EXPECT_EQ(count_rows(cache_column(again.out), ""), 0) << again.out;
@@ -351,7 +576,7 @@ TEST(CacheRun, AnEntryWrittenByAnotherVersionIsIgnored) {
         const char other[32] = "0.0.1-elsewhere";
         io.write(other, 32);
     }
-    const RunResult r = f.cached("b");
+    const test::RunResult r = f.cached("b");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("orogen: note: ignoring the cache entry of 'scree': written by orogen 0.0.1-elsewhere"),
               std::string::npos) << r.err;
@@ -362,7 +587,7 @@ TEST(CacheRun, AnEntryWrittenByAnotherVersionIsIgnored) {
 TEST(CacheRun, AFolderThatCannotBeWrittenGivesAWarningAndTheRunGoesOn) {
     Fixture f;
     const fs::path file = f.dir.write("not-a-folder", "x");
-    const RunResult r = f.run("a", "--cache " + q(file / "cache"));
+    const test::RunResult r = f.run("a", "--cache " + q(file / "cache"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("orogen: warning: cache folder " + (file / "cache").string() + ": cannot create it"), std::string::npos)
         << r.err;
@@ -380,15 +605,15 @@ TEST(CacheRun, EvictionKeepsTheFolderUnderItsLimitAndKeepsTheRecentEntries) {
     // Room for about two runs' entries.
     const std::uint64_t limit = one_run * 2 + one_run / 2;
     for (int seed = 10; seed < 15; ++seed) {
-        const RunResult r = f.cached("s" + std::to_string(seed), "--seed " + std::to_string(seed) +
+        const test::RunResult r = f.cached("s" + std::to_string(seed), "--seed " + std::to_string(seed) +
                                                                      " --cache-size " + std::to_string(limit));
         ASSERT_EQ(r.exit_code, 0) << r.err;
         EXPECT_LE(entry_bytes(f.cache), limit) << "after seed " << seed;
     }
     // The last seed's results are all there; the first seed's are gone.
-    const RunResult last = f.cached("again14", "--seed 14 --cache-size " + std::to_string(limit));
+    const test::RunResult last = f.cached("again14", "--seed 14 --cache-size " + std::to_string(limit));
     EXPECT_EQ(count_rows(cache_column(last.out), ""), 0) << last.out;
-    const RunResult first = f.cached("again10", "--seed 10 --cache-size " + std::to_string(limit));
+    const test::RunResult first = f.cached("again10", "--seed 10 --cache-size " + std::to_string(limit));
     EXPECT_EQ(count_rows(cache_column(first.out), ""), 6) << first.out;
 }
 
@@ -400,18 +625,18 @@ TEST(CacheRun, SeriesAreMadeOnlyWhenANodeThatRunsNeedsThem) {
                           "export:test-series(g, path=\"s.txt\")\n");
     const std::string env = "OROGEN_PLUGIN_PATH=" + std::string(OROGEN_FAKE_PLUGIN_DIR);
     const std::string cache = " --cache " + q(dir / "cache");
-    const RunResult plain = run_orogen("run s.orogen --out plain --no-cache", env, dir.path());
+    const test::RunResult plain = run_orogen("run s.orogen --out plain --no-cache", env, dir.path());
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
     ASSERT_EQ(run_orogen("run s.orogen --out a" + cache, env, dir.path()).exit_code, 0);
-    const RunResult warm = run_orogen("run s.orogen --out b" + cache, env, dir.path());
+    const test::RunResult warm = run_orogen("run s.orogen --out b" + cache, env, dir.path());
     ASSERT_EQ(warm.exit_code, 0) << warm.err;
     EXPECT_EQ(count_rows(cache_column(warm.out), "cached"), 3) << warm.out;
     EXPECT_EQ(slurp(dir / "b" / "s.txt"), slurp(dir / "plain" / "s.txt"));
     // A changed exporter pulls the series again, through the mapped node.
-    const RunResult sums = run_orogen("run s.orogen --out c --set g.amount=3" + cache, env, dir.path());
+    const test::RunResult sums = run_orogen("run s.orogen --out c --set g.amount=3" + cache, env, dir.path());
     ASSERT_EQ(sums.exit_code, 0) << sums.err;
     EXPECT_EQ(count_rows(cache_column(sums.out), ""), 3) << sums.out;  // the export, g, and f (series are never kept)
-    const RunResult plain3 = run_orogen("run s.orogen --out plain3 --no-cache --set g.amount=3", env, dir.path());
+    const test::RunResult plain3 = run_orogen("run s.orogen --out plain3 --no-cache --set g.amount=3", env, dir.path());
     EXPECT_EQ(slurp(dir / "c" / "s.txt"), slurp(dir / "plain3" / "s.txt"));
     EXPECT_NE(slurp(dir / "c" / "s.txt"), slurp(dir / "b" / "s.txt"));
 }
@@ -419,7 +644,7 @@ TEST(CacheRun, SeriesAreMadeOnlyWhenANodeThatRunsNeedsThem) {
 TEST(CacheRun, TheDefaultFolderFollowsXdgCacheHomeAndTheEnvironmentCanTurnItOff) {
     Fixture f;
     const fs::path xdg = f.dir / "xdg";
-    const RunResult r = f.run("a", "", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg));
+    const test::RunResult r = f.run("a", "", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(entries(xdg / "orogen").size(), 6u);
     EXPECT_NE(r.out.find("nodes reused from " + (xdg / "orogen").string()), std::string::npos) << r.out;
@@ -428,11 +653,98 @@ TEST(CacheRun, TheDefaultFolderFollowsXdgCacheHomeAndTheEnvironmentCanTurnItOff)
     EXPECT_FALSE(fs::exists(xdg2));
     ASSERT_EQ(f.run("c", "--no-cache", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg2)).exit_code, 0);
     EXPECT_FALSE(fs::exists(xdg2));
-    const RunResult both = f.run("d", "--no-cache --cache " + q(xdg2));
+    const test::RunResult both = f.run("d", "--no-cache --cache " + q(xdg2));
     EXPECT_EQ(both.exit_code, 2);
-    const RunResult bad = f.run("d", "--cache-size lots");
+    const test::RunResult bad = f.run("d", "--cache-size lots");
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_NE(bad.err.find("--cache-size needs a size"), std::string::npos) << bad.err;
+}
+
+TEST(CacheCommand, InfoCountsTheEntriesAndClearRemovesThemAndNothingElse) {
+    Fixture f;
+    ASSERT_EQ(f.cached("a").exit_code, 0);
+    const auto all = entries(f.cache);
+    ASSERT_EQ(all.size(), 6u);
+    std::uint64_t bytes = 0;
+    for (const auto& e : all) bytes += fs::file_size(e);
+    // The least and most recently used entries, set apart by an hour each way.
+    const auto now = fs::file_time_type::clock::now();
+    fs::last_write_time(all[0], now - std::chrono::hours(30));
+    fs::last_write_time(all[1], now + std::chrono::hours(2));
+    const auto utc = [](fs::file_time_type t) {
+        const std::time_t s = std::chrono::system_clock::to_time_t(std::chrono::file_clock::to_sys(t));
+        std::tm tm{};
+        ::gmtime_r(&s, &tm);
+        char buf[64];
+        std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
+        return std::string(buf);
+    };
+    const std::string oldest = utc(fs::last_write_time(all[0])), newest = utc(fs::last_write_time(all[1]));
+    // Something of the user's in the folder, and a run's temporary.
+    const fs::path mine = f.cache / "notes.txt";
+    std::ofstream(mine) << "keep me";
+    std::ofstream(f.cache / ".tmp-0123456789abcdef-1-0") << "half an entry";
+
+    const test::RunResult info = run_orogen("cache info --cache " + q(f.cache) + " --cache-size 1M");
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("cache folder: " + f.cache.string() + "\n"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("entries:      6 ("), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("limit:        1.0 MiB (--cache-size)"), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("oldest:       " + oldest), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("newest:       " + newest), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("temporaries:  1 (13 bytes)"), std::string::npos) << info.out;
+    // The size, to the byte when small enough, else to a tenth of the unit.
+    char expected_size[64];
+    std::snprintf(expected_size, sizeof expected_size, bytes < 1024 ? "%.0f bytes" : bytes < (1u << 20) ? "%.1f KiB" : "%.1f MiB",
+                  bytes < 1024 ? double(bytes) : bytes < (1u << 20) ? double(bytes) / 1024 : double(bytes) / (1 << 20));
+    EXPECT_NE(info.out.find(std::string("entries:      6 (") + expected_size + ")"), std::string::npos) << info.out;
+
+    const test::RunResult clear = run_orogen("cache clear --cache " + q(f.cache));
+    ASSERT_EQ(clear.exit_code, 0) << clear.err;
+    EXPECT_NE(clear.out.find("removed 6 cache entries (" + std::string(expected_size) + ")"), std::string::npos) << clear.out;
+    EXPECT_TRUE(entries(f.cache).empty());
+    EXPECT_TRUE(fs::exists(mine));                                       // not an entry: left alone
+    EXPECT_TRUE(fs::exists(f.cache / ".tmp-0123456789abcdef-1-0"));  // a run in progress may be writing it
+    const test::RunResult after = run_orogen("cache info --cache " + q(f.cache));
+    EXPECT_NE(after.out.find("entries:      0 (0 bytes)"), std::string::npos) << after.out;
+    EXPECT_EQ(after.out.find("oldest"), std::string::npos) << after.out;
+    EXPECT_NE(after.out.find("limit:        2.0 GiB (the default"), std::string::npos) << after.out;
+    // Cleared means recomputed: the next run reuses nothing.
+    const test::RunResult again = f.cached("b");
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_EQ(count_rows(cache_column(again.out), ""), 6) << again.out;
+}
+
+TEST(CacheCommand, TheDefaultFolderAndBadUsage) {
+    Fixture f;
+    const fs::path xdg = f.dir / "xdg";
+    ASSERT_EQ(f.run("a", "", "OROGEN_NO_CACHE= XDG_CACHE_HOME=" + q(xdg)).exit_code, 0);
+    // Without --cache: the user's cache folder, even where OROGEN_NO_CACHE turns caching off for runs.
+    const test::RunResult info = run_orogen("cache info", "XDG_CACHE_HOME=" + q(xdg));
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("cache folder: " + (xdg / "orogen").string()), std::string::npos) << info.out;
+    EXPECT_NE(info.out.find("entries:      6 ("), std::string::npos) << info.out;
+    EXPECT_EQ(run_orogen("cache clear", "XDG_CACHE_HOME=" + q(xdg)).exit_code, 0);
+    EXPECT_TRUE(entries(xdg / "orogen").empty());
+
+    const test::RunResult missing = run_orogen("cache info --cache " + q(f.dir / "none"));
+    EXPECT_EQ(missing.exit_code, 0) << missing.err;
+    EXPECT_NE(missing.out.find("does not exist yet"), std::string::npos) << missing.out;
+    EXPECT_FALSE(fs::exists(f.dir / "none"));  // looking creates nothing
+    EXPECT_EQ(run_orogen("cache clear --cache " + q(f.dir / "none")).exit_code, 0);
+
+    const test::RunResult file = run_orogen("cache info --cache " + q(f.spec));
+    EXPECT_EQ(file.exit_code, 2);
+    EXPECT_NE(file.err.find("is not a folder"), std::string::npos) << file.err;
+    const test::RunResult no_verb = run_orogen("cache");
+    EXPECT_EQ(no_verb.exit_code, 2);
+    EXPECT_NE(no_verb.err.find("cache needs 'info' or 'clear'"), std::string::npos) << no_verb.err;
+    const test::RunResult bad_verb = run_orogen("cache purge");
+    EXPECT_EQ(bad_verb.exit_code, 2);
+    EXPECT_NE(bad_verb.err.find("got 'purge'"), std::string::npos) << bad_verb.err;
+    EXPECT_EQ(run_orogen("cache info --no-cache").exit_code, 2);
+    const test::RunResult help = run_orogen("--help");
+    EXPECT_NE(help.out.find("orogen cache clear [--cache DIR]"), std::string::npos) << help.out;
 }
 
 TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
@@ -440,7 +752,7 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
     const auto make_png = [&](int seed) {
         dir.write("gen.orogen", "orogen 1\ngrid 65 cell=10\nh = generate:diamond-square(amplitude=300)\n"
                                 "export:png(h, path=\"in.png\", bits=16)\n");
-        const RunResult r = run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
+        const test::RunResult r = run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
         ASSERT_EQ(r.exit_code, 0) << r.err;
         fs::copy_file(dir / "png" / "in.png", dir / "in.png", fs::copy_options::overwrite_existing);
     };
@@ -449,7 +761,7 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
                             "s = erode:thermal(h, talus=30, iterations=5)\nexport:png(s, path=\"s.png\", bits=16)\n");
     const std::string cache = " --cache " + q(dir / "cache");
     ASSERT_EQ(run_orogen("run use.orogen --out a" + cache, "", dir.path()).exit_code, 0);
-    const RunResult same = run_orogen("run use.orogen --out b" + cache, "", dir.path());
+    const test::RunResult same = run_orogen("run use.orogen --out b" + cache, "", dir.path());
     ASSERT_EQ(same.exit_code, 0) << same.err;
     auto rows = cache_column(same.out);
     EXPECT_EQ(row(rows, "h"), "") << same.out;  // the file may have changed: it is read again
@@ -457,12 +769,12 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
     EXPECT_EQ(slurp(dir / "b" / "s.png"), slurp(dir / "a" / "s.png"));
 
     make_png(2);  // the same path, other heights
-    const RunResult changed = run_orogen("run use.orogen --out c" + cache, "", dir.path());
+    const test::RunResult changed = run_orogen("run use.orogen --out c" + cache, "", dir.path());
     ASSERT_EQ(changed.exit_code, 0) << changed.err;
     rows = cache_column(changed.out);
     EXPECT_EQ(row(rows, "s"), "") << changed.out;
     EXPECT_EQ(count_rows(rows, ""), 3) << changed.out;
-    const RunResult plain = run_orogen("run use.orogen --out plain --no-cache", "", dir.path());
+    const test::RunResult plain = run_orogen("run use.orogen --out plain --no-cache", "", dir.path());
     EXPECT_EQ(slurp(dir / "c" / "s.png"), slurp(dir / "plain" / "s.png"));
     EXPECT_NE(slurp(dir / "c" / "s.png"), slurp(dir / "a" / "s.png"));
 }
@@ -473,12 +785,12 @@ TEST(CacheRun, WhatACachedNodeSaidIsSaidAgainWithoutReadingItsValues) {
                           "plates = tectonics:plates(crust, plates=3, steps=20)\n"
                           "export:png(plates, path=\"p.png\", bits=16)\n");
     const std::string cache = " --cache " + q(dir / "cache");
-    const RunResult first = run_orogen("run p.orogen --out a" + cache, "", dir.path());
+    const test::RunResult first = run_orogen("run p.orogen --out a" + cache, "", dir.path());
     ASSERT_EQ(first.exit_code, 0) << first.err;
     const auto said = first.err.find("plates: ");
     ASSERT_NE(said, std::string::npos) << first.err;
     const std::string line = first.err.substr(said, first.err.find('\n', said) - said);
-    const RunResult again = run_orogen("run p.orogen --out b" + cache, "", dir.path());
+    const test::RunResult again = run_orogen("run p.orogen --out b" + cache, "", dir.path());
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_NE(again.err.find(line + "\n"), std::string::npos) << again.err;
     const auto rows = cache_column(again.out);

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <sstream>
+#include <utility>
 
 #include "orogen_test.hpp"
 
@@ -193,6 +194,27 @@ TEST(Png, BadFilesAreRefusedWithTheirName) {
                 << e.what();
         }
     }
+}
+
+TEST(Heightmap, AdoptsFilledVectorsAndRefusesWrongSizes) {
+    std::vector<float> heights{1, 2, 3, 4, 5, 6};
+    const float* data = heights.data();
+    Heightmap hm(3, 2, 10.0, std::move(heights));
+    EXPECT_EQ(hm.heights().data(), data);  // adopted, not copied
+    EXPECT_EQ(hm.view().at(2, 1), 6.0f);
+    std::vector<float> water{0, 0, 0, 0, 0, 0.5f};
+    const float* wdata = water.data();
+    hm.set_layer("water", std::move(water));
+    EXPECT_EQ(hm.layer("water").data, wdata);
+    hm.set_layer("water", std::vector<float>(6, 2.0f));  // replaces
+    EXPECT_EQ(std::as_const(hm).layer("water").data[5], 2.0f);
+    EXPECT_EQ(hm.layer_names(), std::vector<std::string>{"water"});
+    EXPECT_THROW(hm.set_layer("flow", std::vector<float>(5)), Error);
+    EXPECT_FALSE(hm.has_layer("flow"));
+    EXPECT_THROW(Heightmap(3, 3, 1.0, std::vector<float>(6)), Error);
+    // The flat constructor still works as before.
+    const Heightmap flat(2, 2, 1.0, 7.0f);
+    EXPECT_EQ(flat.heights(), std::vector<float>(4, 7.0f));
 }
 
 TEST(Heightmap, MissingLayerNamesTheOnesThatExist) {

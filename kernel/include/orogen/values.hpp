@@ -45,6 +45,10 @@ public:
     Heightmap() = default;
     /// A flat heightmap of `width` × `height` vertices at `elevation` metres.
     Heightmap(int width, int height, double cell, float elevation = 0.0f);
+    /// A heightmap that adopts `heights` (width × height values, row by row, metres) without copying or
+    /// zero-filling: for code that fills the elevations itself (a reader, a generator writing each
+    /// vertex once). Throws orogen::Error if the size is not width × height.
+    Heightmap(int width, int height, double cell, std::vector<float> heights);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -59,6 +63,9 @@ public:
     bool has_layer(std::string_view name) const;
     /// The layer `name`, created (filled with `fill`) if it does not exist yet.
     GridView layer(std::string_view name, float fill = 0.0f);
+    /// Make `values` (size() values, row by row) the layer `name`, replacing a layer of that name, without
+    /// copying or filling. Throws orogen::Error if the size is not size().
+    void set_layer(std::string_view name, std::vector<float> values);
     /// The layer `name`; throws orogen::Error naming the existing layers if absent.
     ConstGridView layer(std::string_view name) const;
     void remove_layer(std::string_view name);
