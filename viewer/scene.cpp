@@ -819,6 +819,13 @@ struct Scene::Impl {
         double b[6];
         renderer->ComputeVisiblePropBounds(b);
         if (b[0] > b[1]) return;
+        if (const Terrain* t = ground(); t && terrain->GetVisibility()) {
+            // The full-resolution height range, not the decimated mesh's: the
+            // same camera whatever the mesh's level of detail (--full, refined).
+            const double* h = t->heights->GetRange();
+            b[2] = std::min(b[2], h[0] * exaggeration);
+            b[3] = std::max(b[3], h[1] * exaggeration);
+        }
         renderer->ComputeAspect();  // before the first render too: the fit depends on the window's shape
         const double centre[3] = {(b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2};
         const double el = (top_view ? 90.0 : std::clamp(angles.elevation, -89.0, 90.0)) * pi / 180,
