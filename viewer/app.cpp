@@ -21,6 +21,7 @@
 #include <vtkRenderWindow.h>
 #include <vtkRenderWindowInteractor.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -395,7 +396,8 @@ private:
         std::cout << "first frame: " << ms_since_process_start() << " ms wall, " << cpu_ms() << " ms CPU\n";
         auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
         // Twice round: the first switch to a layer maps its colours, a switch back uploads the kept texture.
-        for (const char* round : {"", " (again)"})
+        for (const char* round : {"", " (again)"}) {
+            std::vector<double> walls, cpus;
             for (const auto& name : scene_->layer_names()) {
                 const auto t0 = Clock::now();
                 const double c0 = cpu_ms();
@@ -408,7 +410,17 @@ private:
                 std::cout << "layer " << name << round << ": " << ms(t0, t2) << " ms wall, " << c2 - c0
                           << " ms CPU (colour " << ms(t0, t1) << " ms wall " << c1 - c0 << " ms CPU, render "
                           << ms(t1, t2) << " ms wall " << c2 - c1 << " ms CPU)\n";
+                walls.push_back(ms(t0, t2));
+                cpus.push_back(c2 - c0);
             }
+            auto median = [](std::vector<double> v) {
+                std::sort(v.begin(), v.end());
+                return v[v.size() / 2];
+            };
+            std::cout << "layer switch" << (*round ? round : " (first time)") << ": median " << median(walls)
+                      << " ms wall, " << median(cpus) << " ms CPU; min " << *std::min_element(walls.begin(), walls.end())
+                      << " ms wall, " << *std::min_element(cpus.begin(), cpus.end()) << " ms CPU\n";
+        }
         scene_->set_layer(o_.layer.empty() ? "splat" : o_.layer);
         scene_->render();
         double best_wall = 1e9, best_cpu = 1e9;

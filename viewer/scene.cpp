@@ -256,14 +256,15 @@ struct Scene::Impl {
     std::map<std::size_t, Colouring> colourings;  // by layer index; cleared with the content
     /// Finished textures (colour × hillshade, RGB), most recently shown first:
     /// switching back to a layer uploads one and maps nothing. At most
-    /// `texture_cache_bytes` are kept (13 textures of a 1025² terrain, 3 MB
-    /// each; 5 of a 4097² one), besides the one shown.
+    /// `texture_cache_bytes` are kept besides the one shown: every layer of a
+    /// 1025² terrain (3 MB each), two of a 4097² one (50 MB each), so the
+    /// 4097² terrain stays well within 2 GiB.
     struct CachedTexture {
         std::size_t layer;
         vtkSmartPointer<vtkImageData> image;
     };
     std::list<CachedTexture> textures;
-    static constexpr std::size_t texture_cache_bytes = std::size_t(256) << 20;
+    static constexpr std::size_t texture_cache_bytes = std::size_t(128) << 20;
 
     // time series
     vtkNew<vtkActor> plates, collisions, particles;
@@ -1094,6 +1095,7 @@ bool Scene::full_resolution() const { return impl_->full; }
 double Scene::exaggeration() const { return impl_->exaggeration; }
 void Scene::set_exaggeration(double e) {
     impl_->exaggeration = std::clamp(e, 0.01, 100.0);
+    impl_->seen_camera = 0;  // the refinement looks again: heights on screen moved
     impl_->apply_exaggeration();
     if (impl_->ground()) impl_->apply_layer();  // the baked shading follows the exaggerated slopes
     impl_->update_status();
