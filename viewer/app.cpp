@@ -320,6 +320,14 @@ public:
             static_cast<App*>(app)->refine_pending_ = true;
         });
         style_->AddObserver(vtkCommand::EndInteractionEvent, moved);
+        // A coarser mesh while the camera moves, the full one for the still frame.
+        vtkNew<vtkCallbackCommand> start, end;
+        start->SetClientData(this);
+        start->SetCallback([](vtkObject*, unsigned long, void* app, void*) { static_cast<App*>(app)->scene_->set_moving(true); });
+        end->SetClientData(this);
+        end->SetCallback([](vtkObject*, unsigned long, void* app, void*) { static_cast<App*>(app)->scene_->set_moving(false); });
+        style_->AddObserver(vtkCommand::StartInteractionEvent, start);
+        style_->AddObserver(vtkCommand::EndInteractionEvent, end);
         interactor_->Initialize();
         if (!o_.events.empty()) return replay();
         vtkNew<vtkCallbackCommand> tick;

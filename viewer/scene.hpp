@@ -93,6 +93,9 @@ public:
     /// Cheap when the camera has not moved. true if the mesh changed.
     bool refine();
     void set_refine_on_zoom(bool on);
+    /// While the camera moves (a drag), a coarser terrain mesh (at most 129
+    /// samples a side) is drawn; the still frame after it is the full one.
+    void set_moving(bool moving);
 
 private:
     struct Impl;

@@ -442,6 +442,34 @@ TEST_F(Viewer, ZoomingInRefinesTheMeshInViewToFullResolution) {
     EXPECT_NE(state_value(r.out, "detail"), "none");
 }
 
+TEST_F(Viewer, ADragDrawsACoarserMeshAndTheStillFrameAfterItTheFullOne) {
+    const int n = 513;
+    write_vti(dir / "t.vti", rippled(n), n, n);
+    const std::string drag = "# StreamVersion 1\n"
+                             "LeftButtonPressEvent 160 100 0 0 0 0 0\n"
+                             "MouseMoveEvent 170 104 0 0 0 0 0\n"
+                             "MouseMoveEvent 180 108 0 0 0 0 0\n";
+    // Still dragging (no release yet): the coarser mesh.
+    std::ofstream(dir / "dragging.log") << drag;
+    const Result dragging = view("t.vti --events dragging.log --print-state --size 320x200 --screenshot dragging.png");
+    ASSERT_EQ(dragging.code, 0) << dragging.err;
+    EXPECT_EQ(state_value(dragging.out, "moving"), "on");
+    // Released where the last move ended: the same camera, the full mesh.
+    std::ofstream(dir / "dragged.log") << drag << "LeftButtonReleaseEvent 180 108 0 0 0 0 0\n";
+    const Result dragged = view("t.vti --events dragged.log --print-state --size 320x200 --screenshot dragged.png");
+    ASSERT_EQ(dragged.code, 0) << dragged.err;
+    EXPECT_EQ(state_value(dragged.out, "moving"), "off");
+    EXPECT_EQ(state_value(dragged.out, "camera"), state_value(dragging.out, "camera"));
+    const Picture coarse = above_status_line(read_picture(dir / "dragging.png")),
+                  still = above_status_line(read_picture(dir / "dragged.png"));
+    EXPECT_GT(differing_pixels(coarse, still), std::size_t(still.width * still.height / 50));
+    // ... and after r, exactly what a fresh start shows.
+    std::ofstream(dir / "dragged.log", std::ios::app) << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
+    ASSERT_EQ(view("t.vti --events dragged.log --size 320x200 --screenshot reset.png").code, 0);
+    ASSERT_EQ(view("t.vti --size 320x200 --screenshot fresh.png").code, 0);
+    EXPECT_EQ(differing_pixels(read_picture(dir / "reset.png"), read_picture(dir / "fresh.png"), 0), 0u);
+}
+
 // --------------------------------------------------------------------- watch
 
 TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) {
