@@ -12,6 +12,7 @@
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
 #include <vtkColorTransferFunction.h>
+#include <vtkCoordinate.h>
 #include <vtkGLTFImporter.h>
 #include <vtkImageData.h>
 #include <vtkLight.h>
@@ -930,7 +931,15 @@ Scene::Scene(vtkRenderWindow* window) : impl_(std::make_unique<Impl>()) {
         "if (dist > 1.0) { discard; } else { float scale = 1.0 - dist; ambientColor *= scale; diffuseColor *= scale; }\n");
     m.bar->SetNumberOfLabels(5);
     m.bar->SetOrientationToHorizontal();  // bottom right, clear of long titles
-    m.bar->SetPosition(0.6, 0.05);
+    // 48 pixels above the window's bottom whatever its size: the status line
+    // (about 24 pixels) stays clear of the bar and of the category names a
+    // categorical bar writes below its swatches.
+    vtkNew<vtkCoordinate> bar_anchor;
+    bar_anchor->SetCoordinateSystemToNormalizedViewport();
+    bar_anchor->SetValue(0.6, 0.0);
+    m.bar->GetPositionCoordinate()->SetCoordinateSystemToDisplay();
+    m.bar->GetPositionCoordinate()->SetReferenceCoordinate(bar_anchor);
+    m.bar->GetPositionCoordinate()->SetValue(0, 48);
     m.bar->SetWidth(0.38);
     m.bar->SetHeight(0.11);
     m.bar->SetMaximumHeightInPixels(90);
