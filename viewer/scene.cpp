@@ -41,6 +41,7 @@
 #include <vtkWindowToImageFilter.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <cmath>
 #include <chrono>
@@ -318,7 +319,7 @@ struct Scene::Impl {
         textures.clear();
         top = ground()->heights->GetValueRange()[1];
         detail = {};
-        seen_camera = 0;
+        seen_valid = false;
         build_mesh();
         apply_layer();
     }
@@ -421,8 +422,11 @@ struct Scene::Impl {
     };
     Detail detail;
     bool refine_on_zoom = true;
-    vtkMTimeType seen_camera = 0;  // the camera's MTime at the last look, to skip looking again
-    int seen_size[2] = {0, 0};
+    /// What the last look saw (camera, window size, exaggeration): the same
+    /// view needs no new look. (Not the camera's MTime: every render's
+    /// clipping-range update bumps it.) Cleared to look again.
+    std::array<double, 15> seen_view{};
+    bool seen_valid = false;
 
     /// Refinement on zoom. Projects the decimated grid's samples with the
     /// current camera; where its cells on screen (with a margin) lie is the
@@ -435,10 +439,15 @@ struct Scene::Impl {
         if (!ground() || full || step == 1 || !terrain->GetVisibility()) return false;
         vtkCamera* cam = renderer->GetActiveCamera();
         const int* size = window->GetSize();
-        if (cam->GetMTime() == seen_camera && size[0] == seen_size[0] && size[1] == seen_size[1]) return false;
-        seen_camera = cam->GetMTime();
-        seen_size[0] = size[0];
-        seen_size[1] = size[1];
+        const double* p = cam->GetPosition();
+        const double* f = cam->GetFocalPoint();
+        const double* u = cam->GetViewUp();
+        const std::array<double, 15> view{p[0], p[1], p[2], f[0], f[1], f[2], u[0], u[1], u[2], cam->GetViewAngle(),
+                                          cam->GetParallelScale(), double(cam->GetParallelProjection()),
+                                          double(size[0]), double(size[1]), exaggeration};
+        if (seen_valid && view == seen_view) return false;
+        seen_view = view;
+        seen_valid = true;
         const Detail wanted = refine_on_zoom ? detail_in_view(size[0], size[1]) : Detail{};
         if (wanted == detail) return false;
         detail = wanted;
@@ -1118,7 +1127,7 @@ void Scene::set_full_resolution(bool full) {
     m.full = full;
     if (m.ground()) {
         m.build_mesh();
-        m.seen_camera = 0;
+        m.seen_valid = false;
     }
     m.update_status();
 }
@@ -1127,7 +1136,7 @@ bool Scene::full_resolution() const { return impl_->full; }
 double Scene::exaggeration() const { return impl_->exaggeration; }
 void Scene::set_exaggeration(double e) {
     impl_->exaggeration = std::clamp(e, 0.01, 100.0);
-    impl_->seen_camera = 0;  // the refinement looks again: heights on screen moved
+    impl_->seen_valid = false;  // the refinement looks again: heights on screen moved
     impl_->apply_exaggeration();
     if (impl_->ground()) impl_->apply_layer();  // the baked shading follows the exaggerated slopes
     impl_->update_status();
@@ -1214,7 +1223,7 @@ void Scene::set_moving(bool moving) { impl_->set_moving(moving); }
 
 void Scene::set_refine_on_zoom(bool on) {
     impl_->refine_on_zoom = on;
-    impl_->seen_camera = 0;
+    impl_->seen_valid = false;
 }
 
 void Scene::screenshot(const std::string& file) {
