@@ -28,6 +28,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <fcntl.h>
@@ -187,16 +188,28 @@ Options parse(int argc, char** argv) {
     return o;
 }
 
-/// VTK opens an X window even offscreen; without a server it would crash.
-void check_display() {
+/// Closes the X connection after the render window that used it is gone.
+struct CloseDisplay {
+    void operator()(Display* d) const { XCloseDisplay(d); }
+};
+using DisplayPtr = std::unique_ptr<Display, CloseDisplay>;
+
+/// The X connection VTK renders through (VTK opens an X window even
+/// offscreen). Opened here, not by VTK: VTK aborts the process when its own
+/// XOpenDisplay fails, and under a busy Xvfb a connection is now and then
+/// refused (about 1 in 150 runs of the tests on a loaded machine): a few
+/// retries 50 ms apart, then one clear error.
+DisplayPtr open_display() {
     const char* name = std::getenv("DISPLAY");
     const std::string hint =
         "; orogen-view renders through X: on a machine without a screen, run it under a virtual display, "
         "e.g. xvfb-run -a orogen-view FILE --screenshot out.png";
     if (!name || !*name) throw BadInput(std::string("no X display (DISPLAY is not set)") + hint);
-    Display* d = XOpenDisplay(nullptr);
-    if (!d) throw BadInput("cannot connect to the X display '" + std::string(name) + "'" + hint);
-    XCloseDisplay(d);
+    for (int attempt = 0; attempt < 10; ++attempt) {
+        if (Display* d = XOpenDisplay(nullptr)) return DisplayPtr(d);
+        usleep(50000);
+    }
+    throw BadInput("cannot connect to the X display '" + std::string(name) + "'" + hint);
 }
 
 fs::path self_dir() {
@@ -266,7 +279,8 @@ public:
         Content first;
         if (!o_.spec) first = read_files(o_.files);  // bad files are reported before any window opens
         else if (!fs::exists(*o_.spec)) throw BadInput("cannot open '" + o_.spec->string() + "': no such file");
-        check_display();
+        display_ = open_display();
+        window_->SetDisplayId(display_.get());
         window_->SetSize(o_.width, o_.height);
         window_->SetWindowName("orogen-view");
         window_->SetMultiSamples(0);
@@ -348,6 +362,7 @@ public:
 
 private:
     Options o_;
+    DisplayPtr display_;  // before window_: closed after it
     vtkNew<vtkRenderWindow> window_;
     vtkNew<vtkRenderWindowInteractor> interactor_;
     vtkNew<KeyStyle> style_;
