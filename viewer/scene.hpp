@@ -50,6 +50,10 @@ public:
     void toggle_edges();
     void toggle_help();
     void cycle_particle_attribute();
+    /// While idle: colour one layer not yet shown into the texture cache (so
+    /// switching to it only uploads). false when there is nothing left to do.
+    bool prefetch();
+
     /// Full resolution instead of the display decimation of big terrains.
     void set_full_resolution(bool full);
     bool full_resolution() const;
@@ -80,7 +84,18 @@ public:
 
     /// Write the current frame as PNG.
     void screenshot(const std::string& file);
+    /// Draw a still frame: refine the mesh for the camera first (see refine).
     void render();
+    /// Refinement on zoom: when the camera is close enough that the
+    /// decimated mesh's cells in view span more than a few pixels, those
+    /// rows and columns are rebuilt at a finer step (bounded: at most 257
+    /// finer samples a side); zoomed out again, the mesh is the decimated one.
+    /// Cheap when the camera has not moved. true if the mesh changed.
+    bool refine();
+    void set_refine_on_zoom(bool on);
+    /// While the camera moves (a drag), a coarser terrain mesh (at most 129
+    /// samples a side) is drawn; the still frame after it is the full one.
+    void set_moving(bool moving);
 
 private:
     struct Impl;

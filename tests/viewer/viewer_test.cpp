@@ -362,6 +362,114 @@ TEST_F(Viewer, EachKeyDoesWhatTheHelpSays) {
     EXPECT_TRUE(fs::exists(dir / "orogen-view-1.png"));
 }
 
+// ------------------------------------------------- texture cache, refinement
+
+/// The picture without its bottom `rows` (the status line, which names the mesh's decimation).
+Picture above_status_line(Picture p, int rows = 26) {
+    p.height -= rows;
+    p.rgb.resize(std::size_t(p.width) * std::size_t(p.height) * 3);
+    return p;
+}
+
+TEST_F(Viewer, SwitchingBackToALayerShowsWhatAFreshStartShows) {
+    // Textures are kept per layer and per exaggeration: a switch back must show
+    // the same pixels as a fresh start, also after the exaggeration changed
+    // (the kept textures carry the old hillshade and must not be reused).
+    const int n = 65;
+    std::vector<float> flow(n * n);
+    for (int i = 0; i < n * n; ++i) flow[i] = float(i % n) / n;
+    write_vti(dir / "t.vti", plain_and_plateau(), n, n, {{"flow", flow}});
+    ASSERT_EQ(view("t.vti --screenshot fresh.png --size 320x240").code, 0);
+    ASSERT_EQ(view("t.vti --screenshot fresh125.png --size 320x240 --exaggeration 1.25").code, 0);
+    auto after = [&](const std::vector<std::pair<std::string, char>>& keys, const std::string& shot) {
+        std::ofstream(dir / "events.log") << key_events(keys);
+        const Result r = view("t.vti --events events.log --size 320x240 --screenshot " + shot);
+        EXPECT_EQ(r.code, 0) << r.err;
+        return read_picture(dir / shot);
+    };
+    const Picture fresh = read_picture(dir / "fresh.png"), fresh125 = read_picture(dir / "fresh125.png");
+    ASSERT_GT(differing_pixels(fresh, fresh125), 100u);  // the exaggeration changes the shading
+    // splat → height → flow → splat (kept) → height → splat (kept)
+    EXPECT_EQ(differing_pixels(after({{"l", 'l'}, {"l", 'l'}, {"l", 'l'}, {"L", 'L'}, {"L", 'L'}, {"L", 'L'}}, "back.png"), fresh, 0),
+              0u);
+    // splat → height, exaggerate, → splat: coloured again with the new hillshade
+    EXPECT_EQ(differing_pixels(after({{"l", 'l'}, {"plus", '+'}, {"L", 'L'}}, "exaggerated.png"), fresh125, 0), 0u);
+}
+
+/// A 513 × 513 terrain (10 m cells) of short, steep waves: decimated 1:2 by
+/// default, and every second sample missing shows.
+std::vector<float> rippled(int n) {
+    std::vector<float> h(std::size_t(n) * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            h[std::size_t(y) * n + x] = float(25.0 * std::sin(0.9 * x) * std::sin(0.7 * y) + 0.4 * x + 0.2 * y);
+    return h;
+}
+
+TEST_F(Viewer, ZoomingInRefinesTheMeshInViewToFullResolution) {
+    const int n = 513;
+    write_vti(dir / "t.vti", rippled(n), n, n);
+    const std::string close = "--camera 200,60,500 --size 320x200 ";
+    auto state_of = [&](const std::string& args) {
+        const Result r = view("t.vti --events /dev/null --print-state " + args);
+        EXPECT_EQ(r.code, 0) << r.err;
+        return r.out;
+    };
+    // Zoomed out the decimated mesh is all there is; close up, the rows and
+    // columns in view are every sample's.
+    const std::string far = state_of("--size 320x200");
+    EXPECT_EQ(state_value(far, "mesh_step"), "2");
+    EXPECT_EQ(state_value(far, "detail"), "none");
+    const std::string near = state_of(close);
+    EXPECT_EQ(state_value(near, "mesh_step"), "2");
+    EXPECT_NE(state_value(near, "detail").find("step 1"), std::string::npos) << state_value(near, "detail");
+    EXPECT_EQ(state_value(state_of(close + "--no-refine"), "detail"), "none");
+    // The picture: unlike the decimated one, the same as --full's (the status lines differ).
+    ASSERT_EQ(view("t.vti --screenshot auto.png " + close).code, 0);
+    ASSERT_EQ(view("t.vti --screenshot coarse.png --no-refine " + close).code, 0);
+    ASSERT_EQ(view("t.vti --screenshot full.png --full " + close).code, 0);
+    const Picture autop = above_status_line(read_picture(dir / "auto.png")),
+                  coarse = above_status_line(read_picture(dir / "coarse.png")),
+                  full = above_status_line(read_picture(dir / "full.png"));
+    EXPECT_GT(differing_pixels(full, coarse), std::size_t(full.width * full.height / 20));  // the test can see decimation
+    EXPECT_LE(differing_pixels(autop, full), std::size_t(full.width * full.height / 1000));
+    // Zooming with the mouse wheel refines too (when the camera comes to rest).
+    std::string wheel = "# StreamVersion 1\n";
+    for (int i = 0; i < 25; ++i) wheel += "MouseWheelForwardEvent 160 100 0 0 0 0 0\n";
+    std::ofstream(dir / "wheel.log") << wheel;
+    const Result r = view("t.vti --events wheel.log --print-state --size 320x200");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(state_value(r.out, "detail"), "none");
+}
+
+TEST_F(Viewer, ADragDrawsACoarserMeshAndTheStillFrameAfterItTheFullOne) {
+    const int n = 513;
+    write_vti(dir / "t.vti", rippled(n), n, n);
+    const std::string drag = "# StreamVersion 1\n"
+                             "LeftButtonPressEvent 160 100 0 0 0 0 0\n"
+                             "MouseMoveEvent 170 104 0 0 0 0 0\n"
+                             "MouseMoveEvent 180 108 0 0 0 0 0\n";
+    // Still dragging (no release yet): the coarser mesh.
+    std::ofstream(dir / "dragging.log") << drag;
+    const Result dragging = view("t.vti --events dragging.log --print-state --size 320x200 --screenshot dragging.png");
+    ASSERT_EQ(dragging.code, 0) << dragging.err;
+    EXPECT_EQ(state_value(dragging.out, "moving"), "on");
+    // Released where the last move ended: the same camera, the full mesh.
+    std::ofstream(dir / "dragged.log") << drag << "LeftButtonReleaseEvent 180 108 0 0 0 0 0\n";
+    const Result dragged = view("t.vti --events dragged.log --print-state --size 320x200 --screenshot dragged.png");
+    ASSERT_EQ(dragged.code, 0) << dragged.err;
+    EXPECT_EQ(state_value(dragged.out, "moving"), "off");
+    EXPECT_EQ(state_value(dragged.out, "camera"), state_value(dragging.out, "camera"));
+    const Picture coarse = above_status_line(read_picture(dir / "dragging.png")),
+                  still = above_status_line(read_picture(dir / "dragged.png"));
+    EXPECT_GT(differing_pixels(coarse, still), std::size_t(still.width * still.height / 50));
+    // ... and after r, exactly what a fresh start shows.
+    std::ofstream(dir / "dragged.log", std::ios::app) << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
+    ASSERT_EQ(view("t.vti --events dragged.log --size 320x200 --screenshot reset.png").code, 0);
+    ASSERT_EQ(view("t.vti --size 320x200 --screenshot fresh.png").code, 0);
+    EXPECT_EQ(differing_pixels(read_picture(dir / "reset.png"), read_picture(dir / "fresh.png"), 0), 0u);
+}
+
 // --------------------------------------------------------------------- watch
 
 TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) {
