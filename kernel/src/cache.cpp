@@ -1,14 +1,11 @@
 #include "cache.hpp"
 
 #include <orogen/error.hpp>
+#include <orogen/parallel.hpp>
 #include <orogen/plugin.hpp>
 
 #include <openssl/evp.h>
 #include <xxhash.h>
-#include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
-#include <tbb/partitioner.h>
 
 #include <algorithm>
 #include <atomic>
@@ -604,24 +601,28 @@ Digest combine_blocks(std::size_t payload_bytes, const std::vector<Digest>& dige
 void run_jobs(std::vector<Deferred::Copy>& jobs) {
     std::stable_sort(jobs.begin(), jobs.end(), [](const Deferred::Copy& a, const Deferred::Copy& b) { return a.bytes > b.bytes; });
     const std::size_t workers = std::min<std::size_t>(
-        jobs.size(), std::max<std::size_t>(1, tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+        jobs.size(), std::size_t(std::max(1, thread_count())));
     std::atomic<std::size_t> next{0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, workers, 1), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t w = range.begin(); w != range.end(); ++w)
+    parallel_for(0, std::int64_t(workers), 1, [&](std::int64_t w0, std::int64_t w1) {
+        for (std::int64_t w = w0; w != w1; ++w)
             for (std::size_t j = next++; j < jobs.size(); j = next++) jobs[j].run();
-    }, tbb::simple_partitioner());
+    });
 }
 }  // namespace
 
 Digest payload_checksum(std::span<const std::uint8_t> payload) {
     std::vector<Digest> blocks(hash_blocks(payload.size()));
-    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) { blocks[b] = block_checksum(payload, b); });
+    parallel_for(0, std::int64_t(blocks.size()), 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t b = b0; b < b1; ++b) blocks[std::size_t(b)] = block_checksum(payload, std::size_t(b));
+    });
     return combine_checksums(payload.size(), blocks);
 }
 
 Digest payload_hash(std::span<const std::uint8_t> payload) {
     std::vector<Digest> digests(hash_blocks(payload.size()));
-    tbb::parallel_for(std::size_t(0), digests.size(), [&](std::size_t b) { digests[b] = block_digest(payload, b); });
+    parallel_for(0, std::int64_t(digests.size()), 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t b = b0; b < b1; ++b) digests[std::size_t(b)] = block_digest(payload, std::size_t(b));
+    });
     return combine_blocks(payload.size(), digests);
 }
 
