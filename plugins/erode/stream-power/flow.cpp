@@ -198,6 +198,7 @@ void FlowRouter::build_stack(bool label_basins) {
 void FlowRouter::route(double* h, Depressions mode) {
     receivers_from(h);
     pits_ = 0;
+    graph_pits_ = 0;
     for (std::size_t i = 0; i < size_; ++i) pits_ += (receiver_[i] == std::int32_t(i) && !outlet_[i]) ? 1 : 0;
     build_stack(pits_ > 0);
     if (pits_ > 0) resolve_pits(h, mode);
@@ -312,6 +313,7 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
         pending.swap(next);
         if (!progress) break;
     }
+    graph_pits_ = std::int64_t(pending.size());
     if (pending.empty()) {
         build_stack(false);
         return;

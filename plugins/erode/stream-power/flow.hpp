@@ -77,6 +77,8 @@ public:
     const std::vector<std::int64_t>& chunks() const { return chunks_; }
     /// Pits found (before resolution) by the last route().
     std::int64_t pits() const { return pits_; }
+    /// Pits the local floods left to the basin graph in the last route().
+    std::int64_t graph_pits() const { return graph_pits_; }
 
 private:
     void receivers_from(const double* h);  // and the donor bits
@@ -101,6 +103,7 @@ private:
     std::vector<double> area_;
     std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
     std::int64_t pits_ = 0;
+    std::int64_t graph_pits_ = 0;
     std::vector<std::uint32_t> mark_;     // local floods: cells seen in flood number epoch_
     std::vector<std::int32_t> pusher_;   // local floods: the lake cell that reached each cell
     std::vector<std::int32_t> lake_;

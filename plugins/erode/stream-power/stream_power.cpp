@@ -71,9 +71,14 @@ std::int64_t Model::step(double dt) {
     flow_.route(h, settings_.depressions);
     flow_.accumulate();
     const std::int64_t pits = flow_.pits();
-    // 3. Implicit incision.
-    incise(dt);
-    // 4. Hillslope diffusion.
+    // 3. Hillslope diffusion, before the incision and after the routing: the
+    // implicit incision then leaves every eroded cell strictly above its
+    // receiver, so the next step's routing finds (almost) no pits. Diffusion
+    // after the incision raises valley floors unevenly and left 450–700 pits a
+    // step at 1025² (20,000 at 4097²), each paid for by a local flood, the
+    // basin graph and a second stack walk. Both orders are first-order
+    // splittings of the same equation; this one uses the step's flow graph
+    // for the diffused heights, as the incision uses it for the uplifted ones.
     if (diffusion_) {
         std::vector<std::pair<std::int64_t, double>> sink;
         if (!settings_.open.any())
@@ -82,6 +87,8 @@ std::int64_t Model::step(double dt) {
         diffusion_->step(h, dt);
         for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
     }
+    // 4. Implicit incision.
+    incise(dt);
     return pits;
 }
 
