@@ -86,6 +86,7 @@ private:
     void resolve_pits(double* h, Depressions mode);
     bool spill_locally(double* h, Depressions mode, std::int32_t basin, const std::vector<std::uint8_t>& drains);
     void reroute(std::int32_t inside, std::int32_t across);
+    void patch_stack();  // after resolve_pits: the stack through the passes
 
     int width_, height_;
     std::size_t size_;
@@ -95,6 +96,13 @@ private:
     std::vector<std::int32_t> receiver_;
     std::vector<std::uint8_t> donors_;   // bit k: neighbour k sends its water here
     std::vector<std::int32_t> stack_;
+    std::vector<std::int32_t> next_stack_;  // patch_stack's output, swapped with stack_
+    struct Resolved {
+        std::int32_t basin;   // the pit basin (index into roots_)
+        std::int32_t inside;  // its pass cell
+        std::int32_t across;  // the cell its water now goes to
+    };
+    std::vector<Resolved> resolved_;  // resolve_pits, in resolution order
     std::vector<std::int32_t> basin_;    // index of the basin's root in roots_ (during pit resolution)
     std::vector<std::int32_t> roots_;    // outlets and pits, index order
     std::vector<std::int64_t> basin_start_;  // first stack position of each basin (+ end)

@@ -38,7 +38,6 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
     if (h_.size() != flow_.size()) throw std::invalid_argument("stream_power::Model: heights are not width × height");
     if (!uplift_.empty() && uplift_.size() != h_.size())
         throw std::invalid_argument("stream_power::Model: uplift is not width × height");
-    factor_.resize(h_.size());
     pow_table_.resize(std::size_t(kPowTable));
     for (std::int64_t c = 0; c < kPowTable; ++c)
         pow_table_[std::size_t(c)] = std::pow(double(c) * cell * cell, settings.area_exponent);
@@ -93,34 +92,32 @@ std::int64_t Model::step(double dt) {
 }
 
 void Model::incise(double dt) {
-    const std::size_t n = h_.size();
     const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
     const double a0 = cell_ * cell_;
-    const auto& area = flow_.area();
-    const auto& rcv = flow_.receivers();
-    // K·dt·A^m / L^n, in parallel (the pow is the costly part), with a table for small areas.
+    const double* area = flow_.area().data();
+    const std::int32_t* rcv = flow_.receivers().data();
+    // F = K·dt·A^m / L^n, computed where it is used (one pass over the stack,
+    // no per-cell array written and read back), with a table for small areas
+    // (the pow is the costly part) and only for cells that erode.
     const double* tab = pow_table_.data();
     const double l1 = std::pow(cell_, ns), l2 = std::pow(cell_ * kSqrt2, ns);
+    const double table_area = double(kPowTable) * a0;  // areas at or above: pow
     const std::int64_t W = width_;
-    parallel_for(0, std::int64_t(n), 1 << 14, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i) {
-            const std::int64_t r = rcv[std::size_t(i)];
-            if (r == i) {
-                factor_[std::size_t(i)] = 0.0;
-                continue;
-            }
-            const double a = area[std::size_t(i)];
+    auto factor = [&](std::int32_t i, std::int32_t r) {
+        const double a = area[i];
+        double am;
+        if (a < table_area) {
             const double cells = a / a0;
-            const double am = cells < double(kPowTable) && cells == std::floor(cells) ? tab[std::size_t(cells)]
-                                                                                       : std::pow(a, m);
-            const std::int64_t d = r - i;
-            const double len = (d == 1 || d == -1 || d == W || d == -W) ? l1 : l2;
-            factor_[std::size_t(i)] = K * dt * am / len;
+            am = cells == std::floor(cells) ? tab[std::size_t(cells)] : std::pow(a, m);
+        } else {
+            am = std::pow(a, m);
         }
-    });
+        const std::int64_t d = std::int64_t(r) - i;
+        const double len = (d == 1 || d == -1 || d == W || d == -W) ? l1 : l2;
+        return K * dt * am / len;
+    };
     double* h = h_.data();
     const std::int32_t* stack = flow_.stack().data();
-    const double* f = factor_.data();
     const auto& chunks = flow_.chunks();
     // Outlet basins exchange nothing: each group of them is solved by one thread, in stack order.
     parallel_for(0, std::int64_t(chunks.size()) - 1, 1, [&](std::int64_t g0, std::int64_t g1) {
@@ -128,19 +125,19 @@ void Model::incise(double dt) {
             const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
             if (ns == 1.0) {
                 for (std::int64_t s = b; s < e; ++s) {
-                    const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+                    const std::int32_t i = stack[s], r = rcv[i];
                     const double hr = h[r], hi = h[i];
                     if (r == i || hi <= hr) continue;
-                    const double F = f[i];
+                    const double F = factor(i, r);
                     h[i] = (hi + F * hr) / (1.0 + F);
                 }
                 continue;
             }
             for (std::int64_t s = b; s < e; ++s) {
-                const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
+                const std::int32_t i = stack[s], r = rcv[i];
                 const double hr = h[r], hi = h[i];
                 if (r == i || hi <= hr) continue;
-                const double F = f[i], delta = hi - hr;
+                const double F = factor(i, r), delta = hi - hr;
                 // x − Δ + F·x^n = 0 for x = h_i' − h_r' in (0, Δ].
                 double x = delta;
                 for (int it = 0; it < 60; ++it) {

@@ -80,8 +80,7 @@ private:
     Settings settings_;
     std::vector<double> h_, uplift_;
     FlowRouter flow_;
-    std::vector<double> factor_;
-    std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16  // K·dt·A^m / L^n per cell for the current step
+    std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
 };
 
@@ -89,6 +88,6 @@ private:
 std::int64_t lowest_cell(const std::vector<double>& heights);
 
 /// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
-inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 8 + 4 + 4 + 4 + 1 + 1 + 8 + 16;
+inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16;
 
 }  // namespace orogen::stream_power
