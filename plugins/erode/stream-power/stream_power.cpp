@@ -40,7 +40,7 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
         throw std::invalid_argument("stream_power::Model: uplift is not width × height");
     pow_table_.resize(std::size_t(kPowTable));
     for (std::int64_t c = 0; c < kPowTable; ++c)
-        pow_table_[std::size_t(c)] = std::pow(double(c) * cell * cell, settings.area_exponent);
+        pow_table_[std::size_t(c)] = std::pow(double(c) * (cell * cell), settings.area_exponent);
     if (settings.diffusivity > 0.0) {
         diffusion::Settings ds;
         ds.diffusivity = settings.diffusivity;
@@ -97,45 +97,59 @@ void Model::incise(double dt) {
     const double* area = flow_.area().data();
     const std::int32_t* rcv = flow_.receivers().data();
     // F = K·dt·A^m / L^n, computed where it is used (one pass over the stack,
-    // no per-cell array written and read back), with a table for small areas
-    // (the pow is the costly part) and only for cells that erode.
+    // no per-cell array written and read back) and only for cells that erode.
+    // A^m comes from a table when A is a whole number c of cells below 2^16
+    // (c·cell² == A exactly, so the table's pow(c·cell², m) is pow(A, m)):
+    // the pow is the costly part, and most cells drain few cells.
     const double* tab = pow_table_.data();
-    const double l1 = std::pow(cell_, ns), l2 = std::pow(cell_ * kSqrt2, ns);
-    const double table_area = double(kPowTable) * a0;  // areas at or above: pow
+    const double inv_a0 = 1.0 / a0;
+    const double kdt_l1 = K * dt / std::pow(cell_, ns), kdt_l2 = K * dt / std::pow(cell_ * kSqrt2, ns);
     const std::int64_t W = width_;
-    auto factor = [&](std::int32_t i, std::int32_t r) {
-        const double a = area[i];
-        double am;
-        if (a < table_area) {
-            const double cells = a / a0;
-            am = cells == std::floor(cells) ? tab[std::size_t(cells)] : std::pow(a, m);
-        } else {
-            am = std::pow(a, m);
-        }
-        const std::int64_t d = std::int64_t(r) - i;
-        const double len = (d == 1 || d == -1 || d == W || d == -W) ? l1 : l2;
-        return K * dt * am / len;
-    };
     double* h = h_.data();
     const std::int32_t* stack = flow_.stack().data();
     const auto& chunks = flow_.chunks();
     // Outlet basins exchange nothing: each group of them is solved by one thread, in stack order.
     parallel_for(0, std::int64_t(chunks.size()) - 1, 1, [&](std::int64_t g0, std::int64_t g1) {
+        // Local copies: the stores to h must not make the compiler reload them.
+        const double* __restrict const ar = area;
+        const double* __restrict const tb = tab;
+        const std::int32_t* __restrict const rv = rcv;
+        const std::int32_t* __restrict const st = stack;
+        double* __restrict const hh = h;
+        const double c1 = kdt_l1, c2 = kdt_l2, ia0 = inv_a0, a00 = a0, mm = m;
+        const std::int64_t w = W;
+        auto factor = [=](std::int32_t i, std::int32_t r) {
+            const double a = ar[i];
+            const double c = a * ia0;
+            double am;
+            if (c < double(kPowTable - 1)) {
+                const auto ci = std::int64_t(c + 0.5);
+                am = double(ci) * a00 == a ? tb[ci] : std::pow(a, mm);
+            } else {
+                am = std::pow(a, mm);
+            }
+            const std::int64_t d = std::int64_t(r) - i;
+            return am * ((d == 1 || d == -1 || d == w || d == -w) ? c1 : c2);
+        };
         for (std::int64_t g = g0; g < g1; ++g) {
             const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
             if (ns == 1.0) {
                 for (std::int64_t s = b; s < e; ++s) {
-                    const std::int32_t i = stack[s], r = rcv[i];
-                    const double hr = h[r], hi = h[i];
+                    const std::int32_t i = st[s], r = rv[i];
+                    const double hr = hh[r], hi = hh[i];
                     if (r == i || hi <= hr) continue;
-                    const double F = factor(i, r);
-                    h[i] = (hi + F * hr) / (1.0 + F);
+                    // h' = (h + F·h_r')/(1 + F), written as h_r' + (h − h_r')·w with
+                    // w = 1/(1 + F): the division does not wait for the receiver's new
+                    // height, so the chain from one cell to its donor (the next cell,
+                    // mostly) is a subtraction, a product and a sum.
+                    const double wt = 1.0 / (1.0 + factor(i, r));
+                    hh[i] = hr + (hi - hr) * wt;
                 }
                 continue;
             }
             for (std::int64_t s = b; s < e; ++s) {
-                const std::int32_t i = stack[s], r = rcv[i];
-                const double hr = h[r], hi = h[i];
+                const std::int32_t i = st[s], r = rv[i];
+                const double hr = hh[r], hi = hh[i];
                 if (r == i || hi <= hr) continue;
                 const double F = factor(i, r), delta = hi - hr;
                 // x − Δ + F·x^n = 0 for x = h_i' − h_r' in (0, Δ].
@@ -151,7 +165,7 @@ void Model::incise(double dt) {
                     x = next;
                     if (done) break;
                 }
-                h[i] = hr + x;
+                hh[i] = hr + x;
             }
         }
     });
