@@ -23,8 +23,11 @@
 //
 // The "stack" (Braun & Willett 2013) lists the cells so that each cell's
 // receiver comes before it: a depth-first walk up from each outlet over its
-// donors, outlets in index order, donors in neighbour order. It is a pure
-// function of the receivers, so the result does not depend on the thread count.
+// donors, outlets in index order, donors in neighbour order. When there were
+// pits, each resolved pit basin is re-walked from its pass cell and follows
+// the outlet basin its water reaches (in the order the pits were resolved),
+// so the whole map is walked once a step. It is a pure function of the
+// receivers, so the result does not depend on the thread count.
 #pragma once
 
 #include <cstdint>

@@ -9,19 +9,21 @@
 //
 // Each step of dt years: uplift every cell but the outlets (h* = h + U·dt);
 // route water (flow.hpp: D8, pits resolved over the basin graph); accumulate
-// drainage area; then solve the incision implicitly in stack order (Braun &
-// Willett 2013), the receiver's new height known before its donors':
+// drainage area; with D > 0, one implicit alternating-direction diffusion
+// step (diffusion.hpp) with open sides fixed and closed sides closed; then
+// solve the incision implicitly in stack order (Braun & Willett 2013), the
+// receiver's new height known before its donors':
 //
 //     h_i' − h_i* + K·dt·A_i^m·((h_i' − h_r')/L)^n = 0,
 //
-// for n = 1 directly, h_i' = (h_i* + F·h_r')/(1 + F) with F = K·dt·A^m/L; for
+// for n = 1 directly, h_i' = h_r' + (h_i* − h_r')/(1 + F) with F = K·dt·A^m/L; for
 // n ≠ 1 by Newton's method on x = h_i' − h_r' (converges from x = h_i* − h_r'
 // for n ≥ 1; safeguarded for n < 1). The scheme is stable for any dt, and a
 // cell never drops below its receiver. A cell at or below its receiver's new
 // height (a lake in Depressions::route, or a reach dammed by faster uplift
-// downstream) is not eroded. Last, with D > 0, one implicit alternating-
-// direction diffusion step (diffusion.hpp) with open sides fixed and closed
-// sides closed.
+// downstream) is not eroded. Diffusion comes before the incision so that the
+// step ends with every eroded cell above its receiver: the next routing then
+// finds no pits (diffusing last left hundreds a step, docs/benchmarks.md).
 //
 // Every part is a pure function of the previous heights with a fixed visiting
 // order, so the result is the same on any number of threads.
