@@ -568,4 +568,81 @@ void FlowRouter::accumulate() {
     });
 }
 
+void FlowRouter::accumulate_multiple(const double* h, double exponent) {
+    const int W = width_, H = height_;
+    const double a0 = cell_ * cell_;
+    const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
+    lower_.resize(size_);
+    pending_.resize(size_);
+    order_.resize(size_);
+    // 1. Which neighbours each cell sends to (outlets send nothing).
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y)
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                unsigned m = 0;
+                if (!outlet_[std::size_t(i)])
+                    for (int k = 0; k < 8; ++k) {
+                        const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                        if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                        if (h[i + off[k]] < h[i]) m |= 1u << k;
+                    }
+                lower_[std::size_t(i)] = std::uint8_t(m);
+            }
+    });
+    // 2. How many donors each cell waits for, counted from the cell's side
+    // (neighbour j sends here if this cell is in j's lower set, or j has no
+    // lower neighbour and this is j's D8 receiver): no atomics.
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y)
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                int count = 0;
+                for (int k = 0; k < 8; ++k) {
+                    const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                    if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                    const std::int64_t j = i + off[k];
+                    if (outlet_[std::size_t(j)]) continue;
+                    const unsigned mj = lower_[std::size_t(j)];
+                    // Seen from j, this cell is neighbour (k + 4) mod 8.
+                    if (mj ? (mj >> ((k + 4) & 7)) & 1u : receiver_[std::size_t(j)] == i) ++count;
+                }
+                pending_[std::size_t(i)] = std::uint8_t(count);
+                area_[std::size_t(i)] = a0;
+            }
+    });
+    // 3. Kahn: a cell passes its area on once all its donors have added theirs.
+    std::size_t tail = 0;
+    for (std::size_t i = 0; i < size_; ++i)
+        if (pending_[i] == 0) order_[tail++] = std::int32_t(i);
+    double w[8];
+    for (std::size_t q = 0; q < tail; ++q) {
+        const std::int32_t i = order_[q];
+        if (outlet_[std::size_t(i)]) continue;
+        const double ai = area_[std::size_t(i)];
+        const unsigned m = lower_[std::size_t(i)];
+        auto give = [&](std::int64_t j, double amount) {
+            area_[std::size_t(j)] += amount;
+            if (--pending_[std::size_t(j)] == 0) order_[tail++] = std::int32_t(j);
+        };
+        if (m == 0) {
+            const std::int32_t r = receiver_[std::size_t(i)];
+            if (r != i) give(r, ai);
+            continue;
+        }
+        double sum = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            if (!((m >> k) & 1u)) continue;
+            const double slope = (h[i] - h[i + off[k]]) * inv[k];
+            w[k] = exponent == 1.0 ? slope : std::pow(slope, exponent);
+            sum += w[k];
+        }
+        for (int k = 0; k < 8; ++k)
+            if ((m >> k) & 1u) give(i + off[k], ai * (w[k] / sum));
+    }
+    if (tail != size_) throw std::logic_error("FlowRouter: the multiple-flow graph holds a loop");
+}
+
 }  // namespace orogen::stream_power

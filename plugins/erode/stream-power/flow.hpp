@@ -61,6 +61,17 @@ public:
     void route(double* h, Depressions mode);
     /// Drainage area of every cell (m²): its own cell² plus all its donors'.
     void accumulate();
+    /// Drainage area by multiple flow directions (Freeman 1991) over `h`, the
+    /// heights given to the last route() with Depressions::fill (after it, so
+    /// lakes are filled): a cell's water is split among all its strictly lower
+    /// neighbours in proportion to slope^exponent (slope = drop / distance); a
+    /// cell with no lower neighbour (a filled lake, a flat) passes it all to its
+    /// D8 receiver. The receivers, stack and chunks stay the single-flow ones
+    /// (the implicit solver follows the steepest receiver, as fastscape does).
+    /// Every edge then goes down or, within a flat, along the D8 tree, so the
+    /// graph has no loop; the cells are visited in topological order (Kahn),
+    /// sequentially, so the sums are the same on any number of threads.
+    void accumulate_multiple(const double* h, double exponent);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -112,6 +123,9 @@ private:
     std::vector<std::int64_t> chunks_;       // see chunks()
     static constexpr std::int64_t kChunks = 64;
     std::vector<double> area_;
+    std::vector<std::uint8_t> lower_;      // accumulate_multiple: bit k = neighbour k is strictly lower
+    std::vector<std::uint8_t> pending_;    // accumulate_multiple: donors not yet added
+    std::vector<std::int32_t> order_;      // accumulate_multiple: the topological order
     std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
     std::int64_t pits_ = 0;
     std::int64_t graph_pits_ = 0;

@@ -36,6 +36,8 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
       uplift_(std::move(uplift)),
       flow_(width, height, cell, settings.open, settings.open.any() ? 0 : lowest_cell(h_)) {
     if (h_.size() != flow_.size()) throw std::invalid_argument("stream_power::Model: heights are not width × height");
+    if (settings.mfd_exponent > 0.0 && settings.depressions != Depressions::fill)
+        throw std::invalid_argument("stream_power::Model: multiple flow directions need Depressions::fill");
     if (!uplift_.empty() && uplift_.size() != h_.size())
         throw std::invalid_argument("stream_power::Model: uplift is not width × height");
     pow_table_.resize(std::size_t(kPowTable));
@@ -53,7 +55,14 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
 void Model::route_only() {
     std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
     flow_.route(copy.data(), settings_.depressions);
-    flow_.accumulate();
+    accumulate(copy.data());
+}
+
+void Model::accumulate(const double* routed) {
+    if (settings_.mfd_exponent > 0.0)
+        flow_.accumulate_multiple(routed, settings_.mfd_exponent);
+    else
+        flow_.accumulate();
 }
 
 std::int64_t Model::step(double dt) {
@@ -68,7 +77,7 @@ std::int64_t Model::step(double dt) {
     }
     // 2. Routing, depressions, drainage area.
     flow_.route(h, settings_.depressions);
-    flow_.accumulate();
+    accumulate(h);
     const std::int64_t pits = flow_.pits();
     // 3. Hillslope diffusion, before the incision and after the routing: the
     // implicit incision then leaves every eroded cell strictly above its

@@ -47,6 +47,10 @@ struct Settings {
     double diffusivity = 0.0;     ///< D, m²/yr (0: no hillslope diffusion)
     OpenSides open;
     Depressions depressions = Depressions::fill;
+    /// > 0: drainage area by multiple flow directions (Freeman 1991), water split among the lower
+    /// neighbours in proportion to slope^mfd_exponent (needs Depressions::fill); 0: D8.
+    /// The incision follows the steepest receiver either way.
+    double mfd_exponent = 0.0;
 };
 
 /// The state of one landscape: heights (double, m) and the flow graph of the last step.
@@ -76,6 +80,7 @@ public:
 
 private:
     void incise(double dt);
+    void accumulate(const double* routed);  // D8 or multiple-flow area over the routed heights
 
     int width_, height_;
     double cell_;
@@ -90,6 +95,6 @@ private:
 std::int64_t lowest_cell(const std::vector<double>& heights);
 
 /// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
-inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16;
+inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
 
 }  // namespace orogen::stream_power
