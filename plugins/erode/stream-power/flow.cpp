@@ -632,6 +632,10 @@ void FlowRouter::accumulate_multiple(const double* h, double exponent) {
             if (r != i) give(r, ai);
             continue;
         }
+        if ((m & (m - 1)) == 0) {  // one lower neighbour: all of it (no pow)
+            give(i + off[std::countr_zero(m)], ai);
+            continue;
+        }
         double sum = 0.0;
         for (int k = 0; k < 8; ++k) {
             if (!((m >> k) & 1u)) continue;
