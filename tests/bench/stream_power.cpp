@@ -1,7 +1,7 @@
 // bench-links: TBB::tbb
 // One step of the stream-power landscape model (orogen::stream_power::Model::step:
-// uplift, D8 routing, pit resolution, drainage area, implicit incision, ADI
-// diffusion) at 1025² and 4097², and its parts. Targets (2 cores): one step
+// uplift, D8 routing, pit resolution, drainage area (D8, or multiple flow
+// directions with mfd:1), implicit diffusion, implicit incision) at 1025² and 4097², and its parts. Targets (2 cores): one step
 // at 1025² ≤ 60 ms, at 4097² ≤ 1.2 s.
 //
 // Two starting states:
@@ -48,6 +48,7 @@ void BM_stream_power_step(benchmark::State& state) {
     s.area_exponent = 0.45;
     s.slope_exponent = 1.0;
     s.diffusivity = state.range(2) ? 0.01 : 0.0;
+    s.mfd_exponent = state.range(3) ? 1.1 : 0.0;  // routing=mfd: drainage area by multiple flow directions
     Model model(n, n, 30.0, dome(n), std::vector<double>(std::size_t(n) * n, 1e-3), s);
     for (int i = 0; i < 3; ++i) model.step(1e4);
     std::int64_t pits = 0;
@@ -59,11 +60,12 @@ void BM_stream_power_step(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * std::int64_t(n) * n);
 }
 BENCHMARK(BM_stream_power_step)
-    ->ArgNames({"n", "threads", "diffusion"})
-    ->Args({1025, 1, 1})
-    ->Args({1025, 2, 1})
-    ->Args({1025, 2, 0})
-    ->Args({4097, 2, 1})
+    ->ArgNames({"n", "threads", "diffusion", "mfd"})
+    ->Args({1025, 1, 1, 0})
+    ->Args({1025, 2, 1, 0})
+    ->Args({1025, 2, 0, 0})
+    ->Args({1025, 2, 1, 1})
+    ->Args({4097, 2, 1, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

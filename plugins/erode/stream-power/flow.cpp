@@ -79,37 +79,64 @@ int FlowRouter::direction(std::int64_t i) const {
     return -1;
 }
 
+namespace {
+
+/// Steepest-descent direction (0–7, kDx/kDy order; −1: no lower neighbour) of
+/// the inner cells x = 1 … W−2 of one inner row, as doubles: a loop without
+/// branches or integer lanes, which the compiler turns into vector blends (the
+/// comparisons are unpredictable on rough ground). Same arithmetic as the
+/// scalar form, (h_i − h_k)·(1/distance) with ties to the lower k.
+void inner_row_directions(const double* __restrict c, const double* __restrict up, const double* __restrict dn,
+                          int W, double* __restrict dir_out) {
+    const double d = 1.0 / kSqrt2;
+    for (int x = 1; x < W - 1; ++x) {
+        const double hi = c[x];
+        double best = 0.0, dir = -1.0, s;
+        s = (hi - c[x + 1]) * 1.0;  dir = s > best ? 0.0 : dir; best = s > best ? s : best;
+        s = (hi - dn[x + 1]) * d;   dir = s > best ? 1.0 : dir; best = s > best ? s : best;
+        s = (hi - dn[x]) * 1.0;     dir = s > best ? 2.0 : dir; best = s > best ? s : best;
+        s = (hi - dn[x - 1]) * d;   dir = s > best ? 3.0 : dir; best = s > best ? s : best;
+        s = (hi - c[x - 1]) * 1.0;  dir = s > best ? 4.0 : dir; best = s > best ? s : best;
+        s = (hi - up[x - 1]) * d;   dir = s > best ? 5.0 : dir; best = s > best ? s : best;
+        s = (hi - up[x]) * 1.0;     dir = s > best ? 6.0 : dir; best = s > best ? s : best;
+        s = (hi - up[x + 1]) * d;   dir = s > best ? 7.0 : dir;
+        dir_out[x] = dir;
+    }
+}
+
+}  // namespace
+
 void FlowRouter::receivers_from(const double* h) {
-    // Receivers and donor bits in one pass. A cell's donor byte is written by
-    // the (up to 8) cells around it: inside a band of rows only this band's
-    // iterations touch it, so the OR is plain; in the two rows at each end of
-    // a band (shared with the neighbouring bands) it is atomic. OR is
-    // commutative, so the bytes do not depend on the split.
+    // Receivers and donor bits in one pass over rows: first the directions of
+    // a row's inner cells (vectorised), then receivers and donor bits. A
+    // cell's donor byte is written by the (up to 8) cells around it: inside a
+    // band of rows only this band's iterations touch it, so the OR is plain;
+    // in the two rows at each end of a band (shared with the neighbouring
+    // bands) it is atomic. OR is commutative, so the bytes do not depend on
+    // the split.
     const int W = width_, H = height_;
     const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
     std::fill(donors_.begin(), donors_.end(), std::uint8_t(0));
     std::int64_t off[8];
     for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
     parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        std::vector<double> dirs(std::size_t(W), -1.0);
         for (std::int64_t y = y0; y < y1; ++y) {
             const bool inner_row = y > 0 && y < H - 1;
+            const double* row = h + y * W;
+            if (inner_row) inner_row_directions(row, row - W, row + W, W, dirs.data());
             for (int x = 0; x < W; ++x) {
                 const std::int64_t i = y * W + x;
                 if (outlet_[std::size_t(i)]) {
                     receiver_[std::size_t(i)] = std::int32_t(i);
                     continue;
                 }
-                const double hi = h[i];
-                double best = 0.0;
                 int dir = -1;
                 if (inner_row && x > 0 && x < W - 1) {
-                    for (int k = 0; k < 8; ++k) {  // branch-free: the comparisons are unpredictable on rough ground
-                        const double s = (hi - h[i + off[k]]) * inv[k];
-                        const bool better = s > best;
-                        best = better ? s : best;
-                        dir = better ? k : dir;
-                    }
+                    dir = int(dirs[std::size_t(x)]);
                 } else {
+                    const double hi = h[i];
+                    double best = 0.0;
                     for (int k = 0; k < 8; ++k) {
                         const int nx = x + kDx[k], ny = int(y) + kDy[k];
                         if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
@@ -198,6 +225,7 @@ void FlowRouter::build_stack(bool label_basins) {
 void FlowRouter::route(double* h, Depressions mode) {
     receivers_from(h);
     pits_ = 0;
+    graph_pits_ = 0;
     for (std::size_t i = 0; i < size_; ++i) pits_ += (receiver_[i] == std::int32_t(i) && !outlet_[i]) ? 1 : 0;
     build_stack(pits_ > 0);
     if (pits_ > 0) resolve_pits(h, mode);
@@ -260,6 +288,7 @@ bool FlowRouter::spill_locally(double* h, Depressions mode, std::int32_t b, cons
         for (const std::int32_t l : lake_)
             if (h[l] < level) h[l] = level;
     reroute(pusher_[std::size_t(exit)], exit);
+    resolved_.push_back({b, pusher_[std::size_t(exit)], exit});
     return true;
 }
 
@@ -300,6 +329,7 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
             pending.push_back(std::int32_t(b));
     }
     if (mark_.size() != size_) mark_.assign(size_, 0u), pusher_.resize(size_), epoch_ = 0;
+    resolved_.clear();
     for (int pass = 0; pass < 8 && !pending.empty(); ++pass) {
         next.clear();
         for (const std::int32_t b : pending) {
@@ -312,8 +342,9 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
         pending.swap(next);
         if (!progress) break;
     }
+    graph_pits_ = std::int64_t(pending.size());
     if (pending.empty()) {
-        build_stack(false);
+        patch_stack();
         return;
     }
 
@@ -326,38 +357,39 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
         node_basin.push_back(b);
     }
 
-    // Links over every edge (4 forward neighbours: E, SE, S, SW) between two
-    // basins, one of them a pit basin, collected per fixed block of rows;
-    // each block keeps only its lowest link per pair of nodes (by the total
-    // order the global sort uses, so the result does not depend on blocks).
-    std::vector<std::int32_t>& cell_node = basin_;  // basin → node, in place: the labels are not needed after
-    parallel_for(0, std::int64_t(size_), 1 << 15, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i) cell_node[std::size_t(i)] = node[std::size_t(basin_[std::size_t(i)])];
-    });
-    constexpr int kRowBlock = 16;
-    const std::int64_t blocks = (H + kRowBlock - 1) / kRowBlock;
-    std::vector<std::vector<Link>> per_block(static_cast<std::size_t>(blocks));
-    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
-        for (std::int64_t blk = b0; blk < b1; ++blk) {
-            auto& out = per_block[std::size_t(blk)];
-            const int y0 = int(blk) * kRowBlock, y1 = std::min(H, y0 + kRowBlock);
-            for (int y = y0; y < y1; ++y)
-                for (int x = 0; x < W; ++x) {
-                    const std::int64_t i = std::int64_t(y) * W + x;
-                    const std::int32_t ni = cell_node[std::size_t(i)];
-                    for (int k = 0; k < 4; ++k) {
+    // Links over every edge between a pit basin and another basin, found from
+    // the pit basins' own cells (their segments of the stack: basins are
+    // contiguous there), all 8 neighbours; an edge between two pit basins is
+    // taken from its lower-index cell only. Collected per fixed group of pit
+    // basins; each group keeps only its lowest link per pair of nodes (by the
+    // total order the global sort uses, so the result does not depend on the
+    // grouping). The cost follows the lakes' size, not the map's.
+    const std::int64_t np = std::int64_t(pending.size());
+    const std::int64_t link_groups = std::min<std::int64_t>(kChunks, np);
+    std::vector<std::vector<Link>> per_block(static_cast<std::size_t>(link_groups));
+    parallel_for(0, link_groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            auto& out = per_block[std::size_t(g)];
+            for (std::int64_t p = g * np / link_groups; p < (g + 1) * np / link_groups; ++p) {
+                const std::size_t b = std::size_t(pending[std::size_t(p)]);
+                const std::int32_t ni = node[b];
+                for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
+                    const std::int32_t i = stack_[std::size_t(s)];
+                    const int x = i % W, y = i / W;
+                    for (int k = 0; k < 8; ++k) {
                         const int nx = x + kDx[k], ny = y + kDy[k];
-                        if (nx < 0 || nx >= W || ny >= H) continue;
-                        const std::int64_t j = std::int64_t(ny) * W + nx;
-                        const std::int32_t nj = cell_node[std::size_t(j)];
-                        if (ni == nj) continue;
+                        if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                        const std::int32_t j = std::int32_t(std::int64_t(ny) * W + nx);
+                        const std::int32_t nj = node[std::size_t(basin_[std::size_t(j)])];
+                        if (nj == ni || (nj != 0 && j < i)) continue;
                         const double pass = std::max(h[i], h[j]);
                         if (ni < nj)
-                            out.push_back({pass, ni, nj, std::int32_t(i), std::int32_t(j)});
+                            out.push_back({pass, ni, nj, i, j});
                         else
-                            out.push_back({pass, nj, ni, std::int32_t(j), std::int32_t(i)});
+                            out.push_back({pass, nj, ni, j, i});
                     }
                 }
+            }
             std::sort(out.begin(), out.end(), [](const Link& l, const Link& r) {
                 if (l.a != r.a) return l.a < r.a;
                 if (l.b != r.b) return l.b < r.b;
@@ -412,8 +444,10 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
     }
     if (std::int32_t(queue.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
 
-    // Fill, then carve.
-    for (std::int32_t v = 1; v < nodes; ++v) {
+    // Fill, then carve, parents before children (the order of the walk from
+    // the sea), so that each pit basin's way out is already in place.
+    for (std::size_t q = 1; q < queue.size(); ++q) {
+        const std::int32_t v = queue[q];
         const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
         const Link& l = links[std::size_t(out_link[std::size_t(v)])];
         const std::int32_t in = l.a == v ? l.i : l.j, across = l.a == v ? l.j : l.i;
@@ -425,26 +459,194 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
             }
         }
         reroute(in, across);
+        resolved_.push_back({std::int32_t(b), in, across});
     }
 
-    // The new stack: a walk up from the outlets again, now through the passes.
-    build_stack(false);
+    patch_stack();
 }
 
-
-void FlowRouter::accumulate() {
-    const double a0 = cell_ * cell_;
-    const std::int64_t groups = std::int64_t(chunks_.size()) - 1;
-    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
-        for (std::int64_t g = g0; g < g1; ++g) {
-            const std::int64_t b = chunks_[std::size_t(g)], e = chunks_[std::size_t(g + 1)];
-            for (std::int64_t s = b; s < e; ++s) area_[std::size_t(stack_[std::size_t(s)])] = a0;
-            for (std::int64_t s = e; s-- > b;) {
-                const std::int32_t i = stack_[std::size_t(s)], r = receiver_[std::size_t(i)];
-                if (r != i) area_[std::size_t(r)] += area_[std::size_t(i)];
+void FlowRouter::patch_stack() {
+    // The stack through the passes, without walking the whole map again: an
+    // outlet basin's cells keep their order (their receivers did not change),
+    // and each pit basin, re-walked from its pass cell (the walk kept to the
+    // basin's own cells), follows the outlet basin its water now reaches, in
+    // the order the pits were resolved (a basin only spills into one that
+    // already drains, so receivers still come first). Each outlet basin and
+    // the pit basins behind it stay one contiguous block: the blocks are
+    // what chunks() groups for the threads.
+    const std::size_t nb = roots_.size();
+    std::vector<std::int32_t> final_basin(nb, -1);  // the outlet basin each basin drains to
+    for (std::size_t b = 0; b < nb; ++b)
+        if (outlet_[std::size_t(roots_[b])]) final_basin[b] = std::int32_t(b);
+    std::vector<std::int64_t> first(nb + 1, 0);  // resolved_ bucketed by outlet basin, resolution order kept
+    for (const Resolved& r : resolved_) {
+        const std::int32_t f = final_basin[std::size_t(basin_[std::size_t(r.across)])];
+        final_basin[std::size_t(r.basin)] = f;
+        ++first[std::size_t(f) + 1];
+    }
+    for (std::size_t b = 0; b < nb; ++b) first[b + 1] += first[b];
+    std::vector<std::int32_t> attached(resolved_.size());
+    {
+        std::vector<std::int64_t> fill(first.begin(), first.end() - 1);
+        for (std::size_t r = 0; r < resolved_.size(); ++r)
+            attached[std::size_t(fill[std::size_t(final_basin[std::size_t(resolved_[r].basin)])]++)] = std::int32_t(r);
+    }
+    // Block of each outlet basin: where it starts in the new stack.
+    std::vector<std::int32_t> outlets;
+    std::vector<std::int64_t> block_start{0};
+    for (std::size_t b = 0; b < nb; ++b) {
+        if (final_basin[b] != std::int32_t(b)) continue;
+        std::int64_t cells = basin_start_[b + 1] - basin_start_[b];
+        for (std::int64_t a = first[b]; a < first[b + 1]; ++a) {
+            const std::size_t pb = std::size_t(resolved_[std::size_t(attached[std::size_t(a)])].basin);
+            cells += basin_start_[pb + 1] - basin_start_[pb];
+        }
+        outlets.push_back(std::int32_t(b));
+        block_start.push_back(block_start.back() + cells);
+    }
+    if (std::size_t(block_start.back()) != size_) throw std::logic_error("FlowRouter: a pit basin was not resolved");
+    next_stack_.resize(size_);
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * width_ + kDx[k];
+    std::atomic<bool> bad_walk{false};
+    parallel_for(0, std::int64_t(outlets.size()), 16, [&](std::int64_t o0, std::int64_t o1) {
+        std::vector<std::int32_t> walk;
+        for (std::int64_t o = o0; o < o1; ++o) {
+            const std::size_t b = std::size_t(outlets[std::size_t(o)]);
+            std::int32_t* out = next_stack_.data() + block_start[std::size_t(o)];
+            out = std::copy(stack_.begin() + basin_start_[b], stack_.begin() + basin_start_[b + 1], out);
+            for (std::int64_t a = first[b]; a < first[b + 1]; ++a) {
+                const Resolved& r = resolved_[std::size_t(attached[std::size_t(a)])];
+                const std::int64_t cells = basin_start_[std::size_t(r.basin) + 1] - basin_start_[std::size_t(r.basin)];
+                std::int64_t written = 0;
+                walk.push_back(r.inside);
+                while (!walk.empty()) {
+                    const std::int32_t c = walk.back();
+                    walk.pop_back();
+                    if (written++ == cells) break;  // cannot happen: the basin's cells form a tree under the pass
+                    *out++ = c;
+                    unsigned m = donors_[std::size_t(c)];
+                    while (m) {
+                        const int k = std::countr_zero(m);
+                        m &= m - 1;
+                        const std::int32_t d = std::int32_t(c + off[k]);
+                        if (basin_[std::size_t(d)] == r.basin) walk.push_back(d);
+                    }
+                }
+                walk.clear();
+                if (written != cells) bad_walk.store(true, std::memory_order_relaxed);
             }
         }
     });
+    if (bad_walk.load()) throw std::logic_error("FlowRouter: a re-routed pit basin is not a tree under its pass");
+    stack_.swap(next_stack_);
+    chunks_.assign(1, 0);
+    const std::int64_t target = std::max<std::int64_t>(1, std::int64_t(size_) / kChunks);
+    for (std::size_t o = 1; o < block_start.size(); ++o)
+        if (block_start[o] - chunks_.back() >= target || o + 1 == block_start.size()) chunks_.push_back(block_start[o]);
+}
+
+void FlowRouter::accumulate() {
+    const double a0 = cell_ * cell_;
+    // Every cell starts with its own area (a sequential fill, not one in stack order)...
+    parallel_for(0, std::int64_t(size_), 1 << 16, [&](std::int64_t b, std::int64_t e) {
+        std::fill(area_.begin() + b, area_.begin() + e, a0);
+    });
+    // ... and passes its total to its receiver, donors first (reverse stack order).
+    const std::int64_t groups = std::int64_t(chunks_.size()) - 1;
+    const std::int32_t* stack = stack_.data();
+    const std::int32_t* rcv = receiver_.data();
+    double* area = area_.data();
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const std::int64_t b = chunks_[std::size_t(g)], e = chunks_[std::size_t(g + 1)];
+            for (std::int64_t s = e; s-- > b;) {
+                const std::int32_t i = stack[s], r = rcv[i];
+                if (r != i) area[r] += area[i];
+            }
+        }
+    });
+}
+
+void FlowRouter::accumulate_multiple(const double* h, double exponent) {
+    const int W = width_, H = height_;
+    const double a0 = cell_ * cell_;
+    const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
+    lower_.resize(size_);
+    pending_.resize(size_);
+    order_.resize(size_);
+    // 1. Which neighbours each cell sends to (outlets send nothing).
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y)
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                unsigned m = 0;
+                if (!outlet_[std::size_t(i)])
+                    for (int k = 0; k < 8; ++k) {
+                        const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                        if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                        if (h[i + off[k]] < h[i]) m |= 1u << k;
+                    }
+                lower_[std::size_t(i)] = std::uint8_t(m);
+            }
+    });
+    // 2. How many donors each cell waits for, counted from the cell's side
+    // (neighbour j sends here if this cell is in j's lower set, or j has no
+    // lower neighbour and this is j's D8 receiver): no atomics.
+    parallel_for(0, H, 8, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y)
+            for (int x = 0; x < W; ++x) {
+                const std::int64_t i = y * W + x;
+                int count = 0;
+                for (int k = 0; k < 8; ++k) {
+                    const int nx = x + kDx[k], ny = int(y) + kDy[k];
+                    if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
+                    const std::int64_t j = i + off[k];
+                    if (outlet_[std::size_t(j)]) continue;
+                    const unsigned mj = lower_[std::size_t(j)];
+                    // Seen from j, this cell is neighbour (k + 4) mod 8.
+                    if (mj ? (mj >> ((k + 4) & 7)) & 1u : receiver_[std::size_t(j)] == i) ++count;
+                }
+                pending_[std::size_t(i)] = std::uint8_t(count);
+                area_[std::size_t(i)] = a0;
+            }
+    });
+    // 3. Kahn: a cell passes its area on once all its donors have added theirs.
+    std::size_t tail = 0;
+    for (std::size_t i = 0; i < size_; ++i)
+        if (pending_[i] == 0) order_[tail++] = std::int32_t(i);
+    double w[8];
+    for (std::size_t q = 0; q < tail; ++q) {
+        const std::int32_t i = order_[q];
+        if (outlet_[std::size_t(i)]) continue;
+        const double ai = area_[std::size_t(i)];
+        const unsigned m = lower_[std::size_t(i)];
+        auto give = [&](std::int64_t j, double amount) {
+            area_[std::size_t(j)] += amount;
+            if (--pending_[std::size_t(j)] == 0) order_[tail++] = std::int32_t(j);
+        };
+        if (m == 0) {
+            const std::int32_t r = receiver_[std::size_t(i)];
+            if (r != i) give(r, ai);
+            continue;
+        }
+        if ((m & (m - 1)) == 0) {  // one lower neighbour: all of it (no pow)
+            give(i + off[std::countr_zero(m)], ai);
+            continue;
+        }
+        double sum = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            if (!((m >> k) & 1u)) continue;
+            const double slope = (h[i] - h[i + off[k]]) * inv[k];
+            w[k] = exponent == 1.0 ? slope : std::pow(slope, exponent);
+            sum += w[k];
+        }
+        for (int k = 0; k < 8; ++k)
+            if ((m >> k) & 1u) give(i + off[k], ai * (w[k] / sum));
+    }
+    if (tail != size_) throw std::logic_error("FlowRouter: the multiple-flow graph holds a loop");
 }
 
 }  // namespace orogen::stream_power

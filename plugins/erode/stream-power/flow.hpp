@@ -23,8 +23,11 @@
 //
 // The "stack" (Braun & Willett 2013) lists the cells so that each cell's
 // receiver comes before it: a depth-first walk up from each outlet over its
-// donors, outlets in index order, donors in neighbour order. It is a pure
-// function of the receivers, so the result does not depend on the thread count.
+// donors, outlets in index order, donors in neighbour order. When there were
+// pits, each resolved pit basin is re-walked from its pass cell and follows
+// the outlet basin its water reaches (in the order the pits were resolved),
+// so the whole map is walked once a step. It is a pure function of the
+// receivers, so the result does not depend on the thread count.
 #pragma once
 
 #include <cstdint>
@@ -58,6 +61,17 @@ public:
     void route(double* h, Depressions mode);
     /// Drainage area of every cell (m²): its own cell² plus all its donors'.
     void accumulate();
+    /// Drainage area by multiple flow directions (Freeman 1991) over `h`, the
+    /// heights given to the last route() with Depressions::fill (after it, so
+    /// lakes are filled): a cell's water is split among all its strictly lower
+    /// neighbours in proportion to slope^exponent (slope = drop / distance); a
+    /// cell with no lower neighbour (a filled lake, a flat) passes it all to its
+    /// D8 receiver. The receivers, stack and chunks stay the single-flow ones
+    /// (the implicit solver follows the steepest receiver, as fastscape does).
+    /// Every edge then goes down or, within a flat, along the D8 tree, so the
+    /// graph has no loop; the cells are visited in topological order (Kahn),
+    /// sequentially, so the sums are the same on any number of threads.
+    void accumulate_multiple(const double* h, double exponent);
 
     int width() const { return width_; }
     int height() const { return height_; }
@@ -77,6 +91,8 @@ public:
     const std::vector<std::int64_t>& chunks() const { return chunks_; }
     /// Pits found (before resolution) by the last route().
     std::int64_t pits() const { return pits_; }
+    /// Pits the local floods left to the basin graph in the last route().
+    std::int64_t graph_pits() const { return graph_pits_; }
 
 private:
     void receivers_from(const double* h);  // and the donor bits
@@ -84,6 +100,7 @@ private:
     void resolve_pits(double* h, Depressions mode);
     bool spill_locally(double* h, Depressions mode, std::int32_t basin, const std::vector<std::uint8_t>& drains);
     void reroute(std::int32_t inside, std::int32_t across);
+    void patch_stack();  // after resolve_pits: the stack through the passes
 
     int width_, height_;
     std::size_t size_;
@@ -93,14 +110,25 @@ private:
     std::vector<std::int32_t> receiver_;
     std::vector<std::uint8_t> donors_;   // bit k: neighbour k sends its water here
     std::vector<std::int32_t> stack_;
+    std::vector<std::int32_t> next_stack_;  // patch_stack's output, swapped with stack_
+    struct Resolved {
+        std::int32_t basin;   // the pit basin (index into roots_)
+        std::int32_t inside;  // its pass cell
+        std::int32_t across;  // the cell its water now goes to
+    };
+    std::vector<Resolved> resolved_;  // resolve_pits, in resolution order
     std::vector<std::int32_t> basin_;    // index of the basin's root in roots_ (during pit resolution)
     std::vector<std::int32_t> roots_;    // outlets and pits, index order
     std::vector<std::int64_t> basin_start_;  // first stack position of each basin (+ end)
     std::vector<std::int64_t> chunks_;       // see chunks()
     static constexpr std::int64_t kChunks = 64;
     std::vector<double> area_;
+    std::vector<std::uint8_t> lower_;      // accumulate_multiple: bit k = neighbour k is strictly lower
+    std::vector<std::uint8_t> pending_;    // accumulate_multiple: donors not yet added
+    std::vector<std::int32_t> order_;      // accumulate_multiple: the topological order
     std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
     std::int64_t pits_ = 0;
+    std::int64_t graph_pits_ = 0;
     std::vector<std::uint32_t> mark_;     // local floods: cells seen in flood number epoch_
     std::vector<std::int32_t> pusher_;   // local floods: the lake cell that reached each cell
     std::vector<std::int32_t> lake_;

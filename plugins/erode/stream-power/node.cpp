@@ -59,6 +59,7 @@ NodeOutputs run(NodeContext& ctx) {
     s.diffusivity = ctx.real("diffusivity");
     s.open = *parse_sides(ctx.text("open"));
     s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
+    if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
 
     std::vector<double> h(hm->heights().begin(), hm->heights().end());
     // Uplift: the uniform rate plus the layer read as metres accumulated over uplift_layer_years.
@@ -167,6 +168,11 @@ void check(CheckContext& ctx) {
     if (!parse_base_level(ctx.text("base_level")))
         ctx.error("base_level", "'" + ctx.text("base_level") +
                                     "' is not a height; give edge (outlets keep their heights) or metres, e.g. \"0\"");
+    if (ctx.text("routing") == "mfd" && ctx.text("depressions") == "route")
+        ctx.error("routing", "multiple flow directions need filled lakes (water crossing an unfilled lake would "
+                             "flow back into it); use depressions=fill or routing=d8");
+    if (ctx.text("routing") != "mfd" && ctx.given("mfd_exponent"))
+        ctx.error("mfd_exponent", "mfd_exponent weights multiple flow directions; give routing=mfd as well");
     if (ctx.real("dt") > ctx.real("years"))
         ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
     const std::string& layer = ctx.text("uplift_layer");
@@ -205,11 +211,12 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
         .description =
             "dh/dt = U - K A^m S^n + D lap(h): rock uplift U against detachment-limited fluvial incision (drainage "
             "area A, slope S to the receiver) and hillslope diffusion D. Each step of dt years uplifts the land, "
-            "routes water D8 (steepest of 8 neighbours) with pits resolved by local priority floods (Barnes et al. "
+            "routes water D8 (steepest of 8 neighbours; routing=mfd also splits the drainage area among all lower "
+            "neighbours, Freeman 1991) with pits resolved by local priority floods (Barnes et al. "
             "2014) and, where those do not reach, over the basin graph (Cordonnier et al. 2019): each lake spills at "
             "its lowest pass (depressions=fill also fills it). It accumulates drainage area, "
-            "solves the incision implicitly in flow order (Braun & Willett 2013: stable at any dt; Newton's method "
-            "for n != 1) and diffuses implicitly. Water leaves by the open sides, whose vertices are held at base "
+            "diffuses implicitly and solves the incision implicitly in flow order (Braun & Willett 2013: stable at "
+            "any dt; Newton's method for n != 1). Water leaves by the open sides, whose vertices are held at base "
             "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
             "uplift_layer, that layer's metres gained over uplift_layer_years (e.g. the plates' 'uplift'), spread over "
             "uplift_smoothing metres. The same "
@@ -268,6 +275,15 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 Param::choice("depressions", {"fill", "route"}, "fill")
                     .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
                           "the heights stay)"),
+                Param::choice("routing", {"d8", "mfd"}, "d8")
+                    .help("drainage area: d8 (all water to the steepest neighbour) or mfd (split among the lower "
+                          "neighbours by slope^mfd_exponent, Freeman 1991: wider, smoother hillslope areas); the "
+                          "incision follows the steepest neighbour either way"),
+                Param::real("mfd_exponent", 1.1)
+                    .min(0.0, true)
+                    .max(100.0)
+                    .help("routing=mfd: weight of a lower neighbour = slope^p (1.1: Freeman 1991; larger "
+                          "concentrates the flow, towards D8)"),
                 Param::boolean("chi", false).help("also write the layer chi (m; reference area 1 m^2)"),
                 timelapse_param(),
             },

@@ -9,19 +9,21 @@
 //
 // Each step of dt years: uplift every cell but the outlets (h* = h + U·dt);
 // route water (flow.hpp: D8, pits resolved over the basin graph); accumulate
-// drainage area; then solve the incision implicitly in stack order (Braun &
-// Willett 2013), the receiver's new height known before its donors':
+// drainage area; with D > 0, one implicit alternating-direction diffusion
+// step (diffusion.hpp) with open sides fixed and closed sides closed; then
+// solve the incision implicitly in stack order (Braun & Willett 2013), the
+// receiver's new height known before its donors':
 //
 //     h_i' − h_i* + K·dt·A_i^m·((h_i' − h_r')/L)^n = 0,
 //
-// for n = 1 directly, h_i' = (h_i* + F·h_r')/(1 + F) with F = K·dt·A^m/L; for
+// for n = 1 directly, h_i' = h_r' + (h_i* − h_r')/(1 + F) with F = K·dt·A^m/L; for
 // n ≠ 1 by Newton's method on x = h_i' − h_r' (converges from x = h_i* − h_r'
 // for n ≥ 1; safeguarded for n < 1). The scheme is stable for any dt, and a
 // cell never drops below its receiver. A cell at or below its receiver's new
 // height (a lake in Depressions::route, or a reach dammed by faster uplift
-// downstream) is not eroded. Last, with D > 0, one implicit alternating-
-// direction diffusion step (diffusion.hpp) with open sides fixed and closed
-// sides closed.
+// downstream) is not eroded. Diffusion comes before the incision so that the
+// step ends with every eroded cell above its receiver: the next routing then
+// finds no pits (diffusing last left hundreds a step, docs/benchmarks.md).
 //
 // Every part is a pure function of the previous heights with a fixed visiting
 // order, so the result is the same on any number of threads.
@@ -45,6 +47,10 @@ struct Settings {
     double diffusivity = 0.0;     ///< D, m²/yr (0: no hillslope diffusion)
     OpenSides open;
     Depressions depressions = Depressions::fill;
+    /// > 0: drainage area by multiple flow directions (Freeman 1991), water split among the lower
+    /// neighbours in proportion to slope^mfd_exponent (needs Depressions::fill); 0: D8.
+    /// The incision follows the steepest receiver either way.
+    double mfd_exponent = 0.0;
 };
 
 /// The state of one landscape: heights (double, m) and the flow graph of the last step.
@@ -74,14 +80,14 @@ public:
 
 private:
     void incise(double dt);
+    void accumulate(const double* routed);  // D8 or multiple-flow area over the routed heights
 
     int width_, height_;
     double cell_;
     Settings settings_;
     std::vector<double> h_, uplift_;
     FlowRouter flow_;
-    std::vector<double> factor_;
-    std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16  // K·dt·A^m / L^n per cell for the current step
+    std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
 };
 
@@ -89,6 +95,6 @@ private:
 std::int64_t lowest_cell(const std::vector<double>& heights);
 
 /// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
-inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 8 + 4 + 4 + 4 + 1 + 1 + 8 + 16;
+inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
 
 }  // namespace orogen::stream_power

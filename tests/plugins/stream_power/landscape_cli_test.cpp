@@ -26,7 +26,9 @@ TEST(LandscapeCli, OutOfRangeParametersAreCheckTimeErrors) {
                                 "b = erode:stream-power(base, diffusivity=100, dt=0, years=-1)\n"
                                 "c = erode:stream-power(base, uplift_layer=\"uplift\", open=\"nxw\", base_level=\"sea\")\n"
                                 "d = erode:diffusion(base, diffusivity=0)\n"
-                                "e = erode:diffusion(base, years=10, dt=100, fixed=\"top\")\n");
+                                "e = erode:diffusion(base, years=10, dt=100, fixed=\"top\")\n"
+                                "f = erode:stream-power(base, routing=mfd, depressions=route)\n"
+                                "g = erode:stream-power(base, mfd_exponent=2)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -44,6 +46,8 @@ TEST(LandscapeCli, OutOfRangeParametersAreCheckTimeErrors) {
              "'diffusivity' of erode:diffusion is 0, out of range (0, 10] m²/yr",
              "bad.orogen:8:40: error: erode:diffusion: the time step is longer than the run (years); give dt <= years",
              "erode:diffusion: 'top' is not a set of sides",
+             "erode:stream-power: multiple flow directions need filled lakes",
+             "erode:stream-power: mfd_exponent weights multiple flow directions; give routing=mfd as well",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }

@@ -19,7 +19,7 @@
 
 int main(int argc, char** argv) {
     if (argc < 5) {
-        std::fprintf(stderr, "usage: %s TERRAIN.r32 WIDTH HEIGHT CELL [DRAINAGE.png]\n", argv[0]);
+        std::fprintf(stderr, "usage: %s TERRAIN.r32 WIDTH HEIGHT CELL [DRAINAGE.png [MFD_EXPONENT]]\n", argv[0]);
         return 2;
     }
     const int w = std::stoi(argv[2]), h = std::stoi(argv[3]);
@@ -41,7 +41,10 @@ int main(int argc, char** argv) {
     std::vector<double> filled(z.begin(), z.end());
     orogen::stream_power::FlowRouter flow(w, h, cell, orogen::stream_power::OpenSides{});
     flow.route(filled.data(), orogen::stream_power::Depressions::fill);
-    flow.accumulate();
+    if (argc > 6)  // multiple flow directions (Freeman 1991) with this exponent
+        flow.accumulate_multiple(filled.data(), std::stod(argv[6]));
+    else
+        flow.accumulate();
     const auto& area = flow.area();
     double amax = 0.0;
     for (double a : area) amax = std::max(amax, a);

@@ -307,4 +307,127 @@ TEST(StreamPower, ChiGrowsUpstreamByTheIntegral) {
     }
 }
 
+
+// ---- Multiple flow directions (Freeman 1991) --------------------------------------------------
+
+/// Drainage areas of a cone (a peak of slope `slope` at the centre of an n × n map, every side open)
+/// by D8 (exponent 0) or multiple flow directions.
+std::vector<double> cone_areas(int n, double cell, double exponent, std::vector<double>* heights = nullptr) {
+    std::vector<double> hts(std::size_t(n) * n);
+    const double c = 0.5 * (n - 1);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) hts[std::size_t(y) * n + x] = 1000.0 - 0.2 * cell * std::hypot(x - c, y - c);
+    FlowRouter f(n, n, cell, OpenSides{});
+    f.route(hts.data(), Depressions::fill);
+    if (exponent > 0.0)
+        f.accumulate_multiple(hts.data(), exponent);
+    else
+        f.accumulate();
+    if (heights) *heights = hts;
+    return f.area();
+}
+
+TEST(MultipleFlow, OnAConeTheAreaSpreadsAsDivergentFlowDoes) {
+    // Water from a peak spreads over ever wider contours: the area upslope of a
+    // contour length b at distance r is the sector b·r/2, so the specific
+    // catchment area (area per unit contour width) is r/2 (the cone test of
+    // Freeman 1991 and Quinn et al. 1991). With a grid cell's contour width
+    // taken as one cell, A = cell·r/2 in every direction; the cell's own area
+    // and its outflow edge half a cell further out add 2–5 % at 30–90 cells from
+    // the peak. D8 sends each cell's water to one neighbour: the area gathers on
+    // the rays of the grid's 8 directions and stays small between them.
+    const int n = 201;
+    const double cell = 10.0, c = 0.5 * (n - 1);
+    struct Ring { double mean_ratio = 0, cv = 0; };
+    auto ring = [&](const std::vector<double>& area) {
+        std::vector<double> ratio;
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const double r = std::hypot(x - c, y - c);
+                if (r < 30.0 || r > 90.0) continue;
+                ratio.push_back(area[std::size_t(y) * n + x] / (cell * 0.5 * (r * cell)));
+            }
+        Ring out;
+        for (double v : ratio) out.mean_ratio += v / double(ratio.size());
+        for (double v : ratio) out.cv += (v - out.mean_ratio) * (v - out.mean_ratio) / double(ratio.size());
+        out.cv = std::sqrt(out.cv) / out.mean_ratio;
+        return out;
+    };
+    const Ring mfd = ring(cone_areas(n, cell, 1.1)), d8 = ring(cone_areas(n, cell, 0.0));
+    EXPECT_NEAR(mfd.mean_ratio, 1.0, 0.08) << "specific catchment area / (r/2), mean over the ring";
+    EXPECT_LT(mfd.cv, 0.05) << "spread of that ratio over the ring (same in every direction)";
+    EXPECT_GT(d8.cv, 0.4) << "D8 on the same cone (the property that tells the two apart)";
+}
+
+TEST(MultipleFlow, EveryDropReachesAnOutletOnceWithClosedSidesAndLakes) {
+    // Noise with every side closed: about a third of the cells are pits, filled
+    // into lakes (flats whose water follows the D8 tree) between slopes that
+    // split theirs. The one outlet gets the whole map's area (to round-off:
+    // the shares are fractions), nothing is lost or counted twice.
+    const int w = 123, h = 97;
+    const double cell = 30.0;
+    auto hts = noise(w, h, 42, 100.0);
+    const std::int64_t outlet = lowest_cell(hts);
+    FlowRouter f(w, h, cell, OpenSides{false, false, false, false}, outlet);
+    f.route(hts.data(), Depressions::fill);
+    f.accumulate_multiple(hts.data(), 1.1);
+    const double total = double(w) * h * cell * cell;
+    EXPECT_NEAR(f.area()[std::size_t(outlet)], total, 1e-9 * total);
+    for (std::size_t i = 0; i < f.size(); ++i) ASSERT_GE(f.area()[i], cell * cell) << i;
+    // Open sides: the outlets share the map's area.
+    auto hts2 = noise(w, h, 8, 50.0);
+    FlowRouter g(w, h, cell, OpenSides{true, false, true, true});
+    g.route(hts2.data(), Depressions::fill);
+    g.accumulate_multiple(hts2.data(), 1.1);
+    double out = 0.0;
+    for (std::size_t i = 0; i < g.size(); ++i)
+        if (g.is_outlet(std::int64_t(i))) out += g.area()[i];
+    EXPECT_NEAR(out, total, 1e-9 * total);
+}
+
+TEST(MultipleFlow, SameBitsOnOneAndTwoThreadsAndTheSolverStillFollowsTheSteepest) {
+    const int w = 161, h = 129;
+    std::vector<double> results[2], areas[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        Settings s;
+        s.diffusivity = 0.02;
+        s.mfd_exponent = 1.1;
+        s.open = {true, true, false, true};
+        Model model(w, h, 30.0, noise(w, h, 5, 200.0), noise(w, h, 77, 2e-3), s);
+        model.run(2e5, 1e4);
+        results[t] = model.heights();
+        areas[t] = model.flow().area();
+        expect_every_cell_drains(model.flow());
+    }
+    EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
+    EXPECT_EQ(0, std::memcmp(areas[0].data(), areas[1].data(), areas[0].size() * sizeof(double)));
+    // The areas are not D8's (some cell has a fractional share of a cell's area).
+    bool fractional = false;
+    for (double a : areas[0]) fractional = fractional || std::abs(a / 900.0 - std::round(a / 900.0)) > 1e-6;
+    EXPECT_TRUE(fractional);
+    // Unfilled lakes would send water back into themselves: refused.
+    Settings bad;
+    bad.mfd_exponent = 1.1;
+    bad.depressions = Depressions::route;
+    EXPECT_THROW(Model(8, 8, 1.0, noise(8, 8, 1, 1.0), {}, bad), std::invalid_argument);
+}
+
+TEST(MultipleFlow, ACellSplitsItsWaterBySlopeToThePowerP) {
+    // One inner cell 10 m above a row of outlets (3 × 2 map, every side but the
+    // north open): its lower neighbours are south (slope 10) and south-west and
+    // south-east (slope 10/√2); its neighbours west and east are higher.
+    for (double p : {1.0, 1.1, 2.0, 8.0}) {
+        std::vector<double> hts = {20.0, 10.0, 20.0, 0.0, 0.0, 0.0};
+        FlowRouter f(3, 2, 1.0, OpenSides{false, true, true, true});
+        f.route(hts.data(), Depressions::fill);
+        f.accumulate_multiple(hts.data(), p);
+        const double ws = std::pow(10.0, p), wd = std::pow(10.0 / std::sqrt(2.0), p);
+        EXPECT_NEAR(f.area()[4], 1.0 + ws / (ws + 2.0 * wd), 1e-12) << "p = " << p;
+        EXPECT_NEAR(f.area()[3], 1.0 + wd / (ws + 2.0 * wd), 1e-12) << "p = " << p;
+        EXPECT_NEAR(f.area()[5], f.area()[3], 1e-12) << "p = " << p;
+        EXPECT_EQ(f.receivers()[1], 4);  // the solver's receiver: the steepest
+    }
+}
+
 }  // namespace
