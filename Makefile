@@ -56,6 +56,7 @@ FUZZ_TARGETS  = spec overrides png sidecar cache
 SAN_CMAKE    ?=
 export ASAN_OPTIONS  ?= detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
 export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
+export LSAN_OPTIONS  ?= suppressions=$(CURDIR)/tools/lsan.supp
 export TSAN_OPTIONS  ?= halt_on_error=1:second_deadlock_stack=1:suppressions=$(CURDIR)/tools/tsan.supp
 
 # CI's sanitizer phase: ASan + UBSan over the kernel, the fuzz corpora and the plugins its tests use.
