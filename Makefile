@@ -34,7 +34,7 @@ bench: build
 #   make fuzz-smoke  FUZZ_SECONDS (default 20) of each fuzz target from FUZZ_SEED (default 1), so a failure in CI
 #                    replays here with the same seed; the crashing input is printed in hex (needs `make asan`'s build)
 #   make fuzz-long   FUZZ_RUNS (default 1000000) executions of each target, one job each
-SAN_FLAGS   = -O1 -gline-tables-only -fno-omit-frame-pointer
+SAN_FLAGS   = -O1 -gline-tables-only -fno-omit-frame-pointer -fsanitize-ignorelist=$(CURDIR)/tools/sanitizer-ignorelist.txt
 ASAN_BUILD ?= build-asan
 TSAN_BUILD ?= build-tsan
 # The thread-parallel cores (every erode, generate, tectonics and import plugin, the exporters) and their tests,
