@@ -233,26 +233,8 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     check_layers(heights, layers);
     if (ext == ".vti") {
         if (o.decimate != 1) throw BadInput("decimate applies to .vtp meshes only; .vti keeps every sample");
-        AtomicFile file(target);
-        vtkNew<vtkImageData> image;
-        if (o.up == Up::z) {
-            // X east, Y north: VTK's j runs north, so the south row comes first (a copy of each array).
-            image->SetDimensions(heights.width, heights.height, 1);
-            image->SetSpacing(heights.cell, heights.cell, 1.0);
-            image->SetOrigin(0, -(heights.height - 1) * heights.cell + 0.0, 0);
-            image->GetPointData()->AddArray(flipped("height", heights));
-            for (const auto& l : layers) image->GetPointData()->AddArray(flipped(l.name, l.grid));
-        } else {
-            image->SetDimensions(heights.width, 1, heights.height);  // X east, Z south: sample order as stored
-            image->SetSpacing(heights.cell, 1.0, heights.cell);
-            image->SetOrigin(0, 0, 0);
-            image->GetPointData()->AddArray(wrap("height", heights.data, heights.size(), 1));
-            for (const auto& l : layers) image->GetPointData()->AddArray(wrap(l.name, l.grid.data, l.grid.size(), 1));
-        }
-        image->GetPointData()->SetActiveScalars("height");
-        mark_frame(image, o.up);
-        write_with<vtkXMLImageDataWriter>(image, file, o);
-        file.commit();
+        // the whole grid is the one piece that starts at (0, 0)
+        write_heightmap_piece(heights, layers, 0, 0, heights.height, target, o);
         return;
     }
     AtomicFile file(target);
