@@ -8,44 +8,125 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <array>
 #include <numbers>
 #include <sstream>
+#include <type_traits>
 
 namespace orogen::sph {
 
 namespace {
 
-constexpr std::int64_t kGrain = 512;       // particles per parallel task
-constexpr std::int64_t kReorderEvery = 8;  // sub-steps between Morton reorders
-constexpr int kCellBias = 1 << 20;         // keeps cell coordinates non-negative
-
-/// Spread the low 10 bits of v over every third bit (30-bit Morton codes).
-std::uint32_t spread3(std::uint32_t v) {
-    v &= 0x3FFu;
-    v = (v | (v << 16)) & 0x030000FFu;
-    v = (v | (v << 8)) & 0x0300F00Fu;
-    v = (v | (v << 4)) & 0x030C30C3u;
-    v = (v | (v << 2)) & 0x09249249u;
-    return v;
-}
-
-std::uint32_t morton(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
-    return spread3(x) | (spread3(y) << 1) | (spread3(z) << 2);
-}
-
-/// Bucket of cell (cx, cy, cz) in a table of 2^bits ≥ 64 buckets. The low 6
-/// bits are the cell's coordinates mod 4, so the 27 cells around any cell land
-/// in 27 different buckets (no duplicate visits, no check needed); the other
-/// bits hash the 4³ block, so buckets fill evenly however the particles lie.
-std::uint32_t bucket_of(std::uint32_t cx, std::uint32_t cy, std::uint32_t cz, std::uint32_t mask) {
-    const std::uint32_t low = ((cx & 3u) << 4) | ((cy & 3u) << 2) | (cz & 3u);
-    const std::uint32_t block = ((cx >> 2) * 73856093u) ^ ((cy >> 2) * 19349663u) ^ ((cz >> 2) * 83492791u);
-    return ((block << 6) | low) & mask;
-}
+constexpr std::int64_t kGrain = 512;      // particles per parallel task (integration)
+constexpr std::int64_t kCellGrain = 64;   // cells per parallel task (density, forces)
+constexpr float kCellLimit = 524288.0f;   // 2^19: cell coordinates are clamped to ±this (keys fit 63 bits)
+// Candidates are evaluated in kLanes independent partial sums, combined in a
+// fixed order at the end: the compiler maps the lanes onto whatever vector
+// width the clone it runs has (SSE2, AVX2, AVX-512), and since every lane is
+// plain IEEE float arithmetic (no FMA: -ffp-contract=off, no reassociation),
+// every clone, thread count and machine gives the same bits.
+constexpr std::size_t kLanes = 16;
+// Padding candidates sit this far away (m): beyond any support, and still
+// finite when squared (3e30 < FLT_MAX), so masked lanes stay NaN-free.
+constexpr float kFar = 1e15f;
 
 bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+/// Combine the lanes in a fixed pairwise order.
+inline float lane_sum(const float* a) {
+    float t[kLanes];
+    for (std::size_t l = 0; l < kLanes; ++l) t[l] = a[l];
+    for (std::size_t w = kLanes / 2; w > 0; w /= 2)
+        for (std::size_t l = 0; l < w; ++l) t[l] = t[l] + t[l + w];
+    return t[0];
+}
+
+// Runtime dispatch: GCC builds these loops for AVX-512, AVX2 and the x86-64
+// baseline and picks one at load time (any x86-64 runs it; the result bits are
+// the same for every clone, see kLanes).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
+    !defined(__SANITIZE_THREAD__)
+#define OROGEN_SPH_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define OROGEN_SPH_CLONES
+#endif
+
+/// Σ over candidates within the support of the cubic spline's shape
+/// (W / w_norm, dimensionless) at (px, py, pz). The candidate arrays hold `m`
+/// entries, a multiple of kLanes (padded with far-away points).
+OROGEN_SPH_CLONES
+float density_sum(const float* __restrict cx, const float* __restrict cy, const float* __restrict cz, std::size_t m,
+                  float px, float py, float pz, float h2, float inv_h) {
+    float acc[kLanes] = {};
+    for (std::size_t k = 0; k < m; k += kLanes)
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            const float dx = px - cx[k + l], dy = py - cy[k + l], dz = pz - cz[k + l];
+            const float r2 = dx * dx + dy * dy + dz * dz;
+            const float q = std::sqrt(r2) * inv_h;
+            const float f = 1.0f - q;
+            const float inner = 6.0f * q * q * (q - 1.0f) + 1.0f, outer = 2.0f * f * f * f;
+            const float wq = q <= 0.5f ? inner : outer;
+            acc[l] += r2 < h2 ? wq : 0.0f;
+        }
+    return lane_sum(acc);
+}
+
+/// The candidates' fields for the force pass (structure of arrays, kLanes-padded).
+struct ForceCandidates {
+    const float *x, *y, *z, *vx, *vy, *vz, *pterm, *rho;
+};
+
+/// Σ_j (p_i/ρ_i² + p_j/ρ_j² + Π_ij) · (shape of ∂W/∂r) / r · r_ij over the
+/// candidates within the support: the pressure + viscosity acceleration of
+/// particle i is −m · grad_norm / h times the result (m/s² · m⁻¹ ... scaled by
+/// the caller). One division per pair: Π's two denominators and 1/r share it.
+OROGEN_SPH_CLONES
+void force_sum(const ForceCandidates& c, std::size_t m, float px, float py, float pz, float vx, float vy, float vz,
+               float pi, float rhoi, float h2, float inv_h, float visc_eps, float visc_k, float out[3]) {
+    float ax[kLanes] = {}, ay[kLanes] = {}, az[kLanes] = {};
+    const float* __restrict X = c.x;
+    const float* __restrict Y = c.y;
+    const float* __restrict Z = c.z;
+    const float* __restrict VX = c.vx;
+    const float* __restrict VY = c.vy;
+    const float* __restrict VZ = c.vz;
+    const float* __restrict P = c.pterm;
+    const float* __restrict R = c.rho;
+    for (std::size_t k = 0; k < m; k += kLanes)
+        for (std::size_t l = 0; l < kLanes; ++l) {
+            const std::size_t j = k + l;
+            const float dx = px - X[j], dy = py - Y[j], dz = pz - Z[j];
+            const float r2 = dx * dx + dy * dy + dz * dz;
+            const float ux = vx - VX[j], uy = vy - VY[j], uz = vz - VZ[j];
+            const float vr = ux * dx + uy * dy + uz * dz;
+            // term = pi + pj − visc_k·vr / ((r² + ε)(ρi + ρj)) for approaching pairs (Monaghan's Π),
+            // over one denominator D = (r² + ε)(ρi + ρj).
+            const float d = (r2 + visc_eps) * (rhoi + R[j]);
+            const float visc = vr < 0.0f ? visc_k * vr : 0.0f;
+            const float num = (pi + P[j]) * d - visc;
+            // The particle itself (r = 0) adds nothing: its separation vector is zero.
+            const float r = std::max(std::sqrt(r2), 1e-12f);
+            const float q = r * inv_h;
+            const float inner = q * (3.0f * q - 2.0f), outer = -(1.0f - q) * (1.0f - q);
+            const float shape = q <= 0.5f ? inner : outer;
+            const float f = num * shape / (d * r);
+            const float g = r2 < h2 ? f : 0.0f;
+            ax[l] += g * dx;
+            ay[l] += g * dy;
+            az[l] += g * dz;
+        }
+    out[0] = lane_sum(ax);
+    out[1] = lane_sum(ay);
+    out[2] = lane_sum(az);
+}
+
+/// Grow a scratch buffer to at least `m` entries (never shrinks: reused across cells).
+inline float* room(std::vector<float>& v, std::size_t m) {
+    if (v.size() < m) v.resize(m + m / 2);
+    return v.data();
+}
 
 }  // namespace
 
@@ -77,14 +158,19 @@ struct Simulation::Impl {
     std::vector<float> acidity;
     std::vector<std::int32_t> age, lifespan;
     std::vector<std::uint8_t> alive;
-    // Neighbour search.
-    std::vector<std::uint32_t> bucket, order, start;
-    std::uint32_t mask = 63;
-    std::size_t sorted = 0;  // particles in `order`
-    std::vector<std::uint32_t> sort_key, sort_tmp_key, perm, perm_tmp;  // reorder scratch (reuses bucket storage size)
+    // Neighbour search (sort_by_cell): the particles are sorted by cell every sub-step; `ncell` occupied
+    // cells, each with its key and its first particle. sort_keys holds two key arrays (the radix sort's
+    // ping-pong), reused as the permutation's 16 bytes per particle of scratch.
+    std::vector<std::uint64_t> sort_keys;
+    std::vector<std::uint32_t> perm, perm_tmp;
+    std::vector<std::uint64_t> cell_key;
+    std::vector<std::uint32_t> cell_start;
+    std::size_t ncell = 0;
+    std::uint64_t stride_y = 1, stride_z = 1;  // key steps of one cell in y and z (x: 1)
+    int min_cx = 0, min_cy = 0, min_cz = 0;    // the padded box's first cell
 
     Counts counts;
-    std::int64_t substeps = 0, since_reorder = 0;
+    std::int64_t substeps = 0;
     double t = 0.0;
     double removed = 0.0;  // m³ of sediment gone over open edges
     float max_acc = 0.0f;
@@ -210,48 +296,97 @@ struct Simulation::Impl {
         --live;
     }
 
-    /// Sort the particle arrays along the Morton curve of their cells (dead
-    /// ones dropped): stable LSD radix sort of 30-bit keys, ties in index order.
-    void reorder() {
-        since_reorder = 0;
+    /// Cell coordinate (in units of h) of a position in m, clamped so keys fit in 63 bits.
+    float cell_of(float x) const { return std::clamp(std::floor(x * inv_h), -kCellLimit, kCellLimit); }
+
+    /// Every sub-step: sort the live particles by cell (dead ones dropped) and
+    /// list the occupied cells. A cell's key is linear in the particles'
+    /// bounding box of cells, padded by one cell on every side, x fastest: the
+    /// cells x−1, x, x+1 of a row are consecutive keys, so each of the 9 rows
+    /// around a cell is one contiguous run of particles. Stable LSD radix sort
+    /// with ties in the previous order: the order, and with it every
+    /// particle's neighbour and summation order, follows from the state alone.
+    void sort_by_cell() {
         std::size_t m = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            if (!alive[i]) continue;
-            const Vec3& p = pos[i];
-            const auto cx = std::uint32_t(int(std::floor(p.x * inv_h)) + kCellBias);
-            const auto cy = std::uint32_t(int(std::floor(p.y * inv_h)) + kCellBias);
-            const auto cz = std::uint32_t(int(std::floor(p.z * inv_h)) + kCellBias);
-            sort_key[m] = morton(cx, cy, cz);
-            perm[m] = std::uint32_t(i);
-            ++m;
+        for (std::size_t i = 0; i < n; ++i)
+            if (alive[i]) perm[m++] = std::uint32_t(i);
+        if (m == 0) {
+            n = live = ncell = 0;
+            return;
         }
-        std::uint32_t* key = sort_key.data();
-        std::uint32_t* tkey = sort_tmp_key.data();
+        const std::int64_t blocks = (std::int64_t(m) + 4095) / 4096;
+        std::vector<std::array<float, 6>> box(static_cast<std::size_t>(blocks));
+        parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (std::int64_t blk = b0; blk < b1; ++blk) {
+                std::array<float, 6> bb = {kCellLimit, kCellLimit, kCellLimit, -kCellLimit, -kCellLimit, -kCellLimit};
+                const std::size_t lo = std::size_t(blk * 4096), hi = std::min(m, lo + 4096);
+                for (std::size_t k = lo; k < hi; ++k) {
+                    const Vec3& p = pos[perm[k]];
+                    const float c[3] = {cell_of(p.x), cell_of(p.y), cell_of(p.z)};
+                    for (int a = 0; a < 3; ++a) {
+                        bb[std::size_t(a)] = std::min(bb[std::size_t(a)], c[a]);
+                        bb[std::size_t(a) + 3] = std::max(bb[std::size_t(a) + 3], c[a]);
+                    }
+                }
+                box[std::size_t(blk)] = bb;
+            }
+        });
+        std::array<float, 6> bb = box[0];
+        for (const auto& b : box)
+            for (std::size_t a = 0; a < 3; ++a) {
+                bb[a] = std::min(bb[a], b[a]);
+                bb[a + 3] = std::max(bb[a + 3], b[a + 3]);
+            }
+        min_cx = int(bb[0]) - 1;
+        min_cy = int(bb[1]) - 1;
+        min_cz = int(bb[2]) - 1;
+        const auto nx = std::uint64_t(int(bb[3]) - min_cx + 2), ny = std::uint64_t(int(bb[4]) - min_cy + 2),
+                   nz = std::uint64_t(int(bb[5]) - min_cz + 2);
+        stride_y = nx;
+        stride_z = nx * ny;
+        std::uint64_t* key = sort_keys.data();
+        std::uint64_t* tkey = sort_keys.data() + cap;
+        parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
+            for (std::int64_t k = b; k < e; ++k) {
+                const Vec3& p = pos[perm[std::size_t(k)]];
+                key[k] = std::uint64_t(int(cell_of(p.z)) - min_cz) * stride_z +
+                         std::uint64_t(int(cell_of(p.y)) - min_cy) * stride_y + std::uint64_t(int(cell_of(p.x)) - min_cx);
+            }
+        });
+        const std::uint64_t top = nx * ny * nz - 1;
+        const int bits = 64 - __builtin_clzll(top | 1u);
         std::uint32_t* idx = perm.data();
         std::uint32_t* tidx = perm_tmp.data();
-        for (int shift = 0; shift < 30; shift += 10) {
-            std::uint32_t count[1025] = {};
-            for (std::size_t k = 0; k < m; ++k) ++count[((key[k] >> shift) & 1023u) + 1];
-            for (int b = 0; b < 1024; ++b) count[b + 1] += count[b];
+        constexpr int kDigit = 11;
+        for (int shift = 0; shift < bits; shift += kDigit) {
+            std::vector<std::uint32_t> count((1u << kDigit) + 1, 0u);
+            for (std::size_t k = 0; k < m; ++k) ++count[((key[k] >> shift) & ((1u << kDigit) - 1u)) + 1];
+            for (std::size_t b = 0; b < (1u << kDigit); ++b) count[b + 1] += count[b];
             for (std::size_t k = 0; k < m; ++k) {
-                const std::uint32_t dst = count[(key[k] >> shift) & 1023u]++;
+                const std::uint32_t dst = count[(key[k] >> shift) & ((1u << kDigit) - 1u)]++;
                 tkey[dst] = key[k];
                 tidx[dst] = idx[k];
             }
             std::swap(key, tkey);
             std::swap(idx, tidx);
         }
-        // Three passes: the result is in the temporaries' storage.
-        const std::uint32_t* p = idx;
-        permute(pos, p, m);
-        permute(vel, p, m);
-        permute(acc, p, m);
-        permute(density, p, m);
-        permute(pterm, p, m);
-        permute(sediment, p, m);
-        permute(acidity, p, m);
-        permute(age, p, m);
-        permute(lifespan, p, m);
+        ncell = 0;
+        for (std::size_t k = 0; k < m; ++k)
+            if (k == 0 || key[k] != key[k - 1]) {
+                cell_key[ncell] = key[k];
+                cell_start[ncell++] = std::uint32_t(k);
+            }
+        cell_start[ncell] = std::uint32_t(m);
+        // The keys are spent: their 16 bytes per particle are the permutation's scratch.
+        permute(pos, idx, m);
+        permute(vel, idx, m);
+        permute(acc, idx, m);
+        permute(density, idx, m);
+        permute(pterm, idx, m);
+        permute(sediment, idx, m);
+        permute(acidity, idx, m);
+        permute(age, idx, m);
+        permute(lifespan, idx, m);
         std::fill(alive.begin(), alive.begin() + std::ptrdiff_t(m), std::uint8_t(1));
         n = m;
         live = m;
@@ -259,90 +394,47 @@ struct Simulation::Impl {
 
     template <typename T>
     void permute(std::vector<T>& v, const std::uint32_t* p, std::size_t m) {
-        // `exchange` (double) is free between sub-steps: use it as scratch for 8-byte types,
-        // `bucket` + `order` for 4-byte ones, `acc`-sized storage for Vec3.
-        if constexpr (sizeof(T) == 8) {
-            auto* tmp = reinterpret_cast<T*>(exchange.data());
-            for (std::size_t k = 0; k < m; ++k) tmp[k] = v[p[k]];
-            std::copy(tmp, tmp + m, v.begin());
-        } else if constexpr (sizeof(T) == 4) {
-            auto* tmp = reinterpret_cast<T*>(bucket.data());
-            for (std::size_t k = 0; k < m; ++k) tmp[k] = v[p[k]];
-            std::copy(tmp, tmp + m, v.begin());
-        } else {
-            static_assert(sizeof(T) == 12);
-            // Vec3: two passes through the 8-byte scratch would be awkward; use
-            // bucket (4 B) + exchange (8 B) together as 12 bytes per particle.
-            auto* a = reinterpret_cast<float*>(bucket.data());
-            auto* b = reinterpret_cast<double*>(exchange.data());
-            for (std::size_t k = 0; k < m; ++k) {
-                const Vec3& q = v[p[k]];
-                a[k] = q.x;
-                float yz[2] = {q.y, q.z};
-                std::memcpy(&b[k], yz, 8);
-            }
-            for (std::size_t k = 0; k < m; ++k) {
-                float yz[2];
-                std::memcpy(yz, &b[k], 8);
-                v[k] = Vec3{a[k], yz[0], yz[1]};
-            }
-        }
-    }
-
-    std::uint32_t cell_coord(float x) const { return std::uint32_t(int(std::floor(x * inv_h)) + kCellBias); }
-
-    /// Bucket every live particle; stable counting sort into `order`, `start`.
-    void build_grid() {
-        if (since_reorder >= kReorderEvery || live != n) reorder();
-        ++since_reorder;
-        std::uint32_t bits = 6;
-        while ((std::size_t(1) << bits) < 2 * n) ++bits;
-        mask = (1u << bits) - 1u;
-        const std::size_t tsize = std::size_t(mask) + 1;
-        parallel_for(0, std::int64_t(n), 4096, [&](std::int64_t b, std::int64_t e) {
-            for (std::int64_t i = b; i < e; ++i) {
-                const Vec3& p = pos[std::size_t(i)];
-                bucket[std::size_t(i)] = bucket_of(cell_coord(p.x), cell_coord(p.y), cell_coord(p.z), mask);
-            }
+        static_assert(sizeof(T) <= 2 * sizeof(std::uint64_t) && std::is_trivially_copyable_v<T>);
+        auto* tmp = reinterpret_cast<std::byte*>(sort_keys.data());
+        parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
+            for (std::int64_t k = b; k < e; ++k) std::memcpy(tmp + std::size_t(k) * sizeof(T), &v[p[k]], sizeof(T));
         });
-        std::fill(start.begin(), start.begin() + std::ptrdiff_t(tsize + 1), 0u);
-        for (std::size_t i = 0; i < n; ++i) ++start[bucket[i] + 1];
-        for (std::size_t b = 0; b < tsize; ++b) start[b + 1] += start[b];
-        // Scatter using start[b] as a cursor, then shift back (start[b] ends at the old start[b+1]).
-        for (std::size_t i = 0; i < n; ++i) order[start[bucket[i]]++] = std::uint32_t(i);
-        for (std::size_t b = tsize; b > 0; --b) start[b] = start[b - 1];
-        start[0] = 0;
-        sorted = n;
+        parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
+            for (std::int64_t k = b; k < e; ++k) std::memcpy(&v[std::size_t(k)], tmp + std::size_t(k) * sizeof(T), sizeof(T));
+        });
     }
 
-    /// The particles within h of particle i (i itself included), in a fixed
-    /// order (27 cells in order, each bucket's particles in sorted order),
-    /// into nb[] with their squared distances; returns how many. The filter
-    /// is branch-free (write always, advance on a hit): most candidates miss.
-    std::size_t gather(std::size_t i, std::uint32_t* nb, float* r2s, std::size_t room) const {
-        const Vec3 p = pos[i];
-        const std::uint32_t cx = cell_coord(p.x), cy = cell_coord(p.y), cz = cell_coord(p.z);
-        std::size_t c = 0;
-        for (std::uint32_t ox = cx - 1; ox != cx + 2; ++ox)
-            for (std::uint32_t oy = cy - 1; oy != cy + 2; ++oy)
-                for (std::uint32_t oz = cz - 1; oz != cz + 2; ++oz) {
-                    const std::uint32_t b = bucket_of(ox, oy, oz, mask);
-                    const std::uint32_t e = start[b + 1];
-                    std::uint32_t k = start[b];
-                    if (c + (e - k) > room) k = e - std::uint32_t(room - c);  // cannot happen below 4× rest density
-                    for (; k < e; ++k) {
-                        const std::uint32_t j = order[k];
-                        const Vec3& q = pos[j];
-                        const float dx = p.x - q.x, dy = p.y - q.y, dz = p.z - q.z;
-                        const float r2 = dx * dx + dy * dy + dz * dz;
-                        nb[c] = j;
-                        r2s[c] = r2;
-                        c += r2 < h2 ? 1u : 0u;
-                    }
-                }
-        return c;
+    /// The particles in the 9 rows of 3 cells around cell c, as [begin, end)
+    /// runs of the sorted arrays, in a fixed order (z, then y; x ascending
+    /// within a run); empty rows skipped. Returns the number of runs.
+    int rows(std::size_t c, std::uint32_t (*run)[2]) const {
+        const std::uint64_t k = cell_key[c];
+        const std::uint64_t* first = cell_key.data();
+        const std::uint64_t* last = first + ncell;
+        int nr = 0;
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy) {
+                // The padding keeps every key of the row within the box: no wrap-around.
+                const std::uint64_t mid = k + std::uint64_t(std::int64_t(dz)) * stride_z + std::uint64_t(std::int64_t(dy)) * stride_y;
+                const std::uint64_t* lo = std::lower_bound(first, last, mid - 1);
+                const std::uint64_t* hi = lo;
+                while (hi != last && *hi <= mid + 1) ++hi;
+                if (lo == hi) continue;
+                run[nr][0] = cell_start[std::size_t(lo - first)];
+                run[nr][1] = cell_start[std::size_t(hi - first)];
+                ++nr;
+            }
+        return nr;
     }
-    static constexpr std::size_t kRoom = 4096;
+
+    /// Particles in the runs, and that count rounded up to whole kLanes.
+    static std::size_t run_total(const std::uint32_t (*run)[2], int nr) {
+        std::size_t m = 0;
+        for (int r = 0; r < nr; ++r) m += run[r][1] - run[r][0];
+        return m;
+    }
+    static std::size_t padded(std::size_t m) { return (m + kLanes - 1) / kLanes * kLanes; }
+
 
     /// Cubic spline kernel W(r) with support h.
     float kernel(float r2) const {
@@ -400,85 +492,109 @@ struct Simulation::Impl {
         push.z += area * float(nz);
     }
 
+    /// Density and pressure, a cell at a time: the candidates of the cell's 27
+    /// neighbour cells are copied once into contiguous arrays and every particle
+    /// of the cell sums over all of them (lanes of kLanes, out-of-support ones masked).
     void density_pass() {
-        parallel_for(0, std::int64_t(n), kGrain, [&](std::int64_t b, std::int64_t e) {
+        parallel_for(0, std::int64_t(ncell), kCellGrain, [&](std::int64_t c0, std::int64_t c1) {
             FlushDenormals ftz;
-            std::vector<std::uint32_t> nb(kRoom);
-            std::vector<float> r2s(kRoom);
-            for (std::int64_t ii = b; ii < e; ++ii) {
-                const auto i = std::size_t(ii);
-                const std::size_t c = gather(i, nb.data(), r2s.data(), kRoom);
-                float rho = 0.0f;
-                for (std::size_t k = 0; k < c; ++k) rho += kernel(r2s[k]);
-                rho *= mass;
-                // The terrain as the fluid's rest lattice continued behind it (Akinci et al. 2012's boundary
-                // particles, summed once into a table): without it a particle on the ground misses half its
-                // kernel and the fluid crowds against the ground.
-                float phi = 0.0f;
-                Vec3 push{0.0f, 0.0f, 0.0f};
-                const double x = pos[i].x, y = pos[i].y, z = pos[i].z;
-                // Only the terrain: the map's side walls (closed boundary) stay geometric. With them as walls too
-                // (and the quadrant where two meet subtracted once), Martin & Moyce's dam break in its narrow
-                // tank ran 30 % ahead of the measurements; see docs/sph.md.
-                const double above = y - surface(x, z);
-                if (above < double(h)) {
-                    double nrm[3];
-                    normal(x, z, nrm);
-                    add_wall(above * nrm[1], nrm[0], nrm[1], nrm[2], phi, push);  // the distance to the tangent plane
+            std::vector<float> bx, by, bz;
+            std::uint32_t run[9][2];
+            for (std::int64_t cc = c0; cc < c1; ++cc) {
+                const auto c = std::size_t(cc);
+                const int nr = rows(c, run);
+                const std::size_t mp = padded(run_total(run, nr));
+                float* X = room(bx, mp);
+                float* Y = room(by, mp);
+                float* Z = room(bz, mp);
+                std::size_t k = 0;
+                for (int r = 0; r < nr; ++r)
+                    for (std::uint32_t j = run[r][0]; j < run[r][1]; ++j, ++k) {
+                        X[k] = pos[j].x;
+                        Y[k] = pos[j].y;
+                        Z[k] = pos[j].z;
+                    }
+                for (; k < mp; ++k) X[k] = Y[k] = Z[k] = kFar;
+                for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
+                    float rho = mass * (w_norm * density_sum(X, Y, Z, mp, pos[i].x, pos[i].y, pos[i].z, h2, inv_h));
+                    // The terrain as the fluid's rest lattice continued behind it (Akinci et al. 2012's boundary
+                    // particles, summed once into a table): without it a particle on the ground misses half its
+                    // kernel and the fluid crowds against the ground.
+                    float phi = 0.0f;
+                    Vec3 push{0.0f, 0.0f, 0.0f};
+                    const double x = pos[i].x, y = pos[i].y, z = pos[i].z;
+                    // Only the terrain: the map's side walls (closed boundary) stay geometric. With them as walls
+                    // too (and the quadrant where two meet subtracted once), Martin & Moyce's dam break in its
+                    // narrow tank ran 30 % ahead of the measurements; see docs/sph.md.
+                    const double above = y - surface(x, z);
+                    if (above < double(h)) {
+                        double nrm[3];
+                        normal(x, z, nrm);
+                        add_wall(above * nrm[1], nrm[0], nrm[1], nrm[2], phi, push);  // the distance to the tangent plane
+                    }
+                    wall_push[i] = push;
+                    rho += rho0 * phi;
+                    density[i] = rho;
+                    const float ratio = rho / rho0;
+                    const float r2_ = ratio * ratio;
+                    const float p = std::max(0.0f, B * (r2_ * r2_ * r2_ * ratio - 1.0f));
+                    pterm[i] = p / (rho * rho);
                 }
-                wall_push[i] = push;
-                rho += rho0 * phi;
-                density[i] = rho;
-                const float ratio = rho / rho0;
-                const float r2_ = ratio * ratio;
-                const float p = std::max(0.0f, B * (r2_ * r2_ * r2_ * ratio - 1.0f));
-                pterm[i] = p / (rho * rho);
             }
         });
     }
 
+    /// Pressure, viscosity, the ground's push and gravity, a cell at a time as
+    /// in density_pass.
     void force_pass() {
         const float g = float(-s.gravity);
-        const std::int64_t blocks = (std::int64_t(n) + kGrain - 1) / kGrain;
+        const float visc_k = 2.0f * alpha_c_hs;
+        const float scale = -mass * grad_norm * inv_h;  // force_sum's result → m/s²
+        const std::int64_t blocks = (std::int64_t(ncell) + kCellGrain - 1) / kCellGrain;
         std::vector<float> block_max(std::size_t(std::max<std::int64_t>(blocks, 1)), 0.0f);
         parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
             FlushDenormals ftz;
-            std::vector<std::uint32_t> nb(kRoom);
-            std::vector<float> r2s(kRoom);
+            std::vector<float> buf[8];
+            std::uint32_t run[9][2];
             for (std::int64_t blk = b0; blk < b1; ++blk) {
                 float amax = 0.0f;
-                const std::size_t lo = std::size_t(blk * kGrain), hi = std::min(n, lo + std::size_t(kGrain));
-                for (std::size_t i = lo; i < hi; ++i) {
-                    const Vec3 vi = vel[i];
-                    const Vec3 pi3 = pos[i];
-                    const float pi = pterm[i], rhoi = density[i];
-                    float ax = 0, ay = 0, az = 0;
-                    const std::size_t c = gather(i, nb.data(), r2s.data(), kRoom);
-                    for (std::size_t k = 0; k < c; ++k) {
-                        const std::uint32_t j = nb[k];
-                        const float r2 = r2s[k];
-                        const Vec3& pj = pos[j];
-                        const float dx = pi3.x - pj.x, dy = pi3.y - pj.y, dz = pi3.z - pj.z;
-                        const Vec3& vj = vel[j];
-                        const float vx = vi.x - vj.x, vy = vi.y - vj.y, vz = vi.z - vj.z;
-                        const float vr = vx * dx + vy * dy + vz * dz;
-                        float term = pi + pterm[j];
-                        if (vr < 0.0f) {
-                            const float mu = vr / (r2 + visc_eps);
-                            term -= alpha_c_hs * mu * 2.0f / (rhoi + density[j]);
+                const std::size_t clo = std::size_t(blk * kCellGrain), chi = std::min(ncell, clo + std::size_t(kCellGrain));
+                for (std::size_t c = clo; c < chi; ++c) {
+                    const int nr = rows(c, run);
+                    const std::size_t mp = padded(run_total(run, nr));
+                    float* f[8];
+                    for (int a = 0; a < 8; ++a) f[a] = room(buf[a], mp);
+                    std::size_t k = 0;
+                    for (int r = 0; r < nr; ++r)
+                        for (std::uint32_t j = run[r][0]; j < run[r][1]; ++j, ++k) {
+                            f[0][k] = pos[j].x;
+                            f[1][k] = pos[j].y;
+                            f[2][k] = pos[j].z;
+                            f[3][k] = vel[j].x;
+                            f[4][k] = vel[j].y;
+                            f[5][k] = vel[j].z;
+                            f[6][k] = pterm[j];
+                            f[7][k] = density[j];
                         }
-                        const float gw = -mass * term * kernel_grad(r2);
-                        ax += gw * dx;
-                        ay += gw * dy;
-                        az += gw * dz;
+                    for (; k < mp; ++k) {
+                        f[0][k] = f[1][k] = f[2][k] = kFar;
+                        f[3][k] = f[4][k] = f[5][k] = f[6][k] = 0.0f;
+                        f[7][k] = rho0;
                     }
-                    // The ground pushes back with the particle's own pressure (mirrored): −(2 p/ρ²) ρ0 ∇Φ.
-                    const float wall = 2.0f * pi * rho0;
-                    ax += wall * wall_push[i].x;
-                    ay += wall * wall_push[i].y + g;
-                    az += wall * wall_push[i].z;
-                    acc[i] = Vec3{ax, ay, az};
-                    amax = std::max(amax, ax * ax + ay * ay + az * az);
+                    const ForceCandidates cand{f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
+                    for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
+                        const float pi = pterm[i];
+                        float sum[3];
+                        force_sum(cand, mp, pos[i].x, pos[i].y, pos[i].z, vel[i].x, vel[i].y, vel[i].z, pi, density[i],
+                                  h2, inv_h, visc_eps, visc_k, sum);
+                        // The ground pushes back with the particle's own pressure (mirrored): −(2 p/ρ²) ρ0 ∇Φ.
+                        const float wall = 2.0f * pi * rho0;
+                        const float ax = scale * sum[0] + wall * wall_push[i].x;
+                        const float ay = scale * sum[1] + wall * wall_push[i].y + g;
+                        const float az = scale * sum[2] + wall * wall_push[i].z;
+                        acc[i] = Vec3{ax, ay, az};
+                        amax = std::max(amax, ax * ax + ay * ay + az * az);
+                    }
                 }
                 block_max[std::size_t(blk)] = amax;
             }
@@ -711,23 +827,19 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.age.resize(capacity);
     m.lifespan.resize(capacity);
     m.alive.resize(capacity);
-    m.bucket.resize(capacity);
-    m.order.resize(capacity);
-    std::size_t table = 64;
-    while (table < 2 * capacity) table *= 2;
-    m.start.resize(table + 1);
-    m.sort_key.resize(capacity);
-    m.sort_tmp_key.resize(capacity);
+    m.sort_keys.resize(2 * capacity);
     m.perm.resize(capacity);
     m.perm_tmp.resize(capacity);
+    m.cell_key.resize(capacity);
+    m.cell_start.resize(capacity + 1);
 }
 
 Simulation::~Simulation() = default;
 
 std::size_t Simulation::bytes_per_particle() {
-    // pos, vel, acc (36) + density, pterm, acidity, age, lifespan (20) + sediment, exchange (16)
-    // + alive (1) + bucket, order (8) + hash table (≤ 4 × 4 buckets) + sort scratch (16).
-    return 36 + 20 + 16 + 1 + 8 + 16 + 16;
+    // pos, vel, acc, wall_push (48) + density, pterm, acidity, age, lifespan (20) + sediment, exchange (16)
+    // + alive (1) + sort keys (16) + permutation (8) + cell keys and starts (12, at most one cell per particle).
+    return 48 + 20 + 16 + 1 + 16 + 8 + 12;
 }
 
 bool Simulation::add(Vec3 p, Vec3 v, float acidity, std::int32_t lifespan) {
@@ -798,7 +910,7 @@ void Simulation::substep(double dt) {
         ++m.substeps;
         return;
     }
-    m.build_grid();
+    m.sort_by_cell();
     m.density_pass();
     m.force_pass();
     const bool ok = m.integrate(float(dt));
@@ -865,7 +977,7 @@ void Simulation::end_step() {
     }
     ++m.water_steps;
     if (changed) m.lift_all();
-    if (m.live != m.n) m.reorder();
+    if (m.live != m.n) m.sort_by_cell();
 }
 
 std::size_t Simulation::size() const { return impl_->live; }
