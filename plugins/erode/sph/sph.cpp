@@ -168,6 +168,7 @@ struct Simulation::Impl {
     std::size_t ncell = 0;
     std::uint64_t stride_y = 1, stride_z = 1;  // key steps of one cell in y and z (x: 1)
     int min_cx = 0, min_cy = 0, min_cz = 0;    // the padded box's first cell
+    std::array<std::vector<float>, 6> soa;     // x, y, z (m), vx, vy, vz (m/s) of the sorted particles
 
     Counts counts;
     std::int64_t substeps = 0;
@@ -202,12 +203,15 @@ struct Simulation::Impl {
     void vertex_normal(int x, int z, double n[3]) const {
         const int x0 = std::max(x - 1, 0), x1 = std::min(x + 1, w - 1);
         const int z0 = std::max(z - 1, 0), z1 = std::min(z + 1, hgt - 1);
-        const double dx = x1 > x0 ? (H(x1, z) - H(x0, z)) / ((x1 - x0) * cell) : 0.0;
-        const double dz = z1 > z0 ? (H(x, z1) - H(x, z0)) / ((z1 - z0) * cell) : 0.0;
-        const double l = std::sqrt(dx * dx + dz * dz + 1.0);
-        n[0] = -dx / l;
-        n[1] = 1.0 / l;
-        n[2] = -dz / l;
+        // Central differences (one-sided at the map's edges), 1/m; multiplications, not divisions: this runs
+        // for every particle near the ground several times a sub-step.
+        const double sx = x1 - x0 == 2 ? 0.5 * inv_cell : inv_cell, sz = z1 - z0 == 2 ? 0.5 * inv_cell : inv_cell;
+        const double dx = x1 > x0 ? (H(x1, z) - H(x0, z)) * sx : 0.0;
+        const double dz = z1 > z0 ? (H(x, z1) - H(x, z0)) * sz : 0.0;
+        const double il = 1.0 / std::sqrt(dx * dx + dz * dz + 1.0);
+        n[0] = -dx * il;
+        n[1] = il;
+        n[2] = -dz * il;
     }
 
     /// The normal at (x, z): the tile's four vertex normals, bilinearly weighted, normalised.
@@ -229,8 +233,8 @@ struct Simulation::Impl {
             n[k] = (1 - fx) * (1 - fz) * a[k] + fx * (1 - fz) * b[k] + (1 - fx) * fz * c[k] + fx * fz * d[k];
             l += n[k] * n[k];
         }
-        l = std::sqrt(l);
-        for (int k = 0; k < 3; ++k) n[k] /= l;
+        const double il = 1.0 / std::sqrt(l);
+        for (int k = 0; k < 3; ++k) n[k] *= il;
     }
 
     /// Möller–Trumbore: the ray o + t·d against triangle (p0, p1, p2); t in [0, 1] or -1.
@@ -258,6 +262,9 @@ struct Simulation::Impl {
         const double x0 = i * cell, x1 = (i + 1) * cell, z0 = j * cell, z1 = (j + 1) * cell;
         const double a[3] = {x0, H(i, j), z0}, b[3] = {x1, H(i + 1, j), z0};
         const double c[3] = {x0, H(i, j + 1), z1}, e[3] = {x1, H(i + 1, j + 1), z1};
+        // A motion that stays above the tile's highest corner cannot cross its triangles (most particles
+        // off the ground): skip the two ray tests.
+        if (std::min(o[1], o[1] + d[1]) > std::max(std::max(a[1], b[1]), std::max(c[1], e[1]))) return -1.0;
         double best = -1.0;
         for (double t : {ray_triangle(o, d, a, b, e), ray_triangle(o, d, a, e, c)})
             if (t >= 0.0 && (best < 0.0 || t < best)) best = t;
@@ -390,6 +397,18 @@ struct Simulation::Impl {
         std::fill(alive.begin(), alive.begin() + std::ptrdiff_t(m), std::uint8_t(1));
         n = m;
         live = m;
+        // Component arrays of the positions and velocities (fixed until integrate()): a cell's candidates
+        // are then 9 contiguous runs to copy per component.
+        parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
+            for (auto k = std::size_t(b); k < std::size_t(e); ++k) {
+                soa[0][k] = pos[k].x;
+                soa[1][k] = pos[k].y;
+                soa[2][k] = pos[k].z;
+                soa[3][k] = vel[k].x;
+                soa[4][k] = vel[k].y;
+                soa[5][k] = vel[k].z;
+            }
+        });
     }
 
     template <typename T>
@@ -404,28 +423,47 @@ struct Simulation::Impl {
         });
     }
 
-    /// The particles in the 9 rows of 3 cells around cell c, as [begin, end)
+    /// The particles in the 9 rows of 3 cells around a cell, as [begin, end)
     /// runs of the sorted arrays, in a fixed order (z, then y; x ascending
-    /// within a run); empty rows skipped. Returns the number of runs.
-    int rows(std::size_t c, std::uint32_t (*run)[2]) const {
-        const std::uint64_t k = cell_key[c];
-        const std::uint64_t* first = cell_key.data();
-        const std::uint64_t* last = first + ncell;
-        int nr = 0;
-        for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy) {
-                // The padding keeps every key of the row within the box: no wrap-around.
-                const std::uint64_t mid = k + std::uint64_t(std::int64_t(dz)) * stride_z + std::uint64_t(std::int64_t(dy)) * stride_y;
-                const std::uint64_t* lo = std::lower_bound(first, last, mid - 1);
-                const std::uint64_t* hi = lo;
-                while (hi != last && *hi <= mid + 1) ++hi;
-                if (lo == hi) continue;
-                run[nr][0] = cell_start[std::size_t(lo - first)];
-                run[nr][1] = cell_start[std::size_t(hi - first)];
-                ++nr;
-            }
-        return nr;
-    }
+    /// within a run), empty rows skipped. Asked for cells in increasing key
+    /// order (one task's range), each row's lookup moves forward from where
+    /// the previous cell's ended: a binary search only for the first cell or
+    /// after a long gap.
+    class RowWalker {
+    public:
+        explicit RowWalker(const Impl& m) : m_(m) {}
+        int next(std::size_t c, std::uint32_t (*run)[2]) {
+            const std::uint64_t k = m_.cell_key[c];
+            const std::uint64_t* first = m_.cell_key.data();
+            const std::uint64_t* last = first + m_.ncell;
+            int nr = 0, row = 0;
+            for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy, ++row) {
+                    // The box's padding keeps every key of the row within it: no wrap-around.
+                    const std::uint64_t mid =
+                        k + std::uint64_t(std::int64_t(dz)) * m_.stride_z + std::uint64_t(std::int64_t(dy)) * m_.stride_y;
+                    const std::uint64_t* lo = started_ ? at_[row] : first;
+                    if (!started_ || (last - lo > 8 && lo[8] < mid - 1))
+                        lo = std::lower_bound(lo, last, mid - 1);
+                    else
+                        while (lo != last && *lo < mid - 1) ++lo;
+                    at_[row] = lo;
+                    const std::uint64_t* hi = lo;
+                    while (hi != last && *hi <= mid + 1) ++hi;
+                    if (lo == hi) continue;
+                    run[nr][0] = m_.cell_start[std::size_t(lo - first)];
+                    run[nr][1] = m_.cell_start[std::size_t(hi - first)];
+                    ++nr;
+                }
+            started_ = true;
+            return nr;
+        }
+
+    private:
+        const Impl& m_;
+        const std::uint64_t* at_[9] = {};
+        bool started_ = false;
+    };
 
     /// Particles in the runs, and that count rounded up to whole kLanes.
     static std::size_t run_total(const std::uint32_t (*run)[2], int nr) {
@@ -500,20 +538,22 @@ struct Simulation::Impl {
             FlushDenormals ftz;
             std::vector<float> bx, by, bz;
             std::uint32_t run[9][2];
+            RowWalker rows(*this);
             for (std::int64_t cc = c0; cc < c1; ++cc) {
                 const auto c = std::size_t(cc);
-                const int nr = rows(c, run);
+                const int nr = rows.next(c, run);
                 const std::size_t mp = padded(run_total(run, nr));
                 float* X = room(bx, mp);
                 float* Y = room(by, mp);
                 float* Z = room(bz, mp);
                 std::size_t k = 0;
-                for (int r = 0; r < nr; ++r)
-                    for (std::uint32_t j = run[r][0]; j < run[r][1]; ++j, ++k) {
-                        X[k] = pos[j].x;
-                        Y[k] = pos[j].y;
-                        Z[k] = pos[j].z;
-                    }
+                for (int r = 0; r < nr; ++r) {
+                    const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
+                    std::memcpy(X + k, soa[0].data() + j, len * sizeof(float));
+                    std::memcpy(Y + k, soa[1].data() + j, len * sizeof(float));
+                    std::memcpy(Z + k, soa[2].data() + j, len * sizeof(float));
+                    k += len;
+                }
                 for (; k < mp; ++k) X[k] = Y[k] = Z[k] = kFar;
                 for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
                     float rho = mass * (w_norm * density_sum(X, Y, Z, mp, pos[i].x, pos[i].y, pos[i].z, h2, inv_h));
@@ -556,26 +596,23 @@ struct Simulation::Impl {
             FlushDenormals ftz;
             std::vector<float> buf[8];
             std::uint32_t run[9][2];
+            RowWalker rows(*this);
             for (std::int64_t blk = b0; blk < b1; ++blk) {
                 float amax = 0.0f;
                 const std::size_t clo = std::size_t(blk * kCellGrain), chi = std::min(ncell, clo + std::size_t(kCellGrain));
                 for (std::size_t c = clo; c < chi; ++c) {
-                    const int nr = rows(c, run);
+                    const int nr = rows.next(c, run);
                     const std::size_t mp = padded(run_total(run, nr));
                     float* f[8];
                     for (int a = 0; a < 8; ++a) f[a] = room(buf[a], mp);
                     std::size_t k = 0;
-                    for (int r = 0; r < nr; ++r)
-                        for (std::uint32_t j = run[r][0]; j < run[r][1]; ++j, ++k) {
-                            f[0][k] = pos[j].x;
-                            f[1][k] = pos[j].y;
-                            f[2][k] = pos[j].z;
-                            f[3][k] = vel[j].x;
-                            f[4][k] = vel[j].y;
-                            f[5][k] = vel[j].z;
-                            f[6][k] = pterm[j];
-                            f[7][k] = density[j];
-                        }
+                    for (int r = 0; r < nr; ++r) {
+                        const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
+                        for (int a = 0; a < 6; ++a) std::memcpy(f[a] + k, soa[std::size_t(a)].data() + j, len * sizeof(float));
+                        std::memcpy(f[6] + k, pterm.data() + j, len * sizeof(float));
+                        std::memcpy(f[7] + k, density.data() + j, len * sizeof(float));
+                        k += len;
+                    }
                     for (; k < mp; ++k) {
                         f[0][k] = f[1][k] = f[2][k] = kFar;
                         f[3][k] = f[4][k] = f[5][k] = f[6][k] = 0.0f;
@@ -642,7 +679,7 @@ struct Simulation::Impl {
                         const double t2 = hit_tile(ui, uj, o, d);
                         if (t2 >= 0.0 && (t < 0.0 || t2 < t)) t = t2;
                     }
-                    double n3[3];
+                    double n3[3] = {0.0, 1.0, 0.0};  // set below wherever it is read
                     if (t >= 0.0) {
                         for (int k = 0; k < 3; ++k) p[k] = o[k] + t * d[k];
                         normal(p[0], p[2], n3);
@@ -678,7 +715,8 @@ struct Simulation::Impl {
                     p[0] = np.x;
                     p[2] = np.z;
                     const double ys = surface(p[0], p[2]);
-                    normal(p[0], p[2], n3);
+                    // The normal only where it is used: within a radius of the ground or after a hit.
+                    if (contact || p[1] - ys < s.radius || p[1] < ys + 1e-4 * s.radius) normal(p[0], p[2], n3);
                     if (p[1] < ys + 1e-4 * s.radius) {
                         p[1] = ys;
                         const double vn = v[0] * n3[0] + v[1] * n3[1] + v[2] * n3[2];
@@ -832,14 +870,16 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.perm_tmp.resize(capacity);
     m.cell_key.resize(capacity);
     m.cell_start.resize(capacity + 1);
+    for (auto& a : m.soa) a.resize(capacity);
 }
 
 Simulation::~Simulation() = default;
 
 std::size_t Simulation::bytes_per_particle() {
     // pos, vel, acc, wall_push (48) + density, pterm, acidity, age, lifespan (20) + sediment, exchange (16)
-    // + alive (1) + sort keys (16) + permutation (8) + cell keys and starts (12, at most one cell per particle).
-    return 48 + 20 + 16 + 1 + 16 + 8 + 12;
+    // + alive (1) + sort keys (16) + permutation (8) + cell keys and starts (12, at most one cell per particle)
+    // + component copies of position and velocity (24).
+    return 48 + 20 + 16 + 1 + 16 + 8 + 12 + 24;
 }
 
 bool Simulation::add(Vec3 p, Vec3 v, float acidity, std::int32_t lifespan) {
