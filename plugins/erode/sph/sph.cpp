@@ -122,6 +122,18 @@ void force_sum(const ForceCandidates& c, std::size_t m, float px, float py, floa
     out[2] = lane_sum(az);
 }
 
+/// Copy a short run of floats (a row of a few cells: memcpy's call costs more than the copy) in whole
+/// blocks of kSlack: up to kSlack − 1 floats past `len` are read and written, so both arrays have that
+/// much slack at the end (the candidate buffers are then overwritten by the next run or the padding).
+constexpr std::size_t kSlack = 8;
+inline void copy_run(float* __restrict to, const float* __restrict from, std::size_t len) {
+    for (std::size_t k = 0; k < len; k += kSlack) {
+        float b[kSlack];
+        for (std::size_t l = 0; l < kSlack; ++l) b[l] = from[k + l];
+        for (std::size_t l = 0; l < kSlack; ++l) to[k + l] = b[l];
+    }
+}
+
 /// Grow a scratch buffer to at least `m` entries (never shrinks: reused across cells).
 inline float* room(std::vector<float>& v, std::size_t m) {
     if (v.size() < m) v.resize(m + m / 2);
@@ -543,15 +555,15 @@ struct Simulation::Impl {
                 const auto c = std::size_t(cc);
                 const int nr = rows.next(c, run);
                 const std::size_t mp = padded(run_total(run, nr));
-                float* X = room(bx, mp);
-                float* Y = room(by, mp);
-                float* Z = room(bz, mp);
+                float* X = room(bx, mp + kSlack);
+                float* Y = room(by, mp + kSlack);
+                float* Z = room(bz, mp + kSlack);
                 std::size_t k = 0;
                 for (int r = 0; r < nr; ++r) {
                     const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
-                    std::memcpy(X + k, soa[0].data() + j, len * sizeof(float));
-                    std::memcpy(Y + k, soa[1].data() + j, len * sizeof(float));
-                    std::memcpy(Z + k, soa[2].data() + j, len * sizeof(float));
+                    copy_run(X + k, soa[0].data() + j, len);
+                    copy_run(Y + k, soa[1].data() + j, len);
+                    copy_run(Z + k, soa[2].data() + j, len);
                     k += len;
                 }
                 for (; k < mp; ++k) X[k] = Y[k] = Z[k] = kFar;
@@ -604,13 +616,13 @@ struct Simulation::Impl {
                     const int nr = rows.next(c, run);
                     const std::size_t mp = padded(run_total(run, nr));
                     float* f[8];
-                    for (int a = 0; a < 8; ++a) f[a] = room(buf[a], mp);
+                    for (int a = 0; a < 8; ++a) f[a] = room(buf[a], mp + kSlack);
                     std::size_t k = 0;
                     for (int r = 0; r < nr; ++r) {
                         const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
-                        for (int a = 0; a < 6; ++a) std::memcpy(f[a] + k, soa[std::size_t(a)].data() + j, len * sizeof(float));
-                        std::memcpy(f[6] + k, pterm.data() + j, len * sizeof(float));
-                        std::memcpy(f[7] + k, density.data() + j, len * sizeof(float));
+                        for (int a = 0; a < 6; ++a) copy_run(f[a] + k, soa[std::size_t(a)].data() + j, len);
+                        copy_run(f[6] + k, pterm.data() + j, len);
+                        copy_run(f[7] + k, density.data() + j, len);
                         k += len;
                     }
                     for (; k < mp; ++k) {
@@ -856,9 +868,9 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.pos.resize(capacity);
     m.vel.resize(capacity);
     m.acc.resize(capacity);
-    m.density.resize(capacity);
+    m.density.resize(capacity + kSlack);
     m.wall_push.resize(capacity);
-    m.pterm.resize(capacity);
+    m.pterm.resize(capacity + kSlack);  // copy_run's slack
     m.sediment.resize(capacity);
     m.exchange.resize(capacity);
     m.acidity.resize(capacity);
@@ -870,7 +882,7 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.perm_tmp.resize(capacity);
     m.cell_key.resize(capacity);
     m.cell_start.resize(capacity + 1);
-    for (auto& a : m.soa) a.resize(capacity);
+    for (auto& a : m.soa) a.resize(capacity + kSlack);
 }
 
 Simulation::~Simulation() = default;
