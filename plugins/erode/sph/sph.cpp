@@ -150,6 +150,12 @@ struct Simulation::Impl {
     double extent_x = 0.0, extent_z = 0.0;
     std::vector<double> terrain;
     std::vector<double> water_sum;  // Σ over steps of the water depth per vertex, m
+    // The vertex normals (x, y, z per vertex), kept current: exchange_terrain() marks the span of each row it
+    // changed (dirty_lo..dirty_hi, vertex columns) and refresh_normals() recomputes what those changes reach.
+    // normal() runs several times per particle and sub-step; from scratch each took 4 square roots.
+    std::vector<float> vnormal;
+    std::vector<int> dirty_lo, dirty_hi;
+    bool any_dirty = false;
     std::int64_t water_steps = 0;
 
     // Derived fluid constants (float: the SPH loops run in single precision).
@@ -235,11 +241,10 @@ struct Simulation::Impl {
             n[0] = 0, n[1] = 1, n[2] = 0;
             return;
         }
-        double a[3], b[3], c[3], d[3];
-        vertex_normal(i, j, a);
-        vertex_normal(i + 1, j, b);
-        vertex_normal(i, j + 1, c);
-        vertex_normal(i + 1, j + 1, d);
+        const float* a = &vnormal[3 * (std::size_t(j) * std::size_t(w) + std::size_t(i))];
+        const float* b = a + 3;
+        const float* c = a + 3 * std::size_t(w);
+        const float* d = c + 3;
         double l = 0.0;
         for (int k = 0; k < 3; ++k) {
             n[k] = (1 - fx) * (1 - fz) * a[k] + fx * (1 - fz) * b[k] + (1 - fx) * fz * c[k] + fx * fz * d[k];
@@ -295,6 +300,11 @@ struct Simulation::Impl {
         int i, j;
         double fx, fz;
         tile(x, z, i, j, fx, fz);
+        for (int r = j; r <= std::min(j + 1, hgt - 1); ++r) {
+            dirty_lo[std::size_t(r)] = std::min(dirty_lo[std::size_t(r)], i);
+            dirty_hi[std::size_t(r)] = std::max(dirty_hi[std::size_t(r)], std::min(i + 1, w - 1));
+        }
+        any_dirty = true;
         const double dh = volume * inv_cell * inv_cell;
         const auto at = [&](int a, int b) -> double& {
             return terrain[std::size_t(std::min(b, hgt - 1)) * std::size_t(w) + std::size_t(std::min(a, w - 1))];
@@ -307,6 +317,33 @@ struct Simulation::Impl {
         at(i + 1, j) += dh * fx * (1 - fz);
         at(i, j + 1) += dh * (1 - fx) * fz;
         at(i + 1, j + 1) += dh * fx * fz;
+    }
+
+    /// Recompute the cached vertex normals whose stencil (the vertex and its 4
+    /// neighbours) holds a vertex exchange_terrain() changed: per row, the
+    /// union of the dirty spans of the rows above, itself and below, widened by one.
+    void refresh_normals() {
+        if (!any_dirty) return;
+        parallel_for(0, hgt, 16, [&](std::int64_t z0, std::int64_t z1) {
+            for (std::int64_t zz = z0; zz < z1; ++zz) {
+                const auto z = std::size_t(zz);
+                int lo = w, hi = -1;
+                for (std::size_t r = z == 0 ? 0 : z - 1; r <= std::min(z + 1, std::size_t(hgt - 1)); ++r) {
+                    lo = std::min(lo, dirty_lo[r]);
+                    hi = std::max(hi, dirty_hi[r]);
+                }
+                for (int x = std::max(lo - 1, 0); x <= std::min(hi + 1, w - 1); ++x) store_normal(x, int(z));
+            }
+        });
+        std::fill(dirty_lo.begin(), dirty_lo.end(), w);
+        std::fill(dirty_hi.begin(), dirty_hi.end(), -1);
+        any_dirty = false;
+    }
+    void store_normal(int x, int z) {
+        double nv[3];
+        vertex_normal(x, z, nv);
+        float* o = &vnormal[3 * (std::size_t(z) * std::size_t(w) + std::size_t(x))];
+        for (int k = 0; k < 3; ++k) o[k] = float(nv[k]);
     }
 
     // --------------------------------------------------------- particles
@@ -798,7 +835,10 @@ struct Simulation::Impl {
                 changed = true;
             }
         }
-        if (changed) lift_all();
+        if (changed) {
+            refresh_normals();
+            lift_all();
+        }
     }
 
     /// After the terrain changed: lift particles a deposit has covered.
@@ -845,6 +885,11 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.extent_z = (m.hgt - 1) * m.cell;
     m.terrain.assign(terrain.data, terrain.data + terrain.size());
     m.water_sum.assign(terrain.size(), 0.0);
+    m.vnormal.resize(3 * terrain.size());
+    m.dirty_lo.assign(std::size_t(m.hgt), 0);
+    m.dirty_hi.assign(std::size_t(m.hgt), m.w - 1);
+    m.any_dirty = true;
+    m.refresh_normals();  // all of them
 
     const double r = settings.radius;
     const double spacing = 2.0 * r;
@@ -1028,7 +1073,10 @@ void Simulation::end_step() {
         at(ti + 1, tj + 1) += vcell * fx * fz;
     }
     ++m.water_steps;
-    if (changed) m.lift_all();
+    if (changed) {
+        m.refresh_normals();
+        m.lift_all();
+    }
     if (m.live != m.n) m.sort_by_cell();
 }
 
