@@ -47,7 +47,7 @@ inline float lane_sum(const float* a) {
 // baseline and picks one at load time (any x86-64 runs it; the result bits are
 // the same for every clone, see kLanes).
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(__SANITIZE_ADDRESS__) && \
-    !defined(__SANITIZE_THREAD__)
+    !defined(__SANITIZE_THREAD__) && !defined(OROGEN_SPH_NO_CLONES)
 #define OROGEN_SPH_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
 #else
 #define OROGEN_SPH_CLONES
@@ -362,7 +362,7 @@ struct Simulation::Impl {
     /// around a cell is one contiguous run of particles. Stable LSD radix sort
     /// with ties in the previous order: the order, and with it every
     /// particle's neighbour and summation order, follows from the state alone.
-    void sort_by_cell() {
+    void sort_by_cell(bool keep_fields) {
         std::size_t m = 0;
         for (std::size_t i = 0; i < n; ++i)
             if (alive[i]) perm[m++] = std::uint32_t(i);
@@ -436,9 +436,13 @@ struct Simulation::Impl {
         // The keys are spent: their 16 bytes per particle are the permutation's scratch.
         permute(pos, idx, m);
         permute(vel, idx, m);
-        permute(acc, idx, m);
-        permute(density, idx, m);
-        permute(pterm, idx, m);
+        // Density and pressure are recomputed before every use in a sub-step; only a compaction between
+        // steps (end_step) must keep them with their particles for the views and record(). The
+        // accelerations are always recomputed before use.
+        if (keep_fields) {
+            permute(density, idx, m);
+            permute(pterm, idx, m);
+        }
         permute(sediment, idx, m);
         permute(acidity, idx, m);
         permute(age, idx, m);
@@ -1007,7 +1011,7 @@ void Simulation::substep(double dt) {
         ++m.substeps;
         return;
     }
-    m.sort_by_cell();
+    m.sort_by_cell(false);
     m.density_pass();
     m.force_pass();
     const bool ok = m.integrate(float(dt));
@@ -1077,7 +1081,7 @@ void Simulation::end_step() {
         m.refresh_normals();
         m.lift_all();
     }
-    if (m.live != m.n) m.sort_by_cell();
+    if (m.live != m.n) m.sort_by_cell(true);
 }
 
 std::size_t Simulation::size() const { return impl_->live; }

@@ -14,15 +14,16 @@
 // cheapest per particle-step there, and its compressibility is set by c0
 // (δρ/ρ ≈ (v/c0)²). DFSPH pays off with deep, still water and large steps.
 //
-// Neighbours: a hashed cell list (cells of size h, 27 cells per particle):
-// each sub-step every particle's cell gets a Morton (Z-order) code, its
-// bucket is the code's low bits (a power-of-two table ≥ 2 × particles), and a
-// stable counting sort lists the particles by bucket. Every few sub-steps the
-// particle arrays themselves are permuted into that order, so neighbours are
-// neighbours in memory (the low Morton bits are a Z-order walk within each
-// block). Each particle sums its neighbours in a fixed order (27 offsets,
-// buckets once each, particles in bucket order): the same bits for any
-// thread count.
+// Neighbours: a cell list with cells of size h (27 cells per particle). Every
+// sub-step the particle arrays are sorted by cell (a stable radix sort of keys
+// linear in the particles' bounding box of cells, x fastest, padded by one
+// cell), so the 3 cells of each of the 9 rows around a cell are one contiguous
+// run. Density and forces go a cell at a time: the runs are copied once into
+// contiguous arrays and every particle of the cell sums over all of them in
+// 16 independent float lanes (out-of-support candidates masked), which GCC
+// vectorizes; the lanes are added in a fixed order at the end. The order of
+// every sum follows from the state alone: the same bits for any thread count
+// and any of the vector clones (AVX-512, AVX2, baseline x86-64).
 //
 // Terrain contact (the thesis, done correctly): the particle's motion in a
 // sub-step is a ray; Möller–Trumbore tests it against the two triangles of

@@ -4,6 +4,9 @@
 #include "orogen_test.hpp"
 
 #include <gtest/gtest.h>
+#include <algorithm>
+#include <cstring>
+#include <vector>
 #include <openvdb/openvdb.h>
 #include <openvdb/points/PointCount.h>
 #include <openvdb/points/PointDataGrid.h>
@@ -60,18 +63,44 @@ TEST(SphNode, ParticleSeriesOpensWithVtksXmlReaderAndAsOpenVdbPoints) {
             EXPECT_EQ(std::size_t(arr->GetNumberOfTuples()), last);
         }
         if (last > 0) {
-            // Water near rest density, in the map, above the pyramid's foot.
+            // Water near rest density, in the map.
             const double rho = poly->GetPointData()->GetArray("density")->GetTuple1(0);
             EXPECT_GT(rho, 100.0);
             EXPECT_LT(rho, 2000.0);
+            for (vtkIdType k = 0; k < poly->GetNumberOfPoints(); ++k) {
+                double p[3];
+                poly->GetPoint(k, p);
+                // export:vtk's default frame: X east, Y north (the map spans Y ∈ [−32, 0]), Z up.
+                EXPECT_GE(p[0], 0.0);
+                EXPECT_LE(p[0], 32.0);
+                EXPECT_LE(p[1], 0.0);
+                EXPECT_GE(p[1], -32.0);
+            }
+        }
+    }
+    // The last frame (step 20) is the state the eroded heightmap was written in: every particle is on or
+    // above its triangulated surface (diagonal from (i, j) to (i+1, j+1), as the solver's), so Z is up and
+    // the frame is the map's. (Erosion cuts below the pyramid's foot at 0 m, so 0 is no bound.) 1e-5 m: the
+    // heights are written in float.
+    {
+        const std::string raw = slurp(dir / "out" / "wet.r32");
+        ASSERT_EQ(raw.size(), 33u * 33u * 4u);
+        std::vector<float> hm(33 * 33);
+        std::memcpy(hm.data(), raw.data(), raw.size());
+        const auto H = [&](int x, int z) { return double(hm[std::size_t(z) * 33 + std::size_t(x)]); };
+        vtkNew<vtkXMLPolyDataReader> reader;
+        reader->SetFileName((dir / "out" / files.back()).c_str());
+        reader->Update();
+        vtkPolyData* poly = reader->GetOutput();
+        for (vtkIdType k = 0; k < poly->GetNumberOfPoints(); ++k) {
             double p[3];
-            poly->GetPoint(0, p);
-            // export:vtk's default frame: X east, Y north (the map spans Y ∈ [−32, 0]), Z up.
-            EXPECT_GE(p[0], 0.0);
-            EXPECT_LE(p[0], 32.0);
-            EXPECT_LE(p[1], 0.0);
-            EXPECT_GE(p[1], -32.0);
-            EXPECT_GE(p[2], 0.0);
+            poly->GetPoint(k, p);
+            const double x = std::clamp(p[0], 0.0, 32.0), z = std::clamp(-p[1], 0.0, 32.0);
+            const int i = std::min(int(x), 31), j = std::min(int(z), 31);
+            const double fx = x - i, fz = z - j;
+            const double a = H(i, j), b = H(i + 1, j), c = H(i, j + 1), d = H(i + 1, j + 1);
+            const double ys = fx >= fz ? a + fx * (b - a) + fz * (d - b) : a + fz * (c - a) + fx * (d - c);
+            EXPECT_GE(p[2], ys - 1e-5) << "particle " << k << " at " << p[0] << ", " << p[1];
         }
     }
     EXPECT_EQ(last, 20u * 30u) << "20 steps of 30 rain particles, none evaporated yet";
