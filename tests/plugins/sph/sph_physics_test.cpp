@@ -123,3 +123,38 @@ TEST(SphHydrostatics, SettledColumnHasPressureRhoGDepthAndNearlyConstantDensity)
     }
     EXPECT_LT((rmax - rmin) / 1000.0, 0.03) << "density between " << rmin << " and " << rmax;
 }
+
+// The cell list finds every neighbour once: each particle's density equals the sum of the kernel over
+// all pairs (O(n²), in double) for a clumpy cloud whose cells are unevenly filled, well above the floor
+// (so no terrain term). A missed row of cells or a cell visited twice shifts a density by at least one
+// near neighbour's W, far above float round-off (relative 1e-5 here; the sums are ~360 terms).
+TEST(SphNeighbours, DensityEqualsTheSumOverAllPairs) {
+    const Flat floor(41, 41, 0.05);
+    sph::Settings set = fluid(0.05, 20.0, 0.05);
+    const double h = 4 * set.radius, spacing = 2 * set.radius, mass = 1000.0 * spacing * spacing * spacing;
+    const int count = 3000;
+    sph::Simulation sim(floor.view, set, count);
+    std::uint64_t state = 12345;  // a small LCG: any fixed cloud will do
+    const auto next = [&] {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return double(state >> 11) / double(1ull << 53);
+    };
+    for (int k = 0; k < count; ++k) {
+        const double u = next(), v = next(), w = next();
+        ASSERT_TRUE(sim.add({float(0.5 + 0.6 * u * u), float(1.0 + 0.5 * v), float(0.5 + 0.6 * w)}, {}, 0.0f, 0));
+    }
+    sim.substep(0.0);  // sorts, sums the densities, moves nothing
+    const auto pos = sim.positions();
+    const auto rho = sim.densities();
+    ASSERT_EQ(pos.size(), std::size_t(count));
+    for (std::size_t i = 0; i < pos.size(); ++i) {
+        double sum = 0.0;
+        for (std::size_t j = 0; j < pos.size(); ++j) {
+            const double dx = pos[i].x - pos[j].x, dy = pos[i].y - pos[j].y, dz = pos[i].z - pos[j].z;
+            const double q = std::sqrt(dx * dx + dy * dy + dz * dz) / h;
+            if (q < 1.0) sum += q <= 0.5 ? 6.0 * q * q * (q - 1.0) + 1.0 : 2.0 * (1.0 - q) * (1.0 - q) * (1.0 - q);
+        }
+        const double expect = mass * 8.0 / (3.14159265358979323846 * h * h * h) * sum;
+        ASSERT_NEAR(rho[i], expect, 1e-5 * expect) << "particle " << i;
+    }
+}
