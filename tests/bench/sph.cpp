@@ -52,6 +52,7 @@ void BM_sph_step_terrain(benchmark::State& state) {
         benchmark::ClobberMemory();
     }
     state.counters["particles"] = double(sim.size());
+    state.counters["bytes_per_particle"] = double(sph::Simulation::bytes_per_particle());
     state.SetItemsProcessed(state.iterations() * std::int64_t(sim.size()));
 }
 
@@ -92,5 +93,6 @@ BENCHMARK(BM_sph_step_terrain)
     ->Args({100'000, 2})
     ->Args({1'000'000, 2})
     ->Args({100'000, 1})
+    ->Args({1'000'000, 1})
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_sph_step_dambreak)->ArgNames({"threads"})->Arg(2)->Arg(1)->Unit(benchmark::kMillisecond);

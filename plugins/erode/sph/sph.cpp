@@ -412,16 +412,38 @@ struct Simulation::Impl {
         const int bits = 64 - __builtin_clzll(top | 1u);
         std::uint32_t* idx = perm.data();
         std::uint32_t* tidx = perm_tmp.data();
+        // Each pass: per-block digit histograms in parallel, their offsets in (digit, block) order, then each
+        // block scatters its own keys in order. Blocks of fixed size: the same permutation on any thread count.
         constexpr int kDigit = 11;
+        constexpr std::size_t kDigits = std::size_t(1) << kDigit, kBlock = 16384;
+        const std::size_t nblocks = (m + kBlock - 1) / kBlock;
+        std::vector<std::uint32_t> offset(nblocks * kDigits);
         for (int shift = 0; shift < bits; shift += kDigit) {
-            std::vector<std::uint32_t> count((1u << kDigit) + 1, 0u);
-            for (std::size_t k = 0; k < m; ++k) ++count[((key[k] >> shift) & ((1u << kDigit) - 1u)) + 1];
-            for (std::size_t b = 0; b < (1u << kDigit); ++b) count[b + 1] += count[b];
-            for (std::size_t k = 0; k < m; ++k) {
-                const std::uint32_t dst = count[(key[k] >> shift) & ((1u << kDigit) - 1u)]++;
-                tkey[dst] = key[k];
-                tidx[dst] = idx[k];
-            }
+            std::fill(offset.begin(), offset.end(), 0u);
+            parallel_for(0, std::int64_t(nblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
+                for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                    std::uint32_t* count = &offset[b * kDigits];
+                    for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k)
+                        ++count[(key[k] >> shift) & (kDigits - 1)];
+                }
+            });
+            std::uint32_t run = 0;
+            for (std::size_t d = 0; d < kDigits; ++d)
+                for (std::size_t b = 0; b < nblocks; ++b) {
+                    const std::uint32_t c = offset[b * kDigits + d];
+                    offset[b * kDigits + d] = run;
+                    run += c;
+                }
+            parallel_for(0, std::int64_t(nblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
+                for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                    std::uint32_t* cursor = &offset[b * kDigits];
+                    for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k) {
+                        const std::uint32_t dst = cursor[(key[k] >> shift) & (kDigits - 1)]++;
+                        tkey[dst] = key[k];
+                        tidx[dst] = idx[k];
+                    }
+                }
+            });
             std::swap(key, tkey);
             std::swap(idx, tidx);
         }
