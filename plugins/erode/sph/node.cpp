@@ -141,8 +141,8 @@ OROGEN_PLUGIN("erode-sph", "0.1.0", registry) {
         .summary = "hydraulic erosion by SPH water particles (rain and springs) that dissolve, carry and drop terrain",
         .description =
             "The thesis's SPH eroder with a real fluid: weakly compressible SPH (Tait equation of state, "
-            "Monaghan's artificial viscosity, CFL-limited sub-steps), a hashed cell list with particles sorted "
-            "along a Morton curve, terrain contact by a Möller–Trumbore test of each particle's motion against "
+            "Monaghan's artificial viscosity, CFL-limited sub-steps), a cell list with the particles sorted by "
+            "cell every sub-step and vectorized neighbour sums, terrain contact by a Möller–Trumbore test of each particle's motion against "
             "the two triangles of the tile beneath it and an impulse along the normal interpolated from the "
             "tile's vertex normals (no particle ever ends below the surface). Rain spawns `rain` particles per "
             "step rain_height m above random points; springs spawn spring_rate per step at grid-relative points. "

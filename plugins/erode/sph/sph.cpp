@@ -77,10 +77,11 @@ struct ForceCandidates {
     const float *x, *y, *z, *vx, *vy, *vz, *pterm, *rho;
 };
 
-/// Σ_j (p_i/ρ_i² + p_j/ρ_j² + Π_ij) · (shape of ∂W/∂r) / r · r_ij over the
-/// candidates within the support: the pressure + viscosity acceleration of
-/// particle i is −m · grad_norm / h times the result (m/s² · m⁻¹ ... scaled by
-/// the caller). One division per pair: Π's two denominators and 1/r share it.
+/// Σ_j (p_i/ρ_i² + p_j/ρ_j² + Π_ij) · shape'(q) / r · r_ij over the candidates
+/// within the support (shape' the cubic spline's derivative without its
+/// normalisation): particle i's pressure + viscosity acceleration in m/s² is
+/// −m · grad_norm / h times the result, applied by the caller. One division
+/// per pair: Π's two denominators and 1/r share it.
 OROGEN_SPH_CLONES
 void force_sum(const ForceCandidates& c, std::size_t m, float px, float py, float pz, float vx, float vy, float vz,
                float pi, float rhoi, float h2, float inv_h, float visc_eps, float visc_k, float out[3]) {
