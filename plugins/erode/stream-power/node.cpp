@@ -305,7 +305,10 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "any dt; Newton's method for n != 1). Water leaves by the open sides, whose vertices are held at base "
             "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
             "uplift_layer, that layer's metres gained over uplift_layer_years (e.g. the plates' 'uplift'), spread over "
-            "uplift_smoothing metres. The same "
+            "uplift_smoothing metres; with a second input (a heightmap series such as plates.timelapse), the height "
+            "change between its frames over the years they map to (the first frame year 0, the last "
+            "uplift_history_years, default the run's years), spread the same way. deposition=G > 0 lets G Qs/A of "
+            "the sediment flux Qs settle on its way down (Yuan et al. 2019; solved exactly on the receiver tree). The same "
             "result on any number of threads. Adds the layers drainage (upstream area, m^2: draw rivers where it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
             "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",

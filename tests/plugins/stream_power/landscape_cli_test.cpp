@@ -114,15 +114,15 @@ TEST(LandscapeCli, DepositionAndUpliftHistoryAreCheckedBeforeTheRun) {
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
-             "bad.orogen:4:32: error: 'deposition' of erode:stream-power is 20, out of range [0, 10]",
-             "bad.orogen:5:32: error: 'deposition' of erode:stream-power is -0.5, out of range [0, 10]",
+             "bad.orogen:4:41: error: 'deposition' of erode:stream-power is 20, out of range [0, 10]",
+             "bad.orogen:5:41: error: 'deposition' of erode:stream-power is -0.5, out of range [0, 10]",
              "bad.orogen:6:30: error: erode:stream-power input 2 ('uplift_history') must be a series of heightmaps, "
              "but 'base' is a heightmap",
              "bad.orogen:8:5: error: erode:stream-power: input 2 (uplift_history) records no frames: give its node "
              "timelapse_every=K (e.g. tectonics:plates(..., timelapse_every=50)) so that it hands on its heights over "
              "time",
-             "bad.orogen:10:41: error: erode:stream-power: give uplift_layer or an uplift_history input, not both",
-             "bad.orogen:11:30: error: erode:stream-power: uplift_history_years spreads an uplift history; give one as "
+             "bad.orogen:10:53: error: erode:stream-power: give uplift_layer or an uplift_history input, not both",
+             "bad.orogen:11:51: error: erode:stream-power: uplift_history_years spreads an uplift history; give one as "
              "input 2, e.g. plates.timelapse",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;

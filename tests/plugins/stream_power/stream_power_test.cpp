@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <numeric>
 #include <vector>
@@ -476,6 +477,8 @@ TEST_P(DepositionSteadyState, ChannelsCarryOnePlusGTimesTheUplift) {
     ASSERT_GT(la.size(), 200u);
     EXPECT_LT(worst, 0.02) << "largest relative deviation from S = ((1+G)U/K)^(1/n) A^(-m/n), G = " << g;
     const auto [slope, intercept] = fit(la, ls);
+    std::printf("n = %g, G = %g: %zu channel cells, worst deviation %.3g %%, concavity %.4f\n", n, g, la.size(),
+                100.0 * worst, -slope);
     EXPECT_NEAR(-slope, 0.5, 0.01);
     EXPECT_NEAR(std::exp(intercept), s0, 0.02 * s0);
     // At steady state the sediment that leaves is all the rock uplifted: U × the non-outlet area per year.
@@ -551,6 +554,8 @@ TEST(Deposition, EachCellSolvesItsEquationAndTheSedimentBalances) {
                 deposits += Dep > 1e-6;
             }
             EXPECT_LT(worst, 1e-10) << "n = " << n << ", G = " << g << ": largest residual of a cell's equation";
+            std::printf("n = %g, G = %g: residual %.2g, eroded %.4g m3, deposited %.4g m3, out %.4g m3, balance %.2g m3\n",
+                        n, g, worst, eroded, deposited, model.sediment_out(), eroded - deposited - model.sediment_out());
             EXPECT_GT(deposits, 1000);
             EXPECT_GT(deposited, 0.05 * eroded);
             EXPECT_NEAR(eroded - deposited, model.sediment_out(), 1e-9 * eroded) << "n = " << n << ", G = " << g;
@@ -647,6 +652,7 @@ TEST(UpliftHistory, WhenTheUpliftComesChangesTheLandscape) {
         model.run(years, 2e4);
         mean[which] = std::accumulate(model.heights().begin(), model.heights().end(), 0.0) / double(w * h);
     }
+    std::printf("mean height after 2 Myr: uplifted early %.2f m, late %.2f m\n", mean[0], mean[1]);
     EXPECT_GT(mean[1], 1.5 * mean[0]) << "early " << mean[0] << " m, late " << mean[1] << " m";
 }
 
