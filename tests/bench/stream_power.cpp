@@ -52,12 +52,14 @@ void BM_stream_power_step(benchmark::State& state) {
     s.deposition = double(state.range(4));         // G of Yuan et al. (2019); 0: detachment-limited
     Model model(n, n, 30.0, dome(n), std::vector<double>(std::size_t(n) * n, 1e-3), s);
     for (int i = 0; i < 3; ++i) model.step(1e4);
-    std::int64_t pits = 0;
+    std::int64_t pits = 0, passes = 0;
     for (auto _ : state) {
         pits += model.step(1e4);
+        passes += model.deposition_passes();
         benchmark::ClobberMemory();
     }
     state.counters["pits/step"] = double(pits) / double(state.iterations());
+    if (s.deposition > 0.0) state.counters["passes"] = double(passes) / double(state.iterations());
     state.SetItemsProcessed(state.iterations() * std::int64_t(n) * n);
 }
 BENCHMARK(BM_stream_power_step)

@@ -255,7 +255,10 @@ void Model::incise_with_deposition(double dt) {
     const double a0 = cell_ * cell_;
     const std::size_t n = h_.size();
     if (dep_hs_.size() != n) {
-        for (auto* v : {&dep_hs_, &dep_p_, &dep_q_, &dep_sa_, &dep_sb_, &dep_tree_, &dep_x_}) v->assign(n, 0.0);
+        for (auto* v : {&dep_hs_, &dep_tree_, &dep_x_}) v->assign(n, 0.0);
+        dep_pos_.assign(n, 0);
+        dep_p_.assign(2 * n, 0.0);   // p, q pairs
+        dep_sa_.assign(2 * n, 0.0);  // Σα, Σβ pairs
         dep_active_.assign(n, 0);
     }
     const double* area = flow_.area().data();
@@ -266,52 +269,71 @@ void Model::incise_with_deposition(double dt) {
     const double kdt_l1 = K * dt / std::pow(cell_, ns), kdt_l2 = K * dt / std::pow(cell_ * kSqrt2, ns);
     double* h = h_.data();
     const std::int64_t groups = std::int64_t(chunks.size()) - 1;
+    // A^m from the table for whole numbers of cells (as incise() does: the pow is the costly part).
+    const double* tab = pow_table_.data();
+    const double inv_a0 = 1.0 / a0;
+    auto area_power = [=](double a) {
+        const double c = a * inv_a0;
+        if (c < double(kPowTable - 1)) {
+            const auto ci = std::int64_t(c + 0.5);
+            if (double(ci) * a0 == a) return tab[ci];
+        }
+        return std::pow(a, m);
+    };
+    // With D8 the tree's area is the drainage area; with MFD it is summed over the tree.
+    const bool d8 = settings_.mfd_exponent <= 0.0;
     chunk_out_.assign(std::size_t(std::max<std::int64_t>(groups, 0)), 0.0);
+    chunk_passes_.assign(chunk_out_.size(), 0);
     parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        // Scratch indexed by stack position, so that the passes read and write it in order; only
+        // the receiver's sums (and its position) are reached by a jump.
         double* hs = dep_hs_.data();
-        double* P = dep_p_.data();
-        double* Q = dep_q_.data();
-        double* sa = dep_sa_.data();
-        double* sb = dep_sb_.data();
+        auto* pq = reinterpret_cast<double(*)[2]>(dep_p_.data());   // p, q
+        auto* sum = reinterpret_cast<double(*)[2]>(dep_sa_.data());  // Σα, Σβ of the donors
         double* tree = dep_tree_.data();
         double* xp = dep_x_.data();
+        std::int32_t* pos = dep_pos_.data();  // stack position of each cell
         std::uint8_t* act = dep_active_.data();
         for (std::int64_t g = g0; g < g1; ++g) {
             const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
             double lo = 0.0, hi = 0.0;
             for (std::int64_t s = b; s < e; ++s) {
                 const std::int32_t i = stack[s], r = rcv[i];
-                hs[i] = h[i];
+                pos[i] = std::int32_t(s);
+                hs[s] = h[i];
                 // Every cell but a root starts incising, as in the detachment-limited solver, which
                 // skips a cell only once it is at or below its receiver's new height: one that
-                // would end there stops incising below.
-                act[i] = r != i;
-                xp[i] = h[i] - h[r];
+                // ends there stops incising and the chunk is solved again.
+                act[s] = r != i;
+                xp[s] = h[i] - h[r];
+                sum[s][0] = sum[s][1] = 0.0;
+                if (!d8) tree[s] = a0;
                 lo = s == b ? h[i] : std::min(lo, h[i]);
                 hi = s == b ? h[i] : std::max(hi, h[i]);
             }
             const double tol = 1e-12 * std::max(1.0, hi - lo);
             double out = 0.0;
+            int passes = 0;
             for (int iter = 0; iter < 200; ++iter) {
-                for (std::int64_t s = b; s < e; ++s) {
-                    const std::int32_t i = stack[s];
-                    sa[i] = 0.0;
-                    sb[i] = 0.0;
-                    tree[i] = a0;
-                }
+                ++passes;
+                if (iter > 0)
+                    for (std::int64_t s = b; s < e; ++s) {
+                        sum[s][0] = sum[s][1] = 0.0;
+                        if (!d8) tree[s] = a0;
+                    }
                 // Upstream first: p, q of each cell and its flux's α, β handed to its receiver.
                 for (std::int64_t s = e - 1; s >= b; --s) {
                     const std::int32_t i = stack[s], r = rcv[i];
                     if (r == i) continue;
                     double F = 0.0, c = 0.0;
-                    if (act[i]) {
+                    if (act[s]) {
                         const std::int64_t d = std::int64_t(r) - i;
-                        const double lin = std::pow(area[i], m) *
+                        const double lin = area_power(area[i]) *
                                            ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
                         if (ns == 1.0) {
                             F = lin;
                         } else if (ns > 1.0) {  // Newton: the tangent of x^n at x0
-                            const double x0 = std::max(xp[i], 1e-9 * tol);
+                            const double x0 = std::max(xp[s], 1e-9 * tol);
                             const double xn1 = std::pow(x0, ns - 1.0);
                             F = lin * ns * xn1;
                             c = lin * (1.0 - ns) * xn1 * x0;
@@ -319,17 +341,18 @@ void Model::incise_with_deposition(double dt) {
                             // n < 1: x^n is concave with an infinite slope at 0, where Newton's
                             // tangent overshoots past the receiver. The chord from 0 instead
                             // (Picard: F·x0^(n−1)·x) keeps x > 0 and contracts by < 1 − n a pass.
-                            F = lin * std::pow(std::max(xp[i], 1e-9 * tol), ns - 1.0);
+                            F = lin * std::pow(std::max(xp[s], 1e-9 * tol), ns - 1.0);
                         }
                     }
-                    const double T = tree[i], gA = G / T, Sa = sa[i], Sb = sb[i];
+                    const double T = d8 ? area[i] : tree[s], gA = G / T, Sa = sum[s][0], Sb = sum[s][1];
                     const double D = 1.0 + F + gA * (a0 - Sb);
-                    const double p = (hs[i] * (1.0 + gA * a0) + gA * Sa - c) / D, q = F / D;
-                    P[i] = p;
-                    Q[i] = q;
-                    sa[r] += a0 * hs[i] + Sa + (Sb - a0) * p;
-                    sb[r] += (Sb - a0) * q;
-                    tree[r] += T;
+                    const double p = (hs[s] * (1.0 + gA * a0) + gA * Sa - c) / D, q = F / D;
+                    pq[s][0] = p;
+                    pq[s][1] = q;
+                    const std::int32_t rs = pos[r];
+                    sum[rs][0] += a0 * hs[s] + Sa + (Sb - a0) * p;
+                    sum[rs][1] += (Sb - a0) * q;
+                    if (!d8) tree[rs] += T;
                 }
                 // Downstream first: the new heights; the roots keep theirs and take what flows in.
                 out = 0.0;
@@ -338,32 +361,35 @@ void Model::incise_with_deposition(double dt) {
                 for (std::int64_t s = b; s < e; ++s) {
                     const std::int32_t i = stack[s], r = rcv[i];
                     if (r == i) {
-                        out += sa[i] + sb[i] * h[i];
+                        out += sum[s][0] + sum[s][1] * h[i];
                         continue;
                     }
-                    h[i] = P[i] + Q[i] * h[r];
+                    h[i] = pq[s][0] + pq[s][1] * h[r];
                     const double x = h[i] - h[r];
-                    if (act[i]) {
-                        moved = std::max(moved, std::abs(x - xp[i]));
-                        xp[i] = x;
+                    if (act[s]) {
+                        moved = std::max(moved, std::abs(x - xp[s]));
+                        xp[s] = x;
                         if (!(x > 0.0)) {
-                            act[i] = 0;  // would incise below its receiver: it stops incising
+                            act[s] = 0;  // would incise below its receiver: it stops incising
                             changed = true;
                         }
                     } else if (x > 0.0 && iter < kFlips) {
-                        act[i] = 1;  // raised above its receiver (deposition, an iterate): it incises
-                        xp[i] = x;
+                        act[s] = 1;  // raised above its receiver (deposition, an iterate): it incises
+                        xp[s] = x;
                         changed = true;
                     }
                 }
                 if (!changed && (ns == 1.0 || moved <= tol)) break;
             }
             chunk_out_[std::size_t(g)] = out;
+            chunk_passes_[std::size_t(g)] = passes;
         }
     });
     double total = 0.0;
     for (double v : chunk_out_) total += v;  // chunk order: the same sum on any number of threads
     sediment_out_ = total;
+    deposition_passes_ = 0;
+    for (int p : chunk_passes_) deposition_passes_ = std::max(deposition_passes_, p);
 }
 
 void Model::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {

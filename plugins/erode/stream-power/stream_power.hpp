@@ -88,6 +88,8 @@ public:
     double time() const { return time_; }
     /// With deposition: the sediment (m³) that left the map through the outlets in the last step.
     double sediment_out() const { return sediment_out_; }
+    /// With deposition: the most up-and-down passes an outlet basin needed in the last step.
+    int deposition_passes() const { return deposition_passes_; }
 
     /// Route and accumulate over the current heights without eroding (for the output layers).
     void route_only();
@@ -118,12 +120,16 @@ private:
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_
     std::vector<double> history_rate_;
-    // Deposition scratch (allocated when deposition > 0): per cell the uplifted, diffused height h*,
-    // h' = p + q·h'_receiver, the sums over donors of their flux's affine coefficients (V_d = α + β·h'),
-    // the tree's drainage area, the linearisation point (n ≠ 1) and whether the cell incises.
-    std::vector<double> dep_hs_, dep_p_, dep_q_, dep_sa_, dep_sb_, dep_tree_, dep_x_;
+    // Deposition scratch (allocated when deposition > 0), by stack position: the uplifted, diffused
+    // height h*, (p, q) of h' = p + q·h'_receiver, the sums over donors of their flux's affine
+    // coefficients (Σα, Σβ: V_d = α + β·h'), the tree's area (MFD), the linearisation point (n ≠ 1),
+    // whether the cell incises; and by cell its stack position.
+    std::vector<double> dep_hs_, dep_p_, dep_sa_, dep_tree_, dep_x_;
+    std::vector<std::int32_t> dep_pos_;
     std::vector<std::uint8_t> dep_active_;
     std::vector<double> chunk_out_;
+    std::vector<int> chunk_passes_;
+    int deposition_passes_ = 0;
 };
 
 /// The outlet with every side closed: the lowest cell (lowest index among equals).
@@ -131,7 +137,7 @@ std::int64_t lowest_cell(const std::vector<double>& heights);
 
 /// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
 inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
-/// Extra bytes per cell with deposition > 0 (seven doubles and a flag of scratch).
-inline constexpr std::size_t kBytesPerCellDeposition = 7 * 8 + 1;
+/// Extra bytes per cell with deposition > 0 (seven doubles, a position and a flag of scratch).
+inline constexpr std::size_t kBytesPerCellDeposition = 7 * 8 + 4 + 1;
 
 }  // namespace orogen::stream_power
