@@ -439,6 +439,7 @@ struct DepositionCase {
     double n;
     double k;
     double g;
+    double mfd = 0.0;  // > 0: drainage area by multiple flow directions (the sediment follows the D8 tree)
 };
 
 class DepositionSteadyState : public ::testing::TestWithParam<DepositionCase> {};
@@ -450,8 +451,9 @@ TEST_P(DepositionSteadyState, ChannelsCarryOnePlusGTimesTheUplift) {
     // slopes) is 2^(1/n) − 1 off at G = 1: 41 % for n = 2, 100 % for n = 1.
     const int w = 81, h = 61;
     const double cell = 50.0, U = 1e-3;
-    const auto [n, k, g] = GetParam();
+    const auto [n, k, g, mfd] = GetParam();
     Settings s;
+    s.mfd_exponent = mfd;
     s.erodibility = k;
     s.area_exponent = 0.5 * n;
     s.slope_exponent = n;
@@ -490,10 +492,11 @@ TEST_P(DepositionSteadyState, ChannelsCarryOnePlusGTimesTheUplift) {
 
 INSTANTIATE_TEST_SUITE_P(StreamPower, DepositionSteadyState,
                          ::testing::Values(DepositionCase{1.0, 1e-5, 0.0}, DepositionCase{1.0, 1e-5, 1.0},
-                                           DepositionCase{2.0, 1e-7, 1.0}),
+                                           DepositionCase{2.0, 1e-7, 1.0}, DepositionCase{0.7, 3e-5, 1.0},
+                                           DepositionCase{1.0, 1e-5, 1.0, 1.1}),
                          [](const auto& info) {
                              return "n" + std::to_string(int(info.param.n * 10)) + "_G" +
-                                    std::to_string(int(info.param.g));
+                                    std::to_string(int(info.param.g)) + (info.param.mfd > 0.0 ? "_mfd" : "");
                          });
 
 TEST(Deposition, EachCellSolvesItsEquationAndTheSedimentBalances) {
