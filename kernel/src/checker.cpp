@@ -197,6 +197,12 @@ public:
         ++errors_;
     }
     ValueInfo& output() override { return output_; }
+    ValueInfo* side_output(std::string_view name) override {
+        auto it = sides_.find(name);
+        return it != sides_.end() ? &it->second : nullptr;
+    }
+    void set_sides(std::map<std::string, ValueInfo, std::less<>> sides) { sides_ = std::move(sides); }
+    std::map<std::string, ValueInfo, std::less<>> take_sides() { return std::move(sides_); }
     int errors() const { return errors_; }
     ValueInfo take_output() { return std::move(output_); }
 
@@ -209,6 +215,7 @@ private:
     const fs::path& spec_folder_;
     Diagnostics& diags_;
     ValueInfo output_;
+    std::map<std::string, ValueInfo, std::less<>> sides_;
     int errors_ = 0;
 };
 
@@ -537,16 +544,26 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             for (const auto& l : node->adds_layers) out.layers.insert(l);
         }
 
+        // What the side values hold; a mapped node's hold nothing (it ran once per entry).
+        std::map<std::string, ValueInfo, std::less<>> sides;
+        for (const auto& side : node->side_outputs) {
+            ValueInfo si;
+            si.type = planned.mapped_input >= 0 ? ValueType::none : side.series ? ValueType::series : side.type;
+            if (side.series && planned.mapped_input < 0) si.element = side.type;
+            sides[side.name] = si;
+        }
         // The node's own check, once everything it reads is known to be valid.
         if (inputs_ok && params_ok && node->check) {
             CheckContextImpl ctx(plan.grid, input_infos, planned, param_where, call.where, plan.spec_folder, diags,
                                  std::move(out));
+            ctx.set_sides(std::move(sides));
             try {
                 node->check(ctx);
             } catch (const std::exception& e) {
                 diags.error(call.where, call.qualified() + ": " + e.what());
             }
             out = ctx.take_output();
+            sides = ctx.take_sides();
         }
         // A series output: `out` describes its entries.
         if (node->output_series || planned.mapped_input >= 0) {
@@ -558,13 +575,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
         if (!st.name.empty()) {
             defined_at.emplace(st.name, st.name_where);
             values[st.name] = out;
-            // A mapped node's side values are not kept (it ran once per entry): they hold nothing.
-            for (const auto& side : node->side_outputs) {
-                ValueInfo si;
-                si.type = planned.mapped_input >= 0 ? ValueType::none : side.series ? ValueType::series : side.type;
-                if (side.series && planned.mapped_input < 0) si.element = side.type;
-                values[st.name + "." + side.name] = si;
-            }
+            for (auto& [side, si] : sides) values[st.name + "." + side] = std::move(si);
         }
         for (const auto& in : planned.inputs)
             if (!in.empty()) plan.last_use[in] = plan.nodes.size();

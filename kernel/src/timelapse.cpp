@@ -23,12 +23,22 @@ SideOutput timelapse_output() {
 
 void check_timelapse(CheckContext& ctx, std::int64_t steps) {
     const std::int64_t every = ctx.integer("timelapse_every");
-    if (every <= 0) return;
+    ValueInfo* side = ctx.side_output("timelapse");
+    if (every <= 0) {
+        if (side) side->empty = true;  // nothing is recorded: a consumer can say so before the run
+        return;
+    }
     const ValueInfo* in = ctx.input(0);
     const double w = in && in->width > 0 ? in->width : ctx.grid().width;
     const double h = in && in->height > 0 ? in->height : ctx.grid().height;
     // Step 0, every multiple of `every`, and the last step if it is not one.
     const double frames = double(steps / every) + 1.0 + (steps % every != 0 ? 1.0 : 0.0);
+    if (side) {
+        side->count = std::size_t(frames);
+        side->width = int(w);
+        side->height = int(h);
+        if (in && in->cell > 0) side->cell = in->cell;
+    }
     const double bytes = frames * w * h * 4.0 * 2.0;  // heights + water
     const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
     if (bytes > memory / 2)

@@ -49,23 +49,28 @@ void BM_stream_power_step(benchmark::State& state) {
     s.slope_exponent = 1.0;
     s.diffusivity = state.range(2) ? 0.01 : 0.0;
     s.mfd_exponent = state.range(3) ? 1.1 : 0.0;  // routing=mfd: drainage area by multiple flow directions
+    s.deposition = double(state.range(4));         // G of Yuan et al. (2019); 0: detachment-limited
     Model model(n, n, 30.0, dome(n), std::vector<double>(std::size_t(n) * n, 1e-3), s);
     for (int i = 0; i < 3; ++i) model.step(1e4);
-    std::int64_t pits = 0;
+    std::int64_t pits = 0, passes = 0;
     for (auto _ : state) {
         pits += model.step(1e4);
+        passes += model.deposition_passes();
         benchmark::ClobberMemory();
     }
     state.counters["pits/step"] = double(pits) / double(state.iterations());
+    if (s.deposition > 0.0) state.counters["passes"] = double(passes) / double(state.iterations());
     state.SetItemsProcessed(state.iterations() * std::int64_t(n) * n);
 }
 BENCHMARK(BM_stream_power_step)
-    ->ArgNames({"n", "threads", "diffusion", "mfd"})
-    ->Args({1025, 1, 1, 0})
-    ->Args({1025, 2, 1, 0})
-    ->Args({1025, 2, 0, 0})
-    ->Args({1025, 2, 1, 1})
-    ->Args({4097, 2, 1, 0})
+    ->ArgNames({"n", "threads", "diffusion", "mfd", "G"})
+    ->Args({1025, 1, 1, 0, 0})
+    ->Args({1025, 2, 1, 0, 0})
+    ->Args({1025, 2, 0, 0, 0})
+    ->Args({1025, 2, 1, 1, 0})
+    ->Args({1025, 1, 1, 0, 1})
+    ->Args({1025, 2, 1, 0, 1})
+    ->Args({4097, 2, 1, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

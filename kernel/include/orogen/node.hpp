@@ -141,6 +141,9 @@ struct ValueInfo {
     /// For a series: the type of its entries (the fields above then describe an entry).
     ValueType element = ValueType::none;
     std::size_t count = 0;  ///< for a series: entries, 0 if unknown
+    /// A series known to hold no entries at run time (a time-lapse with timelapse_every=0): a
+    /// consumer that needs entries can refuse it at check time.
+    bool empty = false;
 };
 
 /// The default grid from the spec's `grid` statement.
@@ -171,6 +174,9 @@ public:
     virtual void error(std::string_view param, std::string message) = 0;
     /// What the node outputs; starts as the kernel's default guess (see NodeDescriptor::adds_layers).
     virtual ValueInfo& output() = 0;
+    /// What side value `name` will hold, to refine (e.g. mark a time-lapse that records nothing
+    /// as empty); nullptr if the node declares no such side output.
+    virtual ValueInfo* side_output(std::string_view name) { (void)name; return nullptr; }
 
     /// True if heightmap input `i` has layer `name` (or may have it: its layers
     /// are not known before the run). Otherwise reports at `param`

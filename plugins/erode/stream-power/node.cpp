@@ -61,9 +61,28 @@ NodeOutputs run(NodeContext& ctx) {
     s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
 
+    s.deposition = ctx.real("deposition");
+
     std::vector<double> h(hm->heights().begin(), hm->heights().end());
+    const double sigma = ctx.real("uplift_smoothing");
+    // Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp
+    // relief. Four implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides;
+    // backward Euler keeps the maximum principle, so the spread rate is never faster).
+    auto smooth = [&](std::vector<double>& rate) {
+        if (!(sigma > 0.0)) return;
+        diffusion::Settings ds;
+        ds.diffusivity = 1.0;
+        diffusion::Solver blur(hm->width(), hm->height(), hm->cell(), ds);
+        for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
+    };
+    auto fastest_of = [](const std::vector<double>& rate, double base) {
+        double fastest = 0.0;
+        for (double r : rate) fastest = std::max(fastest, std::abs(r + base));
+        return fastest;
+    };
     // Uplift: the uniform rate plus the layer read as metres accumulated over uplift_layer_years.
-    std::vector<double> uplift(n, ctx.real("uplift") * 1e-3);
+    const double uniform = ctx.real("uplift") * 1e-3;  // mm/yr → m/yr
+    std::vector<double> uplift(n, uniform);
     const std::string& layer = ctx.text("uplift_layer");
     if (!layer.empty()) {
         if (!hm->has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
@@ -75,20 +94,9 @@ NodeOutputs run(NodeContext& ctx) {
                 throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " + std::to_string(i));
             rate[i] = double(u.data[i]) / years;
         }
-        // Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp
-        // relief. Four implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides).
-        const double sigma = ctx.real("uplift_smoothing");
-        if (sigma > 0.0) {
-            diffusion::Settings ds;
-            ds.diffusivity = 1.0;
-            diffusion::Solver blur(hm->width(), hm->height(), hm->cell(), ds);
-            for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
-        }
-        double fastest = 0.0;
-        for (std::size_t i = 0; i < n; ++i) {
-            uplift[i] += rate[i];
-            fastest = std::max(fastest, std::abs(uplift[i]));
-        }
+        smooth(rate);
+        for (std::size_t i = 0; i < n; ++i) uplift[i] += rate[i];
+        const double fastest = fastest_of(uplift, 0.0);
         if (fastest * 1e3 > kMaxUpliftMmYr) {
             std::ostringstream msg;
             msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives "
@@ -97,9 +105,62 @@ NodeOutputs run(NodeContext& ctx) {
             throw BadInput(msg.str());
         }
     }
+    // Uplift from a history (e.g. plates.timelapse): frame k's time, normalised so that the first
+    // frame is year 0 of the run and the last is uplift_history_years (default: the run's years);
+    // between frames k and k+1 the rate is their height change over the years between them.
+    stream_power::UpliftHistory history;
+    if (ctx.has_input(1)) {
+        const auto series = ctx.input(1).series();
+        const std::size_t frames = series->size();
+        if (frames < 2)
+            throw BadInput("uplift_history: the series has " + std::to_string(frames) +
+                           " frame(s); a rate needs at least two (the start and the end)");
+        const double span = ctx.real("uplift_history_years") > 0.0 ? ctx.real("uplift_history_years") : ctx.real("years");
+        const double t0 = series->times.front(), t1 = series->times.back();
+        if (!(t1 > t0)) throw BadInput("uplift_history: the series' frames do not advance in time");
+        for (std::size_t k = 0; k < frames; ++k) {
+            history.times.push_back((series->times[k] - t0) / (t1 - t0) * span);
+            if (k > 0 && !(history.times[k] > history.times[k - 1]))
+                throw BadInput("uplift_history: frame " + std::to_string(k) + " is not later than frame " +
+                               std::to_string(k - 1));
+        }
+        const int W = hm->width(), H = hm->height();
+        auto rate_of = [series, times = history.times, W, H, n, smooth](std::size_t k) {
+            const auto a = series->at(k).heightmap(), b = series->at(k + 1).heightmap();
+            for (const auto* f : {a.get(), b.get()})
+                if (f->width() != W || f->height() != H)
+                    throw BadInput("uplift_history: frame " + std::to_string(k) + " is " + std::to_string(f->width()) +
+                                   " x " + std::to_string(f->height()) + ", the terrain " + std::to_string(W) + " x " +
+                                   std::to_string(H));
+            const double years = times[k + 1] - times[k];
+            std::vector<double> rate(n);
+            for (std::size_t i = 0; i < n; ++i) {
+                rate[i] = (double(b->heights()[i]) - double(a->heights()[i])) / years;
+                if (!std::isfinite(rate[i]))
+                    throw BadInput("uplift_history: frame " + std::to_string(k + 1) +
+                                   " holds a non-finite height at sample " + std::to_string(i));
+            }
+            smooth(rate);
+            return rate;
+        };
+        // Refuse an impossible rate before the run (each interval's rate is made again when the run reaches it).
+        for (std::size_t k = 0; k + 1 < frames; ++k) {
+            const double fastest = fastest_of(rate_of(k), uniform);
+            if (fastest * 1e3 > kMaxUpliftMmYr) {
+                std::ostringstream msg;
+                msg << "uplift_history_years: frames " << k << " to " << k + 1 << " spread over "
+                    << history.times[k + 1] - history.times[k] << " years give " << fastest * 1e3
+                    << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
+                    << " mm/yr); give a longer uplift_history_years";
+                throw BadInput(msg.str());
+            }
+        }
+        history.rate = rate_of;
+    }
     const auto base = *parse_base_level(ctx.text("base_level"));
 
     stream_power::Model model(hm->width(), hm->height(), hm->cell(), std::move(h), std::move(uplift), s);
+    if (history.rate) model.set_uplift_history(std::move(history));
     if (base) {
         for (std::size_t i = 0; i < n; ++i)
             if (model.flow().is_outlet(std::int64_t(i))) model.heights()[i] = *base;
@@ -111,6 +172,7 @@ NodeOutputs run(NodeContext& ctx) {
     lapse.record(0, *hm);
     std::vector<float> frame;
     std::int64_t pits = 0, last = 0;
+    double sediment_out = 0.0;  // m³ that left by the outlets (deposition > 0)
     model.run(years, dt, [&](std::int64_t step, std::int64_t steps) {
         ctx.check_cancelled();
         if (every > 0 && (step % every == 0 || step == steps)) {
@@ -118,6 +180,7 @@ NodeOutputs run(NodeContext& ctx) {
             lapse.record(step, ConstGridView(frame.data(), hm->width(), hm->height(), hm->cell()));
         }
         pits += model.flow().pits();
+        sediment_out += model.sediment_out();
         last = steps;
         const std::int64_t bad = model.first_non_finite();
         if (bad >= 0) {
@@ -153,6 +216,7 @@ NodeOutputs run(NodeContext& ctx) {
     const auto [lo, hi] = std::minmax_element(out.begin(), out.end());
     std::ostringstream msg;
     msg << last << " steps of " << dt << " yr; " << pits << " pits resolved; relief " << (*hi - *lo) << " m";
+    if (s.deposition > 0.0) msg << "; " << sediment_out * 1e-9 << " km³ of sediment left by the outlets";
     ctx.info(msg.str());
     lapse.finish(last, *hm);
     NodeOutputs result(hm);
@@ -176,17 +240,39 @@ void check(CheckContext& ctx) {
     if (ctx.real("dt") > ctx.real("years"))
         ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
     const std::string& layer = ctx.text("uplift_layer");
+    const ValueInfo* hist = ctx.input(1);
+    if (hist) {
+        if (!layer.empty())
+            ctx.error("uplift_layer", "give uplift_layer or an uplift_history input, not both (the plates' 'uplift' "
+                                      "layer is the sum of their history's height changes: it would count twice)");
+        if (hist->empty)
+            ctx.error("", "input 2 (uplift_history) records no frames: give its node timelapse_every=K (e.g. "
+                          "tectonics:plates(..., timelapse_every=50)) so that it hands on its heights over time");
+        else if (hist->count == 1)
+            ctx.error("", "input 2 (uplift_history) has 1 frame; a rate needs at least two (the start and the end)");
+        const ValueInfo* in = ctx.input(0);
+        if (in && in->width > 0 && hist->width > 0 && (in->width != hist->width || in->height != hist->height))
+            ctx.error("", "input 2 (uplift_history) is " + std::to_string(hist->width) + " x " +
+                              std::to_string(hist->height) + ", the terrain " + std::to_string(in->width) + " x " +
+                              std::to_string(in->height) + "; record the history on the terrain's grid");
+    } else if (ctx.given("uplift_history_years")) {
+        ctx.error("uplift_history_years",
+                  "uplift_history_years spreads an uplift history; give one as input 2, e.g. plates.timelapse");
+    }
     if (!layer.empty())
         ctx.require_layer(0, "uplift_layer", layer, "tectonics:plates writes 'uplift'; or give \"\" for none");
     else if (ctx.given("uplift_layer_years"))
         ctx.error("uplift_layer_years", "uplift_layer_years scales an uplift layer; name one with uplift_layer");
-    else if (ctx.given("uplift_smoothing"))
-        ctx.error("uplift_smoothing", "uplift_smoothing spreads an uplift layer; name one with uplift_layer");
+    else if (ctx.given("uplift_smoothing") && !hist)
+        ctx.error("uplift_smoothing", "uplift_smoothing spreads an uplift layer or history; name a layer with "
+                                      "uplift_layer or give a history as input 2");
     // Memory: the model holds about kBytesPerCell bytes per cell beside the heightmap.
     const ValueInfo* in = ctx.input(0);
     const std::int64_t w = in && in->width > 0 ? in->width : ctx.grid().width;
     const std::int64_t hgt = in && in->height > 0 ? in->height : ctx.grid().height;
-    const double need = double(w) * double(hgt) * double(stream_power::kBytesPerCell);
+    const double need = double(w) * double(hgt) *
+                        double(stream_power::kBytesPerCell +
+                               (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0));
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (have > 0 && need > 0.5 * have) {
         std::ostringstream msg;
@@ -219,11 +305,18 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "any dt; Newton's method for n != 1). Water leaves by the open sides, whose vertices are held at base "
             "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
             "uplift_layer, that layer's metres gained over uplift_layer_years (e.g. the plates' 'uplift'), spread over "
-            "uplift_smoothing metres. The same "
+            "uplift_smoothing metres; with a second input (a heightmap series such as plates.timelapse), the height "
+            "change between its frames over the years they map to (the first frame year 0, the last "
+            "uplift_history_years, default the run's years), spread the same way. deposition=G > 0 lets G Qs/A of "
+            "the sediment flux Qs settle on its way down (Yuan et al. 2019; solved exactly on the receiver tree). The same "
             "result on any number of threads. Adds the layers drainage (upstream area, m^2: draw rivers where it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
             "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",
-        .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"}},
+        .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"},
+                   {"uplift_history", ValueType::heightmap, Need::optional,
+                    "heights over time (e.g. plates.timelapse): the height change between two frames is rock uplift "
+                    "over the years they map to (uplift_history_years), added to `uplift`",
+                    Many::series}},
         .output = ValueType::heightmap,
         .side_outputs = {timelapse_output()},
         .params =
@@ -262,6 +355,19 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(1e6)
                     .unit("m")
                     .help("spread the uplift layer over about this distance (flexure of the crust; 0 = as is)"),
+                Param::real("uplift_history_years", 0.0)
+                    .min(0.0)
+                    .max(1e9)
+                    .unit("yr")
+                    .help("with an uplift_history input: the years its frames span, from the start of the run "
+                          "(the first frame is year 0, the last this; 0 = the run's years); no history uplift after")
+                    ,
+                Param::real("deposition", 0.0)
+                    .min(0.0)
+                    .max(10.0)
+                    .help("G of Yuan et al. (2019), dimensionless: the sediment flux deposits G·Qs/A on its way "
+                          "down (0 = detachment-limited; ~1 = half the eroded rock settles in the valleys at "
+                          "steady state; Yuan et al. use 0-3)"),
                 Param::real("diffusivity", 0.01)
                     .min(0.0)
                     .max(10.0)

@@ -16,6 +16,9 @@ constexpr double kSqrt2 = 1.4142135623730951;
 /// areas are exact multiples of cell² (sums of integers), and most cells
 /// drain few cells, so the per-cell pow() becomes a lookup.
 constexpr std::int64_t kPowTable = 1 << 16;
+/// Deposition: iterations in which a cell may start incising again; after them the set of
+/// incising cells only shrinks, so the solve ends.
+constexpr int kFlips = 20;
 
 }  // namespace
 
@@ -52,6 +55,37 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
     }
 }
 
+void Model::set_uplift_history(UpliftHistory history) {
+    for (std::size_t k = 1; k < history.times.size(); ++k)
+        if (!(history.times[k] > history.times[k - 1]))
+            throw std::invalid_argument("stream_power::Model: uplift history times must increase");
+    history_ = std::move(history);
+    history_k_ = std::size_t(-1);
+}
+
+void Model::add_history_uplift(double t0, double t1) {
+    // The rate is piecewise constant in time, so the uplift over [t0, t1] is the sum over the
+    // intervals it overlaps of rate × overlap (years): exact for a step that spans frames.
+    const auto& T = history_.times;
+    double* h = h_.data();
+    const std::int64_t n = std::int64_t(h_.size());
+    for (std::size_t k = 0; k + 1 < T.size(); ++k) {
+        const double overlap = std::min(t1, T[k + 1]) - std::max(t0, T[k]);
+        if (!(overlap > 0.0)) continue;
+        if (history_k_ != k) {
+            history_rate_ = history_.rate(k);
+            if (history_rate_.size() != h_.size())
+                throw std::invalid_argument("stream_power::Model: an uplift history rate is not width × height");
+            history_k_ = k;
+        }
+        const double* rate = history_rate_.data();
+        parallel_for(0, n, 1 << 15, [&](std::int64_t b, std::int64_t e) {
+            for (std::int64_t i = b; i < e; ++i)
+                if (!flow_.is_outlet(i)) h[i] += rate[i] * overlap;
+        });
+    }
+}
+
 void Model::route_only() {
     std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
     flow_.route(copy.data(), settings_.depressions);
@@ -75,6 +109,7 @@ std::int64_t Model::step(double dt) {
                 if (!flow_.is_outlet(i)) h[i] += uplift_[std::size_t(i)] * dt;
         });
     }
+    if (history_.rate) add_history_uplift(time_, time_ + dt);
     // 2. Routing, depressions, drainage area.
     flow_.route(h, settings_.depressions);
     accumulate(h);
@@ -95,8 +130,12 @@ std::int64_t Model::step(double dt) {
         diffusion_->step(h, dt);
         for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
     }
-    // 4. Implicit incision.
-    incise(dt);
+    // 4. Implicit incision (and deposition).
+    if (settings_.deposition > 0.0)
+        incise_with_deposition(dt);
+    else
+        incise(dt);
+    time_ += dt;
     return pits;
 }
 
@@ -178,6 +217,179 @@ void Model::incise(double dt) {
             }
         }
     });
+}
+
+// Incision with deposition (Yuan et al. 2019), each cell i with receiver r:
+//
+//     h_i' = h_i* − e_i,   e_i = K·dt·A_i^m·((h_i' − h_r')/L)^n − (G/A_i)·V_i,
+//     V_i = a·e_i + Σ_donors d V_d                         (m³ over the step)
+//
+// h* the uplifted, diffused height, e the net lowering (m), a = cell² the
+// cell's own area and A_i = a + Σ A_d its area over the receiver tree (the
+// D8 area; with routing=mfd the tree's area, so that V/A is the tree's mean
+// lowering). For n = 1 the system is linear and, on a tree, solved exactly in
+// two passes: upstream first (reverse stack), every subtree's sediment flux is
+// an affine function of its receiver's new height, V_d = α_d + β_d·h_r'
+// (induction: a cell's donors give Σα + Σβ·h_i', which with its own equation
+// gives h_i' = p_i + q_i·h_r' and then α_i, β_i); then downstream first
+// (stack order) h_i' = p_i + q_i·h_r'. With D = 1 + F + (G/A)(a − Σβ):
+//
+//     p = (h*(1 + G·a/A) + (G/A)·Σα − c)/D,  q = F/D,  α = a·h* + Σα + (Σβ − a)·p,  β = (Σβ − a)·q,
+//
+// F = K·dt·A^m/L (c = 0). Σβ ≤ 0, so D > 1 + F: the elimination cannot
+// divide by zero and is stable at any dt, as the detachment-limited scheme.
+// For n ≠ 1 the erosion term is linearised about the last iterate x₀ of
+// h_i' − h_r' (n > 1: Newton's method on the whole tree, F → F·n·x₀^(n−1),
+// c = F·(1 − n)·x₀^n; n < 1: the chord, F → F·x₀^(n−1), c = 0, a contraction
+// that keeps x > 0) and the two passes repeat until no height moves by
+// more than 1e-12 of the relief. A cell incises only if it ends above its
+// receiver (a lake, a dammed reach still receives deposition): one whose
+// solution falls to or below its receiver stops incising, one that rises
+// above starts, and the chunk is solved again; after kFlips passes cells may
+// only stop, so the solve ends. What reaches
+// an outlet leaves the map: sediment_out(). Each outlet basin is solved on
+// its own, in a fixed order, so the result does not depend on the threads.
+void Model::incise_with_deposition(double dt) {
+    const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
+    const double G = settings_.deposition;
+    const double a0 = cell_ * cell_;
+    const std::size_t n = h_.size();
+    if (dep_hs_.size() != n) {
+        for (auto* v : {&dep_hs_, &dep_tree_, &dep_x_}) v->assign(n, 0.0);
+        dep_pos_.assign(n, 0);
+        dep_p_.assign(2 * n, 0.0);   // p, q pairs
+        dep_sa_.assign(2 * n, 0.0);  // Σα, Σβ pairs
+        dep_active_.assign(n, 0);
+    }
+    const double* area = flow_.area().data();
+    const std::int32_t* rcv = flow_.receivers().data();
+    const std::int32_t* stack = flow_.stack().data();
+    const auto& chunks = flow_.chunks();
+    const std::int64_t W = width_;
+    const double kdt_l1 = K * dt / std::pow(cell_, ns), kdt_l2 = K * dt / std::pow(cell_ * kSqrt2, ns);
+    double* h = h_.data();
+    const std::int64_t groups = std::int64_t(chunks.size()) - 1;
+    // A^m from the table for whole numbers of cells (as incise() does: the pow is the costly part).
+    const double* tab = pow_table_.data();
+    const double inv_a0 = 1.0 / a0;
+    auto area_power = [=](double a) {
+        const double c = a * inv_a0;
+        if (c < double(kPowTable - 1)) {
+            const auto ci = std::int64_t(c + 0.5);
+            if (double(ci) * a0 == a) return tab[ci];
+        }
+        return std::pow(a, m);
+    };
+    // With D8 the tree's area is the drainage area; with MFD it is summed over the tree.
+    const bool d8 = settings_.mfd_exponent <= 0.0;
+    chunk_out_.assign(std::size_t(std::max<std::int64_t>(groups, 0)), 0.0);
+    chunk_passes_.assign(chunk_out_.size(), 0);
+    parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        // Scratch indexed by stack position, so that the passes read and write it in order; only
+        // the receiver's sums (and its position) are reached by a jump.
+        double* hs = dep_hs_.data();
+        auto* pq = reinterpret_cast<double(*)[2]>(dep_p_.data());   // p, q
+        auto* sum = reinterpret_cast<double(*)[2]>(dep_sa_.data());  // Σα, Σβ of the donors
+        double* tree = dep_tree_.data();
+        double* xp = dep_x_.data();
+        std::int32_t* pos = dep_pos_.data();  // stack position of each cell
+        std::uint8_t* act = dep_active_.data();
+        for (std::int64_t g = g0; g < g1; ++g) {
+            const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
+            double lo = 0.0, hi = 0.0;
+            for (std::int64_t s = b; s < e; ++s) {
+                const std::int32_t i = stack[s], r = rcv[i];
+                pos[i] = std::int32_t(s);
+                hs[s] = h[i];
+                // Every cell but a root starts incising, as in the detachment-limited solver, which
+                // skips a cell only once it is at or below its receiver's new height: one that
+                // ends there stops incising and the chunk is solved again.
+                act[s] = r != i;
+                xp[s] = h[i] - h[r];
+                sum[s][0] = sum[s][1] = 0.0;
+                if (!d8) tree[s] = a0;
+                lo = s == b ? h[i] : std::min(lo, h[i]);
+                hi = s == b ? h[i] : std::max(hi, h[i]);
+            }
+            const double tol = 1e-12 * std::max(1.0, hi - lo);
+            double out = 0.0;
+            int passes = 0;
+            for (int iter = 0; iter < 200; ++iter) {
+                ++passes;
+                if (iter > 0)
+                    for (std::int64_t s = b; s < e; ++s) {
+                        sum[s][0] = sum[s][1] = 0.0;
+                        if (!d8) tree[s] = a0;
+                    }
+                // Upstream first: p, q of each cell and its flux's α, β handed to its receiver.
+                for (std::int64_t s = e - 1; s >= b; --s) {
+                    const std::int32_t i = stack[s], r = rcv[i];
+                    if (r == i) continue;
+                    double F = 0.0, c = 0.0;
+                    if (act[s]) {
+                        const std::int64_t d = std::int64_t(r) - i;
+                        const double lin = area_power(area[i]) *
+                                           ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
+                        if (ns == 1.0) {
+                            F = lin;
+                        } else if (ns > 1.0) {  // Newton: the tangent of x^n at x0
+                            const double x0 = std::max(xp[s], 1e-9 * tol);
+                            const double xn1 = std::pow(x0, ns - 1.0);
+                            F = lin * ns * xn1;
+                            c = lin * (1.0 - ns) * xn1 * x0;
+                        } else {
+                            // n < 1: x^n is concave with an infinite slope at 0, where Newton's
+                            // tangent overshoots past the receiver. The chord from 0 instead
+                            // (Picard: F·x0^(n−1)·x) keeps x > 0 and contracts by < 1 − n a pass.
+                            F = lin * std::pow(std::max(xp[s], 1e-9 * tol), ns - 1.0);
+                        }
+                    }
+                    const double T = d8 ? area[i] : tree[s], gA = G / T, Sa = sum[s][0], Sb = sum[s][1];
+                    const double D = 1.0 + F + gA * (a0 - Sb);
+                    const double p = (hs[s] * (1.0 + gA * a0) + gA * Sa - c) / D, q = F / D;
+                    pq[s][0] = p;
+                    pq[s][1] = q;
+                    const std::int32_t rs = pos[r];
+                    sum[rs][0] += a0 * hs[s] + Sa + (Sb - a0) * p;
+                    sum[rs][1] += (Sb - a0) * q;
+                    if (!d8) tree[rs] += T;
+                }
+                // Downstream first: the new heights; the roots keep theirs and take what flows in.
+                out = 0.0;
+                bool changed = false;
+                double moved = 0.0;
+                for (std::int64_t s = b; s < e; ++s) {
+                    const std::int32_t i = stack[s], r = rcv[i];
+                    if (r == i) {
+                        out += sum[s][0] + sum[s][1] * h[i];
+                        continue;
+                    }
+                    h[i] = pq[s][0] + pq[s][1] * h[r];
+                    const double x = h[i] - h[r];
+                    if (act[s]) {
+                        moved = std::max(moved, std::abs(x - xp[s]));
+                        xp[s] = x;
+                        if (!(x > 0.0)) {
+                            act[s] = 0;  // would incise below its receiver: it stops incising
+                            changed = true;
+                        }
+                    } else if (x > 0.0 && iter < kFlips) {
+                        act[s] = 1;  // raised above its receiver (deposition, an iterate): it incises
+                        xp[s] = x;
+                        changed = true;
+                    }
+                }
+                if (!changed && (ns == 1.0 || moved <= tol)) break;
+            }
+            chunk_out_[std::size_t(g)] = out;
+            chunk_passes_[std::size_t(g)] = passes;
+        }
+    });
+    double total = 0.0;
+    for (double v : chunk_out_) total += v;  // chunk order: the same sum on any number of threads
+    sediment_out_ = total;
+    deposition_passes_ = 0;
+    for (int p : chunk_passes_) deposition_passes_ = std::max(deposition_passes_, p);
 }
 
 void Model::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {

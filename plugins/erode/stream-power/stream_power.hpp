@@ -51,6 +51,21 @@ struct Settings {
     /// neighbours in proportion to slope^mfd_exponent (needs Depressions::fill); 0: D8.
     /// The incision follows the steepest receiver either way.
     double mfd_exponent = 0.0;
+    /// G of Yuan et al. (2019), dimensionless, ≥ 0: a share of the sediment flux settles on its way down,
+    ///     ∂h/∂t = U − K·A^m·S^n + (G/A)·Qs,   Qs = ∫_A (U − ∂h/∂t) dA  (m³/yr, over the cell and its donors).
+    /// 0: detachment-limited (every grain leaves the map; the old solver, unchanged). At steady state
+    /// Qs = U·A, so channels carry (1 + G)·U of incision: S = ((1 + G)·U/K)^(1/n)·A^(−m/n).
+    double deposition = 0.0;
+};
+
+/// Uplift that varies in time as well as in space: a piecewise-constant rate
+/// field between frame times (years from the start of the run, increasing,
+/// first 0). rate(k) gives interval k's rate (m/yr, one per cell), for
+/// t in [times[k], times[k+1]); after the last time there is no history uplift.
+/// It is asked for each interval once, in order, when the run reaches it.
+struct UpliftHistory {
+    std::vector<double> times;
+    std::function<std::vector<double>(std::size_t)> rate;
 };
 
 /// The state of one landscape: heights (double, m) and the flow graph of the last step.
@@ -66,6 +81,16 @@ public:
     /// Run `years` in steps of `dt` (the last one shorter); on_step(step, steps) after each.
     void run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step = {});
 
+    /// Adds a time-varying uplift to the per-cell rate given to the constructor; the run's clock
+    /// starts at 0 and advances by each step's dt.
+    void set_uplift_history(UpliftHistory history);
+    /// Years simulated so far.
+    double time() const { return time_; }
+    /// With deposition: the sediment (m³) that left the map through the outlets in the last step.
+    double sediment_out() const { return sediment_out_; }
+    /// With deposition: the most up-and-down passes an outlet basin needed in the last step.
+    int deposition_passes() const { return deposition_passes_; }
+
     /// Route and accumulate over the current heights without eroding (for the output layers).
     void route_only();
 
@@ -80,6 +105,8 @@ public:
 
 private:
     void incise(double dt);
+    void incise_with_deposition(double dt);
+    void add_history_uplift(double t0, double t1);
     void accumulate(const double* routed);  // D8 or multiple-flow area over the routed heights
 
     int width_, height_;
@@ -89,6 +116,20 @@ private:
     FlowRouter flow_;
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
+    double time_ = 0.0, sediment_out_ = 0.0;
+    UpliftHistory history_;
+    std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_
+    std::vector<double> history_rate_;
+    // Deposition scratch (allocated when deposition > 0), by stack position: the uplifted, diffused
+    // height h*, (p, q) of h' = p + q·h'_receiver, the sums over donors of their flux's affine
+    // coefficients (Σα, Σβ: V_d = α + β·h'), the tree's area (MFD), the linearisation point (n ≠ 1),
+    // whether the cell incises; and by cell its stack position.
+    std::vector<double> dep_hs_, dep_p_, dep_sa_, dep_tree_, dep_x_;
+    std::vector<std::int32_t> dep_pos_;
+    std::vector<std::uint8_t> dep_active_;
+    std::vector<double> chunk_out_;
+    std::vector<int> chunk_passes_;
+    int deposition_passes_ = 0;
 };
 
 /// The outlet with every side closed: the lowest cell (lowest index among equals).
@@ -96,5 +137,7 @@ std::int64_t lowest_cell(const std::vector<double>& heights);
 
 /// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
 inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
+/// Extra bytes per cell with deposition > 0 (seven doubles, a position and a flag of scratch).
+inline constexpr std::size_t kBytesPerCellDeposition = 7 * 8 + 4 + 1;
 
 }  // namespace orogen::stream_power

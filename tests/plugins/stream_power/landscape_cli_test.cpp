@@ -97,6 +97,62 @@ TEST(LandscapeCli, RunsWritesItsLayersAndGivesTheSameBytesOnOneAndTwoThreads) {
     EXPECT_EQ(bytes[0], bytes[1]);
 }
 
+TEST(LandscapeCli, DepositionAndUpliftHistoryAreCheckedBeforeTheRun) {
+    TempDir dir;
+    const auto spec = dir.write("bad.orogen",
+                                "orogen 1\n"
+                                "grid 65 cell=30\n"
+                                "base = generate:shape(kind=pyramid, height=300)\n"
+                                "a = erode:stream-power(base, deposition=20)\n"
+                                "b = erode:stream-power(base, deposition=-0.5)\n"
+                                "c = erode:stream-power(base, base)\n"
+                                "p = tectonics:plates(base, plates=3, steps=20)\n"
+                                "d = erode:stream-power(p, p.timelapse)\n"
+                                "q = tectonics:plates(base, plates=3, steps=20, timelapse_every=5)\n"
+                                "e = erode:stream-power(q, q.timelapse, uplift_layer=\"uplift\")\n"
+                                "f = erode:stream-power(base, uplift_history_years=1e6)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want : {
+             "bad.orogen:4:41: error: 'deposition' of erode:stream-power is 20, out of range [0, 10]",
+             "bad.orogen:5:41: error: 'deposition' of erode:stream-power is -0.5, out of range [0, 10]",
+             "bad.orogen:6:30: error: erode:stream-power input 2 ('uplift_history') must be a series of heightmaps, "
+             "but 'base' is a heightmap",
+             "bad.orogen:8:5: error: erode:stream-power: input 2 (uplift_history) records no frames: give its node "
+             "timelapse_every=K (e.g. tectonics:plates(..., timelapse_every=50)) so that it hands on its heights over "
+             "time",
+             "bad.orogen:10:53: error: erode:stream-power: give uplift_layer or an uplift_history input, not both",
+             "bad.orogen:11:51: error: erode:stream-power: uplift_history_years spreads an uplift history; give one as "
+             "input 2, e.g. plates.timelapse",
+         })
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+}
+
+TEST(LandscapeCli, UpliftFromThePlatesHistoryWithDepositionGivesTheSameBytesOnOneAndTwoThreads) {
+    TempDir dir;
+    const auto spec = dir.write("h.orogen",
+                                "orogen 1\n"
+                                "seed 3\n"
+                                "grid 129 cell=60\n"
+                                "crust = generate:diamond-square(roughness=0.6, amplitude=40)\n"
+                                "p = tectonics:plates(crust, plates=6, steps=200, timelapse_every=25)\n"
+                                "a = erode:stream-power(p, p.timelapse, years=4e5, dt=2e4, uplift=0.2, "
+                                "uplift_history_years=2e5, uplift_smoothing=500, deposition=1)\n"
+                                "export:raw(a, path=\"a.r32\")\n"
+                                "export:raw(p, path=\"p.r32\")\n");
+    std::string bytes[2];
+    for (int t = 0; t < 2; ++t) {
+        const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
+        const RunResult r = run_orogen("run " + q(spec) + " --threads " + std::to_string(t + 1) + " --out " + q(out));
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        EXPECT_NE(r.err.find("km³ of sediment left by the outlets"), std::string::npos) << r.err;
+        bytes[t] = slurp(out + "/a.r32");
+        ASSERT_EQ(bytes[t].size(), std::size_t(129 * 129 * 4));
+        EXPECT_NE(bytes[t], slurp(out + "/p.r32"));
+    }
+    EXPECT_EQ(bytes[0], bytes[1]);
+}
+
 #ifdef OROGEN_FAKE_PLUGIN_DIR
 TEST(LandscapeCli, TimelapseRecordsEveryKStepsOnAClockOfYears) {
     // export:test-series (tests/kernel/fake_plugins) writes "time sample0" per entry.

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <numeric>
 #include <vector>
@@ -431,3 +432,257 @@ TEST(MultipleFlow, ACellSplitsItsWaterBySlopeToThePowerP) {
 }
 
 }  // namespace
+
+// ------------------------------------------------------------ deposition (Yuan et al. 2019)
+
+struct DepositionCase {
+    double n;
+    double k;
+    double g;
+    double mfd = 0.0;  // > 0: drainage area by multiple flow directions (the sediment follows the D8 tree)
+};
+
+class DepositionSteadyState : public ::testing::TestWithParam<DepositionCase> {};
+
+TEST_P(DepositionSteadyState, ChannelsCarryOnePlusGTimesTheUplift) {
+    // dh/dt = U − K A^m S^n + (G/A) Qs. At steady state every cell lowers at U, so the flux
+    // through a cell is Qs = U·A and the deposition term is G·U: the channels must incise
+    // (1 + G)·U, S = ((1 + G)·U/K)^(1/n)·A^(−m/n). A solver that deposited nothing (G = 0's
+    // slopes) is 2^(1/n) − 1 off at G = 1: 41 % for n = 2, 100 % for n = 1.
+    const int w = 81, h = 61;
+    const double cell = 50.0, U = 1e-3;
+    const auto [n, k, g, mfd] = GetParam();
+    Settings s;
+    s.mfd_exponent = mfd;
+    s.erodibility = k;
+    s.area_exponent = 0.5 * n;
+    s.slope_exponent = n;
+    s.diffusivity = 0.0;
+    s.deposition = g;
+    s.open = {true, false, true, false};
+    Model model(w, h, cell, noise(w, h, 1, 10.0), std::vector<double>(std::size_t(w) * h, U), s);
+    model.run(1.2e8, 2e5);
+    const auto& f = model.flow();
+    const auto& hh = model.heights();
+    const double s0 = std::pow((1.0 + g) * U / k, 1.0 / n);
+    std::vector<double> la, ls;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < hh.size(); ++i) {
+        const double a = f.area()[i];
+        const std::int32_t r = f.receivers()[i];
+        if (r == std::int32_t(i) || a < 10 * cell * cell) continue;
+        const double slope = (hh[i] - hh[std::size_t(r)]) / f.distance(std::int64_t(i));
+        worst = std::max(worst, std::abs(slope / (s0 * std::pow(a, -0.5)) - 1.0));
+        la.push_back(std::log(a));
+        ls.push_back(std::log(slope));
+    }
+    ASSERT_GT(la.size(), 200u);
+    EXPECT_LT(worst, 0.02) << "largest relative deviation from S = ((1+G)U/K)^(1/n) A^(-m/n), G = " << g;
+    const auto [slope, intercept] = fit(la, ls);
+    std::printf("n = %g, G = %g: %zu channel cells, worst deviation %.3g %%, concavity %.4f\n", n, g, la.size(),
+                100.0 * worst, -slope);
+    EXPECT_NEAR(-slope, 0.5, 0.01);
+    EXPECT_NEAR(std::exp(intercept), s0, 0.02 * s0);
+    // At steady state the sediment that leaves is all the rock uplifted: U × the non-outlet area per year.
+    double inner = 0.0;
+    for (std::size_t i = 0; i < hh.size(); ++i)
+        if (!f.is_outlet(std::int64_t(i))) inner += cell * cell;
+    if (g > 0.0) EXPECT_NEAR(model.sediment_out(), U * 2e5 * inner, 1e-3 * U * 2e5 * inner);
+}
+
+INSTANTIATE_TEST_SUITE_P(StreamPower, DepositionSteadyState,
+                         ::testing::Values(DepositionCase{1.0, 1e-5, 0.0}, DepositionCase{1.0, 1e-5, 1.0},
+                                           DepositionCase{2.0, 1e-7, 1.0}, DepositionCase{0.7, 3e-5, 1.0},
+                                           DepositionCase{1.0, 1e-5, 1.0, 1.1}),
+                         [](const auto& info) {
+                             return "n" + std::to_string(int(info.param.n * 10)) + "_G" +
+                                    std::to_string(int(info.param.g)) + (info.param.mfd > 0.0 ? "_mfd" : "");
+                         });
+
+TEST(Deposition, EachCellSolvesItsEquationAndTheSedimentBalances) {
+    // One step on noise (lakes left as they are, so the heights before the solve are h + U dt):
+    // every cell must satisfy h* − h' = E − G·V/A with E = K dt A^m ((h' − h'_r)/L)^n and V the
+    // net lowering × cell² summed over the cell and its donors (computed here, from the output);
+    // and eroded − deposited volume = what the model says left through the outlets.
+    for (double n : {1.0, 2.0, 0.7}) {
+        for (double g : {0.5, 3.0}) {
+            const int w = 97, hgt = 83;
+            const double cell = 40.0, U = 2e-3, dt = 2e4;
+            Settings s;
+            s.erodibility = n == 1.0 ? 2e-5 : n == 2.0 ? 4e-7 : 5e-5;
+            s.area_exponent = 0.45 * n;
+            s.slope_exponent = n;
+            s.diffusivity = 0.0;
+            s.deposition = g;
+            s.depressions = Depressions::route;
+            s.open = {true, true, false, true};
+            auto h0 = noise(w, hgt, 9, 300.0);
+            for (int y = 0; y < hgt; ++y)
+                for (int x = 0; x < w; ++x) h0[std::size_t(y) * w + x] += 2.0 * y;  // a tilt: long rivers north
+            Model model(w, hgt, cell, h0, std::vector<double>(h0.size(), U), s);
+            model.step(dt);
+            const auto& f = model.flow();
+            const auto& hn = model.heights();
+            std::vector<double> hs(h0.size());
+            for (std::size_t i = 0; i < h0.size(); ++i) hs[i] = f.is_outlet(std::int64_t(i)) ? h0[i] : h0[i] + U * dt;
+            // V and the tree's area, upstream first.
+            std::vector<double> V(h0.size(), 0.0), A(h0.size(), cell * cell);
+            const auto& st = f.stack();
+            const auto& rv = f.receivers();
+            for (std::size_t k = st.size(); k-- > 0;) {
+                const std::size_t i = std::size_t(st[k]), r = std::size_t(rv[i]);
+                if (r == i) continue;
+                V[i] += cell * cell * (hs[i] - hn[i]);
+                V[r] += V[i];
+                A[r] += A[i];
+            }
+            double eroded = 0.0, deposited = 0.0, worst = 0.0, out = 0.0;
+            int deposits = 0;
+            for (std::size_t i = 0; i < h0.size(); ++i) {
+                const std::size_t r = std::size_t(rv[i]);
+                if (r == i) {
+                    out += V[i];  // what flowed into the outlet
+                    continue;
+                }
+                const double x = hn[i] - hn[r];
+                const bool incises = x > 0.0;  // a cell incises if it ends above its receiver
+                const double E = incises ? s.erodibility * dt * std::pow(f.area()[i], s.area_exponent) *
+                                               std::pow(x / f.distance(std::int64_t(i)), n)
+                                         : 0.0;
+                const double Dep = g * V[i] / A[i];
+                const double res = std::abs((hs[i] - hn[i]) - (E - Dep)) / (1.0 + std::abs(hs[i]));
+                worst = std::max(worst, res);
+                eroded += cell * cell * E;
+                deposited += cell * cell * Dep;
+                deposits += Dep > 1e-6;
+            }
+            EXPECT_LT(worst, 1e-10) << "n = " << n << ", G = " << g << ": largest residual of a cell's equation";
+            std::printf("n = %g, G = %g: residual %.2g, eroded %.4g m3, deposited %.4g m3, out %.4g m3, balance %.2g m3\n",
+                        n, g, worst, eroded, deposited, model.sediment_out(), eroded - deposited - model.sediment_out());
+            EXPECT_GT(deposits, 1000);
+            EXPECT_GT(deposited, 0.05 * eroded);
+            EXPECT_NEAR(eroded - deposited, model.sediment_out(), 1e-9 * eroded) << "n = " << n << ", G = " << g;
+            EXPECT_NEAR(out, model.sediment_out(), 1e-9 * eroded);
+        }
+    }
+}
+
+TEST(Deposition, AVanishingCoefficientIsTheDetachmentLimitedSolver) {
+    // G → 0: the two-pass solver must give the old one's heights (to its tolerance).
+    for (double n : {1.0, 2.0}) {
+        const int w = 70, h = 60;
+        Settings s;
+        s.erodibility = n == 1.0 ? 2e-5 : 4e-7;
+        s.slope_exponent = n;
+        s.diffusivity = 0.01;
+        Model a(w, h, 30.0, noise(w, h, 3, 100.0), noise(w, h, 4, 2e-3), s);
+        s.deposition = 1e-13;
+        Model b(w, h, 30.0, noise(w, h, 3, 100.0), noise(w, h, 4, 2e-3), s);
+        a.run(1e5, 1e4);
+        b.run(1e5, 1e4);
+        for (std::size_t i = 0; i < a.heights().size(); ++i)
+            ASSERT_NEAR(a.heights()[i], b.heights()[i], 1e-7) << "n = " << n << ", cell " << i;
+    }
+}
+
+// ------------------------------------------------------------ uplift from a history
+
+/// A three-frame history on the grid: frame 0 flat, then `first` m gained by the first interval
+/// and `second` by the second, in a bump at the centre.
+UpliftHistory bump_history(int w, int h, double years, double first, double second) {
+    auto bump = [w, h](double metres) {
+        std::vector<double> v(std::size_t(w) * h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const double r2 = std::pow(x - 0.5 * w, 2) + std::pow(y - 0.5 * h, 2);
+                v[std::size_t(y) * w + x] = metres * std::exp(-r2 / (0.08 * w * h));
+            }
+        return v;
+    };
+    UpliftHistory u;
+    u.times = {0.0, 0.5 * years, years};
+    u.rate = [=](std::size_t k) {
+        auto r = bump(k == 0 ? first : second);
+        for (double& v : r) v /= 0.5 * years;
+        return r;
+    };
+    return u;
+}
+
+TEST(UpliftHistory, EachIntervalUpliftsByItsOwnFrames) {
+    // K = 0: the heights are the start plus the integral of the rate; at mid-run a history that
+    // uplifts only in its first half has given all its metres, one that uplifts only in its second
+    // half none. dt = 3e4 does not divide the half (1e5): steps straddle the frame time.
+    const int w = 60, h = 50;
+    const double years = 2e5, dt = 3e4;
+    Settings s;
+    s.erodibility = 0.0;
+    s.diffusivity = 0.0;
+    s.depressions = Depressions::route;  // lakes keep their heights: only the uplift changes them
+    const auto start = noise(w, h, 2, 5.0);
+    const UpliftHistory early = bump_history(w, h, years, 400.0, 0.0);
+    for (int which = 0; which < 2; ++which) {
+        Model model(w, h, 30.0, start, {}, s);
+        model.set_uplift_history(which == 0 ? bump_history(w, h, years, 400.0, 0.0) : bump_history(w, h, years, 0.0, 400.0));
+        model.run(1e5, dt);  // the first half
+        const auto mid = model.heights();
+        model.run(1e5, dt);  // the second half
+        const auto gain = early.rate(0);
+        for (std::size_t i = 0; i < start.size(); ++i) {
+            if (model.flow().is_outlet(std::int64_t(i))) {
+                ASSERT_EQ(model.heights()[i], start[i]);
+                continue;
+            }
+            const double total = gain[i] * 1e5;  // the bump's metres at this cell
+            ASSERT_NEAR(model.heights()[i], start[i] + total, 1e-9 * (1.0 + total)) << i;
+            ASSERT_NEAR(mid[i], start[i] + (which == 0 ? total : 0.0), 1e-9 * (1.0 + total)) << which << ", " << i;
+        }
+    }
+}
+
+TEST(UpliftHistory, WhenTheUpliftComesChangesTheLandscape) {
+    // With incision the same 400 m give different ranges: uplifted early, the rivers have had the
+    // second half to cut it down; uplifted late, the bump stands higher at the end.
+    const int w = 60, h = 50;
+    const double years = 2e6;
+    Settings s;
+    s.erodibility = 1e-5;
+    s.deposition = 1.0;
+    double mean[2];
+    for (int which = 0; which < 2; ++which) {
+        Model model(w, h, 30.0, noise(w, h, 2, 5.0), {}, s);
+        model.set_uplift_history(which == 0 ? bump_history(w, h, years, 400.0, 0.0) : bump_history(w, h, years, 0.0, 400.0));
+        model.run(years, 2e4);
+        mean[which] = std::accumulate(model.heights().begin(), model.heights().end(), 0.0) / double(w * h);
+    }
+    std::printf("mean height after 2 Myr: uplifted early %.2f m, late %.2f m\n", mean[0], mean[1]);
+    EXPECT_GT(mean[1], 1.5 * mean[0]) << "early " << mean[0] << " m, late " << mean[1] << " m";
+}
+
+TEST(StreamPower, SameBitsOnOneAndTwoThreadsWithDepositionAndAnUpliftHistory) {
+    const int w = 161, h = 129;
+    std::vector<double> results[2];
+    double out[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        for (double n : {1.0, 2.0}) {
+            Settings s;
+            s.diffusivity = 0.02;
+            s.deposition = 1.5;
+            s.slope_exponent = n;
+            s.erodibility = n == 1.0 ? 2e-5 : 4e-7;
+            s.open = {true, true, false, true};
+            Model model(w, h, 30.0, noise(w, h, 5, 200.0), noise(w, h, 77, 2e-3), s);
+            model.set_uplift_history(bump_history(w, h, 2e5, 100.0, 50.0));
+            model.run(2e5, 1e4);
+            if (n == 1.0) {
+                results[t] = model.heights();
+                out[t] = model.sediment_out();
+            } else {
+                results[t].insert(results[t].end(), model.heights().begin(), model.heights().end());
+            }
+        }
+    }
+    EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
+    EXPECT_EQ(0, std::memcmp(&out[0], &out[1], sizeof(double)));
+}
