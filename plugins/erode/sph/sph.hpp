@@ -46,6 +46,7 @@
 
 #include <orogen/grid.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -83,6 +84,10 @@ struct Settings {
     /// m: no vertex is lowered by more than this in one sub-step (keeps single
     /// particles from drilling holes; material is conserved either way).
     double max_dig = 0.05;
+
+    /// Particles per chunk of the parallel terrain exchange (see settle() in sph.cpp); any value gives the
+    /// same bits, a serial loop's included. Not a node parameter: for the tests that check exactly that.
+    std::size_t settle_chunk = 16384;
 };
 
 struct Vec3 {
