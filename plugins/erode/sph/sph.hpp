@@ -40,7 +40,8 @@
 // dissolves acidity·Δt·(C − s) of terrain, above it deposits deposit·Δt·(s − C);
 // when it evaporates (lifespan) or reaches the sea it leaves all it carries.
 // Terrain changes go to the 4 vertices of the tile under the particle with
-// bilinear weights, in double, serially in particle order, so
+// bilinear weights, in double, each vertex's additions in particle order
+// (chunks of particles in parallel, rows two chunks share queued), so
 // terrain + carried + removed-over-an-open-edge is constant to round-off.
 #pragma once
 
