@@ -833,9 +833,139 @@ struct Simulation::Impl {
         return true;
     }
 
-    /// Serial, in particle order: apply the exchanges to the terrain, remove
-    /// particles that left or reached the sea.
+    /// Apply the exchanges to the terrain, remove particles that left or reached
+    /// the sea. Every terrain vertex receives its additions in particle order,
+    /// as a serial loop would, on any thread count: the particles are cut into
+    /// fixed chunks of s.settle_chunk (sorted by cell, z slowest, so a chunk
+    /// covers a band of terrain rows); a row only one chunk's band reaches is
+    /// that chunk's and is changed by it directly, in parallel with the other
+    /// chunks; what goes to rows two bands share is queued and applied
+    /// afterwards, serially, chunk by chunk in order. The sediment that leaves
+    /// over an open edge is summed in the same serial pass, in particle order.
+    /// A queued exchange (16 bytes; queued only where a particle's tile reaches a shared row, so a few
+    /// per cent of the particles at 16384 a chunk, at most two entries per particle).
+    struct Deferred {
+        float x, z;     // m, where the exchange happens; x NaN: a particle that left over an open edge
+        double volume;  // m³ added to the terrain there (< 0: taken); or the sediment that left with it
+    };
+    std::vector<int> row_owner;  // per terrain row: the chunk that owns it, -1 none, -2 shared
+
+    /// exchange_terrain (w, hgt ≥ 2) restricted to the rows for which `mine(row)`; true if it skipped one.
+    template <typename Mine>
+    bool exchange_rows(double x, double z, double volume, Mine mine) {
+        int i, j;
+        double fx, fz;
+        tile(x, z, i, j, fx, fz);
+        const double dh = volume * inv_cell * inv_cell;
+        const int i1 = std::min(i + 1, w - 1);
+        bool skipped = false;
+        for (int r = j; r <= std::min(j + 1, hgt - 1); ++r) {
+            if (!mine(r)) {
+                skipped = true;
+                continue;
+            }
+            dirty_lo[std::size_t(r)] = std::min(dirty_lo[std::size_t(r)], i);
+            dirty_hi[std::size_t(r)] = std::max(dirty_hi[std::size_t(r)], i1);
+            double* row = &terrain[std::size_t(r) * std::size_t(w)];
+            const double fr = r == j ? 1 - fz : fz;
+            // The same products, in the same order, as exchange_terrain.
+            row[i] += dh * (1 - fx) * fr;
+            row[i1] += dh * fx * fr;
+        }
+        return skipped;
+    }
+
     void settle() {
+        const std::size_t chunk = std::max<std::size_t>(s.settle_chunk, 1);
+        const std::size_t chunks = (n + chunk - 1) / chunk;
+        if (w < 2 || hgt < 2 || chunks <= 1) return settle_serial();
+        // 1. Each chunk's band of rows (the rows of every tile it may change).
+        std::vector<std::array<int, 2>> band(chunks);
+        parallel_for(0, std::int64_t(chunks), 1, [&](std::int64_t c0, std::int64_t c1) {
+            for (auto c = std::size_t(c0); c < std::size_t(c1); ++c) {
+                int lo = hgt, hi = -1;
+                for (std::size_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) {
+                    if (!alive[i]) continue;
+                    const double x = exchange[i];
+                    if (!(x != 0.0 && !std::isnan(x)) && !(double(pos[i].y) < s.sea_level)) continue;
+                    int ti, tj;
+                    double fx, fz;
+                    tile(pos[i].x, pos[i].z, ti, tj, fx, fz);
+                    lo = std::min(lo, tj);
+                    hi = std::max(hi, std::min(tj + 1, hgt - 1));
+                }
+                band[c] = {lo, hi};
+            }
+        });
+        row_owner.assign(std::size_t(hgt), -1);
+        for (std::size_t c = 0; c < chunks; ++c)
+            for (int r = band[c][0]; r <= band[c][1]; ++r) {
+                int& o = row_owner[std::size_t(r)];
+                o = o == -1 ? int(c) : -2;
+            }
+        // 2. In parallel: the owned rows, the particles' sediment, the sea; the rest queued.
+        std::vector<std::vector<Deferred>> queue(chunks);
+        std::vector<std::array<std::int64_t, 2>> tally(chunks);  // sea kills, terrain changed
+        parallel_for(0, std::int64_t(chunks), 1, [&](std::int64_t c0, std::int64_t c1) {
+            for (auto c = std::size_t(c0); c < std::size_t(c1); ++c) {
+                const int me = int(c);
+                const auto mine = [&](int r) { return row_owner[std::size_t(r)] == me; };
+                std::int64_t sea = 0, changed = 0;
+                auto& q = queue[c];
+                const auto apply = [&](float x, float z, double volume) {
+                    if (exchange_rows(x, z, volume, mine)) q.push_back(Deferred{x, z, volume});
+                    changed = 1;
+                };
+                for (std::size_t i = c * chunk; i < std::min(n, (c + 1) * chunk); ++i) {
+                    if (!alive[i]) continue;
+                    const double x = exchange[i];
+                    const Vec3& p = pos[i];
+                    if (std::isnan(x)) {  // left over an open edge, with its sediment (summed in step 3)
+                        q.push_back(Deferred{std::numeric_limits<float>::quiet_NaN(), 0.0f, sediment[i]});
+                        sediment[i] = 0.0;
+                        alive[i] = 0;
+                        continue;
+                    }
+                    if (x != 0.0) {
+                        apply(p.x, p.z, -x);
+                        sediment[i] += x;
+                    }
+                    if (double(p.y) < s.sea_level) {
+                        if (sediment[i] != 0.0) apply(p.x, p.z, sediment[i]);
+                        sediment[i] = 0.0;
+                        alive[i] = 0;
+                        ++sea;
+                    }
+                }
+                tally[c] = {sea, changed};
+            }
+        });
+        // 3. Serially, in particle order: the shared rows and the departures.
+        bool changed = false;
+        const auto shared = [&](int r) { return row_owner[std::size_t(r)] == -2; };
+        for (std::size_t c = 0; c < chunks; ++c) {
+            for (const Deferred& d : queue[c]) {
+                if (std::isnan(d.x)) {
+                    removed += d.volume;
+                    --live;
+                    ++counts.left;
+                } else {
+                    exchange_rows(d.x, d.z, d.volume, shared);
+                }
+            }
+            live -= std::size_t(tally[c][0]);
+            counts.sea += tally[c][0];
+            changed = changed || tally[c][1] != 0;
+        }
+        if (changed) {
+            any_dirty = true;
+            refresh_normals();
+            lift_all();
+        }
+    }
+
+    /// settle() in one loop, in particle order (few particles, or a map one vertex wide).
+    void settle_serial() {
         bool changed = false;
         for (std::size_t i = 0; i < n; ++i) {
             if (!alive[i]) continue;

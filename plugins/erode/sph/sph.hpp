@@ -40,12 +40,14 @@
 // dissolves acidity·Δt·(C − s) of terrain, above it deposits deposit·Δt·(s − C);
 // when it evaporates (lifespan) or reaches the sea it leaves all it carries.
 // Terrain changes go to the 4 vertices of the tile under the particle with
-// bilinear weights, in double, serially in particle order, so
+// bilinear weights, in double, each vertex's additions in particle order
+// (chunks of particles in parallel, rows two chunks share queued), so
 // terrain + carried + removed-over-an-open-edge is constant to round-off.
 #pragma once
 
 #include <orogen/grid.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -83,6 +85,10 @@ struct Settings {
     /// m: no vertex is lowered by more than this in one sub-step (keeps single
     /// particles from drilling holes; material is conserved either way).
     double max_dig = 0.05;
+
+    /// Particles per chunk of the parallel terrain exchange (see settle() in sph.cpp); any value gives the
+    /// same bits, a serial loop's included. Not a node parameter: for the tests that check exactly that.
+    std::size_t settle_chunk = 16384;
 };
 
 struct Vec3 {

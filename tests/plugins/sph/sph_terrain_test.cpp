@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -154,6 +155,67 @@ TEST(SphDeterminism, SameBytesOnOneAndTwoThreads) {
     ASSERT_EQ(positions[0].size(), positions[1].size());
     ASSERT_GT(positions[0].size(), 100u);
     EXPECT_EQ(0, std::memcmp(positions[0].data(), positions[1].data(), positions[0].size() * sizeof(float)));
+}
+
+// The terrain exchange runs in parallel over fixed chunks of particles, rows two
+// chunks share applied afterwards in particle order (settle() in sph.cpp): every
+// vertex must receive its additions in the serial loop's order, so chunks of
+// 1000 particles (bands of rows each owns, a few rows shared) and of 3 (every
+// row shared by many) on 2 threads give the serial loop's bits: the double
+// terrain volume, the carried and removed sediment, the float terrain and
+// every particle, with sea kills (closed) and departures over the edges
+// (open). Fails when the queued shared rows are dropped (checked); reversing
+// the chunk order of the queue was not caught (those additions commuted here).
+TEST(SphDeterminism, TheChunkedTerrainExchangeGivesTheSerialLoopsBits) {
+    const std::vector<float> h = make_diamond_square(4);
+    const double lowest = *std::min_element(h.begin(), h.end());
+    for (const auto boundary : {sph::Boundary::closed, sph::Boundary::open}) {
+        struct Run {
+            double volume = 0, carried = 0, removed = 0;
+            std::vector<float> terrain, positions;
+            sph::Counts counts;
+        };
+        std::vector<Run> runs;
+        for (const std::size_t chunk : {std::numeric_limits<std::size_t>::max(), std::size_t(1000), std::size_t(3)}) {
+            tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+            sph::Settings s = erosion_settings();
+            s.boundary = boundary;
+            if (boundary == sph::Boundary::closed) s.sea_level = lowest + 2.0;  // m: the lowest pools
+            s.settle_chunk = chunk;
+            sph::Simulation sim(view(h), s, 20000);
+            for (int step = 1; step <= 50; ++step) {  // 100 rain particles a step living 200 steps
+                sim.rain(100, 2.0, 11, step, 2.0f, 200);
+                sim.advance(0.05, step);
+                sim.end_step();
+            }
+            Run r;
+            r.volume = sim.terrain_volume();
+            r.carried = sim.carried_sediment();
+            r.removed = sim.removed_sediment();
+            r.terrain.resize(h.size());
+            sim.write_terrain(GridView{r.terrain.data(), kSize, kSize, 1.0});
+            for (const sph::Vec3& p : sim.positions()) r.positions.insert(r.positions.end(), {p.x, p.y, p.z});
+            r.counts = sim.counts();
+            runs.push_back(std::move(r));
+        }
+        const Run& serial = runs[0];
+        ASSERT_GT(serial.positions.size(), 3u * 1000u);  // chunks of 1000: bands of rows owned and shared
+        for (std::size_t k = 1; k < runs.size(); ++k) {
+            const Run& chunked = runs[k];
+            SCOPED_TRACE(k == 1 ? "chunks of 1000" : "chunks of 3");
+            EXPECT_EQ(serial.volume, chunked.volume);
+            EXPECT_EQ(serial.carried, chunked.carried);
+            EXPECT_EQ(serial.removed, chunked.removed);
+            EXPECT_EQ(0, std::memcmp(serial.terrain.data(), chunked.terrain.data(), serial.terrain.size() * sizeof(float)));
+            ASSERT_EQ(serial.positions.size(), chunked.positions.size());
+            EXPECT_EQ(0, std::memcmp(serial.positions.data(), chunked.positions.data(),
+                                     serial.positions.size() * sizeof(float)));
+            EXPECT_EQ(serial.counts.sea, chunked.counts.sea);
+            EXPECT_EQ(serial.counts.left, chunked.counts.left);
+        }
+        if (boundary == sph::Boundary::closed) EXPECT_GT(serial.counts.sea, 0);
+        if (boundary == sph::Boundary::open) EXPECT_GT(serial.counts.left, 0);
+    }
 }
 
 TEST(SphDitches, DifferentSeedsCutDifferentDitchesAndTheSameSeedTheSame) {
