@@ -60,6 +60,7 @@ struct Arrays {
     float *fw, *fe, *fn, *fs;  ///< outflow fluxes, m³/s (pass 1 updates each cell's own in place)
     const float* mask;
     int w, h;
+    int sum_x0, sum_w;  ///< the columns row_sums() covers: all of them, or a tiled run's owned ones
 };
 
 struct RowSums {
@@ -215,7 +216,8 @@ inline float max_of8(F8 t) {
 /// The row's sums and maxima, from what pass 2 wrote (a separate loop over
 /// data still in cache, so the cell loop has no reductions).
 OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row, float gravity) {
-    const std::size_t W = std::size_t(a.w);
+    const std::size_t W = std::size_t(a.sum_w);
+    row += std::size_t(a.sum_x0);
     const float* __restrict s1 = a.s1 + row;
     const float* __restrict d = a.d + row;
     const float* __restrict b = a.b_next + row;
@@ -264,7 +266,7 @@ OROGEN_PIPE_CLONES double sum_row(const float* __restrict v, std::size_t n) {
 }
 
 template <bool HasMask, bool Rescale>
-OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, double scale, bool sums) {
+OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, double scale) {
     const int W = a.w;
     const std::size_t Ws = std::size_t(W), row = std::size_t(y) * Ws;
     const bool hn = y > 0, hs = y + 1 < a.h;
@@ -278,7 +280,7 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
     };
     if (!hn || !hs || W < 3) {
         for (int x = 0; x < W; ++x) edge(x);
-        return sums ? row_sums(a, row, k.gravity) : RowSums{};
+        return row_sums(a, row, k.gravity);
     }
     edge(0);
     const float gx_scale = 0.5f * k.inv_l;
@@ -286,15 +288,15 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
     for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
         water_cell(a, k, i, Ws, true, true, true, true, gx_scale, gy_scale, m(i), Rescale, scale);
     edge(W - 1);
-    return sums ? row_sums(a, row, k.gravity) : RowSums{};
+    return row_sums(a, row, k.gravity);
 }
 
-/// Pass 2 for one row; with `sums`, the row's sums and maxima (a tiled run
-/// makes its own over the owned cells: Solver::Impl::tile_reductions).
-RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale, bool sums) {
-    if (a.mask)
-        return rescale ? water_row_impl<true, true>(a, k, y, scale, sums) : water_row_impl<true, false>(a, k, y, scale, sums);
-    return rescale ? water_row_impl<false, true>(a, k, y, scale, sums) : water_row_impl<false, false>(a, k, y, scale, sums);
+/// Pass 2 for one row, and the row's sums and maxima over the columns
+/// [sum_x0, sum_x0 + sum_w) (in a tiled run only the maxima and the
+/// finiteness check are used: Solver::Impl::tile_reductions makes the sums).
+RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale) {
+    if (a.mask) return rescale ? water_row_impl<true, true>(a, k, y, scale) : water_row_impl<true, false>(a, k, y, scale);
+    return rescale ? water_row_impl<false, true>(a, k, y, scale) : water_row_impl<false, false>(a, k, y, scale);
 }
 
 /// Pass 3 for one row: out[x] = s1 back-traced from (x, y) along (u, v) by
@@ -371,7 +373,7 @@ struct Solver::Impl {
     void exchange();
     /// Sums and maxima of a tiled sub-step over the owned cells, combined
     /// across ranks exactly as a single process combines its rows.
-    void tile_reductions(const Arrays& a, float gravity, double& total_s1, double& total_new, bool& finite,
+    void tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
                          float& vm, float& dm);
 };
 
@@ -383,8 +385,17 @@ constexpr int kCarry = 18;
 /// Continue a row's lane sums (as row_sums/sum_row accumulate them) over the
 /// values v[0..n), which are the whole grid's columns gx0.. of that row;
 /// `full` = the columns the 8 lanes take (the rest go to the tail).
-inline void continue_lanes(double* lanes, const float* v, int n, int gx0, int full) {
-    for (int x = 0; x < n; ++x) {
+inline void continue_lanes(double* lanes, const float* __restrict v, int n, int gx0, int full) {
+    int x = 0;
+    // Up to the first column that is a multiple of 8, one by one.
+    for (; x < n && gx0 + x < full && (gx0 + x) % 8 != 0; ++x) lanes[(gx0 + x) % 8] += double(v[x]);
+    // Whole groups of 8 in registers (lane j gets column 8m + j, in order, as in row_sums).
+    double acc[8];
+    for (int j = 0; j < 8; ++j) acc[j] = lanes[j];
+    for (; x + 8 <= n && gx0 + x + 8 <= full; x += 8)
+        for (int j = 0; j < 8; ++j) acc[j] += double(v[x + j]);
+    for (int j = 0; j < 8; ++j) lanes[j] = acc[j];
+    for (; x < n; ++x) {
         const int gx = gx0 + x;
         if (gx < full) lanes[gx % 8] += double(v[x]);
         else lanes[8] += double(v[x]);
@@ -405,39 +416,19 @@ void Solver::Impl::exchange() {
     exchanging += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void Solver::Impl::tile_reductions(const Arrays& a, float gravity, double& total_s1, double& total_new, bool& finite,
+void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
                                    float& vm, float& dm) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t W = std::size_t(w);
-    // Order-free parts first, over the owned cells: the maxima as row_sums
-    // takes them (max of min(|v|², g·d), sqrt after: monotonic, so the same
-    // bits), and whether terrain and water are finite (a single process sees
-    // that in the sum of both, which is finite exactly when every value is).
-    std::vector<float> row_vm(static_cast<std::size_t>(oh)), row_dm(static_cast<std::size_t>(oh));
-    std::vector<std::uint8_t> row_bad(static_cast<std::size_t>(oh));
-    parallel_for(0, oh, 16, [&](std::int64_t r0, std::int64_t r1) {
-        FlushDenormals ftz;
-        for (std::int64_t r = r0; r < r1; ++r) {
-            const std::size_t row = std::size_t(oy + r) * W + std::size_t(ox);
-            float v2 = 0.0f, d = 0.0f;
-            bool bad = false;
-            for (int x = 0; x < ow; ++x) {
-                const std::size_t i = row + std::size_t(x);
-                const float uu = a.u[i], vv = a.v[i], dd = a.d[i];
-                v2 = std::max(v2, std::min(uu * uu + vv * vv, gravity * dd));
-                d = std::max(d, dd);
-                bad = bad || !std::isfinite(a.b_next[i]) || !std::isfinite(dd);
-            }
-            row_vm[std::size_t(r)] = std::sqrt(v2);
-            row_dm[std::size_t(r)] = d;
-            row_bad[std::size_t(r)] = bad;
-        }
-    });
+    // Order-free parts first: the maxima and the finiteness check that the
+    // sweep took over the owned columns of every row (row_sums, as one
+    // process takes them over whole rows: a maximum is the same in any order;
+    // the sum of terrain and water is finite exactly when every value is).
     float m[3] = {0.0f, 0.0f, 0.0f};  // vmax, dmax, 1 if a value is not finite
-    for (int r = 0; r < oh; ++r) {
-        m[0] = std::max(m[0], row_vm[std::size_t(r)]);
-        m[1] = std::max(m[1], row_dm[std::size_t(r)]);
-        if (row_bad[std::size_t(r)]) m[2] = 1.0f;
+    for (int r = oy; r < oy + oh; ++r) {
+        m[0] = std::max(m[0], row_vmax[std::size_t(r)]);
+        m[1] = std::max(m[1], row_dmax[std::size_t(r)]);
+        if (!std::isfinite(row_check[std::size_t(r)])) m[2] = 1.0f;
     }
     // The sediment totals: each row's 8 lanes carried west to east through
     // the tiles of its row, then the rows in order, as one process adds them.
@@ -597,14 +588,14 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     if (tiled) exchange();
 
     Arrays ar{b_cur, b_next, st.water.data, st.sediment.data, s1.data(), u.data(), v.data(), st.flux_west.data,
-              st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H};
+              st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H, ox, ow};
     // Chunks of rows: few and large, since each chunk leaves its edge rows
     // to the clean-up passes below.
     const std::int64_t grain = std::max<std::int64_t>(16, H / 16);
     const bool rescale = sediment_scale != 1.0;
     const double sed_scale_d = sediment_scale;
     auto water = [&](int y) {
-        RowSums r = water_row(ar, k, y, rescale, sed_scale_d, !tiled);
+        RowSums r = water_row(ar, k, y, rescale, sed_scale_d);
         row_s1[std::size_t(y)] = r.s1;
         row_water[std::size_t(y)] = r.water;
         row_check[std::size_t(y)] = r.check;
@@ -655,7 +646,7 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     float vm = 0.0f, dm = 0.0f;
     bool finite = true;
     if (tiled) {
-        tile_reductions(ar, k.gravity, total_s1, total_new, finite, vm, dm);
+        tile_reductions(ar, total_s1, total_new, finite, vm, dm);
         tiled_total_new = total_new;
     } else {
         for (int y = 0; y < H; ++y) {
