@@ -45,12 +45,14 @@ export:raw(t2, path="t.r32")
 export:vtk(t2, path="t.vti")
 )";
 
-/// A node that is not tiled (Diamond-Square runs on rank 0) before a tiled one: its value is cut into tiles and sent.
+/// A node that is not tiled (generate:shape runs on rank 0) before tiled ones: its value is cut into tiles and
+/// sent (Diamond-Square adds its tile of the fractal to it).
 const char* kScatterSpec = R"(orogen 1
 seed 3
 grid 65 cell=1
 
-d = generate:diamond-square(amplitude=40)
+s = generate:shape(kind=pyramid, height=40)
+d = generate:diamond-square(s, amplitude=10)
 t = erode:thermal(d, talus=25, iterations=12, neighbourhood=moore)
 export:raw(t, path="t.r32")
 )";
@@ -130,6 +132,24 @@ const auto kCaseName = [](const auto& info) {
     std::string t = info.param.tiles.empty() ? "auto" : info.param.tiles;
     return std::to_string(info.param.ranks) + "_ranks_" + t;
 };
+
+/// Diamond-Square on its own and added to a tiled base: each rank makes its tile from the coarser levels near it.
+const char* kDiamondSquareSpec = R"(orogen 1
+seed 5
+grid 97x61 cell=2
+
+d = generate:diamond-square(amplitude=40, roughness=0.6)
+f = generate:fault(iterations=50, displacement=0.5)
+e = generate:diamond-square(f, amplitude=3)
+export:raw(d, path="d.r32")
+export:raw(e, path="e.r32")
+)";
+
+class DiamondSquareSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(DiamondSquareSeam, DiamondSquareEqualsOneProcess) {
+    expect_same_outputs(kDiamondSquareSpec, {"d.r32", "e.r32"}, GetParam());
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, DiamondSquareSeam, kErosionCases, kCaseName);
 
 class PipeSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(PipeSeam, PipeEqualsOneProcess) { expect_same_outputs(kPipeSpec, {"q.r32", "p.vti", "q.vti"}, GetParam()); }
