@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <cstring>
+#include <ctime>
 #include <sstream>
 #include <utility>
 
@@ -365,7 +366,8 @@ struct Solver::Impl {
     Tiling* tiles = nullptr;
     int ox = 0, oy = 0, ow = 0, oh = 0, gx0 = 0, gw = 0;
     std::vector<double> carry;  ///< per owned row: kCarry running sums (see tile_reductions)
-    double exchanging = 0.0, reducing = 0.0;  ///< s
+    double exchanging = 0.0, reducing = 0.0;  ///< s, wall clock
+    double cpu_exchanging = 0.0, cpu_reducing = 0.0;  ///< s of this process's CPU time (MPI waits by polling: counted)
     double tiled_total_new = 0.0;  ///< a tiled run's sediment total of the last sub-step (whole grid, m)
 
     void substep(double dt, std::int64_t step, std::int64_t sub);
@@ -376,6 +378,12 @@ struct Solver::Impl {
     void tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
                          float& vm, float& dm);
 };
+
+double process_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 namespace {
 // Per row, for each of s1 and the new sediment: the 8 lanes and the tail of
@@ -409,16 +417,19 @@ inline double lanes_total(const double* l) {
 
 void Solver::Impl::exchange() {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = process_cpu_seconds();
     const double cell = st.height.cell;
     const GridView grids[] = {{b_cur, w, h, cell}, st.water, st.sediment, st.flux_west, st.flux_east,
                               st.flux_north, st.flux_south};
     tiles->exchange_halos(grids, kTileHalo);
     exchanging += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cpu_exchanging += process_cpu_seconds() - c0;
 }
 
 void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
                                    float& vm, float& dm) {
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = process_cpu_seconds();
     const std::size_t W = std::size_t(w);
     // Order-free parts first: the maxima and the finiteness check that the
     // sweep took over the owned columns of every row (row_sums, as one
@@ -464,6 +475,7 @@ void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& to
     dm = m[1];
     finite = m[2] == 0.0f;
     reducing += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cpu_reducing += process_cpu_seconds() - c0;
 }
 
 Solver::Solver(const State& state, const Settings& settings, const float* rain_mask, Tiling* tiling)
@@ -702,6 +714,8 @@ ConstGridView Solver::current_height() const {
 
 double Solver::seconds_exchanging() const { return impl_->exchanging; }
 double Solver::seconds_reducing() const { return impl_->reducing; }
+double Solver::cpu_seconds_exchanging() const { return impl_->cpu_exchanging; }
+double Solver::cpu_seconds_reducing() const { return impl_->cpu_reducing; }
 
 double Solver::total_water() const {
     if (impl_->tiles) return std::numeric_limits<double>::quiet_NaN();

@@ -93,6 +93,9 @@ struct State {
 /// since each sub-step's length depends on the whole grid's speeds anyway.
 constexpr int kTileHalo = 3;
 
+/// CPU seconds this process has used (all its threads).
+double process_cpu_seconds();
+
 class Solver {
 public:
     /// `rain_mask` (optional) holds one non-negative factor per cell.
@@ -133,6 +136,9 @@ public:
     /// A tiled run's seconds so far in halo exchanges and in the cross-rank reductions (wall clock).
     double seconds_exchanging() const;
     double seconds_reducing() const;
+    /// The same, in CPU seconds of this process (an MPI wait polls, so it counts here too).
+    double cpu_seconds_exchanging() const;
+    double cpu_seconds_reducing() const;
 
 private:
     struct Impl;
