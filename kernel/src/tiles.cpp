@@ -217,12 +217,21 @@ void TiledRun::max_all(float* values, int count) {
     mpi::max_all(values, count);
 }
 
-void TiledRun::carry_east(std::span<double> carry, const std::function<void(std::span<double>)>& advance) {
+void TiledRun::carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) {
     const int c = rank_ % split_.cols;
     const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
-    if (west >= 0) mpi::recv(carry.data(), carry.size() * sizeof(double), west, kTagCarry);
-    advance(carry);
-    if (east >= 0) mpi::send(carry.data(), carry.size() * sizeof(double), east, kTagCarry);
+    const int rows = per_row > 0 ? int(carry.size() / std::size_t(per_row)) : 0;
+    // Blocks of 64 rows: small enough that the east neighbour starts soon, large
+    // enough that a 4096-row tile sends 64 messages (a few latencies) a call.
+    constexpr int kBlock = 64;
+    for (int first = 0; first < rows; first += kBlock) {
+        const int count = std::min(kBlock, rows - first);
+        double* block = carry.data() + std::size_t(first) * std::size_t(per_row);
+        const std::size_t bytes = std::size_t(count) * std::size_t(per_row) * sizeof(double);
+        if (west >= 0) mpi::recv(block, bytes, west, kTagCarry);
+        advance(first, count);
+        if (east >= 0) mpi::send(block, bytes, east, kTagCarry);
+    }
 }
 
 std::vector<double> TiledRun::gather_rows(std::span<const double> mine, int per_row) {

@@ -67,7 +67,7 @@ public:
     void min_max(float& lo, float& hi) override;
     void exchange_halos(std::span<const GridView> held, int halo) override;
     void max_all(float* values, int count) override;
-    void carry_east(std::span<double> carry, const std::function<void(std::span<double>)>& advance) override;
+    void carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) override;
     std::vector<double> gather_rows(std::span<const double> mine, int per_row) override;
     double seconds_waiting() const override { return waiting_; }
 

@@ -86,16 +86,21 @@ public:
     /// `values[0..count)`, on every rank (exact: a maximum does not round).
     /// Opens with the failure agreement (throws PeerFailed).
     virtual void max_all(float* values, int count) = 0;
-    /// Collective, along each row of tiles from west to east: `carry` comes
-    /// in from the west neighbour (the westmost tile keeps what the caller put
-    /// there), `advance` carries it over this tile's columns, and it goes on
-    /// to the east neighbour. This reproduces a single process's sequential
-    /// accumulation along whole rows (floating-point sums are not
-    /// associative, so partial sums per tile would not give its bits). Every
-    /// tile of a row of tiles passes the same number of values. The caller
-    /// must not throw between its last collective and this call on one rank
-    /// only (a west neighbour that never sends would hang it).
-    virtual void carry_east(std::span<double> carry, const std::function<void(std::span<double>)>& advance) = 0;
+    /// Collective, along each row of tiles from west to east: `carry` holds
+    /// `per_row` values for each of this tile's rows; they come in from the
+    /// west neighbour (the westmost tile keeps what the caller put there),
+    /// `advance(first, count)` carries rows [first, first + count) of them over
+    /// this tile's columns, and they go on to the east neighbour. This
+    /// reproduces a single process's sequential accumulation along whole rows
+    /// (floating-point sums are not associative, so partial sums per tile
+    /// would not give its bits). The rows travel in blocks, so that a tile
+    /// works on a block while its east neighbour works on the one before: the
+    /// chain costs about one tile's pass plus a block's per tile to the east,
+    /// not a whole pass per tile. Every tile of a row of tiles has the same
+    /// rows. The caller must not throw between its last collective and this
+    /// call on one rank only (a west neighbour that never sends would hang it).
+    virtual void carry_east(std::span<double> carry, int per_row,
+                            const std::function<void(int first, int count)>& advance) = 0;
     /// Collective: `per_row` values for each row of the whole grid, in row
     /// order, on every rank, taken from the eastmost tile of each row of
     /// tiles (`mine`: owned().height × per_row values there; ignored

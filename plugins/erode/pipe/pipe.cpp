@@ -445,13 +445,13 @@ void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& to
     // the tiles of its row, then the rows in order, as one process adds them.
     const int full = gw - gw % 8;
     carry.assign(std::size_t(oh) * kCarry, 0.0);
-    tiles->carry_east(carry, [&](std::span<double> c) {
-        parallel_for(0, oh, 16, [&](std::int64_t r0, std::int64_t r1) {
+    tiles->carry_east(carry, kCarry, [&](int first, int count) {
+        parallel_for(first, first + count, 16, [&](std::int64_t r0, std::int64_t r1) {
             FlushDenormals ftz;  // as in the sweep: denormal inputs read as 0
             for (std::int64_t r = r0; r < r1; ++r) {
                 const std::size_t row = std::size_t(oy + r) * W + std::size_t(ox);
-                continue_lanes(c.data() + std::size_t(r) * kCarry, a.s1 + row, ow, gx0, full);
-                continue_lanes(c.data() + std::size_t(r) * kCarry + 9, a.s + row, ow, gx0, full);
+                continue_lanes(carry.data() + std::size_t(r) * kCarry, a.s1 + row, ow, gx0, full);
+                continue_lanes(carry.data() + std::size_t(r) * kCarry + 9, a.s + row, ow, gx0, full);
             }
         });
     });
