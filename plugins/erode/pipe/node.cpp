@@ -118,7 +118,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         ctx.info(msg.str());
     }
     std::vector<float>().swap(held_mask);
-    // The owned parts back into the tile, one grid at a time (each freed as it goes).
+    // The owned parts back into the tile (moved within each grid, see to_tile).
     std::vector<float> after = to_tile(std::move(held[0]));
     for (int k = 1; k < 8; ++k) hm->set_layer(names[k], to_tile(std::move(held[k])));
     // As run() checks: in a tiled run the solver's own check covers each sub-step already.
