@@ -161,6 +161,35 @@ TEST_P(HydraulicSeam, HydraulicEqualsOneProcess) {
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, HydraulicSeam, kErosionCases, kCaseName);
 
+/// The lines "NODE: suspended sediment X m, ..." of a run's output, in order.
+std::vector<std::string> suspended_lines(const RunResult& r) {
+    std::vector<std::string> lines;
+    for (const std::string* text : {&r.out, &r.err})
+        for (std::size_t at = text->find("suspended sediment"); at != std::string::npos;
+             at = text->find("suspended sediment", at + 1)) {
+            const std::size_t start = text->rfind('\n', at) == std::string::npos ? 0 : text->rfind('\n', at) + 1;
+            lines.push_back(text->substr(start, text->find('\n', at) - start));
+        }
+    std::sort(lines.begin(), lines.end());
+    return lines;
+}
+
+TEST(Mpi, PipeSedimentTotalsAreTheSingleProcesssToTheLastBit) {
+    // The closed-wall fix-up's total (a double over every cell) is carried through the tiles in the single
+    // process's order; its 17 digits are printed once per node.
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", kPipeSpec);
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one"));
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    const auto expected = suspended_lines(one);
+    ASSERT_EQ(expected.size(), 2u) << one.out << one.err;
+    for (const auto& [ranks, tiles] : {std::pair{4, "2x2"}, std::pair{3, "1x3"}}) {
+        const RunResult many = run_mpi(ranks, "run " + q(spec) + " --out " + q(dir / tiles) + " --tiles " + tiles);
+        ASSERT_EQ(many.exit_code, 0) << many.err;
+        EXPECT_EQ(suspended_lines(many), expected) << tiles;
+    }
+}
+
 TEST(Mpi, TilesNarrowerThanPipeOrHydraulicHalosAreRefusedAtTheNode) {
     TempDir dir;
     // 20 columns in 1x4: tiles 5 wide. Pipe needs 3 (fine), hydraulic 12 (refused); 1x8: tiles 2 wide, both refused.

@@ -22,6 +22,17 @@ using namespace orogen;
 // following erode:pipe continues exactly where this one stopped.
 constexpr const char* kFluxLayers[] = {"flux_west", "flux_east", "flux_north", "flux_south"};
 
+/// The whole grid's suspended sediment summed after the last sub-step's
+/// transport (m, summed over the cells), to the last bit (17 digits): the
+/// closed-wall fix-up's total, which a tiled run sums in the single
+/// process's order (tests/mpi compares the two lines).
+std::string suspended_line(const pipe::Solver& solver) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << "suspended sediment " << solver.total_sediment() << " m, summed over the cells";
+    return msg.str();
+}
+
 /// check_finite()'s message, with the sample's index in the whole grid (a tiled run holds a tile).
 void check_finite_tile(const float* v, const TileRect& own, int grid_width, const char* what, std::int64_t step) {
     for (int y = 0; y < own.height; ++y)
@@ -116,6 +127,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
             << tiles.seconds_waiting() - waited_before << " s; CPU " << cpu << " s, of which halo exchange and reductions "
             << cpu_other << " s";
         ctx.info(msg.str());
+        if (tiles.rank() == 0) ctx.info(suspended_line(solver));
     }
     std::vector<float>().swap(held_mask);
     // The owned parts back into the tile (moved within each grid, see to_tile).
@@ -202,6 +214,7 @@ NodeOutputs run(NodeContext& ctx) {
         std::ostringstream msg;
         msg << steps << " steps of " << dt << " s in " << solver.substeps() << " sub-steps";
         ctx.info(msg.str());
+        ctx.info(suspended_line(solver));
     }
     ctx.check_finite(hm->heights(), "height", steps);
     ctx.check_finite(st.water.span(), "water", steps);
