@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Tiled erosion at 4097² on 1, 2 and 4 ranks (docs/benchmarks.md, "MPI").
-# usage: tests/bench/mpi_scaling.sh [BUILD_DIR] [REPEATS] [thermal|pipe] [SIZE]
+# usage: tests/bench/mpi_scaling.sh [BUILD_DIR] [REPEATS] [thermal|pipe|hydraulic] [SIZE]
 # Prints, per configuration and repetition: the eroder's seconds (rank 0's
 # timing table), rank 0's info line (its time in the steps, the halo exchange,
 # for pipe the cross-rank reductions, and the wait for the other ranks), every
@@ -17,7 +17,8 @@ case "$node" in
   thermal) step='t = erode:thermal(f, talus=30, rate=0.5, iterations=64)'; kind=erode:thermal ;;
   # 6 steps of 0.25 s: 12 CFL sub-steps at 4097² (the count is the same on any number of ranks).
   pipe) step='t = erode:pipe(f, steps=6, dt=0.25, rain=0.001)'; kind=erode:pipe ;;
-  *) echo "unknown node $node (thermal or pipe)" >&2; exit 2 ;;
+  hydraulic) step='t = erode:hydraulic(f, iterations=16)'; kind=erode:hydraulic ;;
+  *) echo "unknown node $node (thermal, pipe or hydraulic)" >&2; exit 2 ;;
 esac
 cat >"$work/spec.orogen" <<SPEC
 orogen 1
