@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -58,15 +59,12 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
             std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
                       held + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox));
     };
-    auto to_tile = [&](const float* held, float* tile) {
-        for (int y = 0; y < own.height; ++y)
-            std::copy(held + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox),
-                      held + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox) + std::size_t(own.width),
-                      tile + std::size_t(y) * std::size_t(own.width));
-    };
-    // Two states (double-buffered): terrain, water, sediment each.
-    std::vector<float> storage(6 * n, 0.0f);
-    auto grid = [&](int k) { return GridView{storage.data() + std::size_t(k) * n, grown.width, grown.height, cell}; };
+    // Two states (double-buffered): terrain, water, sediment each. The tile's
+    // water and sediment layers are dropped meanwhile (memory about the
+    // single process's per vertex); its heights stay, as `before`.
+    std::vector<float> storage[6];
+    for (auto& g : storage) g.assign(n, 0.0f);
+    auto grid = [&](int k) { return GridView{storage[k].data(), grown.width, grown.height, cell}; };
     hydraulic::State a{grid(0), grid(1), grid(2)}, b{grid(3), grid(4), grid(5)};
     to_grown(hm.heights().data(), a.height.data);
     to_grown(std::as_const(hm).layer("water").data, a.water.data);
@@ -78,6 +76,8 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
         tiles.exchange_halo({held_layer.data(), grown.width, grown.height, cell}, kTileHalo);
     }
     const float* hard = layer ? held_layer.data() : nullptr;
+    hm.remove_layer("water");  // after the hardness layer's copy (it may be one of them)
+    hm.remove_layer("sediment");
     using clock = std::chrono::steady_clock;
     clock::duration exchanging{}, sweeping{};  // for the info line (docs/benchmarks.md)
     const double waited_before = tiles.seconds_waiting();
@@ -115,19 +115,32 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
          << tiles.seconds_waiting() - waited_before << " s";
     ctx.info(note.str());
     // The layers run() adds, from the final state (b's grids are free now: scratch for them).
-    GridView eroded = hm.layer("eroded", 0.0f);
-    std::vector<float> after(hm.size());
-    to_tile(a.height.data, after.data());
-    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm.heights()[i];
-    to_tile(a.water.data, hm.layer("water", 0.0f).data);
-    to_tile(a.sediment.data, hm.layer("sediment", 0.0f).data);
     for (const char* l : {"flux_west", "flux_east", "flux_north", "flux_south"}) hm.remove_layer(l);
     hydraulic::outflow({a.height, a.water, a.sediment}, s, hard, b.height);
-    to_tile(b.height.data, hm.layer("flow", 0.0f).data);
-    if (s.hardness == hydraulic::Hardness::steepness) {
-        hydraulic::steepness_hardness(a.height, b.water);
-        to_tile(b.water.data, hm.layer("hardness", 0.0f).data);
-    }
+    const bool steep = s.hardness == hydraulic::Hardness::steepness;
+    if (steep) hydraulic::steepness_hardness(a.height, b.water);
+    // Each grid back as a tile, its owned part moved to its front in place (a
+    // copy into fresh memory costs page faults: seconds of system time at
+    // 4097² on a loaded machine). Row y's destination never passes its source.
+    auto take = [&](const GridView& g) {
+        std::vector<float>* owner = nullptr;
+        for (auto& v : storage)
+            if (v.data() == g.data) owner = &v;
+        for (int y = 0; y < own.height; ++y)
+            std::memmove(owner->data() + std::size_t(y) * std::size_t(own.width),
+                         owner->data() + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox),
+                         std::size_t(own.width) * sizeof(float));
+        owner->resize(std::size_t(own.width) * std::size_t(own.height));
+        return std::move(*owner);
+    };
+    std::vector<float>().swap(held_layer);
+    std::vector<float> after = take(a.height);
+    GridView eroded = hm.layer("eroded", 0.0f);
+    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm.heights()[i];
+    hm.set_layer("water", take(a.water));
+    hm.set_layer("sediment", take(a.sediment));
+    hm.set_layer("flow", take(b.height));
+    if (steep) hm.set_layer("hardness", take(b.water));
     hm.heights() = std::move(after);
 }
 
