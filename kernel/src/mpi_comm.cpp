@@ -76,6 +76,15 @@ double sum_all(double value) {
 
 void barrier() { check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier"); }
 
+void max_all(float* values, int count) {
+    check(MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
+}
+
+void allgatherv(const double* send, int send_count, double* recv, const int* counts, const int* displs) {
+    check(MPI_Allgatherv(send, send_count, MPI_DOUBLE, recv, counts, displs, MPI_DOUBLE, MPI_COMM_WORLD),
+          "MPI_Allgatherv");
+}
+
 void sendrecv(const void* send_data, std::size_t send_bytes, int to, void* recv_data, std::size_t recv_bytes, int from,
               int tag) {
     const int dest = to < 0 ? MPI_PROC_NULL : to, source = from < 0 ? MPI_PROC_NULL : from;
@@ -141,6 +150,10 @@ void max_all(int*, int) {}
 void min_max_all(float&, float&) {}
 double sum_all(double value) { return value; }
 void barrier() {}
+void max_all(float*, int) {}
+void allgatherv(const double* send, int send_count, double* recv, const int*, const int* displs) {
+    std::copy(send, send + send_count, recv + displs[0]);
+}
 void sendrecv(const void*, std::size_t, int to, void*, std::size_t, int from, int) {
     if (to >= 0 || from >= 0) unavailable();
 }

@@ -42,6 +42,11 @@ void min_max_all(float& lo, float& hi);
 /// The sum of every rank's `value`, in rank order (exact for integers below 2^53).
 double sum_all(double value);
 void barrier();
+/// Element by element, the largest of every rank's `values[0..count)` (in place).
+void max_all(float* values, int count);
+/// Every rank's `send[0..counts[rank])` concatenated in rank order into
+/// `recv` (at `displs[r]` for rank r), on every rank.
+void allgatherv(const double* send, int send_count, double* recv, const int* counts, const int* displs);
 /// Send `send` to rank `to` and receive `recv` from rank `from` at once; -1 for
 /// either means no such neighbour (nothing sent or received).
 void sendrecv(const void* send, std::size_t send_bytes, int to, void* recv, std::size_t recv_bytes, int from, int tag);

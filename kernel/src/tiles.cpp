@@ -140,7 +140,7 @@ int TiledRun::agree(int exit_code, int* reporter) {
 
 namespace {
 
-constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagTile = 20;
+constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagCarry = 15, kTagTile = 20;
 
 /// Copy the rectangle (x, y, w, h) of `grid` (row length `stride`) into `out`, or back with `to_grid`.
 void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, bool to_grid) {
@@ -154,50 +154,108 @@ void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, 
 
 }  // namespace
 
-void TiledRun::exchange_halo(GridView held, int halo) {
+void TiledRun::agree_or_throw() {
     const auto t0 = std::chrono::steady_clock::now();
     const int code = agree(0);
     waiting_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (code) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
+}
+
+void TiledRun::exchange_halo(GridView held, int halo) { exchange_halos(std::span<const GridView>(&held, 1), halo); }
+
+void TiledRun::exchange_halos(std::span<const GridView> grids, int halo) {
+    agree_or_throw();
     const TileRect o = owned(), g = grown(halo);
-    if (held.width != g.width || held.height != g.height)
-        throw Error("internal error: exchange_halo got a " + std::to_string(held.width) + "x" +
-                    std::to_string(held.height) + " grid for a grown tile of " + std::to_string(g.width) + "x" +
-                    std::to_string(g.height));
-    if (halo == 0 || ranks() == 1) return;
+    for (const GridView& held : grids)
+        if (held.width != g.width || held.height != g.height)
+            throw Error("internal error: exchange_halo got a " + std::to_string(held.width) + "x" +
+                        std::to_string(held.height) + " grid for a grown tile of " + std::to_string(g.width) + "x" +
+                        std::to_string(g.height));
+    if (halo == 0 || ranks() == 1 || grids.empty()) return;
     const int r = rank_ / split_.cols, c = rank_ % split_.cols;
     const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
     const int north = r > 0 ? rank_ - split_.cols : -1, south = r + 1 < split_.rows ? rank_ + split_.cols : -1;
-    const int ox = o.x0 - g.x0, oy = o.y0 - g.y0;  // the owned part inside `held`
+    const int ox = o.x0 - g.x0, oy = o.y0 - g.y0;  // the owned part inside each grid
+    const std::size_t count = grids.size();
     std::vector<float> out, in;
-    // East and west: the owned rows only (the corners come with the rows below).
+    // East and west: the owned rows only (the corners come with the rows below);
+    // grid k's block of halo × o.height values at k·block in each message.
     auto columns = [&](int send_x, int to, int recv_x, int from, int tag) {
-        out.resize(std::size_t(halo) * std::size_t(o.height));
-        in.resize(out.size());
-        if (to >= 0) copy_rect(held.data, held.width, send_x, oy, halo, o.height, out.data(), false);
+        const std::size_t block = std::size_t(halo) * std::size_t(o.height);
+        out.resize(to >= 0 ? block * count : 0);
+        in.resize(from >= 0 ? block * count : 0);
+        if (to >= 0)
+            for (std::size_t k = 0; k < count; ++k)
+                copy_rect(grids[k].data, grids[k].width, send_x, oy, halo, o.height, out.data() + k * block, false);
         mpi::sendrecv(out.data(), out.size() * sizeof(float), to, in.data(), in.size() * sizeof(float), from, tag);
-        if (from >= 0) copy_rect(held.data, held.width, recv_x, oy, halo, o.height, in.data(), true);
+        if (from >= 0)
+            for (std::size_t k = 0; k < count; ++k)
+                copy_rect(grids[k].data, grids[k].width, recv_x, oy, halo, o.height, in.data() + k * block, true);
     };
-    columns(ox, west, ox + o.width, east, kTagWest);        // my first columns go west, the east's come in
+    columns(ox, west, ox + o.width, east, kTagWest);  // my first columns go west, the east's come in
     columns(ox + o.width - halo, east, ox - halo, west, kTagEast);
-    // North and south: whole rows of `held`, halo columns included (the same
-    // columns for both, as tiles in one column of the split share their cuts).
+    // North and south: whole rows of each grid, halo columns included (the
+    // same columns for both, as tiles in one column of the split share their cuts).
     auto rows = [&](int send_y, int to, int recv_y, int from, int tag) {
-        const std::size_t n = std::size_t(halo) * std::size_t(held.width);
-        if (to >= 0) out.assign(held.row(send_y), held.row(send_y) + n);
-        else out.clear();
-        in.resize(from >= 0 ? n : 0);
+        const std::size_t block = std::size_t(halo) * std::size_t(g.width);
+        out.resize(to >= 0 ? block * count : 0);
+        in.resize(from >= 0 ? block * count : 0);
+        if (to >= 0)
+            for (std::size_t k = 0; k < count; ++k)
+                std::memcpy(out.data() + k * block, grids[k].row(send_y), block * sizeof(float));
         mpi::sendrecv(out.data(), out.size() * sizeof(float), to, in.data(), in.size() * sizeof(float), from, tag);
-        if (from >= 0) std::memcpy(held.row(recv_y), in.data(), n * sizeof(float));
+        if (from >= 0)
+            for (std::size_t k = 0; k < count; ++k)
+                std::memcpy(grids[k].row(recv_y), in.data() + k * block, block * sizeof(float));
     };
     rows(oy, north, oy + o.height, south, kTagNorth);
     rows(oy + o.height - halo, south, oy - halo, north, kTagSouth);
 }
 
+void TiledRun::max_all(float* values, int count) {
+    agree_or_throw();
+    mpi::max_all(values, count);
+}
+
+void TiledRun::carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) {
+    const int c = rank_ % split_.cols;
+    const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
+    const int rows = per_row > 0 ? int(carry.size() / std::size_t(per_row)) : 0;
+    // Blocks of 64 rows: small enough that the east neighbour starts soon, large
+    // enough that a 4096-row tile sends 64 messages (a few latencies) a call.
+    constexpr int kBlock = 64;
+    for (int first = 0; first < rows; first += kBlock) {
+        const int count = std::min(kBlock, rows - first);
+        double* block = carry.data() + std::size_t(first) * std::size_t(per_row);
+        const std::size_t bytes = std::size_t(count) * std::size_t(per_row) * sizeof(double);
+        if (west >= 0) mpi::recv(block, bytes, west, kTagCarry);
+        advance(first, count);
+        if (east >= 0) mpi::send(block, bytes, east, kTagCarry);
+    }
+}
+
+std::vector<double> TiledRun::gather_rows(std::span<const double> mine, int per_row) {
+    // Rank order is row-major, so the eastmost tiles in rank order hold the rows in grid order.
+    std::vector<int> counts(std::size_t(ranks()), 0), displs(std::size_t(ranks()), 0);
+    int at = 0;
+    for (int r = 0; r < ranks(); ++r) {
+        displs[std::size_t(r)] = at;
+        if (r % split_.cols == split_.cols - 1) counts[std::size_t(r)] = split_.tile(r).height * per_row;
+        at += counts[std::size_t(r)];
+    }
+    std::vector<double> all(std::size_t(split_.grid_height) * std::size_t(per_row));
+    const int n = counts[std::size_t(rank_)];
+    if (n && mine.size() != std::size_t(n))
+        throw Error("internal error: gather_rows got " + std::to_string(mine.size()) + " values for " +
+                    std::to_string(n));
+    mpi::allgatherv(mine.data(), n, all.data(), counts.data(), displs.data());
+    return all;
+}
+
 void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
 
 void TiledRun::min_max(float& lo, float& hi) {
-    if (const int code = agree(0)) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
+    agree_or_throw();
     mpi::min_max_all(lo, hi);
 }
 

@@ -65,6 +65,10 @@ public:
     TileRect tile(int rank) const override { return split_.tile(rank); }
     void exchange_halo(GridView held, int halo) override;
     void min_max(float& lo, float& hi) override;
+    void exchange_halos(std::span<const GridView> held, int halo) override;
+    void max_all(float* values, int count) override;
+    void carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) override;
+    std::vector<double> gather_rows(std::span<const double> mine, int per_row) override;
     double seconds_waiting() const override { return waiting_; }
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
@@ -90,6 +94,8 @@ public:
     const TileSplit& split() const { return split_; }
 
 private:
+    /// The opening agreement of every collective a tiled node calls: throws PeerFailed if a rank failed.
+    void agree_or_throw();
     enum class Place { tiles, rank0 };
     TileSplit split_;
     int rank_;

@@ -1,35 +1,48 @@
 #!/usr/bin/env bash
-# Tiled thermal erosion at 4097² on 1, 2 and 4 ranks (docs/benchmarks.md, "MPI").
-# usage: tests/bench/mpi_scaling.sh [BUILD_DIR] [REPEATS]
-# Prints, per configuration and repetition: the thermal node's seconds (rank 0's
-# timing table), rank 0's sweep / halo-exchange split and every rank's peak RSS.
+# Tiled erosion at 4097² on 1, 2 and 4 ranks (docs/benchmarks.md, "MPI").
+# usage: tests/bench/mpi_scaling.sh [BUILD_DIR] [REPEATS] [thermal|pipe|hydraulic] [SIZE]
+# Prints, per configuration and repetition: the eroder's seconds (rank 0's
+# timing table), rank 0's info line (its time in the steps, the halo exchange,
+# for pipe the cross-rank reductions, and the wait for the other ranks), every
+# rank's peak RSS and the CPU seconds of all ranks, with the load average.
 set -euo pipefail
 build=${1:-build}
 reps=${2:-3}
+node=${3:-thermal}
+size=${4:-4097}
 orogen=$(realpath "$build/bin/orogen")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-cat >"$work/thermal.orogen" <<'SPEC'
+case "$node" in
+  thermal) step='t = erode:thermal(f, talus=30, rate=0.5, iterations=64)'; kind=erode:thermal ;;
+  # 6 steps of 0.25 s: 12 CFL sub-steps at 4097² (the count is the same on any number of ranks).
+  pipe) step='t = erode:pipe(f, steps=6, dt=0.25, rain=0.001)'; kind=erode:pipe ;;
+  hydraulic) step='t = erode:hydraulic(f, iterations=16)'; kind=erode:hydraulic ;;
+  *) echo "unknown node $node (thermal, pipe or hydraulic)" >&2; exit 2 ;;
+esac
+cat >"$work/spec.orogen" <<SPEC
 orogen 1
 seed 1
-grid 4097 cell=1
+grid $size cell=1
 
 f = generate:fault(iterations=200, displacement=0.5)
-t = erode:thermal(f, talus=30, rate=0.5, iterations=64)
+$step
 SPEC
 mpirun=(mpirun --oversubscribe --allow-run-as-root)
 one() {  # label, command...
   local label=$1; shift
   for r in $(seq "$reps"); do
     rm -rf "$work/out"
-    "$@" run "$work/thermal.orogen" --out "$work/out" --threads 1 >"$work/log" 2>&1
-    local t ex rss
-    t=$(awk '$2=="erode:thermal"{print $4}' "$work/log")
-    ex=$(grep -o 'sweeps [0-9.e-]* s, halo exchange [0-9.e-]* s ([0-9.e-]* %), of which waiting for the other ranks [0-9.e-]* s' "$work/log" | head -1 || true)
+    local load
+    load=$(cut -d' ' -f1-3 /proc/loadavg)
+    "$@" run "$work/spec.orogen" --out "$work/out" --threads 1 --no-cache >"$work/log" 2>&1
+    local t info rss cpu
+    t=$(awk -v k="$kind" '$2==k{print $4}' "$work/log")
+    info=$(grep -o 'rank 0 of [0-9]*: .*' "$work/log" | head -1 || true)
     rss=$(grep 'Maximum resident' "$work/log" | awk '{printf "%d ", $6/1024}')
     # CPU seconds (user + system) summed over the ranks: what the run costs whatever the machine's load.
     cpu=$(awk '/User time/{u+=$4} /System time/{s+=$4} END{printf "%.2f", u+s}' "$work/log")
-    echo "$label rep $r: thermal ${t} s; ${ex:-single process}; peak RSS MiB per rank: $rss; CPU s (all ranks, whole run): $cpu"
+    echo "$label rep $r (load $load): $node ${t} s; ${info:-single process}; peak RSS MiB per rank: $rss; CPU s (all ranks, whole run): $cpu"
   done
 }
 one "1 process (no mpirun)" /usr/bin/time -v "$orogen"

@@ -45,12 +45,14 @@ export:raw(t2, path="t.r32")
 export:vtk(t2, path="t.vti")
 )";
 
-/// A node that is not tiled (Diamond-Square runs on rank 0) before a tiled one: its value is cut into tiles and sent.
+/// A node that is not tiled (generate:shape runs on rank 0) before tiled ones: its value is cut into tiles and
+/// sent (Diamond-Square adds its tile of the fractal to it).
 const char* kScatterSpec = R"(orogen 1
 seed 3
 grid 65 cell=1
 
-d = generate:diamond-square(amplitude=40)
+s = generate:shape(kind=pyramid, height=40)
+d = generate:diamond-square(s, amplitude=10)
 t = erode:thermal(d, talus=25, iterations=12, neighbourhood=moore)
 export:raw(t, path="t.r32")
 )";
@@ -91,6 +93,137 @@ INSTANTIATE_TEST_SUITE_P(Ranks, Seam,
                              std::string t = info.param.tiles.empty() ? "auto" : info.param.tiles;
                              return std::to_string(info.param.ranks) + "_ranks_" + t;
                          });
+
+/// Pipe erosion twice (closed walls with the sediment fix-up and a rain mask
+/// from a layer, then open edges continuing from the first's water, sediment
+/// and fluxes): every layer it writes goes into the .vti.
+const char* kPipeSpec = R"(orogen 1
+seed 11
+grid 97x61 cell=2
+
+f = generate:fault(iterations=300, displacement=0.5)
+t = erode:thermal(f, talus=20, iterations=5, hardness=height)
+p = erode:pipe(t, steps=30, dt=0.5, rain=0.01, creep=0.2, rain_mask="hardness")
+q = erode:pipe(p, steps=7, dt=0.3, rain=0.002, boundary=open)
+export:raw(q, path="q.r32")
+export:vtk(p, path="p.vti")
+export:vtk(q, path="q.vti")
+)";
+
+/// Olsen's hydraulic automaton in its three hardness modes (steepness, a
+/// layer, constant), with sweeps shorter than the others at the end.
+const char* kHydraulicSpec = R"(orogen 1
+seed 13
+grid 97x61 cell=2
+
+f = generate:fault(iterations=300, displacement=0.5)
+t = erode:thermal(f, talus=20, iterations=5, hardness=height)
+h1 = erode:hydraulic(t, iterations=23, rain=0.02)
+h2 = erode:hydraulic(h1, iterations=6, hardness="hardness", evaporation=0.3)
+h3 = erode:hydraulic(h2, iterations=5, hardness=constant)
+export:raw(h3, path="h.r32")
+export:vtk(h1, path="h1.vti")
+export:vtk(h3, path="h3.vti")
+)";
+
+const auto kErosionCases = ::testing::Values(Case{1, ""}, Case{2, ""}, Case{3, ""}, Case{4, ""}, Case{2, "2x1"},
+                                             Case{3, "3x1"}, Case{3, "1x3"}, Case{4, "2x2"});
+const auto kCaseName = [](const auto& info) {
+    std::string t = info.param.tiles.empty() ? "auto" : info.param.tiles;
+    return std::to_string(info.param.ranks) + "_ranks_" + t;
+};
+
+/// Diamond-Square on its own and added to a tiled base: each rank makes its tile from the coarser levels near it.
+const char* kDiamondSquareSpec = R"(orogen 1
+seed 5
+grid 97x61 cell=2
+
+d = generate:diamond-square(amplitude=40, roughness=0.6)
+f = generate:fault(iterations=50, displacement=0.5)
+e = generate:diamond-square(f, amplitude=3)
+export:raw(d, path="d.r32")
+export:raw(e, path="e.r32")
+)";
+
+class DiamondSquareSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(DiamondSquareSeam, DiamondSquareEqualsOneProcess) {
+    expect_same_outputs(kDiamondSquareSpec, {"d.r32", "e.r32"}, GetParam());
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, DiamondSquareSeam, kErosionCases, kCaseName);
+
+class PipeSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(PipeSeam, PipeEqualsOneProcess) { expect_same_outputs(kPipeSpec, {"q.r32", "p.vti", "q.vti"}, GetParam()); }
+INSTANTIATE_TEST_SUITE_P(Ranks, PipeSeam, kErosionCases, kCaseName);
+
+class HydraulicSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(HydraulicSeam, HydraulicEqualsOneProcess) {
+    expect_same_outputs(kHydraulicSpec, {"h.r32", "h1.vti", "h3.vti"}, GetParam());
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, HydraulicSeam, kErosionCases, kCaseName);
+
+/// The lines "NODE: suspended sediment X m, ..." of a run's output, in order.
+std::vector<std::string> suspended_lines(const RunResult& r) {
+    std::vector<std::string> lines;
+    for (const std::string* text : {&r.out, &r.err})
+        for (std::size_t at = text->find("suspended sediment"); at != std::string::npos;
+             at = text->find("suspended sediment", at + 1)) {
+            const std::size_t start = text->rfind('\n', at) == std::string::npos ? 0 : text->rfind('\n', at) + 1;
+            lines.push_back(text->substr(start, text->find('\n', at) - start));
+        }
+    std::sort(lines.begin(), lines.end());
+    return lines;
+}
+
+TEST(Mpi, PipeSedimentTotalsAreTheSingleProcesssToTheLastBit) {
+    // The closed-wall fix-up's total (a double over every cell) is carried through the tiles in the single
+    // process's order; its 17 digits are printed once per node.
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", kPipeSpec);
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one"));
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    const auto expected = suspended_lines(one);
+    ASSERT_EQ(expected.size(), 2u) << one.out << one.err;
+    for (const auto& [ranks, tiles] : {std::pair{4, "2x2"}, std::pair{3, "1x3"}}) {
+        const RunResult many = run_mpi(ranks, "run " + q(spec) + " --out " + q(dir / tiles) + " --tiles " + tiles);
+        ASSERT_EQ(many.exit_code, 0) << many.err;
+        EXPECT_EQ(suspended_lines(many), expected) << tiles;
+    }
+}
+
+TEST(Mpi, TilesNarrowerThanPipeOrHydraulicHalosAreRefusedAtTheNode) {
+    TempDir dir;
+    // 20 columns in 1x4: tiles 5 wide. Pipe needs 3 (fine), hydraulic 12 (refused); 1x8: tiles 2 wide, both refused.
+    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 20x16\nf = generate:fault()\np = erode:pipe(f, steps=2)\n"
+                                            "h = erode:hydraulic(p, iterations=3)\nexport:raw(h, path=\"h.r32\")\n");
+    const RunResult r = run_mpi(4, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 1x4");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("s.orogen:5:5: error: 'h' (erode:hydraulic) exchanges a halo of 12 vertices with each "
+                         "neighbouring tile, so tiles must be at least 12 vertices wide, but --tiles 1x4 cuts the "
+                         "20x16 grid into tiles 5 wide; use fewer columns (--tiles), fewer ranks or a larger grid"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("'p' (erode:pipe)"), std::string::npos) << r.err;
+    const RunResult narrow = run_mpi(8, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 8x1");
+    EXPECT_EQ(narrow.exit_code, 2);
+    EXPECT_NE(narrow.err.find("s.orogen:4:5: error: 'p' (erode:pipe) exchanges a halo of 3 vertices with each "
+                              "neighbouring tile, so tiles must be at least 3 vertices high, but --tiles 8x1 cuts the "
+                              "20x16 grid into tiles 2 high; use fewer rows (--tiles), fewer ranks or a larger grid"),
+              std::string::npos)
+        << narrow.err;
+    EXPECT_FALSE(fs::exists(dir / "o" / "h.r32"));
+}
+
+TEST(Mpi, PipeTimelapseIsRefusedInATiledRun) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 33\nf = generate:fault()\n"
+                                            "p = erode:pipe(f, steps=8, timelapse_every=2)\nexport:raw(p, path=\"p.r32\")\n");
+    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "o"));
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("s.orogen:4:5: error: 'p' (erode:pipe): time-lapses are not recorded in a tiled run yet; "
+                         "set timelapse_every=0 or run without mpirun"),
+              std::string::npos)
+        << r.err;
+}
 
 TEST(Mpi, WholeValueFromRankZeroIsCutIntoTiles) { expect_same_outputs(kScatterSpec, {"t.r32"}, {3, "3x1"}); }
 
@@ -164,6 +297,27 @@ TEST(Mpi, ARankThatFailsEndsEveryRankWithOneErrorAndNoOutputs) {
     std::vector<std::string> left;
     for (const auto& e : fs::directory_iterator(dir / "many")) left.push_back(e.path().filename().string());
     EXPECT_TRUE(left.empty()) << left.size() << " entries left, first " << (left.empty() ? "" : left[0]);
+}
+
+TEST(Mpi, APipeRankWithABadRainMaskEndsEveryRankWithOneError) {
+    TempDir dir;
+    write_poisoned_raw(dir, 400, 16);  // as a rain mask: a negative factor in the east tile only
+    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 400x16\nf = generate:fault()\nm = import:raw(path=\"p.r32\")\n"
+                                            "export:raw(f, path=\"f.r32\")\n"
+                                            "p = erode:pipe(f, m, steps=4)\nexport:raw(p, path=\"p.r32\")\n");
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one"));
+    ASSERT_EQ(one.exit_code, 2) << one.err;
+    // Rank 1 fails before the solver's first collective; rank 0 meets its failure there.
+    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "many") + " --tiles 1x2");
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    const auto line = [](const std::string& err) {
+        const auto at = err.find("error: node 'p'");
+        return at == std::string::npos ? std::string() : err.substr(at, err.find('\n', at) - at);
+    };
+    EXPECT_NE(line(one.err).find("rain_mask: the mask holds a negative or NaN value"), std::string::npos) << one.err;
+    EXPECT_EQ(line(r.err), line(one.err)) << r.err;
+    EXPECT_EQ(r.err.find("error:"), r.err.rfind("error:")) << r.err;
+    EXPECT_TRUE(fs::is_empty(dir / "many"));
 }
 
 TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {

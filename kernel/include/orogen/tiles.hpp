@@ -16,7 +16,11 @@
 #include <orogen/error.hpp>
 #include <orogen/grid.hpp>
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
 
 namespace orogen {
 
@@ -69,6 +73,42 @@ public:
     virtual double seconds_waiting() const = 0;
     /// Collective: the least and greatest of each rank's `lo`/`hi` (exact).
     virtual void min_max(float& lo, float& hi) = 0;
+
+    // For eroders whose every step needs global reductions (erode:pipe's
+    // CFL limit and sediment fix-up): several fields at once, and sums in
+    // the single process's order.
+
+    /// Collective: exchange_halo() for several grids of the same size (each
+    /// covering grown(halo)) at once: one opening agreement and one message
+    /// per side, whatever the number of grids.
+    virtual void exchange_halos(std::span<const GridView> held, int halo) = 0;
+    /// Collective: element by element, the greatest of every rank's
+    /// `values[0..count)`, on every rank (exact: a maximum does not round).
+    /// Opens with the failure agreement (throws PeerFailed).
+    virtual void max_all(float* values, int count) = 0;
+    /// Collective, along each row of tiles from west to east: `carry` holds
+    /// `per_row` values for each of this tile's rows; they come in from the
+    /// west neighbour (the westmost tile keeps what the caller put there),
+    /// `advance(first, count)` carries rows [first, first + count) of them over
+    /// this tile's columns, and they go on to the east neighbour. This
+    /// reproduces a single process's sequential accumulation along whole rows
+    /// (floating-point sums are not associative, so partial sums per tile
+    /// would not give its bits). The rows travel in blocks, so that a tile
+    /// works on a block while its east neighbour works on the one before: the
+    /// chain costs about one tile's pass plus a block's per tile to the east,
+    /// not a whole pass per tile. Every tile of a row of tiles has the same
+    /// rows. The caller must not throw between its last collective and this
+    /// call on one rank only (a west neighbour that never sends would hang it).
+    virtual void carry_east(std::span<double> carry, int per_row,
+                            const std::function<void(int first, int count)>& advance) = 0;
+    /// Collective: `per_row` values for each row of the whole grid, in row
+    /// order, on every rank, taken from the eastmost tile of each row of
+    /// tiles (`mine`: owned().height × per_row values there; ignored
+    /// elsewhere). With carry_east(): whole-row results, then summed in row
+    /// order by every rank alike.
+    virtual std::vector<double> gather_rows(std::span<const double> mine, int per_row) = 0;
+    /// Whether this tile is the eastmost of its row of tiles (the one whose `mine` gather_rows() takes).
+    bool eastmost() const { return owned().x1() == grid_width(); }
 };
 
 }  // namespace orogen

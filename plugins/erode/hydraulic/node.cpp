@@ -5,6 +5,11 @@
 #include <orogen/plugin.hpp>
 #include <orogen/timelapse.hpp>
 
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -12,6 +17,132 @@
 namespace {
 
 using namespace orogen;
+
+/// A tiled run's steps per halo exchange (temporal blocking, as erode:thermal's sweeps).
+constexpr int kStepsPerSweep = 4;
+/// One step reads 3 vertices across a tile edge: a cell's inflow needs its
+/// axis neighbours' flow factors, a factor needs its axis neighbours'
+/// altitude after rain and dissolving, which needs their axis neighbours'
+/// terrain (the slope). So a sweep of kStepsPerSweep steps needs this many.
+constexpr int kTileHalo = 3 * kStepsPerSweep;
+
+/// check_finite()'s message, with the sample's index in the whole grid (a tiled run holds a tile).
+void check_finite_owned(ConstGridView held, const TileRect& own, int ox, int oy, int grid_width, const char* what,
+                        std::int64_t step) {
+    for (int y = 0; y < own.height; ++y)
+        for (int x = 0; x < own.width; ++x)
+            if (const float v = held.row(y + oy)[ox + x]; !std::isfinite(v)) {
+                std::ostringstream msg;
+                msg << "non-finite " << what << " (" << v << ") at sample "
+                    << std::int64_t(own.y0 + y) * grid_width + (own.x0 + x) << " after step " << step
+                    << "; the simulation became unstable";
+                throw Error(msg.str());
+            }
+}
+
+/// One rank's tile of a tiled run (orogen/tiles.hpp). The step is a pure
+/// function of the previous state (no global sums), so the rank works on its
+/// tile grown by kTileHalo: before each sweep of kStepsPerSweep steps the
+/// halo of terrain, water and sediment is refilled from the neighbours; the
+/// sweep treats the grown tile's edge as the map's edge, whose wrong effect
+/// travels 3 vertices a step, so after the sweep the owned vertices hold the
+/// single process's bits and only the halo is stale. Once more at the end,
+/// for the `flow` and `hardness` layers (stencils of 2 and 1 vertices).
+void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::Settings& s, const float* layer,
+               std::int64_t iterations) {
+    const TileRect own = tiles.owned(), grown = tiles.grown(kTileHalo);
+    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
+    const std::size_t n = std::size_t(grown.width) * std::size_t(grown.height);
+    const double cell = hm.cell();
+    auto to_grown = [&](const float* tile, float* held) {
+        for (int y = 0; y < own.height; ++y)
+            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
+                      held + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox));
+    };
+    // Two states (double-buffered): terrain, water, sediment each. The tile's
+    // water and sediment layers are dropped meanwhile (memory about the
+    // single process's per vertex); its heights stay, as `before`.
+    std::vector<float> storage[6];
+    for (auto& g : storage) g.assign(n, 0.0f);
+    auto grid = [&](int k) { return GridView{storage[k].data(), grown.width, grown.height, cell}; };
+    hydraulic::State a{grid(0), grid(1), grid(2)}, b{grid(3), grid(4), grid(5)};
+    to_grown(hm.heights().data(), a.height.data);
+    to_grown(std::as_const(hm).layer("water").data, a.water.data);
+    to_grown(std::as_const(hm).layer("sediment").data, a.sediment.data);
+    std::vector<float> held_layer;
+    if (layer) {  // the hardness of the halo too, once: it does not change
+        held_layer.assign(n, 0.0f);
+        to_grown(layer, held_layer.data());
+        tiles.exchange_halo({held_layer.data(), grown.width, grown.height, cell}, kTileHalo);
+    }
+    const float* hard = layer ? held_layer.data() : nullptr;
+    hm.remove_layer("water");  // after the hardness layer's copy (it may be one of them)
+    hm.remove_layer("sediment");
+    using clock = std::chrono::steady_clock;
+    clock::duration exchanging{}, sweeping{};  // for the info line (docs/benchmarks.md)
+    const double waited_before = tiles.seconds_waiting();
+    auto exchange = [&] {
+        const auto t0 = clock::now();
+        const GridView grids[] = {a.height, a.water, a.sediment};
+        tiles.exchange_halos(grids, kTileHalo);
+        exchanging += clock::now() - t0;
+    };
+    for (std::int64_t i = 0; i < iterations;) {
+        const int k = int(std::min<std::int64_t>(kStepsPerSweep, iterations - i));
+        exchange();
+        const auto t1 = clock::now();
+        for (int j = 0; j < k; ++j) {
+            hydraulic::step({a.height, a.water, a.sediment}, b, s, hard);
+            std::swap(a, b);
+            ++i;
+            ctx.check_cancelled();
+            if (i % 64 == 0 || i == iterations) {  // as run() checks
+                check_finite_owned(a.height, own, ox, oy, tiles.grid_width(), "height", i);
+                check_finite_owned(a.water, own, ox, oy, tiles.grid_width(), "water", i);
+                check_finite_owned(a.sediment, own, ox, oy, tiles.grid_width(), "sediment", i);
+                ctx.progress(double(i) / double(iterations));
+            }
+        }
+        sweeping += clock::now() - t1;
+    }
+    exchange();  // the halo `flow` and `hardness` read
+    const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
+    std::ostringstream note;
+    note.precision(3);
+    note << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height << " at ("
+         << own.x0 << ", " << own.y0 << "), " << iterations << " steps: sweeps " << sw << " s, halo exchange " << ex
+         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %), of which waiting for the other ranks "
+         << tiles.seconds_waiting() - waited_before << " s";
+    ctx.info(note.str());
+    // The layers run() adds, from the final state (b's grids are free now: scratch for them).
+    for (const char* l : {"flux_west", "flux_east", "flux_north", "flux_south"}) hm.remove_layer(l);
+    hydraulic::outflow({a.height, a.water, a.sediment}, s, hard, b.height);
+    const bool steep = s.hardness == hydraulic::Hardness::steepness;
+    if (steep) hydraulic::steepness_hardness(a.height, b.water);
+    // Each grid back as a tile, its owned part moved to its front in place (a
+    // copy into fresh memory costs page faults: seconds of system time at
+    // 4097² on a loaded machine). Row y's destination never passes its source.
+    auto take = [&](const GridView& g) {
+        std::vector<float>* owner = nullptr;
+        for (auto& v : storage)
+            if (v.data() == g.data) owner = &v;
+        for (int y = 0; y < own.height; ++y)
+            std::memmove(owner->data() + std::size_t(y) * std::size_t(own.width),
+                         owner->data() + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox),
+                         std::size_t(own.width) * sizeof(float));
+        owner->resize(std::size_t(own.width) * std::size_t(own.height));
+        return std::move(*owner);
+    };
+    std::vector<float>().swap(held_layer);
+    std::vector<float> after = take(a.height);
+    GridView eroded = hm.layer("eroded", 0.0f);
+    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm.heights()[i];
+    hm.set_layer("water", take(a.water));
+    hm.set_layer("sediment", take(a.sediment));
+    hm.set_layer("flow", take(b.height));
+    if (steep) hm.set_layer("hardness", take(b.water));
+    hm.heights() = std::move(after);
+}
 
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
@@ -36,8 +167,12 @@ NodeOutputs run(NodeContext& ctx) {
     GridView eroded = hm->layer("eroded", 0.0f);
     if (s.hardness == hydraulic::Hardness::layer) layer = std::as_const(*hm).layer(hardness).data;
 
-    const std::vector<float> before = hm->heights();
     const std::int64_t iterations = ctx.integer("iterations");
+    if (Tiling* tiles = ctx.tiling()) {
+        run_tiled(ctx, *tiles, *hm, s, layer, iterations);
+        return hm;
+    }
+    const std::vector<float> before = hm->heights();
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0);  // time = step count
     lapse.record(0, *hm);
     hydraulic::erode({hm->view(), water, sediment}, iterations, s, layer,
@@ -118,6 +253,7 @@ OROGEN_PLUGIN("erode-hydraulic", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"water", "sediment", "eroded", "flow"},
+        .tile_halo = kTileHalo,
         .check = check,
         .run = run,
     });

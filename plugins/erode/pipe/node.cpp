@@ -6,7 +6,9 @@
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
-
+#include <chrono>
+#include <cmath>
+#include <cstring>
 #include <sstream>
 #include <string>
 #include <utility>
@@ -19,6 +21,127 @@ using namespace orogen;
 // The pipe fluxes are state too (the water's momentum): kept as layers so a
 // following erode:pipe continues exactly where this one stopped.
 constexpr const char* kFluxLayers[] = {"flux_west", "flux_east", "flux_north", "flux_south"};
+
+/// The whole grid's suspended sediment summed after the last sub-step's
+/// transport (m, summed over the cells), to the last bit (17 digits): the
+/// closed-wall fix-up's total, which a tiled run sums in the single
+/// process's order (tests/mpi compares the two lines).
+std::string suspended_line(const pipe::Solver& solver) {
+    std::ostringstream msg;
+    msg.precision(17);
+    msg << "suspended sediment " << solver.total_sediment() << " m, summed over the cells";
+    return msg.str();
+}
+
+/// check_finite()'s message, with the sample's index in the whole grid (a tiled run holds a tile).
+void check_finite_tile(const float* v, const TileRect& own, int grid_width, const char* what, std::int64_t step) {
+    for (int y = 0; y < own.height; ++y)
+        for (int x = 0; x < own.width; ++x)
+            if (const float f = v[std::size_t(y) * std::size_t(own.width) + std::size_t(x)]; !std::isfinite(f)) {
+                std::ostringstream msg;
+                msg << "non-finite " << what << " (" << f << ") at sample "
+                    << std::int64_t(own.y0 + y) * grid_width + (own.x0 + x) << " after step " << step
+                    << "; the simulation became unstable";
+                throw Error(msg.str());
+            }
+}
+
+/// One rank's tile of a tiled run (orogen/tiles.hpp). The state moves into
+/// grids covering the tile grown by pipe::kTileHalo (the tile's own layers
+/// are dropped meanwhile, so memory stays about the single process's per
+/// cell); the solver refills their halo before every sub-step and reduces
+/// across ranks (pipe.hpp), so the owned cells end with the single
+/// process's bits; then the owned part goes back into the tile's layers.
+NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap> hm, const pipe::Settings& s,
+                      std::vector<float> mask) {
+    const TileRect own = tiles.owned(), grown = tiles.grown(pipe::kTileHalo);
+    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
+    const std::size_t grown_size = std::size_t(grown.width) * std::size_t(grown.height);
+    const double cell = hm->cell();
+    auto to_grown = [&](const float* tile) {
+        std::vector<float> held(grown_size, 0.0f);
+        for (int y = 0; y < own.height; ++y)
+            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
+                      held.begin() + std::ptrdiff_t(std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox)));
+        return held;
+    };
+    // The owned part moved to the front of the grown grid, which then is the
+    // tile (it keeps the grown capacity, a few halo rows more: fresh memory
+    // for a copy costs page faults, several seconds of system time for the
+    // 8 grids of a 4097² run on a loaded machine). Row y's destination never
+    // passes its source, so rows are moved in order.
+    auto to_tile = [&](std::vector<float>&& held) {
+        for (int y = 0; y < own.height; ++y)
+            std::memmove(held.data() + std::size_t(y) * std::size_t(own.width),
+                         held.data() + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox),
+                         std::size_t(own.width) * sizeof(float));
+        held.resize(std::size_t(own.width) * std::size_t(own.height));
+        return std::move(held);
+    };
+    // 0 height, 1 water, 2 sediment, 3-6 fluxes, 7 flow (speed).
+    const char* names[] = {"", "water", "sediment", kFluxLayers[0], kFluxLayers[1], kFluxLayers[2], kFluxLayers[3],
+                           "flow"};
+    std::vector<float> held[8];
+    held[0] = to_grown(hm->heights().data());
+    for (int k = 1; k < 8; ++k) {
+        if (hm->has_layer(names[k])) {
+            held[k] = to_grown(std::as_const(*hm).layer(names[k]).data);
+            hm->remove_layer(names[k]);
+        } else {
+            held[k].assign(grown_size, 0.0f);  // a new state starts at 0, as the layer would
+        }
+    }
+    auto view = [&](int k) { return GridView{held[k].data(), grown.width, grown.height, cell}; };
+    std::vector<float> held_mask;
+    if (!mask.empty()) {  // the rain factors of the halo too, once: they do not change
+        held_mask = to_grown(mask.data());
+        std::vector<float>().swap(mask);
+        tiles.exchange_halo({held_mask.data(), grown.width, grown.height, cell}, pipe::kTileHalo);
+    }
+    pipe::State st{view(0), view(1), view(2), view(3), view(4), view(5), view(6), view(7)};
+    const std::int64_t steps = ctx.integer("steps");
+    const double dt = ctx.real("dt");
+    using clock = std::chrono::steady_clock;
+    const double waited_before = tiles.seconds_waiting();
+    const auto t0 = clock::now();
+    const double cpu0 = pipe::process_cpu_seconds();
+    {
+        pipe::Solver solver(st, s, held_mask.empty() ? nullptr : held_mask.data(), &tiles);
+        for (std::int64_t i = 1; i <= steps; ++i) {
+            ctx.check_cancelled();
+            solver.advance(dt, i);
+            if (i % 16 == 0 || i == steps) ctx.progress(double(i) / double(steps));
+        }
+        solver.finish();
+        const double total = std::chrono::duration<double>(clock::now() - t0).count();
+        const double ex = solver.seconds_exchanging(), red = solver.seconds_reducing();
+        const double cpu = pipe::process_cpu_seconds() - cpu0;
+        const double cpu_other = solver.cpu_seconds_exchanging() + solver.cpu_seconds_reducing();
+        std::ostringstream msg;
+        msg.precision(3);
+        msg << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height
+            << " at (" << own.x0 << ", " << own.y0 << "), " << steps << " steps of " << dt << " s in "
+            << solver.substeps() << " sub-steps: " << total << " s, halo exchange " << ex << " s ("
+            << (total > 0 ? 100.0 * ex / total : 0.0) << " %), reductions " << red << " s ("
+            << (total > 0 ? 100.0 * red / total : 0.0) << " %), of which waiting for the other ranks "
+            << tiles.seconds_waiting() - waited_before << " s; CPU " << cpu << " s, of which halo exchange and reductions "
+            << cpu_other << " s";
+        ctx.info(msg.str());
+        if (tiles.rank() == 0) ctx.info(suspended_line(solver));
+    }
+    std::vector<float>().swap(held_mask);
+    // The owned parts back into the tile (moved within each grid, see to_tile).
+    std::vector<float> after = to_tile(std::move(held[0]));
+    for (int k = 1; k < 8; ++k) hm->set_layer(names[k], to_tile(std::move(held[k])));
+    // As run() checks: in a tiled run the solver's own check covers each sub-step already.
+    check_finite_tile(after.data(), own, tiles.grid_width(), "height", steps);
+    check_finite_tile(std::as_const(*hm).layer("water").data, own, tiles.grid_width(), "water", steps);
+    check_finite_tile(std::as_const(*hm).layer("sediment").data, own, tiles.grid_width(), "sediment", steps);
+    GridView eroded = hm->layer("eroded", 0.0f);
+    for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm->heights()[i];
+    hm->heights() = std::move(after);
+    return hm;
+}
 
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
@@ -62,6 +185,7 @@ NodeOutputs run(NodeContext& ctx) {
     bool pipe_state = true;
     for (const char* l : kFluxLayers) pipe_state = pipe_state && hm->has_layer(l);
     if (!pipe_state) hm->remove_layer("flow");
+    if (Tiling* tiles = ctx.tiling()) return run_tiled(ctx, *tiles, std::move(hm), s, std::move(mask));
     pipe::State st;
     st.height = hm->view();
     st.water = hm->layer("water", 0.0f);
@@ -90,6 +214,7 @@ NodeOutputs run(NodeContext& ctx) {
         std::ostringstream msg;
         msg << steps << " steps of " << dt << " s in " << solver.substeps() << " sub-steps";
         ctx.info(msg.str());
+        ctx.info(suspended_line(solver));
     }
     ctx.check_finite(hm->heights(), "height", steps);
     ctx.check_finite(st.water.span(), "water", steps);
@@ -191,6 +316,7 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"water", "sediment", "flow", "eroded", "flux_west", "flux_east", "flux_north", "flux_south"},
+        .tile_halo = pipe::kTileHalo,
         .check = check,
         .run = run,
     });

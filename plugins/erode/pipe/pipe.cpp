@@ -4,8 +4,11 @@
 #include <orogen/parallel.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstring>
+#include <ctime>
 #include <sstream>
 #include <utility>
 
@@ -58,6 +61,7 @@ struct Arrays {
     float *fw, *fe, *fn, *fs;  ///< outflow fluxes, m³/s (pass 1 updates each cell's own in place)
     const float* mask;
     int w, h;
+    int sum_x0, sum_w;  ///< the columns row_sums() covers: all of them, or a tiled run's owned ones
 };
 
 struct RowSums {
@@ -213,7 +217,8 @@ inline float max_of8(F8 t) {
 /// The row's sums and maxima, from what pass 2 wrote (a separate loop over
 /// data still in cache, so the cell loop has no reductions).
 OROGEN_PIPE_CLONES RowSums row_sums(const Arrays& a, std::size_t row, float gravity) {
-    const std::size_t W = std::size_t(a.w);
+    const std::size_t W = std::size_t(a.sum_w);
+    row += std::size_t(a.sum_x0);
     const float* __restrict s1 = a.s1 + row;
     const float* __restrict d = a.d + row;
     const float* __restrict b = a.b_next + row;
@@ -287,6 +292,9 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
     return row_sums(a, row, k.gravity);
 }
 
+/// Pass 2 for one row, and the row's sums and maxima over the columns
+/// [sum_x0, sum_x0 + sum_w) (in a tiled run only the maxima and the
+/// finiteness check are used: Solver::Impl::tile_reductions makes the sums).
 RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale) {
     if (a.mask) return rescale ? water_row_impl<true, true>(a, k, y, scale) : water_row_impl<true, false>(a, k, y, scale);
     return rescale ? water_row_impl<false, true>(a, k, y, scale) : water_row_impl<false, false>(a, k, y, scale);
@@ -323,15 +331,15 @@ OROGEN_PIPE_CLONES void transport_cells(const float* __restrict u, const float* 
     cell(W - 1, W - 2, W - 1);
 }
 
-/// Pass 3: sediment at each cell = s1 back-traced along the velocity; returns the row's sum.
-double transport_row(const Arrays& a, const Sub& k, int y) {
+/// Pass 3: sediment at each cell = s1 back-traced along the velocity; returns the row's sum (with `sums`).
+double transport_row(const Arrays& a, const Sub& k, int y, bool sums = true) {
     const std::size_t row = std::size_t(y) * std::size_t(a.w);
     const std::size_t W = std::size_t(a.w);
     const float* mid = a.s1 + row;
     const float* up = y > 0 ? mid - W : mid;
     const float* dn = y + 1 < a.h ? mid + W : mid;
     transport_cells(a.u + row, a.v + row, up, mid, dn, a.s + row, a.w, k.dt * k.inv_l);
-    return sum_row(a.s + row, std::size_t(a.w));
+    return sums ? sum_row(a.s + row, std::size_t(a.w)) : 0.0;
 }
 
 }  // namespace
@@ -352,10 +360,126 @@ struct Solver::Impl {
     std::vector<std::uint8_t> water_done, transport_done;  ///< rows the fused sweep did (per sub-step)
     bool finished = false;
 
+    // A tiled run: the grids are the grown tile; [ox, ox + ow) × [oy, oy + oh)
+    // is the owned part, whose first column is column gx0 of the whole grid
+    // (gw columns wide: the 8-lane row sums follow its columns).
+    Tiling* tiles = nullptr;
+    int ox = 0, oy = 0, ow = 0, oh = 0, gx0 = 0, gw = 0;
+    std::vector<double> carry;  ///< per owned row: kCarry running sums (see tile_reductions)
+    double exchanging = 0.0, reducing = 0.0;  ///< s, wall clock
+    double cpu_exchanging = 0.0, cpu_reducing = 0.0;  ///< s of this process's CPU time (MPI waits by polling: counted)
+    double tiled_total_new = 0.0;  ///< a tiled run's sediment total of the last sub-step (whole grid, m)
+
     void substep(double dt, std::int64_t step, std::int64_t sub);
+    /// Refill the halo of every field a sub-step reads across a tile edge.
+    void exchange();
+    /// Sums and maxima of a tiled sub-step over the owned cells, combined
+    /// across ranks exactly as a single process combines its rows.
+    void tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
+                         float& vm, float& dm);
 };
 
-Solver::Solver(const State& state, const Settings& settings, const float* rain_mask) : impl_(new Impl) {
+double process_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+namespace {
+// Per row, for each of s1 and the new sediment: the 8 lanes and the tail of
+// row_sums()/sum_row(), in that order.
+constexpr int kCarry = 18;
+
+/// Continue a row's lane sums (as row_sums/sum_row accumulate them) over the
+/// values v[0..n), which are the whole grid's columns gx0.. of that row;
+/// `full` = the columns the 8 lanes take (the rest go to the tail).
+inline void continue_lanes(double* lanes, const float* __restrict v, int n, int gx0, int full) {
+    int x = 0;
+    // Up to the first column that is a multiple of 8, one by one.
+    for (; x < n && gx0 + x < full && (gx0 + x) % 8 != 0; ++x) lanes[(gx0 + x) % 8] += double(v[x]);
+    // Whole groups of 8 in registers (lane j gets column 8m + j, in order, as in row_sums).
+    double acc[8];
+    for (int j = 0; j < 8; ++j) acc[j] = lanes[j];
+    for (; x + 8 <= n && gx0 + x + 8 <= full; x += 8)
+        for (int j = 0; j < 8; ++j) acc[j] += double(v[x + j]);
+    for (int j = 0; j < 8; ++j) lanes[j] = acc[j];
+    for (; x < n; ++x) {
+        const int gx = gx0 + x;
+        if (gx < full) lanes[gx % 8] += double(v[x]);
+        else lanes[8] += double(v[x]);
+    }
+}
+
+inline double lanes_total(const double* l) {
+    return (((l[0] + l[1]) + (l[2] + l[3])) + ((l[4] + l[5]) + (l[6] + l[7]))) + l[8];  // total8(t) + tail
+}
+}  // namespace
+
+void Solver::Impl::exchange() {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = process_cpu_seconds();
+    const double cell = st.height.cell;
+    const GridView grids[] = {{b_cur, w, h, cell}, st.water, st.sediment, st.flux_west, st.flux_east,
+                              st.flux_north, st.flux_south};
+    tiles->exchange_halos(grids, kTileHalo);
+    exchanging += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cpu_exchanging += process_cpu_seconds() - c0;
+}
+
+void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
+                                   float& vm, float& dm) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = process_cpu_seconds();
+    const std::size_t W = std::size_t(w);
+    // Order-free parts first: the maxima and the finiteness check that the
+    // sweep took over the owned columns of every row (row_sums, as one
+    // process takes them over whole rows: a maximum is the same in any order;
+    // the sum of terrain and water is finite exactly when every value is).
+    float m[3] = {0.0f, 0.0f, 0.0f};  // vmax, dmax, 1 if a value is not finite
+    for (int r = oy; r < oy + oh; ++r) {
+        m[0] = std::max(m[0], row_vmax[std::size_t(r)]);
+        m[1] = std::max(m[1], row_dmax[std::size_t(r)]);
+        if (!std::isfinite(row_check[std::size_t(r)])) m[2] = 1.0f;
+    }
+    // The sediment totals: each row's 8 lanes carried west to east through
+    // the tiles of its row, then the rows in order, as one process adds them.
+    const int full = gw - gw % 8;
+    carry.assign(std::size_t(oh) * kCarry, 0.0);
+    tiles->carry_east(carry, kCarry, [&](int first, int count) {
+        parallel_for(first, first + count, 16, [&](std::int64_t r0, std::int64_t r1) {
+            FlushDenormals ftz;  // as in the sweep: denormal inputs read as 0
+            for (std::int64_t r = r0; r < r1; ++r) {
+                const std::size_t row = std::size_t(oy + r) * W + std::size_t(ox);
+                continue_lanes(carry.data() + std::size_t(r) * kCarry, a.s1 + row, ow, gx0, full);
+                continue_lanes(carry.data() + std::size_t(r) * kCarry + 9, a.s + row, ow, gx0, full);
+            }
+        });
+    });
+    std::vector<double> mine;
+    if (tiles->eastmost()) {
+        mine.resize(std::size_t(oh) * 2);
+        for (int r = 0; r < oh; ++r) {
+            mine[2 * std::size_t(r)] = lanes_total(carry.data() + std::size_t(r) * kCarry);
+            mine[2 * std::size_t(r) + 1] = lanes_total(carry.data() + std::size_t(r) * kCarry + 9);
+        }
+    }
+    const std::vector<double> rows = tiles->gather_rows(mine, 2);
+    total_s1 = 0.0;
+    total_new = 0.0;
+    for (std::size_t y = 0; y < rows.size() / 2; ++y) {
+        total_s1 += rows[2 * y];
+        total_new += rows[2 * y + 1];
+    }
+    tiles->max_all(m, 3);
+    vm = m[0];
+    dm = m[1];
+    finite = m[2] == 0.0f;
+    reducing += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    cpu_reducing += process_cpu_seconds() - c0;
+}
+
+Solver::Solver(const State& state, const Settings& settings, const float* rain_mask, Tiling* tiling)
+    : impl_(new Impl) {
     Impl& m = *impl_;
     m.st = state;
     m.cfg = settings;
@@ -363,6 +487,21 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
     m.w = state.height.width;
     m.h = state.height.height;
     m.n = state.height.size();
+    m.tiles = tiling;
+    if (tiling) {
+        const TileRect own = tiling->owned(), grown = tiling->grown(kTileHalo);
+        if (grown.width != m.w || grown.height != m.h)
+            throw Error("pipe::Solver: a tiled run's state grids must cover the grown tile");
+        m.ox = own.x0 - grown.x0;
+        m.oy = own.y0 - grown.y0;
+        m.ow = own.width;
+        m.oh = own.height;
+        m.gx0 = own.x0;
+        m.gw = tiling->grid_width();
+    } else {
+        m.ow = m.w;
+        m.oh = m.h;
+    }
     for (const GridView& g : {state.water, state.sediment, state.flux_west, state.flux_east, state.flux_north,
                               state.flux_south, state.speed})
         if (g.width != m.w || g.height != m.h) throw Error("pipe::Solver: state grids differ in size");
@@ -385,13 +524,14 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
     // The first sub-step's CFL limit comes from the state (speed and water of
     // the previous run's last sub-step), so a continued run schedules its
     // sub-steps exactly as one longer run would.
-    parallel_for(0, m.h, 16, [&](std::int64_t y0, std::int64_t y1) {
+    // (Over the owned cells of a tiled run: the halo is not filled yet.)
+    parallel_for(0, m.oh, 16, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y) {
             float vm = 0.0f, dm = 0.0f;
-            const float* sp = state.speed.row(int(y));
-            const float* wa = state.water.row(int(y));
-            for (int x = 0; x < m.w; ++x) {
+            const float* sp = state.speed.row(int(y) + m.oy) + m.ox;
+            const float* wa = state.water.row(int(y) + m.oy) + m.ox;
+            for (int x = 0; x < m.ow; ++x) {
                 vm = std::max(vm, sp[x]);
                 dm = std::max(dm, wa[x]);
             }
@@ -399,10 +539,14 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
             m.row_dmax[std::size_t(y)] = dm;
         }
     });
-    for (int y = 0; y < m.h; ++y) {
-        m.vmax = std::max(m.vmax, double(m.row_vmax[std::size_t(y)]));
-        m.dmax = std::max(m.dmax, double(m.row_dmax[std::size_t(y)]));
+    float vd[2] = {0.0f, 0.0f};
+    for (int y = 0; y < m.oh; ++y) {
+        vd[0] = std::max(vd[0], m.row_vmax[std::size_t(y)]);
+        vd[1] = std::max(vd[1], m.row_dmax[std::size_t(y)]);
     }
+    if (tiling) tiling->max_all(vd, 2);  // the whole grid's (a maximum is exact in any order)
+    m.vmax = double(vd[0]);
+    m.dmax = double(vd[1]);
 }
 
 Solver::~Solver() = default;
@@ -452,9 +596,11 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     k.kappa = float(std::min(0.2, cfg.creep * dt / (l * l)));
 
     const int W = w, H = h;
+    const bool tiled = tiles != nullptr;
+    if (tiled) exchange();
 
     Arrays ar{b_cur, b_next, st.water.data, st.sediment.data, s1.data(), u.data(), v.data(), st.flux_west.data,
-              st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H};
+              st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H, ox, ow};
     // Chunks of rows: few and large, since each chunk leaves its edge rows
     // to the clean-up passes below.
     const std::int64_t grain = std::max<std::int64_t>(16, H / 16);
@@ -491,7 +637,7 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
                 water_done[std::size_t(yw)] = 1;
             }
             if (yt > y0 + 1 && yt < y1 - 2) {
-                row_snew[std::size_t(yt)] = transport_row(ar, k, int(yt));
+                row_snew[std::size_t(yt)] = transport_row(ar, k, int(yt), !tiled);
                 transport_done[std::size_t(yt)] = 1;
             }
         }
@@ -504,20 +650,27 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     parallel_for(0, H, grain, [&](std::int64_t y0, std::int64_t y1) {
         FlushDenormals ftz;
         for (std::int64_t y = y0; y < y1; ++y)
-            if (!transport_done[std::size_t(y)]) row_snew[std::size_t(y)] = transport_row(ar, k, int(y));
+            if (!transport_done[std::size_t(y)]) row_snew[std::size_t(y)] = transport_row(ar, k, int(y), !tiled);
     });
 
     // ---- reductions, in row order
     double total_s1 = 0.0, total_new = 0.0, check = 0.0;
     float vm = 0.0f, dm = 0.0f;
-    for (int y = 0; y < H; ++y) {
-        total_s1 += row_s1[std::size_t(y)];
-        total_new += row_snew[std::size_t(y)];
-        check += row_check[std::size_t(y)];
-        vm = std::max(vm, row_vmax[std::size_t(y)]);
-        dm = std::max(dm, row_dmax[std::size_t(y)]);
+    bool finite = true;
+    if (tiled) {
+        tile_reductions(ar, total_s1, total_new, finite, vm, dm);
+        tiled_total_new = total_new;
+    } else {
+        for (int y = 0; y < H; ++y) {
+            total_s1 += row_s1[std::size_t(y)];
+            total_new += row_snew[std::size_t(y)];
+            check += row_check[std::size_t(y)];
+            vm = std::max(vm, row_vmax[std::size_t(y)]);
+            dm = std::max(dm, row_dmax[std::size_t(y)]);
+        }
+        finite = std::isfinite(check);
     }
-    if (!std::isfinite(check) || !std::isfinite(total_new) || !std::isfinite(vm)) {
+    if (!finite || !std::isfinite(total_new) || !std::isfinite(vm)) {
         std::ostringstream msg;
         msg << "non-finite terrain, water or sediment at step " << step << " (sub-step " << sub << ", dt "
             << dt << " s); the simulation became unstable";
@@ -559,13 +712,20 @@ ConstGridView Solver::current_height() const {
     return {m.b_cur, m.st.height.width, m.st.height.height, m.st.height.cell};
 }
 
+double Solver::seconds_exchanging() const { return impl_->exchanging; }
+double Solver::seconds_reducing() const { return impl_->reducing; }
+double Solver::cpu_seconds_exchanging() const { return impl_->cpu_exchanging; }
+double Solver::cpu_seconds_reducing() const { return impl_->cpu_reducing; }
+
 double Solver::total_water() const {
+    if (impl_->tiles) return std::numeric_limits<double>::quiet_NaN();
     double t = 0.0;
     for (double r : impl_->row_water) t += r;
     return t;
 }
 
 double Solver::total_sediment() const {
+    if (impl_->tiles) return impl_->tiled_total_new * impl_->sediment_scale;
     double t = 0.0;
     for (double r : impl_->row_snew) t += r;
     return t * impl_->sediment_scale;

@@ -44,6 +44,7 @@
 #pragma once
 
 #include <orogen/grid.hpp>
+#include <orogen/tiles.hpp>
 
 #include <cstdint>
 #include <memory>
@@ -85,10 +86,33 @@ struct State {
     GridView speed;     ///< carrying speed min(|v|, √(g·d)) of the last sub-step, m/s (also read at start: the first sub-step's CFL)
 };
 
+/// Vertices of the neighbouring tiles one sub-step reads, in a tiled run:
+/// the sediment transport of a cell reads s1 of its 3 × 3 block (1), s1 of a
+/// cell reads its axis neighbours' fluxes (2), a flux reads its axis
+/// neighbour's water surface (3). The halo is refilled before every sub-step,
+/// since each sub-step's length depends on the whole grid's speeds anyway.
+constexpr int kTileHalo = 3;
+
+/// CPU seconds this process has used (all its threads).
+double process_cpu_seconds();
+
 class Solver {
 public:
     /// `rain_mask` (optional) holds one non-negative factor per cell.
-    Solver(const State& state, const Settings& settings, const float* rain_mask = nullptr);
+    ///
+    /// With `tiling` (a tiled run, orogen/tiles.hpp), the state grids and the
+    /// mask cover this rank's tile grown by kTileHalo (tiling->grown()); the
+    /// owned part holds the state, the mask must be valid on the halo too
+    /// (the caller exchanges it once). Before each sub-step the solver refills
+    /// the halo of every field a sub-step reads across a tile edge (terrain,
+    /// water, sediment, the 4 fluxes); the edge of the grown tile then acts
+    /// as a wall whose wrong effect reaches kTileHalo cells in, i.e. halo
+    /// cells only. The reductions (the CFL maxima, the sediment totals of the
+    /// closed-wall fix-up, the finiteness check) run over the owned cells and
+    /// are combined across ranks in the single process's order, so every
+    /// owned cell gets the single process's bits. Collective: every rank
+    /// constructs, advances and finishes alike.
+    Solver(const State& state, const Settings& settings, const float* rain_mask = nullptr, Tiling* tiling = nullptr);
     ~Solver();
     Solver(const Solver&) = delete;
     Solver& operator=(const Solver&) = delete;
@@ -106,8 +130,15 @@ public:
 
     std::int64_t substeps() const { return substeps_; }
     /// Sums of the last sub-step, in double (m³ = m·cell²... here in m summed over cells).
+    /// total_water() is kept in a single process only (NaN in a tiled run).
     double total_water() const;
     double total_sediment() const;
+    /// A tiled run's seconds so far in halo exchanges and in the cross-rank reductions (wall clock).
+    double seconds_exchanging() const;
+    double seconds_reducing() const;
+    /// The same, in CPU seconds of this process (an MPI wait polls, so it counts here too).
+    double cpu_seconds_exchanging() const;
+    double cpu_seconds_reducing() const;
 
 private:
     struct Impl;

@@ -27,4 +27,14 @@ struct Params {
 /// any thread count.
 void generate(GridView out, const Params& params, std::uint64_t seed);
 
+/// The part of generate()'s surface on a `width` × `height` grid that `out`
+/// covers, `out` holding the vertices from column x0 and row y0 on: the same
+/// bits generate() gives there (a tile of a tiled run). It computes each
+/// level only where a vertex of the tile depends on it: the tile grown by one
+/// interval of that level on each side beyond the intervals holding it (a
+/// square step reads the neighbouring diamond centres, which read their
+/// corners), so the work is about the tile's plus a border of a few vertices
+/// a level, and the memory about the tile's.
+void generate_tile(GridView out, int x0, int y0, int width, int height, const Params& params, std::uint64_t seed);
+
 }  // namespace orogen::diamond_square

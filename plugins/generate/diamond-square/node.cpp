@@ -2,6 +2,7 @@
 #include "diamond_square.hpp"
 
 #include <orogen/plugin.hpp>
+#include <orogen/tiles.hpp>
 
 using namespace orogen;
 
@@ -21,8 +22,28 @@ OROGEN_PLUGIN("diamond-square", "0.1.0", registry) {
                 Param::real("roughness", 0.5).min(0, true).max(1).help("offset scale kept per level: higher is rougher"),
                 Param::real("amplitude", 100.0).min(0).max(1e6).unit("m").help("random range of the corners and the first level: ±amplitude"),
             },
+        // Tiled: each rank makes its own tile (diamond_square::generate_tile),
+        // computing each coarser level only near it; no halo.
+        .tile_halo = 0,
         .run = [](NodeContext& ctx) -> NodeOutputs {
             std::shared_ptr<Heightmap> hm;
+            const diamond_square::Params params{ctx.real("amplitude"), ctx.real("roughness")};
+            if (Tiling* tiles = ctx.tiling()) {
+                const TileRect own = tiles->owned();
+                Heightmap fractal(own.width, own.height, ctx.grid().cell);
+                diamond_square::generate_tile(fractal.view(), own.x0, own.y0, tiles->grid_width(), tiles->grid_height(),
+                                              params, ctx.seed());
+                if (ctx.has_input(0)) {
+                    hm = ctx.take_heightmap(0);  // the base's tile
+                    auto& h = hm->heights();
+                    const auto& f = fractal.heights();
+                    for (std::size_t i = 0; i < h.size(); ++i) h[i] += f[i];
+                } else {
+                    hm = std::make_shared<Heightmap>(std::move(fractal));
+                }
+                ctx.progress(1.0);
+                return hm;
+            }
             if (ctx.has_input(0)) {
                 hm = ctx.take_heightmap(0);
                 Heightmap fractal(hm->width(), hm->height(), hm->cell());

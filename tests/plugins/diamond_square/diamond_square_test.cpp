@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 using namespace orogen;
 
@@ -99,4 +101,31 @@ TEST(DiamondSquare, AmplitudeScalesTheSurfaceExactly) {
     const Heightmap a = make(65, 33, 10.0, 0.5, 4);
     const Heightmap b = make(65, 33, 20.0, 0.5, 4);
     for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(2.0f * a.heights()[i], b.heights()[i]);
+}
+
+// A tiled run's tiles (generate_tile: each rank its own, every level computed
+// only near the tile) must be the whole grid's bits: any size, any cut, tiles
+// down to one vertex, at the grid's edges and corners and inside.
+TEST(DiamondSquare, EveryTileEqualsTheWholeGridsVertices) {
+    const int sizes[][2] = {{1, 1}, {2, 3}, {5, 5}, {17, 9}, {33, 33}, {65, 40}, {97, 61}, {130, 7}};
+    for (const auto& [w, h] : sizes) {
+        const Heightmap whole = make(w, h, 50.0, 0.55, 9);
+        // Cuts into 1, 2, 3 and 5 parts a side (as split_grid cuts: floor(k·size/parts)), and 1-vertex tiles.
+        for (const int parts : {1, 2, 3, 5, 1000}) {
+            const int cols = std::min(parts, w), rows = std::min(parts, h);
+            for (int r = 0; r < rows; ++r)
+                for (int c = 0; c < cols; ++c) {
+                    const int x0 = c * w / cols, x1 = (c + 1) * w / cols, y0 = r * h / rows, y1 = (r + 1) * h / rows;
+                    Heightmap tile(x1 - x0, y1 - y0, 1.0, std::nanf(""));
+                    diamond_square::generate_tile(tile.view(), x0, y0, w, h, {50.0, 0.55}, 9);
+                    for (int y = y0; y < y1; ++y)
+                        for (int x = x0; x < x1; ++x) {
+                            const float a = whole.view().at(x, y), b = tile.view().at(x - x0, y - y0);
+                            ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0)
+                                << w << "x" << h << ", tile at (" << x0 << ", " << y0 << "), vertex (" << x << ", " << y
+                                << "): " << a << " vs " << b;
+                        }
+                }
+        }
+    }
 }
