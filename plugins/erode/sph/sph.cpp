@@ -544,7 +544,11 @@ struct Simulation::Impl {
         // pass for the component arrays): positions and velocities gathered straight into their component
         // arrays (fixed until integrate(): a cell's candidates are then 9 contiguous runs to copy per
         // component), the sediment into the keys' scratch, acidity, age and lifespan into the
-        // accelerations' 12 bytes (recomputed by force_pass before integrate() reads them).
+        // accelerations' 12 bytes (recomputed by force_pass before integrate() reads them). Within a
+        // sub-step the positions and velocities stay in the component arrays only: density_pass,
+        // force_pass and integrate() read them there, and integrate() writes the sorted pos and vel
+        // (every particle: it and the exception it may end in need no write-back here). After a
+        // compaction between steps (keep_fields) they are written back for the views and record().
         auto* sed_tmp = reinterpret_cast<std::byte*>(sort_keys.data());
         auto* rest_tmp = reinterpret_cast<std::byte*>(acc.data());
         static_assert(sizeof(Vec3) == 12 && sizeof(float) + 2 * sizeof(std::int32_t) == 12);
@@ -566,8 +570,10 @@ struct Simulation::Impl {
         });
         parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
             for (auto k = std::size_t(b); k < std::size_t(e); ++k) {
-                pos[k] = Vec3{soa[0][k], soa[1][k], soa[2][k]};
-                vel[k] = Vec3{soa[3][k], soa[4][k], soa[5][k]};
+                if (keep_fields) {
+                    pos[k] = Vec3{soa[0][k], soa[1][k], soa[2][k]};
+                    vel[k] = Vec3{soa[3][k], soa[4][k], soa[5][k]};
+                }
                 std::memcpy(&sediment[k], sed_tmp + 8 * k, 8);
                 std::memcpy(&acidity[k], rest_tmp + 12 * k, 4);
                 std::memcpy(&age[k], rest_tmp + 12 * k + 4, 4);
@@ -721,13 +727,13 @@ struct Simulation::Impl {
                 std::size_t k = gather3(from, to, run, nr);
                 for (; k < mp; ++k) X[k] = Y[k] = Z[k] = kFar;
                 for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
-                    float rho = mass * (w_norm * density_sum(X, Y, Z, mp, pos[i].x, pos[i].y, pos[i].z, h2, inv_h));
+                    float rho = mass * (w_norm * density_sum(X, Y, Z, mp, soa[0][i], soa[1][i], soa[2][i], h2, inv_h));
                     // The terrain as the fluid's rest lattice continued behind it (Akinci et al. 2012's boundary
                     // particles, summed once into a table): without it a particle on the ground misses half its
                     // kernel and the fluid crowds against the ground.
                     float phi = 0.0f;
                     Vec3 push{0.0f, 0.0f, 0.0f};
-                    const double x = pos[i].x, y = pos[i].y, z = pos[i].z;
+                    const double x = soa[0][i], y = soa[1][i], z = soa[2][i];
                     // Only the terrain: the map's side walls (closed boundary) stay geometric. With them as walls
                     // too (and the quadrant where two meet subtracted once), Martin & Moyce's dam break in its
                     // narrow tank ran 30 % ahead of the measurements; see docs/sph.md.
@@ -786,7 +792,7 @@ struct Simulation::Impl {
                     for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
                         const float pi = pterm[i];
                         float sum[3];
-                        force_sum(cand, mp, pos[i].x, pos[i].y, pos[i].z, vel[i].x, vel[i].y, vel[i].z, pi, density[i],
+                        force_sum(cand, mp, soa[0][i], soa[1][i], soa[2][i], soa[3][i], soa[4][i], soa[5][i], pi, density[i],
                                   h2, inv_h, visc_eps, visc_k, sum);
                         // The ground pushes back with the particle's own pressure (mirrored): −(2 p/ρ²) ρ0 ∇Φ.
                         const float wall = 2.0f * pi * rho0;
@@ -822,14 +828,24 @@ struct Simulation::Impl {
                 const std::size_t lo = std::size_t(blk * kGrain), hi = std::min(n, lo + std::size_t(kGrain));
                 for (std::size_t i = lo; i < hi; ++i) {
                     exchange[i] = 0.0;
-                    if (!alive[i]) continue;
-                    double v[3] = {vel[i].x + double(acc[i].x) * ddt, vel[i].y + double(acc[i].y) * ddt,
-                                   vel[i].z + double(acc[i].z) * ddt};
-                    const double o[3] = {pos[i].x, pos[i].y, pos[i].z};
+                    const auto keep = [&] {  // pos and vel unchanged: as sorted
+                        pos[i] = Vec3{soa[0][i], soa[1][i], soa[2][i]};
+                        vel[i] = Vec3{soa[3][i], soa[4][i], soa[5][i]};
+                    };
+                    if (!alive[i]) {  // not after sort_by_cell (it drops the dead); kept for safety
+                        keep();
+                        continue;
+                    }
+                    // The sorted positions and velocities are in the component arrays (sort_by_cell); pos and
+                    // vel are written below, for every particle.
+                    double v[3] = {soa[3][i] + double(acc[i].x) * ddt, soa[4][i] + double(acc[i].y) * ddt,
+                                   soa[5][i] + double(acc[i].z) * ddt};
+                    const double o[3] = {soa[0][i], soa[1][i], soa[2][i]};
                     const double d[3] = {v[0] * ddt, v[1] * ddt, v[2] * ddt};
                     double p[3] = {o[0] + d[0], o[1] + d[1], o[2] + d[2]};
                     if (!std::isfinite(p[0] + p[1] + p[2] + v[0] + v[1] + v[2])) {
                         block_bad[std::size_t(blk)] = 1;  // reported by substep(); never index the terrain with it
+                        keep();
                         continue;
                     }
                     bool contact = false;
