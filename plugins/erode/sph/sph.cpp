@@ -122,16 +122,48 @@ void force_sum(const ForceCandidates& c, std::size_t m, float px, float py, floa
     out[2] = lane_sum(az);
 }
 
-/// Copy a short run of floats (a row of a few cells: memcpy's call costs more than the copy) in whole
-/// blocks of kSlack: up to kSlack − 1 floats past `len` are read and written, so both arrays have that
-/// much slack at the end (the candidate buffers are then overwritten by the next run or the padding).
+/// A cell's candidates are copied in whole blocks of kSlack floats (a row of a few cells: memcpy's call
+/// costs more than the copy): up to kSlack − 1 floats past a run are read and written, so the source
+/// arrays and the candidate buffers have that much slack at the end (what is written past a run is then
+/// overwritten by the next run or the padding).
 constexpr std::size_t kSlack = 8;
-inline void copy_run(float* __restrict to, const float* __restrict from, std::size_t len) {
-    for (std::size_t k = 0; k < len; k += kSlack) {
-        float b[kSlack];
-        for (std::size_t l = 0; l < kSlack; ++l) b[l] = from[k + l];
-        for (std::size_t l = 0; l < kSlack; ++l) to[k + l] = b[l];
+
+/// Candidate buffers per thread, kept across tasks and sub-steps (density_pass uses the first 3,
+/// force_pass all 8): vectors of a task's own were allocated and zero-filled anew for every task. Neither
+/// pass starts parallel work inside a task, so a thread runs one task at a time on them.
+struct Scratch {
+    std::vector<float> buf[8];
+};
+thread_local Scratch scratch;
+
+/// Gather a cell's candidates: the runs [run[r][0], run[r][1]) of A source arrays, one run after
+/// another, into A destination arrays, copied for all A arrays per block of kSlack floats (see
+/// kSlack: up to kSlack − 1 floats past each run are read and written). One loop per run for all
+/// arrays: with a loop per run and array, the loops' set-up cost more than the copies (runs of ~20).
+/// Returns the candidates gathered.
+template <int A>
+inline std::size_t gather_runs(const float* const (&from)[A], float* const (&to)[A], const std::uint32_t (*run)[2],
+                               int nr) {
+    std::size_t k = 0;
+    for (int r = 0; r < nr; ++r) {
+        const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
+        for (std::size_t b = 0; b < len; b += kSlack)
+            for (int a = 0; a < A; ++a) {
+                float t[kSlack];
+                for (std::size_t l = 0; l < kSlack; ++l) t[l] = from[a][j + b + l];
+                for (std::size_t l = 0; l < kSlack; ++l) to[a][k + b + l] = t[l];
+            }
+        k += len;
     }
+    return k;
+}
+OROGEN_SPH_CLONES
+std::size_t gather3(const float* const (&from)[3], float* const (&to)[3], const std::uint32_t (*run)[2], int nr) {
+    return gather_runs<3>(from, to, run, nr);
+}
+OROGEN_SPH_CLONES
+std::size_t gather8(const float* const (&from)[8], float* const (&to)[8], const std::uint32_t (*run)[2], int nr) {
+    return gather_runs<8>(from, to, run, nr);
 }
 
 /// Grow a scratch buffer to at least `m` entries (never shrinks: reused across cells).
@@ -212,6 +244,10 @@ struct Simulation::Impl {
         int i, j;
         double fx, fz;
         tile(x, z, i, j, fx, fz);
+        return surface_in(i, j, fx, fz);
+    }
+    /// surface() in tile (i, j) at fractions (fx, fz), as tile() gives them.
+    double surface_in(int i, int j, double fx, double fz) const {
         if (w == 1 || hgt == 1) return H(0, 0);
         const double a = H(i, j), b = H(i + 1, j), c = H(i, j + 1), d = H(i + 1, j + 1);
         if (fx >= fz) return a + fx * (b - a) + fz * (d - b);
@@ -237,6 +273,11 @@ struct Simulation::Impl {
         int i, j;
         double fx, fz;
         tile(x, z, i, j, fx, fz);
+        normal_in(i, j, fx, fz, n);
+    }
+    /// normal() in tile (i, j) at fractions (fx, fz): the callers that need the surface height at the same
+    /// point too (density_pass, integrate) locate the tile once for both.
+    void normal_in(int i, int j, double fx, double fz, double n[3]) const {
         if (w == 1 || hgt == 1) {
             n[0] = 0, n[1] = 1, n[2] = 0;
             return;
@@ -363,9 +404,27 @@ struct Simulation::Impl {
     /// with ties in the previous order: the order, and with it every
     /// particle's neighbour and summation order, follows from the state alone.
     void sort_by_cell(bool keep_fields) {
-        std::size_t m = 0;
-        for (std::size_t i = 0; i < n; ++i)
-            if (alive[i]) perm[m++] = std::uint32_t(i);
+        // The live particles, in index order: counted per block of kListBlock in parallel, each block's
+        // first place from those counts, then each block lists its own (the serial loop's list).
+        constexpr std::size_t kListBlock = 16384;
+        std::vector<std::size_t> first(n / kListBlock + 2, 0);
+        const auto list_blocks = std::int64_t((n + kListBlock - 1) / kListBlock);
+        parallel_for(0, list_blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                std::size_t c = 0;
+                for (std::size_t i = b * kListBlock; i < std::min(n, (b + 1) * kListBlock); ++i) c += alive[i];
+                first[b + 1] = c;
+            }
+        });
+        for (std::size_t b = 0; b < std::size_t(list_blocks); ++b) first[b + 1] += first[b];
+        const std::size_t m = first[std::size_t(list_blocks)];
+        parallel_for(0, list_blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                std::size_t k = first[b];
+                for (std::size_t i = b * kListBlock; i < std::min(n, (b + 1) * kListBlock); ++i)
+                    if (alive[i]) perm[k++] = std::uint32_t(i);
+            }
+        });
         if (m == 0) {
             n = live = ncell = 0;
             return;
@@ -448,42 +507,82 @@ struct Simulation::Impl {
             std::swap(key, tkey);
             std::swap(idx, tidx);
         }
-        ncell = 0;
-        for (std::size_t k = 0; k < m; ++k)
-            if (k == 0 || key[k] != key[k - 1]) {
-                cell_key[ncell] = key[k];
-                cell_start[ncell++] = std::uint32_t(k);
+        // The occupied cells (where the sorted key changes), found per block of kListBlock keys in parallel
+        // as the particle list above: the serial scan's table.
+        const auto key_blocks = std::int64_t((m + kListBlock - 1) / kListBlock);
+        first.assign(std::size_t(key_blocks) + 1, 0);
+        const auto starts_cell = [&](std::size_t k) { return k == 0 || key[k] != key[k - 1]; };
+        parallel_for(0, key_blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                std::size_t c = 0;
+                for (std::size_t k = b * kListBlock; k < std::min(m, (b + 1) * kListBlock); ++k) c += starts_cell(k);
+                first[b + 1] = c;
             }
+        });
+        for (std::size_t b = 0; b < std::size_t(key_blocks); ++b) first[b + 1] += first[b];
+        parallel_for(0, key_blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                std::size_t c = first[b];
+                for (std::size_t k = b * kListBlock; k < std::min(m, (b + 1) * kListBlock); ++k)
+                    if (starts_cell(k)) {
+                        cell_key[c] = key[k];
+                        cell_start[c++] = std::uint32_t(k);
+                    }
+            }
+        });
+        ncell = first[std::size_t(key_blocks)];
         cell_start[ncell] = std::uint32_t(m);
-        // The keys are spent: their 16 bytes per particle are the permutation's scratch.
-        permute(pos, idx, m);
-        permute(vel, idx, m);
         // Density and pressure are recomputed before every use in a sub-step; only a compaction between
         // steps (end_step) must keep them with their particles for the views and record(). The
-        // accelerations are always recomputed before use.
+        // accelerations are always recomputed before use. The keys are spent: their 16 bytes per particle
+        // are the permutation's scratch.
         if (keep_fields) {
             permute(density, idx, m);
             permute(pterm, idx, m);
         }
-        permute(sediment, idx, m);
-        permute(acidity, idx, m);
-        permute(age, idx, m);
-        permute(lifespan, idx, m);
-        std::fill(alive.begin(), alive.begin() + std::ptrdiff_t(m), std::uint8_t(1));
-        n = m;
-        live = m;
-        // Component arrays of the positions and velocities (fixed until integrate()): a cell's candidates
-        // are then 9 contiguous runs to copy per component.
+        // The other fields in one gather and one write-back (they were 6 permutes of two passes each and a
+        // pass for the component arrays): positions and velocities gathered straight into their component
+        // arrays (fixed until integrate(): a cell's candidates are then 9 contiguous runs to copy per
+        // component), the sediment into the keys' scratch, acidity, age and lifespan into the
+        // accelerations' 12 bytes (recomputed by force_pass before integrate() reads them). Within a
+        // sub-step the positions and velocities stay in the component arrays only: density_pass,
+        // force_pass and integrate() read them there, and integrate() writes the sorted pos and vel
+        // (every particle: it and the exception it may end in need no write-back here). After a
+        // compaction between steps (keep_fields) they are written back for the views and record().
+        auto* sed_tmp = reinterpret_cast<std::byte*>(sort_keys.data());
+        auto* rest_tmp = reinterpret_cast<std::byte*>(acc.data());
+        static_assert(sizeof(Vec3) == 12 && sizeof(float) + 2 * sizeof(std::int32_t) == 12);
         parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
             for (auto k = std::size_t(b); k < std::size_t(e); ++k) {
-                soa[0][k] = pos[k].x;
-                soa[1][k] = pos[k].y;
-                soa[2][k] = pos[k].z;
-                soa[3][k] = vel[k].x;
-                soa[4][k] = vel[k].y;
-                soa[5][k] = vel[k].z;
+                const std::size_t i = idx[k];
+                const Vec3 p = pos[i], v = vel[i];
+                soa[0][k] = p.x;
+                soa[1][k] = p.y;
+                soa[2][k] = p.z;
+                soa[3][k] = v.x;
+                soa[4][k] = v.y;
+                soa[5][k] = v.z;
+                std::memcpy(sed_tmp + 8 * k, &sediment[i], 8);
+                std::memcpy(rest_tmp + 12 * k, &acidity[i], 4);
+                std::memcpy(rest_tmp + 12 * k + 4, &age[i], 4);
+                std::memcpy(rest_tmp + 12 * k + 8, &lifespan[i], 4);
             }
         });
+        parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
+            for (auto k = std::size_t(b); k < std::size_t(e); ++k) {
+                if (keep_fields) {
+                    pos[k] = Vec3{soa[0][k], soa[1][k], soa[2][k]};
+                    vel[k] = Vec3{soa[3][k], soa[4][k], soa[5][k]};
+                }
+                std::memcpy(&sediment[k], sed_tmp + 8 * k, 8);
+                std::memcpy(&acidity[k], rest_tmp + 12 * k, 4);
+                std::memcpy(&age[k], rest_tmp + 12 * k + 4, 4);
+                std::memcpy(&lifespan[k], rest_tmp + 12 * k + 8, 4);
+                alive[k] = 1;
+            }
+        });
+        n = m;
+        live = m;
     }
 
     template <typename T>
@@ -611,7 +710,9 @@ struct Simulation::Impl {
     void density_pass() {
         parallel_for(0, std::int64_t(ncell), kCellGrain, [&](std::int64_t c0, std::int64_t c1) {
             FlushDenormals ftz;
-            std::vector<float> bx, by, bz;
+            std::vector<float>& bx = scratch.buf[0];
+            std::vector<float>& by = scratch.buf[1];
+            std::vector<float>& bz = scratch.buf[2];
             std::uint32_t run[9][2];
             RowWalker rows(*this);
             for (std::int64_t cc = c0; cc < c1; ++cc) {
@@ -621,30 +722,28 @@ struct Simulation::Impl {
                 float* X = room(bx, mp + kSlack);
                 float* Y = room(by, mp + kSlack);
                 float* Z = room(bz, mp + kSlack);
-                std::size_t k = 0;
-                for (int r = 0; r < nr; ++r) {
-                    const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
-                    copy_run(X + k, soa[0].data() + j, len);
-                    copy_run(Y + k, soa[1].data() + j, len);
-                    copy_run(Z + k, soa[2].data() + j, len);
-                    k += len;
-                }
+                const float* const from[3] = {soa[0].data(), soa[1].data(), soa[2].data()};
+                float* const to[3] = {X, Y, Z};
+                std::size_t k = gather3(from, to, run, nr);
                 for (; k < mp; ++k) X[k] = Y[k] = Z[k] = kFar;
                 for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
-                    float rho = mass * (w_norm * density_sum(X, Y, Z, mp, pos[i].x, pos[i].y, pos[i].z, h2, inv_h));
+                    float rho = mass * (w_norm * density_sum(X, Y, Z, mp, soa[0][i], soa[1][i], soa[2][i], h2, inv_h));
                     // The terrain as the fluid's rest lattice continued behind it (Akinci et al. 2012's boundary
                     // particles, summed once into a table): without it a particle on the ground misses half its
                     // kernel and the fluid crowds against the ground.
                     float phi = 0.0f;
                     Vec3 push{0.0f, 0.0f, 0.0f};
-                    const double x = pos[i].x, y = pos[i].y, z = pos[i].z;
+                    const double x = soa[0][i], y = soa[1][i], z = soa[2][i];
                     // Only the terrain: the map's side walls (closed boundary) stay geometric. With them as walls
                     // too (and the quadrant where two meet subtracted once), Martin & Moyce's dam break in its
                     // narrow tank ran 30 % ahead of the measurements; see docs/sph.md.
-                    const double above = y - surface(x, z);
+                    int ti, tj;
+                    double fx, fz;
+                    tile(x, z, ti, tj, fx, fz);
+                    const double above = y - surface_in(ti, tj, fx, fz);
                     if (above < double(h)) {
                         double nrm[3];
-                        normal(x, z, nrm);
+                        normal_in(ti, tj, fx, fz, nrm);
                         add_wall(above * nrm[1], nrm[0], nrm[1], nrm[2], phi, push);  // the distance to the tangent plane
                     }
                     wall_push[i] = push;
@@ -669,7 +768,7 @@ struct Simulation::Impl {
         std::vector<float> block_max(std::size_t(std::max<std::int64_t>(blocks, 1)), 0.0f);
         parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
             FlushDenormals ftz;
-            std::vector<float> buf[8];
+            std::vector<float>* buf = scratch.buf;
             std::uint32_t run[9][2];
             RowWalker rows(*this);
             for (std::int64_t blk = b0; blk < b1; ++blk) {
@@ -680,14 +779,10 @@ struct Simulation::Impl {
                     const std::size_t mp = padded(run_total(run, nr));
                     float* f[8];
                     for (int a = 0; a < 8; ++a) f[a] = room(buf[a], mp + kSlack);
-                    std::size_t k = 0;
-                    for (int r = 0; r < nr; ++r) {
-                        const std::size_t j = run[r][0], len = run[r][1] - run[r][0];
-                        for (int a = 0; a < 6; ++a) copy_run(f[a] + k, soa[std::size_t(a)].data() + j, len);
-                        copy_run(f[6] + k, pterm.data() + j, len);
-                        copy_run(f[7] + k, density.data() + j, len);
-                        k += len;
-                    }
+                    const float* const from[8] = {soa[0].data(), soa[1].data(), soa[2].data(), soa[3].data(),
+                                                  soa[4].data(), soa[5].data(), pterm.data(),  density.data()};
+                    float* const to[8] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
+                    std::size_t k = gather8(from, to, run, nr);
                     for (; k < mp; ++k) {
                         f[0][k] = f[1][k] = f[2][k] = kFar;
                         f[3][k] = f[4][k] = f[5][k] = f[6][k] = 0.0f;
@@ -697,7 +792,7 @@ struct Simulation::Impl {
                     for (std::size_t i = cell_start[c]; i < cell_start[c + 1]; ++i) {
                         const float pi = pterm[i];
                         float sum[3];
-                        force_sum(cand, mp, pos[i].x, pos[i].y, pos[i].z, vel[i].x, vel[i].y, vel[i].z, pi, density[i],
+                        force_sum(cand, mp, soa[0][i], soa[1][i], soa[2][i], soa[3][i], soa[4][i], soa[5][i], pi, density[i],
                                   h2, inv_h, visc_eps, visc_k, sum);
                         // The ground pushes back with the particle's own pressure (mirrored): −(2 p/ρ²) ρ0 ∇Φ.
                         const float wall = 2.0f * pi * rho0;
@@ -733,14 +828,24 @@ struct Simulation::Impl {
                 const std::size_t lo = std::size_t(blk * kGrain), hi = std::min(n, lo + std::size_t(kGrain));
                 for (std::size_t i = lo; i < hi; ++i) {
                     exchange[i] = 0.0;
-                    if (!alive[i]) continue;
-                    double v[3] = {vel[i].x + double(acc[i].x) * ddt, vel[i].y + double(acc[i].y) * ddt,
-                                   vel[i].z + double(acc[i].z) * ddt};
-                    const double o[3] = {pos[i].x, pos[i].y, pos[i].z};
+                    const auto keep = [&] {  // pos and vel unchanged: as sorted
+                        pos[i] = Vec3{soa[0][i], soa[1][i], soa[2][i]};
+                        vel[i] = Vec3{soa[3][i], soa[4][i], soa[5][i]};
+                    };
+                    if (!alive[i]) {  // not after sort_by_cell (it drops the dead); kept for safety
+                        keep();
+                        continue;
+                    }
+                    // The sorted positions and velocities are in the component arrays (sort_by_cell); pos and
+                    // vel are written below, for every particle.
+                    double v[3] = {soa[3][i] + double(acc[i].x) * ddt, soa[4][i] + double(acc[i].y) * ddt,
+                                   soa[5][i] + double(acc[i].z) * ddt};
+                    const double o[3] = {soa[0][i], soa[1][i], soa[2][i]};
                     const double d[3] = {v[0] * ddt, v[1] * ddt, v[2] * ddt};
                     double p[3] = {o[0] + d[0], o[1] + d[1], o[2] + d[2]};
                     if (!std::isfinite(p[0] + p[1] + p[2] + v[0] + v[1] + v[2])) {
                         block_bad[std::size_t(blk)] = 1;  // reported by substep(); never index the terrain with it
+                        keep();
                         continue;
                     }
                     bool contact = false;
@@ -789,9 +894,10 @@ struct Simulation::Impl {
                     Vec3 np{float(p[0]), float(p[1]), float(p[2])};
                     p[0] = np.x;
                     p[2] = np.z;
-                    const double ys = surface(p[0], p[2]);
+                    tile(p[0], p[2], ui, uj, fx, fz);
+                    const double ys = surface_in(ui, uj, fx, fz);
                     // The normal only where it is used: within a radius of the ground or after a hit.
-                    if (contact || p[1] - ys < s.radius || p[1] < ys + 1e-4 * s.radius) normal(p[0], p[2], n3);
+                    if (contact || p[1] - ys < s.radius || p[1] < ys + 1e-4 * s.radius) normal_in(ui, uj, fx, fz, n3);
                     if (p[1] < ys + 1e-4 * s.radius) {
                         p[1] = ys;
                         const double vn = v[0] * n3[0] + v[1] * n3[1] + v[2] * n3[2];
@@ -1071,7 +1177,7 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.acc.resize(capacity);
     m.density.resize(capacity + kSlack);
     m.wall_push.resize(capacity);
-    m.pterm.resize(capacity + kSlack);  // copy_run's slack
+    m.pterm.resize(capacity + kSlack);  // kSlack: the candidate gathering's slack
     m.sediment.resize(capacity);
     m.exchange.resize(capacity);
     m.acidity.resize(capacity);
