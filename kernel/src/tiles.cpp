@@ -20,6 +20,19 @@ TileRect Tiling::grown(int halo) const {
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
+std::string Tiling::sweep_note(std::int64_t steps, double sweeping_s, double exchanging_s,
+                               double waited_before) const {
+    const TileRect own = owned();
+    std::ostringstream note;
+    note.precision(3);
+    note << "rank " << rank() << " of " << ranks() << ": tile " << own.width << "x" << own.height << " at (" << own.x0
+         << ", " << own.y0 << "), " << steps << " steps: sweeps " << sweeping_s << " s, halo exchange "
+         << exchanging_s << " s ("
+         << (sweeping_s + exchanging_s > 0 ? 100.0 * exchanging_s / (sweeping_s + exchanging_s) : 0.0)
+         << " %), of which waiting for the other ranks " << seconds_waiting() - waited_before << " s";
+    return note.str();
+}
+
 // ------------------------------------------------------------------ the split
 
 TileRect TileSplit::tile(int index) const {

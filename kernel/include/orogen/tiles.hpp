@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace orogen {
@@ -71,6 +72,11 @@ public:
     /// (its opening agreement), as opposed to moving the halo: under load or
     /// with uneven tiles, most of an exchange's time is this wait.
     virtual double seconds_waiting() const = 0;
+    /// The line a tiled sweeping eroder reports when it ends (NodeContext::info):
+    /// "rank R of N: tile WxH at (X, Y), STEPS steps: sweeps S s, halo exchange
+    /// E s (P %), of which waiting for the other ranks W s", W counted from
+    /// `waited_before` (seconds_waiting() when the node started).
+    std::string sweep_note(std::int64_t steps, double sweeping_s, double exchanging_s, double waited_before) const;
     /// Collective: the least and greatest of each rank's `lo`/`hi` (exact).
     virtual void min_max(float& lo, float& hi) = 0;
 

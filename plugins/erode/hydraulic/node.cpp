@@ -107,13 +107,7 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
     }
     exchange();  // the halo `flow` and `hardness` read
     const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
-    std::ostringstream note;
-    note.precision(3);
-    note << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height << " at ("
-         << own.x0 << ", " << own.y0 << "), " << iterations << " steps: sweeps " << sw << " s, halo exchange " << ex
-         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %), of which waiting for the other ranks "
-         << tiles.seconds_waiting() - waited_before << " s";
-    ctx.info(note.str());
+    ctx.info(tiles.sweep_note(iterations, sw, ex, waited_before));
     // The layers run() adds, from the final state (b's grids are free now: scratch for them).
     for (const char* l : {"flux_west", "flux_east", "flux_north", "flux_south"}) hm.remove_layer(l);
     hydraulic::outflow({a.height, a.water, a.sediment}, s, hard, b.height);

@@ -86,13 +86,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         }
     }
     const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
-    std::ostringstream note;
-    note.precision(3);
-    note << "rank " << tiles.rank() << " of " << tiles.ranks() << ": tile " << own.width << "x" << own.height << " at ("
-         << own.x0 << ", " << own.y0 << "), " << iterations << " steps: sweeps " << sw << " s, halo exchange " << ex
-         << " s (" << (sw + ex > 0 ? 100.0 * ex / (sw + ex) : 0.0) << " %), of which waiting for the other ranks "
-         << tiles.seconds_waiting() - waited_before << " s";
-    ctx.info(note.str());
+    ctx.info(tiles.sweep_note(iterations, sw, ex, waited_before));
     std::vector<float>().swap(held_layer);  // freed now (assigning {} would keep the capacity)
     // The owned part back into the tile; the tile's old heights are `before` for the layers.
     std::vector<float> after(hm->size());
