@@ -507,7 +507,7 @@ int main(int argc, char** argv) {
     if (argc < 2) return usage_error("no command given");
     Args args;
     args.command = argv[1];
-    if (args.command == "--help" || args.command == "-h" || args.command == "help" && argc == 2) {
+    if (args.command == "--help" || args.command == "-h" || (args.command == "help" && argc == 2)) {
         std::fputs(usage_text, stdout);
         return exit_ok;
     }

@@ -5,9 +5,14 @@
 #include <orogen/random.hpp>
 #include <orogen/values.hpp>
 
+#include "digest.hpp"
+
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <fstream>
 #include <sstream>
+#include <thread>
 #include <utility>
 
 #include "orogen_test.hpp"
@@ -94,6 +99,94 @@ TEST(AtomicFile, AMissingFolderIsAClearError) {
         EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "no-such-folder" / "x.png").string() + ": folder " +
                                              (dir / "no-such-folder").string() + " does not exist");
     }
+}
+
+namespace {
+std::string hash_of_bytes_on_disk(const std::filesystem::path& p) {
+    const std::vector<std::uint8_t> bytes = read_file(p);
+    return sha256_hex(bytes);
+}
+}  // namespace
+
+// The digest taken while writing is the file's: pieces of every size (into the 64 KiB block, straight
+// past it, single characters, tellp() between them) give the hash of the bytes on disk, and
+// sha256_file() answers it from memory, without reading the file.
+TEST(AtomicFile, TheDigestTakenWhileWritingIsTheFilesAndSparesTheReadBack) {
+    TempDir dir;
+    const auto target = dir / "mixed.bin";
+    std::string big(300000, '\0');
+    for (std::size_t i = 0; i < big.size(); ++i) big[i] = char((i * 2654435761u) >> 13);
+    {
+        AtomicFile f(target);
+        f.stream() << "header " << 42 << '\n';
+        EXPECT_EQ(f.stream().tellp(), std::streampos(10));
+        f.stream().write(big.data(), 1000);                     // into the block
+        f.stream().write(big.data(), std::streamsize(big.size()));  // straight through
+        for (int i = 0; i < 70000; ++i) f.stream().put(char(i));    // overflows the block one byte at a time
+        f.write({reinterpret_cast<const std::uint8_t*>(big.data()), 5});
+        f.commit();
+    }
+    const std::string on_disk = hash_of_bytes_on_disk(target);
+    EXPECT_EQ(detail::remembered_sha256(target), on_disk);
+    EXPECT_EQ(sha256_file(target), on_disk);
+    EXPECT_EQ(std::filesystem::file_size(target), 10u + 1000u + big.size() + 70000u + 5u);
+}
+
+// Whatever might make the digest wrong makes sha256_file() read the file instead: a seek that
+// overwrites bytes, the temporary written by name, and the file changed after the commit.
+TEST(AtomicFile, ASeekAWriteByNameOrALaterChangeMeansTheFileIsReadAgain) {
+    TempDir dir;
+    {
+        AtomicFile f(dir / "seek.bin");
+        f.stream() << "aaaaaaaa";
+        f.stream().seekp(2);
+        f.stream() << "BB";
+        f.stream().seekp(0, std::ios::end);
+        f.commit();
+    }
+    EXPECT_EQ(orogen::test::slurp(dir / "seek.bin"), "aaBBaaaa");
+    EXPECT_EQ(detail::remembered_sha256(dir / "seek.bin"), "");
+    EXPECT_EQ(sha256_file(dir / "seek.bin"), hash_of_bytes_on_disk(dir / "seek.bin"));
+    {
+        AtomicFile f(dir / "by-name.bin");
+        f.stream().close();  // as the VTK and GDAL exporters do
+        std::ofstream(f.temporary(), std::ios::binary) << "written by a library";
+        f.commit();
+    }
+    EXPECT_EQ(detail::remembered_sha256(dir / "by-name.bin"), "");
+    EXPECT_EQ(sha256_file(dir / "by-name.bin"), hash_of_bytes_on_disk(dir / "by-name.bin"));
+    {
+        AtomicFile f(dir / "later.bin");
+        f.stream() << "first version";
+        f.commit();
+    }
+    ASSERT_NE(detail::remembered_sha256(dir / "later.bin"), "");
+    // Rewritten in place with as many bytes: the inode and size stay, the times do not (past the file
+    // system's clock tick, a few ms on Linux: digest.hpp).
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    std::ofstream(dir / "later.bin", std::ios::binary | std::ios::in | std::ios::out) << "FIRST VERSION";
+    EXPECT_EQ(sha256_file(dir / "later.bin"), hash_of_bytes_on_disk(dir / "later.bin"));
+    EXPECT_EQ(detail::remembered_sha256(dir / "later.bin"), "");
+}
+
+// A moved AtomicFile keeps hashing what it writes; an abandoned one remembers nothing.
+TEST(AtomicFile, AMovedFileKeepsItsDigestAndAnAbandonedOneLeavesNone) {
+    TempDir dir;
+    {
+        AtomicFile a(dir / "moved.bin");
+        a.stream() << "before the move, ";
+        AtomicFile b(std::move(a));
+        b.stream() << "after the move";
+        b.commit();
+    }
+    EXPECT_EQ(orogen::test::slurp(dir / "moved.bin"), "before the move, after the move");
+    EXPECT_EQ(detail::remembered_sha256(dir / "moved.bin"), hash_of_bytes_on_disk(dir / "moved.bin"));
+    {
+        AtomicFile f(dir / "abandoned.bin");
+        f.stream() << std::string(100000, 'x');
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "abandoned.bin"));
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1);  // no temporary left
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -32,7 +33,12 @@ public:
     const std::filesystem::path& target() const { return target_; }
     /// The temporary file: hand it to a library that writes by file name.
     const std::filesystem::path& temporary() const { return temporary_; }
-    /// A stream on the temporary file (binary).
+    /// A stream on the temporary file (binary). What goes through it in order
+    /// is hashed (SHA-256) on the way, so the run's manifest need not read the
+    /// file again; a seek other than tellp() voids that (sha256_file() then
+    /// reads it), as does writing the temporary file by name. To hand the file
+    /// to a library that writes by name, close() the stream before anything is
+    /// written through it; after writing, leave closing to commit().
     std::ofstream& stream();
     void write(std::span<const std::uint8_t> bytes);
     /// Flush, fsync and rename over the target. Throws orogen::Error on failure
@@ -40,11 +46,17 @@ public:
     void commit();
     bool committed() const { return committed_; }
 
+    class Hashing;  ///< the stream's buffer: SHA-256 of what passes (io.cpp)
+
 private:
     friend void commit_all(std::span<AtomicFile*> files);
+    void install_hashing();
+    void flush_checked();  ///< flush, close and fsync the temporary file; throws orogen::Error
     std::filesystem::path target_;
     std::filesystem::path temporary_;
+    std::unique_ptr<Hashing> hashing_;  // before stream_: the stream, which points at it, goes first
     std::ofstream stream_;
+    std::string digest_;  ///< set while committing when every byte went through stream() in order
     bool committed_ = false;
 };
 
@@ -81,7 +93,9 @@ std::string heightmap_memory_problem(double width, double height, std::uint64_t 
 /// "3.6 TiB", "512 MiB".
 std::string human_bytes(double bytes);
 
-/// SHA-256 of a file as 64 lowercase hex digits (as `sha256sum` prints it).
+/// SHA-256 of a file as 64 lowercase hex digits (as `sha256sum` prints it). A file an AtomicFile
+/// committed after writing it only through stream() is not read again: its digest was taken while it
+/// was written, and stands while the file's inode, size and times are unchanged.
 std::string sha256_file(const std::filesystem::path& path);
 std::string sha256_hex(std::span<const std::uint8_t> bytes);
 
