@@ -129,18 +129,13 @@ std::string sha256_file(const std::filesystem::path& path) {
     if (std::string known = detail::remembered_sha256(path); !known.empty()) return known;
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error("cannot read " + path.string() + " to hash it");
-    std::unique_ptr<EVP_MD_CTX, void (*)(EVP_MD_CTX*)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-    if (!ctx || EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr) != 1)
-        throw Error("internal error: OpenSSL's SHA-256 is not available");
+    detail::Sha256 sha;
     std::vector<char> buffer(std::size_t(1) << 20);
     while (in) {
         in.read(buffer.data(), std::streamsize(buffer.size()));
-        EVP_DigestUpdate(ctx.get(), buffer.data(), std::size_t(in.gcount()));
+        sha.update(buffer.data(), std::size_t(in.gcount()));
     }
-    unsigned char d[EVP_MAX_MD_SIZE];
-    unsigned int n = 0;
-    EVP_DigestFinal_ex(ctx.get(), d, &n);
-    return to_hex(d, n);
+    return sha.hex();
 }
 
 }  // namespace orogen
