@@ -72,6 +72,18 @@ float density_sum(const float* __restrict cx, const float* __restrict cy, const 
     return lane_sum(acc);
 }
 
+/// Tait's equation of state, p = B((ρ/ρ0)⁷ − 1) clamped at 0 (Pa), stored as p/ρ² (m⁵/(kg·s²)) for the
+/// force pass, for `count` particles.
+OROGEN_SPH_CLONES
+void pressure_terms(const float* __restrict rho, float* __restrict pterm, std::size_t count, float rho0, float B) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const float ratio = rho[i] / rho0;
+        const float r2 = ratio * ratio;
+        const float p = std::max(0.0f, B * (r2 * r2 * r2 * ratio - 1.0f));
+        pterm[i] = p / (rho[i] * rho[i]);
+    }
+}
+
 /// The candidates' fields for the force pass (structure of arrays, kLanes-padded).
 struct ForceCandidates {
     const float *x, *y, *z, *vx, *vy, *vz, *pterm, *rho;
@@ -213,6 +225,11 @@ struct Simulation::Impl {
     // ping-pong), reused as the permutation's 16 bytes per particle of scratch.
     std::vector<std::uint64_t> sort_keys;
     std::vector<std::uint32_t> perm, perm_tmp;
+    std::vector<std::uint8_t> moved;  // per sorted entry: changed cell since the last sort (merge_movers)
+    std::int64_t merged_sorts = 0;    // sorts done by merge_movers
+    std::size_t keyed = 0;            // particles [0, keyed) have a cell from the last sort (in soa)
+    std::vector<std::uint32_t> radix_offset;                           // radix_sort's histograms
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> mover_list;  // merge_movers' movers
     std::vector<std::uint64_t> cell_key;
     std::vector<std::uint32_t> cell_start;
     std::size_t ncell = 0;
@@ -396,6 +413,104 @@ struct Simulation::Impl {
     /// Cell coordinate (in units of h) of a position in m, clamped so keys fit in 63 bits.
     float cell_of(float x) const { return std::clamp(std::floor(x * inv_h), -kCellLimit, kCellLimit); }
 
+    /// Stable LSD radix sort of (key, idx) by the low `bits` bits of key: each pass, per-block digit
+    /// histograms in parallel, their offsets in (digit, block) order, then each block scatters its own
+    /// keys in order. Blocks of fixed size: the same permutation on any thread count. The result is left
+    /// in key/idx (the pointers are swapped with the scratch t* as the passes go).
+    void radix_sort(std::uint64_t*& key, std::uint64_t*& tkey, std::uint32_t*& idx, std::uint32_t*& tidx,
+                    std::size_t m, int bits) {
+        constexpr int kDigit = 11;
+        constexpr std::size_t kDigits = std::size_t(1) << kDigit, kBlock = 16384;
+        const std::size_t nblocks = (m + kBlock - 1) / kBlock;
+        radix_offset.resize(nblocks * kDigits);
+        for (int shift = 0; shift < bits; shift += kDigit) {
+            parallel_for(0, std::int64_t(nblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
+                for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                    std::uint32_t* count = &radix_offset[b * kDigits];
+                    std::fill(count, count + kDigits, 0u);
+                    for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k)
+                        ++count[(key[k] >> shift) & (kDigits - 1)];
+                }
+            });
+            std::uint32_t run = 0;
+            for (std::size_t d = 0; d < kDigits; ++d)
+                for (std::size_t b = 0; b < nblocks; ++b) {
+                    const std::uint32_t c = radix_offset[b * kDigits + d];
+                    radix_offset[b * kDigits + d] = run;
+                    run += c;
+                }
+            parallel_for(0, std::int64_t(nblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
+                for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                    std::uint32_t* cursor = &radix_offset[b * kDigits];
+                    for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k) {
+                        const std::uint32_t dst = cursor[(key[k] >> shift) & (kDigits - 1)]++;
+                        tkey[dst] = key[k];
+                        tidx[dst] = idx[k];
+                    }
+                }
+            });
+            std::swap(key, tkey);
+            std::swap(idx, tidx);
+        }
+    }
+
+    /// The stable sort of (key, idx) by key when few particles changed cell (`moved`, `movers` of the m):
+    /// a stable sort orders by (key, idx), idx rising along the list, and the particles that kept their
+    /// cell are already in that order (the last sort's, less the dead). So they are taken out in order,
+    /// the movers sorted by (key, idx) on their own, and the two merged: the radix sort's permutation
+    /// exactly, at a few per cent of the particles' sorting work. Blocks of the kept list merge in
+    /// parallel, each with the movers between its first key and the next block's (a unique result).
+    /// `mv_first[b]`: the movers before block b of kBlock entries (mv_first[blocks] = all of them).
+    static constexpr std::size_t kMoverBlock = 16384;
+    void merge_movers(std::uint64_t* key, std::uint64_t* tkey, std::uint32_t* idx, std::uint32_t* tidx,
+                      std::size_t m, const std::vector<std::size_t>& mv_first) {
+        constexpr std::size_t kBlock = kMoverBlock;
+        const std::size_t blocks = (m + kBlock - 1) / kBlock;
+        const std::size_t movers = mv_first[blocks];
+        mover_list.resize(movers);
+        parallel_for(0, std::int64_t(blocks), 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                std::size_t mk = mv_first[b], sk = b * kBlock - mv_first[b];
+                for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k)
+                    if (moved[k]) {
+                        mover_list[mk++] = {key[k], idx[k]};
+                    } else {
+                        tkey[sk] = key[k];
+                        tidx[sk++] = idx[k];
+                    }
+            }
+        });
+        std::sort(mover_list.begin(), mover_list.end());
+        const std::size_t kept = m - movers;
+        const std::size_t sblocks = (kept + kBlock - 1) / kBlock;
+        const auto movers_before = [&](std::size_t s) -> std::size_t {  // movers ordered before kept entry s
+            if (s >= kept) return movers;
+            return std::size_t(std::lower_bound(mover_list.begin(), mover_list.end(), std::pair{tkey[s], tidx[s]}) -
+                               mover_list.begin());
+        };
+        parallel_for(0, std::int64_t(sblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                const std::size_t s0 = b * kBlock, s1 = std::min(kept, s0 + kBlock);
+                std::size_t a = b == 0 ? 0 : movers_before(s0);
+                const std::size_t a1 = movers_before(s1);
+                std::size_t out = s0 + a;
+                for (std::size_t s = s0; s < s1; ++s) {
+                    const std::pair here{tkey[s], tidx[s]};
+                    for (; a < a1 && mover_list[a] < here; ++a, ++out) {
+                        key[out] = mover_list[a].first;
+                        idx[out] = mover_list[a].second;
+                    }
+                    key[out] = here.first;
+                    idx[out++] = here.second;
+                }
+                for (; a < a1; ++a, ++out) {
+                    key[out] = mover_list[a].first;
+                    idx[out] = mover_list[a].second;
+                }
+            }
+        });
+    }
+
     /// Every sub-step: sort the live particles by cell (dead ones dropped) and
     /// list the occupied cells. A cell's key is linear in the particles'
     /// bounding box of cells, padded by one cell on every side, x fastest: the
@@ -426,7 +541,7 @@ struct Simulation::Impl {
             }
         });
         if (m == 0) {
-            n = live = ncell = 0;
+            n = live = ncell = keyed = 0;
             return;
         }
         const std::int64_t blocks = (std::int64_t(m) + 4095) / 4096;
@@ -461,55 +576,42 @@ struct Simulation::Impl {
         stride_z = nx * ny;
         std::uint64_t* key = sort_keys.data();
         std::uint64_t* tkey = sort_keys.data() + cap;
-        parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
-            for (std::int64_t k = b; k < e; ++k) {
-                const Vec3& p = pos[perm[std::size_t(k)]];
-                key[k] = std::uint64_t(int(cell_of(p.z)) - min_cz) * stride_z +
-                         std::uint64_t(int(cell_of(p.y)) - min_cy) * stride_y + std::uint64_t(int(cell_of(p.x)) - min_cx);
+        // The keys, and which particles changed cell since the last sort (`moved`; a particle spawned
+        // since has no cell yet). The component arrays still hold every particle's position at that sort,
+        // in its order (integrate() writes pos, never them), so the others keep their old order.
+        const auto key_blocks = std::int64_t((m + kListBlock - 1) / kListBlock);
+        first.assign(std::size_t(key_blocks) + 1, 0);
+        parallel_for(0, key_blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
+                std::size_t c = 0;
+                for (std::size_t k = b * kListBlock; k < std::min(m, (b + 1) * kListBlock); ++k) {
+                    const std::size_t i = perm[k];
+                    const Vec3& p = pos[i];
+                    const float cx = cell_of(p.x), cy = cell_of(p.y), cz = cell_of(p.z);
+                    key[k] = std::uint64_t(int(cz) - min_cz) * stride_z + std::uint64_t(int(cy) - min_cy) * stride_y +
+                             std::uint64_t(int(cx) - min_cx);
+                    const bool mv = i >= keyed || cx != cell_of(soa[0][i]) || cy != cell_of(soa[1][i]) ||
+                                    cz != cell_of(soa[2][i]);
+                    moved[k] = mv;
+                    c += mv;
+                }
+                first[b + 1] = c;
             }
         });
-        const std::uint64_t top = nx * ny * nz - 1;
-        const int bits = 64 - __builtin_clzll(top | 1u);
+        for (std::size_t b = 0; b < std::size_t(key_blocks); ++b) first[b + 1] += first[b];
+        const std::size_t movers = first[std::size_t(key_blocks)];
         std::uint32_t* idx = perm.data();
         std::uint32_t* tidx = perm_tmp.data();
-        // Each pass: per-block digit histograms in parallel, their offsets in (digit, block) order, then each
-        // block scatters its own keys in order. Blocks of fixed size: the same permutation on any thread count.
-        constexpr int kDigit = 11;
-        constexpr std::size_t kDigits = std::size_t(1) << kDigit, kBlock = 16384;
-        const std::size_t nblocks = (m + kBlock - 1) / kBlock;
-        std::vector<std::uint32_t> offset(nblocks * kDigits);
-        for (int shift = 0; shift < bits; shift += kDigit) {
-            std::fill(offset.begin(), offset.end(), 0u);
-            parallel_for(0, std::int64_t(nblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
-                for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
-                    std::uint32_t* count = &offset[b * kDigits];
-                    for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k)
-                        ++count[(key[k] >> shift) & (kDigits - 1)];
-                }
-            });
-            std::uint32_t run = 0;
-            for (std::size_t d = 0; d < kDigits; ++d)
-                for (std::size_t b = 0; b < nblocks; ++b) {
-                    const std::uint32_t c = offset[b * kDigits + d];
-                    offset[b * kDigits + d] = run;
-                    run += c;
-                }
-            parallel_for(0, std::int64_t(nblocks), 1, [&](std::int64_t b0, std::int64_t b1) {
-                for (auto b = std::size_t(b0); b < std::size_t(b1); ++b) {
-                    std::uint32_t* cursor = &offset[b * kDigits];
-                    for (std::size_t k = b * kBlock; k < std::min(m, (b + 1) * kBlock); ++k) {
-                        const std::uint32_t dst = cursor[(key[k] >> shift) & (kDigits - 1)]++;
-                        tkey[dst] = key[k];
-                        tidx[dst] = idx[k];
-                    }
-                }
-            });
-            std::swap(key, tkey);
-            std::swap(idx, tidx);
+        if (keyed == 0 || double(movers) > s.merge_movers_up_to * double(m)) {
+            const std::uint64_t top = nx * ny * nz - 1;
+            radix_sort(key, tkey, idx, tidx, m, 64 - __builtin_clzll(top | 1u));
+        } else {
+            static_assert(kListBlock == kMoverBlock);  // `first` counts the movers per block
+            merge_movers(key, tkey, idx, tidx, m, first);
+            ++merged_sorts;
         }
         // The occupied cells (where the sorted key changes), found per block of kListBlock keys in parallel
         // as the particle list above: the serial scan's table.
-        const auto key_blocks = std::int64_t((m + kListBlock - 1) / kListBlock);
         first.assign(std::size_t(key_blocks) + 1, 0);
         const auto starts_cell = [&](std::size_t k) { return k == 0 || key[k] != key[k - 1]; };
         parallel_for(0, key_blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
@@ -583,6 +685,7 @@ struct Simulation::Impl {
         });
         n = m;
         live = m;
+        keyed = m;
     }
 
     template <typename T>
@@ -747,14 +850,13 @@ struct Simulation::Impl {
                         add_wall(above * nrm[1], nrm[0], nrm[1], nrm[2], phi, push);  // the distance to the tangent plane
                     }
                     wall_push[i] = push;
-                    rho += rho0 * phi;
-                    density[i] = rho;
-                    const float ratio = rho / rho0;
-                    const float r2_ = ratio * ratio;
-                    const float p = std::max(0.0f, B * (r2_ * r2_ * r2_ * ratio - 1.0f));
-                    pterm[i] = p / (rho * rho);
+                    density[i] = rho + rho0 * phi;
                 }
             }
+            // The task's particles are contiguous (cells c0..c1): their pressures in one vector loop, off
+            // the per-particle path (its two divisions were a quarter of this pass, one particle at a time).
+            pressure_terms(density.data() + cell_start[std::size_t(c0)], pterm.data() + cell_start[std::size_t(c0)],
+                           cell_start[std::size_t(c1)] - cell_start[std::size_t(c0)], rho0, B);
         });
     }
 
@@ -1187,6 +1289,7 @@ Simulation::Simulation(ConstGridView terrain, const Settings& settings, std::siz
     m.sort_keys.resize(2 * capacity);
     m.perm.resize(capacity);
     m.perm_tmp.resize(capacity);
+    m.moved.resize(capacity);
     m.cell_key.resize(capacity);
     m.cell_start.resize(capacity + 1);
     for (auto& a : m.soa) a.resize(capacity + kSlack);
@@ -1197,8 +1300,10 @@ Simulation::~Simulation() = default;
 std::size_t Simulation::bytes_per_particle() {
     // pos, vel, acc, wall_push (48) + density, pterm, acidity, age, lifespan (20) + sediment, exchange (16)
     // + alive (1) + sort keys (16) + permutation (8) + cell keys and starts (12, at most one cell per particle)
-    // + component copies of position and velocity (24).
-    return 48 + 20 + 16 + 1 + 16 + 8 + 12 + 24;
+    // + component copies of position and velocity (24) + moved-since-last-sort flag (1).
+    // merge_movers' list (12 B per mover, at most merge_movers_up_to = 1/8 of the particles, so
+    // 1.5 B per particle) lives only during a sort and is counted with it: 147 in all.
+    return 48 + 20 + 16 + 1 + 16 + 8 + 12 + 24 + 1 + 1;
 }
 
 bool Simulation::add(Vec3 p, Vec3 v, float acidity, std::int32_t lifespan) {
@@ -1346,6 +1451,7 @@ std::size_t Simulation::size() const { return impl_->live; }
 std::size_t Simulation::capacity() const { return impl_->cap; }
 const Counts& Simulation::counts() const { return impl_->counts; }
 std::int64_t Simulation::substeps() const { return impl_->substeps; }
+std::int64_t Simulation::merged_sorts() const { return impl_->merged_sorts; }
 double Simulation::time() const { return impl_->t; }
 double Simulation::surface(double x, double z) const { return impl_->surface(x, z); }
 

@@ -89,6 +89,10 @@ struct Settings {
     /// Particles per chunk of the parallel terrain exchange (see settle() in sph.cpp); any value gives the
     /// same bits, a serial loop's included. Not a node parameter: for the tests that check exactly that.
     std::size_t settle_chunk = 16384;
+    /// The largest share of the particles that may have changed cell since the last sort for the sort to
+    /// merge them into the others' order (merge_movers in sph.cpp) instead of radix-sorting all; either
+    /// gives the same permutation. Not a node parameter: for the tests (0: always the radix sort).
+    double merge_movers_up_to = 0.125;
 };
 
 struct Vec3 {
@@ -146,6 +150,8 @@ public:
     std::size_t capacity() const;
     const Counts& counts() const;
     std::int64_t substeps() const;
+    /// Sorts by cell that merged the particles which changed cell into the others' order (the rest radix-sorted all).
+    std::int64_t merged_sorts() const;
     double time() const;
     /// The terrain's triangulated surface height at (x, z), m.
     double surface(double x, double z) const;

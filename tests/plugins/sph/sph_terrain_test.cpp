@@ -218,6 +218,48 @@ TEST(SphDeterminism, TheChunkedTerrainExchangeGivesTheSerialLoopsBits) {
     }
 }
 
+TEST(SphDeterminism, MergingTheParticlesThatChangedCellGivesTheRadixSortsBits) {
+    // The sort by cell merges the few particles that changed cell into the others' order (their order
+    // from the last sort) instead of radix-sorting all: both must give the same permutation, and with
+    // it every neighbour and summation order. Rain keeps adding particles (movers) and they flow.
+    const std::vector<float> h = make_diamond_square(4);
+    struct Run {
+        std::vector<float> terrain, positions, densities;
+        std::int64_t merged = 0, substeps = 0;
+    };
+    std::vector<Run> runs;
+    for (const double up_to : {0.0, 0.125, 1.0}) {
+        tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
+        sph::Settings s = erosion_settings();
+        s.merge_movers_up_to = up_to;
+        sph::Simulation sim(view(h), s, 20000);
+        for (int step = 1; step <= 40; ++step) {
+            sim.rain(100, 2.0, 5, step, 2.0f, 200);
+            sim.advance(0.05, step);
+            sim.end_step();
+        }
+        Run r;
+        r.terrain.resize(h.size());
+        sim.write_terrain(GridView{r.terrain.data(), kSize, kSize, 1.0});
+        for (const sph::Vec3& p : sim.positions()) r.positions.insert(r.positions.end(), {p.x, p.y, p.z});
+        r.densities.assign(sim.densities().begin(), sim.densities().end());
+        r.merged = sim.merged_sorts();
+        r.substeps = sim.substeps();
+        runs.push_back(std::move(r));
+    }
+    EXPECT_EQ(runs[0].merged, 0);
+    EXPECT_GT(2 * runs[1].merged, runs[1].substeps);  // most sub-steps: few particles change cell
+    EXPECT_GT(runs[2].merged, runs[1].merged);        // with no limit, more of them
+    ASSERT_GT(runs[0].positions.size(), 3u * 2000u);
+    for (std::size_t k = 1; k < runs.size(); ++k) {
+        SCOPED_TRACE(k == 1 ? "merge up to 1/8 moved" : "merge always");
+        ASSERT_EQ(runs[0].positions.size(), runs[k].positions.size());
+        EXPECT_EQ(0, std::memcmp(runs[0].positions.data(), runs[k].positions.data(), runs[0].positions.size() * 4));
+        EXPECT_EQ(0, std::memcmp(runs[0].densities.data(), runs[k].densities.data(), runs[0].densities.size() * 4));
+        EXPECT_EQ(0, std::memcmp(runs[0].terrain.data(), runs[k].terrain.data(), runs[0].terrain.size() * 4));
+    }
+}
+
 TEST(SphDitches, DifferentSeedsCutDifferentDitchesAndTheSameSeedTheSame) {
     // The thesis (§4.1): its SPH runs gave "totally different surface
     // transformations" each time; here that is the seed's doing, and repeatable.
