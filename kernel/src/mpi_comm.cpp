@@ -80,6 +80,10 @@ void max_all(float* values, int count) {
     check(MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
 }
 
+void allgather(const int* send, int count, int* recv) {
+    check(MPI_Allgather(send, count, MPI_INT, recv, count, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
+}
+
 void allgatherv(const double* send, int send_count, double* recv, const int* counts, const int* displs) {
     check(MPI_Allgatherv(send, send_count, MPI_DOUBLE, recv, counts, displs, MPI_DOUBLE, MPI_COMM_WORLD),
           "MPI_Allgatherv");
@@ -87,19 +91,25 @@ void allgatherv(const double* send, int send_count, double* recv, const int* cou
 
 void sendrecv(const void* send_data, std::size_t send_bytes, int to, void* recv_data, std::size_t recv_bytes, int from,
               int tag) {
-    const int dest = to < 0 ? MPI_PROC_NULL : to, source = from < 0 ? MPI_PROC_NULL : from;
-    if (to < 0) send_bytes = 0;
-    if (from < 0) recv_bytes = 0;
-    std::size_t done_s = 0, done_r = 0;
-    do {  // both sides cut their messages into the same pieces (the sizes match pairwise)
-        const std::size_t s = std::min(kPiece, send_bytes - done_s), r = std::min(kPiece, recv_bytes - done_r);
-        check(MPI_Sendrecv(static_cast<const char*>(send_data) + done_s, int(s), MPI_BYTE, dest, tag,
-                           static_cast<char*>(recv_data) + done_r, int(r), MPI_BYTE, source, tag, MPI_COMM_WORLD,
-                           MPI_STATUS_IGNORE),
-              "MPI_Sendrecv");
-        done_s += s;
-        done_r += r;
-    } while (done_s < send_bytes || done_r < recv_bytes);
+    // Non-blocking pieces, all posted, then waited for: the message to `to` and the one from `from` may
+    // differ in size (export:tiles' fetch), and MPI matches the pieces of one sender and tag in order.
+    std::vector<MPI_Request> requests;
+    auto post = [&](char* data, std::size_t bytes, int peer, bool sending) {
+        std::size_t done = 0;
+        do {  // one empty message for an empty one: the peer posts one empty receive
+            const std::size_t n = std::min(kPiece, bytes - done);
+            requests.emplace_back();
+            if (sending)
+                check(MPI_Isend(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()), "MPI_Isend");
+            else
+                check(MPI_Irecv(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()), "MPI_Irecv");
+            done += n;
+        } while (done < bytes);
+    };
+    if (from >= 0) post(static_cast<char*>(recv_data), recv_bytes, from, false);
+    if (to >= 0) post(const_cast<char*>(static_cast<const char*>(send_data)), send_bytes, to, true);
+    if (!requests.empty())
+        check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
 }
 
 void send(const void* data, std::size_t bytes, int to, int tag) {
@@ -151,6 +161,7 @@ void min_max_all(float&, float&) {}
 double sum_all(double value) { return value; }
 void barrier() {}
 void max_all(float*, int) {}
+void allgather(const int* send, int count, int* recv) { std::copy(send, send + count, recv); }
 void allgatherv(const double* send, int send_count, double* recv, const int*, const int* displs) {
     std::copy(send, send + send_count, recv + displs[0]);
 }

@@ -44,11 +44,14 @@ double sum_all(double value);
 void barrier();
 /// Element by element, the largest of every rank's `values[0..count)` (in place).
 void max_all(float* values, int count);
+/// Every rank's `send[0..count)` concatenated in rank order into `recv` (count × ranks values), on every rank.
+void allgather(const int* send, int count, int* recv);
 /// Every rank's `send[0..counts[rank])` concatenated in rank order into
 /// `recv` (at `displs[r]` for rank r), on every rank.
 void allgatherv(const double* send, int send_count, double* recv, const int* counts, const int* displs);
 /// Send `send` to rank `to` and receive `recv` from rank `from` at once; -1 for
-/// either means no such neighbour (nothing sent or received).
+/// either means no such neighbour (nothing sent or received). The two sizes
+/// may differ; `from` must send exactly `recv_bytes` with the same tag.
 void sendrecv(const void* send, std::size_t send_bytes, int to, void* recv, std::size_t recv_bytes, int from, int tag);
 void send(const void* data, std::size_t bytes, int to, int tag);
 void recv(void* data, std::size_t bytes, int from, int tag);

@@ -20,6 +20,15 @@ TileRect Tiling::grown(int halo) const {
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
+int Tiling::rank_at(int x, int y) const {
+    for (int r = 0; r < ranks(); ++r) {
+        const TileRect t = tile(r);
+        if (x >= t.x0 && x < t.x1() && y >= t.y0 && y < t.y1()) return r;
+    }
+    throw Error("internal error: vertex (" + std::to_string(x) + ", " + std::to_string(y) + ") lies outside the " +
+                std::to_string(grid_width()) + "x" + std::to_string(grid_height()) + " grid");
+}
+
 std::string Tiling::sweep_note(std::int64_t steps, double sweeping_s, double exchanging_s,
                                double waited_before) const {
     const TileRect own = owned();
@@ -153,7 +162,8 @@ int TiledRun::agree(int exit_code, int* reporter) {
 
 namespace {
 
-constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagCarry = 15, kTagTile = 20;
+constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagCarry = 15, kTagTile = 20,
+              kTagFetch = 21;
 
 /// Copy the rectangle (x, y, w, h) of `grid` (row length `stride`) into `out`, or back with `to_grid`.
 void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, bool to_grid) {
@@ -263,6 +273,57 @@ std::vector<double> TiledRun::gather_rows(std::span<const double> mine, int per_
                     std::to_string(n));
     mpi::allgatherv(mine.data(), n, all.data(), counts.data(), displs.data());
     return all;
+}
+
+std::vector<float> TiledRun::fetch(const float* mine, TileRect want) {
+    agree_or_throw();
+    if (want.width < 0 || want.height < 0 || (want.width > 0 && want.height > 0 &&
+                                              (want.x0 < 0 || want.y0 < 0 || want.x1() > grid_width() ||
+                                               want.y1() > grid_height())))
+        throw Error("internal error: fetch of a " + std::to_string(want.width) + "x" + std::to_string(want.height) +
+                    " rectangle at (" + std::to_string(want.x0) + ", " + std::to_string(want.y0) +
+                    ") outside the grid");
+    if (want.width == 0 || want.height == 0) want = {};
+    // Every rank learns every rank's rectangle, so each knows what to send whom without asking.
+    const int n = ranks();
+    std::vector<int> wants(std::size_t(4 * n));
+    const int own_want[4] = {want.x0, want.y0, want.width, want.height};
+    mpi::allgather(own_want, 4, wants.data());
+    auto want_of = [&](int r) {
+        const int* w = &wants[std::size_t(4 * r)];
+        return TileRect{w[0], w[1], w[2], w[3]};
+    };
+    auto overlap = [](TileRect a, TileRect b) {
+        const int x0 = std::max(a.x0, b.x0), y0 = std::max(a.y0, b.y0);
+        const int x1 = std::min(a.x1(), b.x1()), y1 = std::min(a.y1(), b.y1());
+        return x1 > x0 && y1 > y0 ? TileRect{x0, y0, x1 - x0, y1 - y0} : TileRect{};
+    };
+    const TileRect o = owned();
+    std::vector<float> out(std::size_t(want.width) * std::size_t(want.height)), give_buffer, take_buffer;
+    // Round s: send to rank + s what it wants of this tile, receive from rank − s what it holds of `want`.
+    // Both ends of a pair compute the same rectangle, so an empty one is skipped on both.
+    for (int s = 0; s < n; ++s) {
+        const int to = (rank_ + s) % n, from = (rank_ - s + n) % n;
+        const TileRect give = overlap(o, want_of(to)), take = overlap(tile(from), want);
+        give_buffer.resize(std::size_t(give.width) * std::size_t(give.height));
+        copy_rect(const_cast<float*>(mine), o.width, give.x0 - o.x0, give.y0 - o.y0, give.width, give.height,
+                  give_buffer.data(), false);
+        if (s == 0) {
+            take_buffer.swap(give_buffer);  // this rank's own part of its own rectangle
+        } else {
+            take_buffer.resize(std::size_t(take.width) * std::size_t(take.height));
+            mpi::sendrecv(give_buffer.data(), give_buffer.size() * sizeof(float), give.width ? to : -1,
+                          take_buffer.data(), take_buffer.size() * sizeof(float), take.width ? from : -1, kTagFetch);
+        }
+        copy_rect(out.data(), want.width, take.x0 - want.x0, take.y0 - want.y0, take.width, take.height,
+                  take_buffer.data(), true);
+    }
+    return out;
+}
+
+double TiledRun::sum_all(double value) {
+    agree_or_throw();
+    return mpi::sum_all(value);
 }
 
 void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }

@@ -70,6 +70,8 @@ public:
     void carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) override;
     std::vector<double> gather_rows(std::span<const double> mine, int per_row) override;
     double seconds_waiting() const override { return waiting_; }
+    std::vector<float> fetch(const float* mine, TileRect want) override;
+    double sum_all(double value) override;
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
     static bool runs_tiled(const PlannedNode& node);

@@ -332,6 +332,51 @@ TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
     EXPECT_FALSE(fs::exists(dir / "o" / "manifest.json"));
 }
 
+/// Engine tiles (export:tiles), each written by the rank holding its middle sample: 16-bit PNG and
+/// float RAW with their VRTs, in tiles that straddle the ranks' tiles (17 samples every 16 columns and rows,
+/// against cuts at columns 24, 48, 72 or 48 and rows 20, 40 or 30), and 16-bit RAW tiles of 65 samples, which
+/// have their middles at columns 32 and 80 only and so leave some ranks none to write (an empty fetch).
+const char* kEngineTilesSpec = R"(orogen 1
+seed 9
+grid 97x61 cell=2
+
+f = generate:fault(iterations=300, displacement=0.5)
+t = erode:thermal(f, talus=20, iterations=9, hardness=height)
+export:tiles(t, path="png/t.json", tile_size=17)
+export:tiles(t, path="r32/t.json", tile_size=17, format=r32)
+export:tiles(t, path="big/t.json", tile_size=65, format=r16, low=-5, high=4)
+)";
+
+class EngineTilesSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(EngineTilesSeam, EveryRanksEngineTilesEqualOneProcesss) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", kEngineTilesSpec);
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q");
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    const RunResult many = run_mpi(GetParam().ranks, "run " + q(spec) + " --out " + q(dir / "many") +
+                                                         (GetParam().tiles.empty() ? "" : " --tiles " + GetParam().tiles));
+    ASSERT_EQ(many.exit_code, 0) << many.err;
+    // Every file one process wrote, the same bytes, and no other: png/ 6 × 4 tiles, r32/ 6 × 4 tiles and a
+    // VRT each, big/ 2 × 1 tiles and a VRT each, and in each folder the index and the mosaic VRT.
+    std::vector<std::string> a, b;
+    for (const auto& e : fs::recursive_directory_iterator(dir / "one"))
+        if (e.is_regular_file() && e.path().filename() != "manifest.json") a.push_back(fs::relative(e.path(), dir / "one").string());
+    for (const auto& e : fs::recursive_directory_iterator(dir / "many"))
+        if (e.is_regular_file() && e.path().filename() != "manifest.json") b.push_back(fs::relative(e.path(), dir / "many").string());
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    EXPECT_EQ(a.size(), (24u + 2u) + (48u + 2u) + (4u + 2u));
+    ASSERT_EQ(a, b);
+    for (const auto& f : a)
+        EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / "many" / f)) << f << " differs on " << GetParam().ranks << " ranks";
+    // The manifest of the tiled run lists every file, hashed.
+    const std::string manifest = slurp(dir / "many" / "manifest.json");
+    for (const auto& f : b) EXPECT_NE(manifest.find("\"" + f + "\""), std::string::npos) << f;
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, EngineTilesSeam,
+                         ::testing::Values(Case{2, ""}, Case{3, "3x1"}, Case{4, "1x4"}, Case{4, "2x2"}), kCaseName);
+
+
 /// Every point array of `image` by name, as floats.
 std::map<std::string, std::vector<float>> arrays_of(vtkImageData* image) {
     std::map<std::string, std::vector<float>> out;

@@ -115,6 +115,23 @@ public:
     virtual std::vector<double> gather_rows(std::span<const double> mine, int per_row) = 0;
     /// Whether this tile is the eastmost of its row of tiles (the one whose `mine` gather_rows() takes).
     bool eastmost() const { return owned().x1() == grid_width(); }
+
+    // For nodes whose pieces of work do not follow the tiles (export:tiles'
+    // engine tiles straddle them): any rectangle of the grid, from whichever
+    // ranks hold it.
+
+    /// The rank whose tile holds vertex (x, y) of the whole grid.
+    int rank_at(int x, int y) const;
+    /// Collective: every rank asks for one rectangle `want` inside the whole
+    /// grid (width or height 0: nothing) and gets its values, row-major, taken
+    /// from the tiles that hold them. `mine`: this rank's tile, owned().width ×
+    /// owned().height values, row-major. Opens with the failure agreement
+    /// (throws PeerFailed).
+    virtual std::vector<float> fetch(const float* mine, TileRect want) = 0;
+    /// Collective: the sum of every rank's `value`, added in rank order on
+    /// every rank (the same bits everywhere; exact for integers below 2^53).
+    /// Opens with the failure agreement.
+    virtual double sum_all(double value) = 0;
 };
 
 }  // namespace orogen

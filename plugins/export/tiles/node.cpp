@@ -5,6 +5,7 @@
 #include <orogen/io.hpp>
 #include <orogen/parallel.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/tiles.hpp>
 
 #include <cstring>
 #include <filesystem>
@@ -28,7 +29,11 @@ void check(CheckContext& ctx) {
 
 NodeOutputs run(NodeContext& ctx) {
     const Heightmap& hm = *ctx.input(0).heightmap();
-    const ConstGridView grid = hm.view();
+    // In a tiled (MPI) run the heightmap is this rank's tile of the grid; each rank writes the engine tiles
+    // whose middle lies in its tile, rank 0 the index and the VRTs (the same files, bytes and names
+    // as one process writes).
+    Tiling* tiling = ctx.tiling();
+    const int rank = tiling ? tiling->rank() : 0;
     const Format format = format_named(ctx.text("format"));
     const int tile_size = int(ctx.integer("tile_size"));
     const std::filesystem::path index_path = ctx.text("path");
@@ -37,36 +42,64 @@ NodeOutputs run(NodeContext& ctx) {
 
     Index index;
     index.format = format;
-    index.width = hm.width();
-    index.height = hm.height();
+    index.width = tiling ? tiling->grid_width() : hm.width();
+    index.height = tiling ? tiling->grid_height() : hm.height();
     index.tile_size = tile_size;
     index.cell = hm.cell();
-    index.range = ctx.real("low") != 0.0 || ctx.real("high") != 0.0 ? raw::Range{ctx.real("low"), ctx.real("high")}
-                                                                      : raw::min_max(grid);
-    index.tiles = layout(hm.width(), hm.height(), tile_size, stem, format);
+    if (ctx.real("low") != 0.0 || ctx.real("high") != 0.0) {
+        index.range = raw::Range{ctx.real("low"), ctx.real("high")};
+    } else {
+        index.range = raw::min_max(hm.view());
+        if (tiling) {  // the whole grid's (float minima and maxima are exact in any order)
+            float lo = float(index.range.low), hi = float(index.range.high);
+            tiling->min_max(lo, hi);
+            index.range = {double(lo), double(hi)};
+        }
+    }
+    index.tiles = layout(index.width, index.height, tile_size, stem, format);
     const Tile& last = index.tiles.back();
     if (last.width != tile_size || last.height != tile_size)
         ctx.warn("the last tiles are " + std::to_string(last.width) + " × " + std::to_string(last.height) +
                  " samples where the others are " + std::to_string(tile_size) + "; for equal tiles use a grid of k·" +
                  std::to_string(tile_size - 1) + " + 1 samples a side");
 
+    // This rank's engine tiles (those whose middle sample lies in its tile: the ranks get about equal shares
+    // even when the engine tiles are nearly as large as theirs), and the samples they cover (`box`, fetched
+    // from the ranks that hold them).
+    std::vector<Tile> mine;
+    for (const Tile& t : index.tiles)
+        if (!tiling || tiling->rank_at(t.x0 + (t.width - 1) / 2, t.y0 + (t.height - 1) / 2) == rank) mine.push_back(t);
+    TileRect box{};
+    if (!mine.empty()) {
+        int x0 = index.width, y0 = index.height, x1 = 0, y1 = 0;
+        for (const Tile& t : mine) {
+            x0 = std::min(x0, t.x0), y0 = std::min(y0, t.y0);
+            x1 = std::max(x1, t.x0 + t.width), y1 = std::max(y1, t.y0 + t.height);
+        }
+        box = {x0, y0, x1 - x0, y1 - y0};
+    }
+    std::vector<float> fetched;
+    if (tiling) fetched = tiling->fetch(hm.heights().data(), box);
+    const ConstGridView grid = tiling ? ConstGridView{fetched.data(), box.width, box.height, hm.cell()} : hm.view();
+    for (Tile& t : mine) t.x0 -= box.x0, t.y0 -= box.y0;  // now within `grid` (box is the whole grid for one process)
+
     // Where each file goes (the kernel's bookkeeping, on this thread), then the tiles encoded and written in
     // parallel: each tile's bytes depend on its samples only, so the files are the same on any thread count.
     std::vector<std::filesystem::path> targets;
-    for (const Tile& t : index.tiles) targets.push_back(ctx.output_path((folder / t.file).string()));
+    for (const Tile& t : mine) targets.push_back(ctx.output_path((folder / t.file).string()));
     const bool vrt = ctx.flag("vrt");
-    std::vector<std::filesystem::path> raw_vrts;
-    if (vrt && format != Format::png16)
+    std::vector<std::filesystem::path> raw_vrts;  // rank 0 writes them all (text, a few hundred bytes each)
+    if (vrt && format != Format::png16 && rank == 0)
         for (const Tile& t : index.tiles) raw_vrts.push_back(ctx.output_path((folder / (t.file + ".vrt")).string()));
     const int level = int(ctx.integer("compression"));
-    std::vector<std::size_t> clamped(index.tiles.size(), 0);
+    std::vector<std::size_t> clamped(mine.size(), 0);
     std::size_t done = 0;
-    for (std::size_t first = 0; first < index.tiles.size(); first += 8) {  // in groups, for progress and Ctrl-C
+    for (std::size_t first = 0; first < mine.size(); first += 8) {  // in groups, for progress and Ctrl-C
         ctx.check_cancelled();
-        const std::size_t end = std::min(first + 8, index.tiles.size());
+        const std::size_t end = std::min(first + 8, mine.size());
         parallel_for(std::int64_t(first), std::int64_t(end), 1, [&](std::int64_t i0, std::int64_t i1) {
             for (std::int64_t i = i0; i < i1; ++i) {
-                const Tile& t = index.tiles[std::size_t(i)];
+                const Tile& t = mine[std::size_t(i)];
                 const std::vector<float> samples = cut(grid, t);
                 const ConstGridView view{samples.data(), t.width, t.height, hm.cell()};
                 AtomicFile file(targets[std::size_t(i)]);
@@ -91,10 +124,11 @@ NodeOutputs run(NodeContext& ctx) {
             }
         });
         done = end;
-        ctx.progress(double(done) / double(index.tiles.size()));
+        ctx.progress(double(done) / double(mine.size()));
     }
     std::size_t outside = 0;
     for (std::size_t c : clamped) outside += c;
+    if (tiling) outside = std::size_t(tiling->sum_all(double(outside)));
     if (outside > 0)
         ctx.warn(std::to_string(outside) + " samples lie outside low..high and were clamped to its ends");
 
@@ -102,6 +136,7 @@ NodeOutputs run(NodeContext& ctx) {
         const std::string text = raw_tile_vrt(index, index.tiles[i]);
         write_file_atomically(raw_vrts[i], {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
     }
+    if (rank != 0) return {};
     if (vrt) {
         const std::string text = mosaic_vrt(index);
         write_file_atomically(ctx.output_path((folder / (stem + ".vrt")).string()),
@@ -146,6 +181,7 @@ OROGEN_PLUGIN("export-tiles", "0.1.0", registry) {
                 Param::boolean("vrt", true).help("also write <stem>.vrt, the tiles as one GDAL raster"),
                 Param::integer("compression", 6).min(0).max(12).help("png16: deflate level (libdeflate), 0 to 12"),
             },
+        .tile_halo = 0,  // tiled: each rank writes the engine tiles whose middle is in its tile
         .check = check,
         .run = run,
     });
