@@ -326,6 +326,11 @@ double TiledRun::sum_all(double value) {
     return mpi::sum_all(value);
 }
 
+void TiledRun::share_from_rank0(std::string& bytes) {
+    agree_or_throw();
+    mpi::broadcast(bytes);
+}
+
 void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
 
 void TiledRun::min_max(float& lo, float& hi) {
@@ -433,7 +438,9 @@ void TiledRun::produced(const PlannedNode& node) {
     if (node.value_name.empty()) return;
     const Place p = runs_tiled(node) ? Place::tiles : Place::rank0;
     places_[node.value_name] = p;
-    for (const auto& side : node.node->side_outputs) places_[node.value_name + "." + side.name] = p;
+    for (const auto& side : node.node->side_outputs)
+        places_[node.value_name + "." + side.name] =
+            side.type == ValueType::heightmap && !side.series ? p : Place::rank0;
 }
 
 }  // namespace orogen

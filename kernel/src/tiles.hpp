@@ -72,6 +72,7 @@ public:
     double seconds_waiting() const override { return waiting_; }
     std::vector<float> fetch(const float* mine, TileRect want) override;
     double sum_all(double value) override;
+    void share_from_rank0(std::string& bytes) override;
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
     static bool runs_tiled(const PlannedNode& node);
@@ -80,7 +81,8 @@ public:
     /// values on rank 0 for the others (tiles are gathered there). Returns
     /// whether this rank runs the node.
     bool prepare_inputs(const PlannedNode& node, std::vector<Value>& inputs);
-    /// Record where `node`'s outputs live (tiles, or rank 0 only).
+    /// Record where `node`'s outputs live (tiles, or rank 0 only). A tiled node's side values that are not
+    /// heightmaps (tectonics:plates' history) are whole values, held on rank 0.
     void produced(const PlannedNode& node);
     /// Collective: every rank's exit code so far (0 ok); returns the worst, and in `reporter` the lowest rank
     /// that failed (the one whose message is printed).

@@ -332,6 +332,34 @@ TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
     EXPECT_FALSE(fs::exists(dir / "o" / "manifest.json"));
 }
 
+/// The plates, twice (peaks with subduction and rifts, then the thesis's Voronoi cells): rank 0 runs Box2D,
+/// every rank draws the outcome into its tile; the heights, the uplift, boundary and plate layers and the
+/// plates' history (a whole value, from rank 0) are the single process's, and a tiled eroder follows.
+const char* kPlatesSpec = R"(orogen 1
+seed 21
+grid 97x61 cell=50
+
+c = generate:fault(iterations=100, displacement=0.5)
+p = tectonics:plates(c, plates=8, steps=400, oceanic_fraction=0.5, rift_threshold=2000, cones=40)
+q = tectonics:plates(p, plates=6, steps=200, ranges=cells, cones=30, drive=thesis)
+t = erode:thermal(q, talus=30, iterations=6)
+export:raw(q, path="q.r32")
+export:vtk(q, path="q.vti")
+export:raw(t, path="t.r32")
+export:vtk-plates(p.plates, path="plates/p.pvd")
+)";
+
+class PlatesSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(PlatesSeam, PlatesEqualOneProcess) {
+    expect_same_outputs(kPlatesSpec,
+                        {"q.r32", "q.vti", "t.r32", "plates/p.pvd", "plates/p_plates_000040.vtp",
+                         "plates/p_collisions_000040.vtp"},
+                        GetParam());
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, PlatesSeam,
+                         ::testing::Values(Case{1, ""}, Case{2, ""}, Case{3, "3x1"}, Case{3, "1x3"}, Case{4, "2x2"}),
+                         kCaseName);
+
 /// Engine tiles (export:tiles), each written by the rank holding its middle sample: 16-bit PNG and
 /// float RAW with their VRTs, in tiles that straddle the ranks' tiles (17 samples every 16 columns and rows,
 /// against cuts at columns 24, 48, 72 or 48 and rows 20, 40 or 30), and 16-bit RAW tiles of 65 samples, which

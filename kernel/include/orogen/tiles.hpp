@@ -132,6 +132,14 @@ public:
     /// every rank (the same bits everywhere; exact for integers below 2^53).
     /// Opens with the failure agreement.
     virtual double sum_all(double value) = 0;
+
+    // For nodes that compute something once for the whole grid and draw it
+    // into every tile (tectonics:plates runs Box2D on rank 0).
+
+    /// Collective: rank 0's `bytes` on every rank (others' are replaced).
+    /// Opens with the failure agreement, so rank 0 failing before the call
+    /// ends the others with PeerFailed rather than a hang.
+    virtual void share_from_rank0(std::string& bytes) = 0;
 };
 
 }  // namespace orogen

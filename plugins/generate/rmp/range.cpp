@@ -114,30 +114,42 @@ std::vector<int> crossed_cells(const SiteIndex& index, Point2 a, Point2 b, std::
 
 int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
                 GridView* uplift) {
+    return raise_range(terrain, terrain.width, terrain.height, 0, 0, a, b, params, seed, uplift);
+}
+
+int raise_range(GridView terrain, int width, int height, int wx0, int wy0, Point2 a, Point2 b,
+                const RangeParams& params, std::uint64_t seed, GridView* uplift) {
     if (params.cones < 1) throw BadInput("range: cones must be at least 1 (got " + std::to_string(params.cones) + ")");
-    if (terrain.width < 1 || terrain.height < 1 || !terrain.data) throw BadInput("range: the terrain grid is empty");
+    if (width < 1 || height < 1 || !terrain.data) throw BadInput("range: the terrain grid is empty");
+    if (wx0 < 0 || wy0 < 0 || wx0 + terrain.width > width || wy0 + terrain.height > height)
+        throw BadInput("range: the window must lie inside the grid");
     if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(b.x) || !std::isfinite(b.y))
         throw BadInput("range: the end points must be finite numbers");
     if (uplift && (uplift->width != terrain.width || uplift->height != terrain.height))
         throw BadInput("range: the uplift grid must have the terrain's size");
-    const double ex = terrain.width - 1, ey = terrain.height - 1;
+    const double ex = width - 1, ey = height - 1;
     a = {std::clamp(a.x, 0.0, ex), std::clamp(a.y, 0.0, ey)};
     b = {std::clamp(b.x, 0.0, ex), std::clamp(b.y, 0.0, ey)};
 
-    const std::vector<Point2> sites = random_sites(params.cones, terrain.width, terrain.height, seed);
-    const SiteIndex index(sites, terrain.width, terrain.height);
+    // The diagram and the crossed cells of the whole grid (O(cones + cells crossed)), then only the
+    // window's part of each cell's spans.
+    const std::vector<Point2> sites = random_sites(params.cones, width, height, seed);
+    const SiteIndex index(sites, width, height);
     std::vector<CellPolygon> polygons;
     const std::vector<int> cells = crossed_cells(index, a, b, &polygons);
     std::vector<SiteIndex::Span> spans;
+    const int wx1 = wx0 + terrain.width, wy1 = wy0 + terrain.height;
     for (std::size_t k = 0; k < cells.size(); ++k) {
         const float amount = float(cell_amount(params.height, params.jitter, seed, cells[k]));
         index.spans_of(cells[k], polygons[k], spans);
         for (const auto& sp : spans) {
-            float* row = terrain.row(sp.y);
-            for (int x = sp.x0; x <= sp.x1; ++x) row[x] += amount;
+            if (sp.y < wy0 || sp.y >= wy1) continue;
+            const int x0 = std::max(sp.x0, wx0), x1 = std::min(sp.x1, wx1 - 1);
+            float* row = terrain.row(sp.y - wy0);
+            for (int x = x0; x <= x1; ++x) row[x - wx0] += amount;
             if (uplift) {
-                float* urow = uplift->row(sp.y);
-                for (int x = sp.x0; x <= sp.x1; ++x) urow[x] += amount;
+                float* urow = uplift->row(sp.y - wy0);
+                for (int x = x0; x <= x1; ++x) urow[x - wx0] += amount;
             }
         }
     }

@@ -31,4 +31,10 @@ struct RangeParams {
 int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
                 GridView* uplift = nullptr);
 
+/// The same range of a width × height grid, added only to the samples of `window` (global sample
+/// coordinates; `terrain` and `uplift` hold exactly them): a rank's tile in a tiled run gets the bits the
+/// whole grid gets there. Returns the number of cells raised (over the whole grid).
+int raise_range(GridView terrain, int width, int height, int x0, int y0, Point2 a, Point2 b,
+                const RangeParams& params, std::uint64_t seed, GridView* uplift = nullptr);
+
 }  // namespace orogen::rmp

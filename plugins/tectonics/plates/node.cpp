@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
+#include <orogen/tiles.hpp>
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
@@ -37,29 +38,44 @@ plates::Params params_from(NodeContext& ctx) {
 
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
+    // In a tiled (MPI) run `hm` is this rank's tile: rank 0 runs the simulation for the whole grid (Box2D is
+    // serial and touches no grid), every rank draws its outcome into its own tile (plates::draw_tile).
+    Tiling* tiling = ctx.tiling();
+    const int width = tiling ? tiling->grid_width() : hm->width();
+    const int height = tiling ? tiling->grid_height() : hm->height();
     const plates::Params params = params_from(ctx);
     plates::Params bounded = params;
-    bounded.max_plates = plates::max_plates(hm->width(), hm->height());
+    bounded.max_plates = plates::max_plates(width, height);
 
-    const auto start = plates::random_plates(plates::area_size(hm->width(), hm->height()),
-                                             int(ctx.integer("plates")), ctx.real("oceanic_fraction"),
-                                             params.speed, ctx.seed());
+    const auto start = plates::random_plates(plates::area_size(width, height), int(ctx.integer("plates")),
+                                             ctx.real("oceanic_fraction"), params.speed, ctx.seed());
     plates::Layers layers;
     layers.uplift = hm->layer("uplift", 0.0f);  // added to an earlier tectonics node's uplift
     layers.boundary = hm->layer("boundary", 0.0f);
     layers.plate = hm->layer("plate", -1.0f);
     layers.terrain = hm->view();
 
-    Timelapse lapse(ctx.integer("timelapse_every"), params.dt);  // time in simulated seconds
-    lapse.record(0, *hm);
-    auto result = plates::simulate(
-        start, bounded, ctx.seed(), layers,
-        [&](std::int64_t step) {
-            ctx.check_cancelled();
-            if (step % 32 == 0) ctx.progress(double(step) / double(params.steps));
-        },
-        ctx.integer("timelapse_every"), [&](std::int64_t step, ConstGridView terrain) { lapse.record(step, terrain); });
-    lapse.finish(params.steps, *hm);
+    const auto on_step = [&](std::int64_t step) {
+        ctx.check_cancelled();
+        if (step % 32 == 0) ctx.progress(double(step) / double(params.steps));
+    };
+    plates::Result result;
+    Timelapse lapse(ctx.integer("timelapse_every"), params.dt);  // time in simulated seconds (refused tiled)
+    if (tiling) {
+        std::string replay;
+        if (tiling->rank() == 0) {
+            result = plates::simulate_events(start, bounded, ctx.seed(), width, height, hm->cell(), on_step);
+            replay = plates::encode(result.replay);
+        }
+        tiling->share_from_rank0(replay);
+        if (tiling->rank() != 0) result.replay = plates::decode_replay(replay);
+        plates::draw_tile(result.replay, bounded, ctx.seed(), layers, tiling->owned());
+    } else {
+        lapse.record(0, *hm);
+        result = plates::simulate(start, bounded, ctx.seed(), layers, on_step, ctx.integer("timelapse_every"),
+                                  [&](std::int64_t step, ConstGridView terrain) { lapse.record(step, terrain); });
+        lapse.finish(params.steps, *hm);
+    }
     ctx.check_finite(hm->heights(), "height", params.steps);
     const auto& s = result.stats;
     ctx.info(std::to_string(s.events[1]) + " convergent (" + std::to_string(s.subductions) + " subducting), " +
@@ -172,6 +188,7 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"uplift", "boundary", "plate"},
+        .tile_halo = 0,  // tiled: Box2D on rank 0, its outcome drawn by every rank into its tile
         .check = check,
         .run = run,
     });

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <cstring>
 #include <numbers>
 #include <string>
 
@@ -113,6 +114,37 @@ Polygon world_polygon(const b2Body* body) {
     return poly;
 }
 
+/// Every relief width scales with the Voronoi cell size (profiles.hpp).
+ReliefShape relief_shape(const Params& params, int w, int h) {
+    ReliefShape shape;
+    shape.cell = std::sqrt(double(w) * double(h) / double(std::max(1, params.cones)));
+    shape.range_height = params.height;
+    shape.jitter = params.jitter;
+    shape.trench_depth = params.trench_depth;
+    shape.arc_height = params.arc_height;
+    shape.rift_depth = params.rift_depth;
+    shape.ridge_height = params.ridge_height;
+    shape.saturation = params.saturation;
+    return shape;
+}
+
+/// One stamp: into the relief's activity fields, or (cells) straight onto the terrain that holds `at` of the
+/// relief's grid (the whole grid in one process, a tile in a tiled run).
+void draw_stamp(const ReliefStamp& stamp, const Params& params, BoundaryRelief& relief, GridView terrain,
+                GridView* uplift, TileRect at) {
+    switch (stamp.kind) {
+    case ReliefStamp::Kind::range: relief.add_range(stamp.a, stamp.b); break;
+    case ReliefStamp::Kind::subduction: relief.add_subduction(stamp.a, stamp.b, stamp.toward_light); break;
+    case ReliefStamp::Kind::rift: relief.add_rift(stamp.a, stamp.b); break;
+    case ReliefStamp::Kind::cells: {
+        const rmp::RangeParams range{params.cones, params.height, params.jitter};
+        rmp::raise_range(terrain, relief.width(), relief.height(), at.x0, at.y0, stamp.a, stamp.b, range, stamp.seed,
+                         uplift);
+        break;
+    }
+    }
+}
+
 class Simulation : public b2ContactListener {
 public:
     Simulation(const Params& params, std::uint64_t seed, const Layers& layers)
@@ -121,17 +153,11 @@ public:
         size_ = area_size(w, h);
         spu_ = samples_per_unit(w, h);
         cell_ = layers.terrain.cell;
-        // Every relief width scales with the Voronoi cell size (profiles.hpp).
-        ReliefShape shape;
-        shape.cell = std::sqrt(double(w) * double(h) / double(std::max(1, params.cones)));
-        shape.range_height = params.height;
-        shape.jitter = params.jitter;
-        shape.trench_depth = params.trench_depth;
-        shape.arc_height = params.arc_height;
-        shape.rift_depth = params.rift_depth;
-        shape.ridge_height = params.ridge_height;
-        shape.saturation = params.saturation;
-        relief_.emplace(w, h, shape, random::hash(seed, purpose_relief));
+        draws_ = layers.terrain.data != nullptr;  // else simulate_events(): the replay only
+        if (draws_) relief_.emplace(w, h, relief_shape(params, w, h), random::hash(seed, purpose_relief));
+        result_.replay.width = w;
+        result_.replay.height = h;
+        result_.replay.cell = cell_;
         world_.SetAllowSleeping(false);  // a resting plate must still feel the beams
         world_.SetContactListener(this);
         result_.history.width = (w - 1) * cell_;
@@ -215,7 +241,7 @@ public:
             result_.stats.relief_seconds += seconds_since(t1);
             if (params_.rift_threshold > 0.0) rift(step);
             if (step % std::max(1, params_.record_every) == 0 || step == params_.steps) snapshot(step);
-            if (on_snapshot && snapshot_every > 0 && step % snapshot_every == 0 && step < params_.steps) {
+            if (draws_ && on_snapshot && snapshot_every > 0 && step % snapshot_every == 0 && step < params_.steps) {
                 const GridView& t = layers_.terrain;
                 scratch_.assign(t.data, t.data + t.size());
                 GridView copy{scratch_.data(), t.width, t.height, t.cell};
@@ -225,7 +251,7 @@ public:
             if (on_step) on_step(step);
         }
         const auto t2 = Clock::now();
-        relief_->apply(layers_.terrain, uplift());  // the accumulated boundaries, saturated and textured
+        if (draws_) relief_->apply(layers_.terrain, uplift());  // the accumulated boundaries, saturated and textured
         result_.stats.relief_seconds += seconds_since(t2);
         finish();
         return std::move(result_);
@@ -390,23 +416,28 @@ private:
 
             Point2 a = spu_ * e.p0, b = spu_ * e.p1;  // samples
             if (e.kind == BoundaryKind::transform || !clip_segment(a, b, w, h)) continue;
-            if (e.kind == BoundaryKind::divergent) {
-                relief_->add_rift(a, b);
-                continue;
-            }
+            ReliefStamp stamp;
+            stamp.a = a;
+            stamp.b = b;
             const double contrast = e.a->density - e.b->density;
-            if (std::abs(contrast) >= params_.subduction_contrast) {
+            if (e.kind == BoundaryKind::divergent) {
+                stamp.kind = ReliefStamp::Kind::rift;
+            } else if (std::abs(contrast) >= params_.subduction_contrast) {
                 // The denser plate dives: the overriding (light) plate lies on
                 // the normal's side if a is the dense one.
-                const Point2 toward_light = contrast > 0.0 ? e.normal : -1.0 * e.normal;
-                relief_->add_subduction(a, b, toward_light);
+                stamp.kind = ReliefStamp::Kind::subduction;
+                stamp.toward_light = contrast > 0.0 ? e.normal : -1.0 * e.normal;
                 ++result_.stats.subductions;
             } else if (params_.ranges == RangeStyle::peaks) {
-                relief_->add_range(a, b);
+                stamp.kind = ReliefStamp::Kind::range;
             } else {
-                rmp::RangeParams range{params_.cones, params_.height, params_.jitter};
-                rmp::raise_range(layers_.terrain, a, b, range, random::hash(seed_, purpose_range, index), uplift());
+                stamp.kind = ReliefStamp::Kind::cells;
+                stamp.seed = random::hash(seed_, purpose_range, index);
             }
+            if (draws_)
+                draw_stamp(stamp, params_, *relief_, layers_.terrain, uplift(),
+                           TileRect{0, 0, layers_.terrain.width, layers_.terrain.height});
+            result_.replay.stamps.push_back(stamp);
         }
         pending_.clear();
     }
@@ -496,6 +527,9 @@ private:
             result_.final_plates.push_back(std::move(s));
             result_.final_ids.push_back(p->id);
         }
+        result_.replay.final_polygons = in_samples;
+        result_.replay.final_ids = result_.final_ids;
+        result_.replay.boundaries = result_.history.collisions;
         if (layers_.plate.data) {
             std::fill(layers_.plate.data, layers_.plate.data + layers_.plate.size(), -1.0f);
             for (std::size_t i = 0; i < in_samples.size(); ++i)
@@ -524,6 +558,7 @@ private:
     std::map<std::uint64_t, std::int64_t> last_touch_;  // plate pair → last step with a two-point contact
     std::vector<PendingEvent> pending_;
     std::int64_t step_ = 0;
+    bool draws_ = true;  // false: simulate_events(), nothing drawn
     std::optional<BoundaryRelief> relief_;
     std::vector<float> scratch_;  ///< a time-lapse snapshot: the terrain with the relief so far
     Result result_;
@@ -610,11 +645,10 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
     return simulate(plates, params, seed, layers, on_step, 0, {});
 }
 
-Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
-                const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every,
-                const SnapshotFn& on_snapshot) {
-    if (!layers.terrain.data || layers.terrain.width < 2 || layers.terrain.height < 2)
-        throw BadInput("the plate simulation needs a heightmap of at least 2 × 2 samples");
+namespace {
+
+void validate(std::span<const PlateSpec> plates, const Params& params, int width, int height) {
+    if (width < 2 || height < 2) throw BadInput("the plate simulation needs a heightmap of at least 2 × 2 samples");
     if (params.steps < 1) throw BadInput("steps must be at least 1, got " + std::to_string(params.steps));
     if (!(params.dt > 0.0) || !std::isfinite(params.dt))
         throw BadInput("dt must be a positive number of seconds, got " + std::to_string(params.dt));
@@ -633,6 +667,12 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
                                std::to_string(min_gap_units).substr(0, 4) + " u, which Box2D would weld away");
         }
     }
+}
+
+Result run_simulation(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
+                      const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every,
+                      const SnapshotFn& on_snapshot) {
+    validate(plates, params, layers.terrain.width, layers.terrain.height);
     Simulation sim(params, seed, layers);
     sim.add_beams();
     for (std::size_t i = 0; i < plates.size(); ++i) sim.add_plate(plates[i], int(i));
@@ -643,9 +683,156 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
     return sim.run(on_step, snapshot_every, on_snapshot);
 }
 
+}  // namespace
+
+Result simulate(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, const Layers& layers,
+                const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every,
+                const SnapshotFn& on_snapshot) {
+    if (!layers.terrain.data) throw BadInput("the plate simulation needs a heightmap of at least 2 × 2 samples");
+    return run_simulation(plates, params, seed, layers, on_step, snapshot_every, on_snapshot);
+}
+
+Result simulate_events(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, int width,
+                       int height, double cell, const std::function<void(std::int64_t)>& on_step) {
+    Layers none;
+    none.terrain = GridView{nullptr, width, height, cell};
+    return run_simulation(plates, params, seed, none, on_step, 0, {});
+}
+
+void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, const Layers& layers, TileRect tile) {
+    const int w = replay.width, h = replay.height;
+    if (!layers.terrain.data || layers.terrain.width != tile.width || layers.terrain.height != tile.height ||
+        tile.x0 < 0 || tile.y0 < 0 || tile.x1() > w || tile.y1() > h)
+        throw BadInput("draw_tile: the terrain must hold the tile, and the tile lie inside the simulation's grid");
+    // The relief's activity fields over the tile and the margin its volcanoes reach across.
+    const ReliefShape shape = relief_shape(params, w, h);
+    const std::uint64_t relief_seed = random::hash(seed, purpose_relief);
+    const int m = BoundaryRelief(w, h, TileRect{0, 0, 1, 1}, shape, relief_seed).vent_margin();
+    const int x0 = std::max(0, tile.x0 - m), y0 = std::max(0, tile.y0 - m);
+    const TileRect window{x0, y0, std::min(w, tile.x1() + m) - x0, std::min(h, tile.y1() + m) - y0};
+    BoundaryRelief relief(w, h, window, shape, relief_seed);
+    GridView uplift = layers.uplift;
+    GridView* up = uplift.data ? &uplift : nullptr;
+    for (const ReliefStamp& stamp : replay.stamps) draw_stamp(stamp, params, relief, layers.terrain, up, tile);
+    relief.apply(layers.terrain, tile, up);
+    if (layers.plate.data) {
+        std::fill(layers.plate.data, layers.plate.data + layers.plate.size(), -1.0f);
+        for (std::size_t i = 0; i < replay.final_polygons.size(); ++i)
+            fill_polygon(layers.plate, tile, replay.final_polygons[i], float(replay.final_ids[i]));
+    }
+    if (layers.boundary.data) {
+        const int radius = std::max(0, std::min(w, h) / 512);
+        for (const CollisionEvent& e : replay.boundaries)
+            draw_segment(layers.boundary, tile, (1.0 / replay.cell) * e.a, (1.0 / replay.cell) * e.b,
+                         float(int(e.kind)), radius);
+    }
+}
+
+// ------------------------------------------------------------- the replay's bytes
+
+namespace {
+
+constexpr char kReplayMagic[8] = {'o', 'r', 'p', 'l', 'a', 't', 'e', '1'};
+
+template <typename T>
+void put(std::string& out, const T& v) {
+    out.append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+
+struct Reader {
+    std::string_view bytes;
+    std::size_t at = 0;
+    template <typename T>
+    T get() {
+        if (bytes.size() - at < sizeof(T)) throw Error("internal error: a plate replay ends early");
+        T v;
+        std::memcpy(&v, bytes.data() + at, sizeof v);
+        at += sizeof v;
+        return v;
+    }
+    std::size_t count(std::size_t each) {
+        const auto n = get<std::uint64_t>();
+        if (each > 0 && n > (bytes.size() - at) / each) throw Error("internal error: a plate replay ends early");
+        return std::size_t(n);
+    }
+};
+
+}  // namespace
+
+std::string encode(const Replay& r) {
+    std::string out(kReplayMagic, sizeof kReplayMagic);
+    put(out, std::int32_t(r.width));
+    put(out, std::int32_t(r.height));
+    put(out, r.cell);
+    put(out, std::uint64_t(r.stamps.size()));
+    for (const ReliefStamp& s : r.stamps) {
+        put(out, std::uint8_t(s.kind));
+        put(out, s.a.x), put(out, s.a.y), put(out, s.b.x), put(out, s.b.y);
+        put(out, s.toward_light.x), put(out, s.toward_light.y);
+        put(out, s.seed);
+    }
+    put(out, std::uint64_t(r.boundaries.size()));
+    for (const CollisionEvent& e : r.boundaries) {
+        put(out, e.step), put(out, std::int32_t(e.plate_a)), put(out, std::int32_t(e.plate_b));
+        put(out, e.a.x), put(out, e.a.y), put(out, e.b.x), put(out, e.b.y);
+        put(out, std::uint8_t(e.kind)), put(out, e.impulse);
+    }
+    put(out, std::uint64_t(r.final_polygons.size()));
+    for (std::size_t i = 0; i < r.final_polygons.size(); ++i) {
+        put(out, std::int32_t(r.final_ids[i]));
+        put(out, std::uint64_t(r.final_polygons[i].size()));
+        for (const Point2& p : r.final_polygons[i]) put(out, p.x), put(out, p.y);
+    }
+    return out;
+}
+
+Replay decode_replay(std::string_view bytes) {
+    Reader in{bytes};
+    if (bytes.size() < sizeof kReplayMagic || std::memcmp(bytes.data(), kReplayMagic, sizeof kReplayMagic) != 0)
+        throw Error("internal error: not a plate replay");
+    in.at = sizeof kReplayMagic;
+    Replay r;
+    r.width = in.get<std::int32_t>();
+    r.height = in.get<std::int32_t>();
+    r.cell = in.get<double>();
+    r.stamps.resize(in.count(1 + 6 * 8 + 8));
+    for (ReliefStamp& s : r.stamps) {
+        s.kind = ReliefStamp::Kind(in.get<std::uint8_t>());
+        s.a.x = in.get<double>(), s.a.y = in.get<double>(), s.b.x = in.get<double>(), s.b.y = in.get<double>();
+        s.toward_light.x = in.get<double>(), s.toward_light.y = in.get<double>();
+        s.seed = in.get<std::uint64_t>();
+    }
+    r.boundaries.resize(in.count(8 + 4 + 4 + 4 * 8 + 1 + 8));
+    for (CollisionEvent& e : r.boundaries) {
+        e.step = in.get<std::int64_t>();
+        e.plate_a = in.get<std::int32_t>(), e.plate_b = in.get<std::int32_t>();
+        e.a.x = in.get<double>(), e.a.y = in.get<double>(), e.b.x = in.get<double>(), e.b.y = in.get<double>();
+        e.kind = BoundaryKind(in.get<std::uint8_t>());
+        e.impulse = in.get<double>();
+    }
+    const std::size_t n = in.count(4 + 8);
+    r.final_polygons.resize(n);
+    r.final_ids.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        r.final_ids[i] = in.get<std::int32_t>();
+        r.final_polygons[i].resize(in.count(16));
+        for (Point2& p : r.final_polygons[i]) p.x = in.get<double>(), p.y = in.get<double>();
+    }
+    if (in.at != bytes.size()) throw Error("internal error: a plate replay has bytes after its end");
+    return r;
+}
+
 // ------------------------------------------------------------- rasterising
 
 void draw_segment(GridView layer, Point2 a, Point2 b, float value, int radius) {
+    draw_segment(layer, TileRect{0, 0, layer.width, layer.height}, a, b, value, radius);
+}
+
+void fill_polygon(GridView layer, std::span<const Point2> polygon, float value) {
+    fill_polygon(layer, TileRect{0, 0, layer.width, layer.height}, polygon, value);
+}
+
+void draw_segment(GridView layer, TileRect at, Point2 a, Point2 b, float value, int radius) {
     int x0 = int(std::lround(a.x)), y0 = int(std::lround(a.y));
     const int x1 = int(std::lround(b.x)), y1 = int(std::lround(b.y));
     const int dx = std::abs(x1 - x0), dy = -std::abs(y1 - y0);
@@ -655,7 +842,7 @@ void draw_segment(GridView layer, Point2 a, Point2 b, float value, int radius) {
         for (int oy = -radius; oy <= radius; ++oy)
             for (int ox = -radius; ox <= radius; ++ox) {
                 const int x = x0 + ox, y = y0 + oy;
-                if (x >= 0 && x < layer.width && y >= 0 && y < layer.height) layer.at(x, y) = value;
+                if (x >= at.x0 && x < at.x1() && y >= at.y0 && y < at.y1()) layer.at(x - at.x0, y - at.y0) = value;
             }
         if (x0 == x1 && y0 == y1) break;
         const int e2 = 2 * err;
@@ -664,11 +851,11 @@ void draw_segment(GridView layer, Point2 a, Point2 b, float value, int radius) {
     }
 }
 
-void fill_polygon(GridView layer, std::span<const Point2> polygon, float value) {
+void fill_polygon(GridView layer, TileRect at, std::span<const Point2> polygon, float value) {
     if (polygon.size() < 3) return;
     double ymin = polygon[0].y, ymax = ymin;
     for (const Point2& v : polygon) ymin = std::min(ymin, v.y), ymax = std::max(ymax, v.y);
-    const int y0 = std::max(0, int(std::ceil(ymin))), y1 = std::min(layer.height - 1, int(std::floor(ymax)));
+    const int y0 = std::max(at.y0, int(std::ceil(ymin))), y1 = std::min(at.y1() - 1, int(std::floor(ymax)));
     if (y0 > y1) return;
     parallel_for(y0, y1 + 1, 64, [&](std::int64_t r0, std::int64_t r1) {
         for (std::int64_t y = r0; y < r1; ++y) {
@@ -683,8 +870,8 @@ void fill_polygon(GridView layer, std::span<const Point2> polygon, float value) 
                     lo = std::min(lo, x), hi = std::max(hi, x2);
                 }
             }
-            const int x0 = std::max(0, int(std::ceil(lo))), x1 = std::min(layer.width - 1, int(std::floor(hi)));
-            for (int x = x0; x <= x1; ++x) layer.at(x, int(y)) = value;
+            const int x0 = std::max(at.x0, int(std::ceil(lo))), x1 = std::min(at.x1() - 1, int(std::floor(hi)));
+            for (int x = x0; x <= x1; ++x) layer.at(x - at.x0, int(y) - at.y0) = value;
         }
     });
 }

@@ -27,6 +27,7 @@
 #include "polygon.hpp"
 
 #include <orogen/grid.hpp>
+#include <orogen/tiles.hpp>
 #include <orogen/values.hpp>
 
 #include <array>
@@ -34,6 +35,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -148,11 +150,37 @@ struct Stats {
     double relief_seconds = 0.0;            ///< wall time raising ranges, rifts, trenches
 };
 
+/// One boundary's relief, in the order the simulation made them (what
+/// draw_tile() replays).
+struct ReliefStamp {
+    enum class Kind : std::uint8_t { range, subduction, rift, cells };
+    Kind kind = Kind::range;
+    Point2 a, b;                ///< samples, clipped to the grid
+    Point2 toward_light;        ///< subduction: from the dense plate toward the light one
+    std::uint64_t seed = 0;     ///< cells: the RMP range's seed
+};
+
+/// What draws a finished simulation into any rectangle of the grid without
+/// running Box2D again: a tiled run's rank 0 simulates, the others receive
+/// this (encode/decode) and draw their tiles from it.
+struct Replay {
+    int width = 0, height = 0;  ///< the whole grid, samples
+    double cell = 1.0;          ///< m
+    std::vector<ReliefStamp> stamps;
+    std::vector<CollisionEvent> boundaries;  ///< every event (the boundary layer), metres
+    std::vector<Polygon> final_polygons;     ///< samples
+    std::vector<int> final_ids;
+};
+std::string encode(const Replay& replay);
+/// Throws orogen::Error if `bytes` is not what encode() wrote.
+Replay decode_replay(std::string_view bytes);
+
 struct Result {
     PlateHistory history;  ///< metres, heightmap coordinates (sample × cell)
     Stats stats;
     std::vector<PlateSpec> final_plates;  ///< simulation units, world polygons at the end
     std::vector<int> final_ids;
+    Replay replay;  ///< recorded on every run
 };
 
 /// Run the simulation from `plates` (simulation units, see area_size).
@@ -172,10 +200,26 @@ Result simulate(std::span<const PlateSpec> plates, const Params& params, std::ui
                 const std::function<void(std::int64_t)>& on_step, std::int64_t snapshot_every,
                 const SnapshotFn& on_snapshot);
 
+/// The simulation alone, for a width × height grid of `cell` metres: Box2D,
+/// rifting and the history, no grid touched (result.replay says what to
+/// draw). simulate() over the whole grid is this followed by draw_tile() over it.
+Result simulate_events(std::span<const PlateSpec> plates, const Params& params, std::uint64_t seed, int width,
+                       int height, double cell, const std::function<void(std::int64_t)>& on_step = {});
+
+/// Draws `replay` into the rectangle `tile` of its grid: `layers` hold
+/// exactly the tile's samples (terrain required; uplift, boundary, plate
+/// optional as in simulate()). Every sample gets the bits simulate() gives it
+/// over the whole grid. `params` and `seed` are the simulation's.
+void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, const Layers& layers, TileRect tile);
+
 /// Draw segment a–b (sample coordinates) into `layer` with `value`, `radius`
 /// samples thick on each side (Bresenham walk, clipped to the grid).
 void draw_segment(GridView layer, Point2 a, Point2 b, float value, int radius);
 /// Fill every sample inside the convex polygon (sample coordinates) with `value`.
 void fill_polygon(GridView layer, std::span<const Point2> polygon, float value);
+/// The same two for a layer that holds the rectangle `at` of the grid (a, b and the polygon in the grid's
+/// sample coordinates, clipped to `at`).
+void draw_segment(GridView layer, TileRect at, Point2 a, Point2 b, float value, int radius);
+void fill_polygon(GridView layer, TileRect at, std::span<const Point2> polygon, float value);
 
 }  // namespace orogen::plates

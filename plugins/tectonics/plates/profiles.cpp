@@ -108,7 +108,7 @@ Point2 unit_normal_of(Point2 a, Point2 b) {
 // far past an end the sample lies. Rows are walked over the band's exact
 // x-interval, so the cost is the band's area, not its bounding box's.
 template <typename Op>
-void stamp_with(std::vector<float>& field, int width, int height, Point2 a, Point2 b, Point2 normal, double end_reach,
+void stamp_with(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
                 const Table& profile, const Table& taper, Op op) {
     const double s_lo = profile.lo(), s_hi = profile.hi();
     const double dx = b.x - a.x, dy = b.y - a.y;
@@ -121,7 +121,8 @@ void stamp_with(std::vector<float>& field, int width, int height, Point2 a, Poin
                             at(-end_reach, s_hi)};
     double ymin = quad[0].y, ymax = quad[0].y;
     for (const Point2& q : quad) ymin = std::min(ymin, q.y), ymax = std::max(ymax, q.y);
-    const int y0 = std::max(0, int(std::ceil(ymin))), y1 = std::min(height - 1, int(std::floor(ymax)));
+    // Only the window's rows and columns; every sample's value is computed from its global position alone.
+    const int y0 = std::max(window.y0, int(std::ceil(ymin))), y1 = std::min(window.y1() - 1, int(std::floor(ymax)));
     if (y0 > y1) return;
     parallel_for(y0, y1 + 1, 8, [&](std::int64_t r0, std::int64_t r1) {
         for (std::int64_t yy = r0; yy < r1; ++yy) {
@@ -139,30 +140,30 @@ void stamp_with(std::vector<float>& field, int width, int height, Point2 a, Poin
                 }
             }
             if (!(lo <= hi)) continue;
-            const int x0 = std::max(0, int(std::ceil(lo))), x1 = std::min(width - 1, int(std::floor(hi)));
-            float* row = field.data() + std::size_t(yy) * std::size_t(width);
+            const int x0 = std::max(window.x0, int(std::ceil(lo))), x1 = std::min(window.x1() - 1, int(std::floor(hi)));
+            float* row = field.data() + std::size_t(yy - window.y0) * std::size_t(window.width);
             for (int x = x0; x <= x1; ++x) {
                 const double px = x - a.x, py = y - a.y;
                 const double u = px * t.x + py * t.y;
                 const double s = px * normal.x + py * normal.y;
                 if (s < s_lo || s > s_hi) continue;
                 const double beyond = u < 0.0 ? -u : (u > len ? u - len : 0.0);
-                op(row[x], float(beyond > 0.0 ? profile(s) * taper(beyond) : profile(s)));
+                op(row[x - window.x0], float(beyond > 0.0 ? profile(s) * taper(beyond) : profile(s)));
             }
         }
     });
 }
 
-void stamp(std::vector<float>& field, int width, int height, Point2 a, Point2 b, Point2 normal, double end_reach,
+void stamp(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
            const Table& profile, const Table& taper) {
-    stamp_with(field, width, height, a, b, normal, end_reach, profile, taper, [](float& v, float d) { v += d; });
+    stamp_with(field, window, a, b, normal, end_reach, profile, taper, [](float& v, float d) { v += d; });
 }
 
 // The same band, keeping the largest value: order-independent, so repeated
 // contacts at one place keep one shape instead of summing into a smear.
-void stamp_max(std::vector<float>& field, int width, int height, Point2 a, Point2 b, Point2 normal,
-               double end_reach, const Table& profile, const Table& taper) {
-    stamp_with(field, width, height, a, b, normal, end_reach, profile, taper,
+void stamp_max(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
+               const Table& profile, const Table& taper) {
+    stamp_with(field, window, a, b, normal, end_reach, profile, taper,
                [](float& v, float d) { v = std::max(v, d); });
 }
 
@@ -243,12 +244,21 @@ double ridged_field(double x, double y, double spacing, std::uint64_t seed) {
 }
 
 BoundaryRelief::BoundaryRelief(int width, int height, const ReliefShape& shape, std::uint64_t seed)
-    : width_(width), height_(height), shape_(shape), widths_(relief_widths(std::max(shape.cell, 1e-6))), seed_(seed) {
+    : BoundaryRelief(width, height, TileRect{0, 0, width, height}, shape, seed) {}
+
+BoundaryRelief::BoundaryRelief(int width, int height, TileRect window, const ReliefShape& shape, std::uint64_t seed)
+    : width_(width), height_(height), window_(window), shape_(shape),
+      widths_(relief_widths(std::max(shape.cell, 1e-6))), seed_(seed) {
     if (width < 1 || height < 1) throw BadInput("boundary relief needs a grid of at least 1 × 1 samples");
+    if (window.x0 < 0 || window.y0 < 0 || window.width < 1 || window.height < 1 || window.x1() > width ||
+        window.y1() > height)
+        throw BadInput("boundary relief: the window must lie inside the grid");
 }
 
+int BoundaryRelief::vent_margin() const { return int(std::ceil(2.0 * widths_.vent_spacing)) + 2; }
+
 std::vector<float>& BoundaryRelief::field(std::vector<float>& f) {
-    if (f.empty()) f.assign(std::size_t(width_) * std::size_t(height_), 0.0f);
+    if (f.empty()) f.assign(std::size_t(window_.width) * std::size_t(window_.height), 0.0f);
     return f;
 }
 
@@ -269,7 +279,7 @@ void BoundaryRelief::add_range(Point2 a, Point2 b) {
         const double t = 1.0 - std::abs(s) / w.range_half;
         return t > 0.0 ? h * t * t : 0.0;
     });
-    stamp(field(range_), width_, height_, a, b, unit_normal_of(a, b), w.end_reach, profile, taper_table(w));
+    stamp(field(range_), window_, a, b, unit_normal_of(a, b), w.end_reach, profile, taper_table(w));
 }
 
 void BoundaryRelief::add_subduction(Point2 a, Point2 b, Point2 toward_light) {
@@ -285,14 +295,14 @@ void BoundaryRelief::add_subduction(Point2 a, Point2 b, Point2 toward_light) {
         const double t = 1.0 - (q < 0.0 ? -q / w.trench_outer : q / w.trench_inner);
         return t > 0.0 ? depth * std::pow(t, 1.5) : 0.0;
     });
-    stamp(field(trench_), width_, height_, a, b, n, w.end_reach, trench, taper_table(w));
+    stamp(field(trench_), window_, a, b, n, w.end_reach, trench, taper_table(w));
     // The volcanic line: a band inland whose activity lights up the vents in it.
     const double sa = w.arc_offset, ah = shape_.arc_height;
     const Table arc(sa - w.arc_band, sa + w.arc_band, [&](double s) {
         const double q = (s - sa) / w.arc_band;
         return q * q < 1.0 ? ah * (1.0 - q * q) : 0.0;
     });
-    stamp(field(arc_), width_, height_, a, b, n, w.end_reach, arc, taper_table(w));
+    stamp(field(arc_), window_, a, b, n, w.end_reach, arc, taper_table(w));
 }
 
 void BoundaryRelief::add_rift(Point2 a, Point2 b) {
@@ -305,19 +315,19 @@ void BoundaryRelief::add_rift(Point2 a, Point2 b) {
     const Table rift(-w.rift_half - edge, w.rift_half + edge, [&](double s) {
         return depth * (1.0 - smoothstep((std::abs(s) - w.rift_half) / edge));
     });
-    stamp(field(rift_), width_, height_, a, b, n, w.end_reach, rift, taper_table(w));
+    stamp(field(rift_), window_, a, b, n, w.end_reach, rift, taper_table(w));
     // Where on the flank (the largest over contacts): 1 on the floor, 0 at
     // the rim; terraced at compose time into three fault blocks.
     const Table flank(-w.rift_half, w.rift_half, [&](double s) {
         return std::clamp((w.rift_half - std::abs(s)) / (w.rift_half - w.rift_floor), 0.0, 1.0);
     });
-    stamp_max(field(flank_), width_, height_, a, b, n, w.end_reach, flank, taper_table(w));
+    stamp_max(field(flank_), window_, a, b, n, w.end_reach, flank, taper_table(w));
     const double rh = shape_.ridge_height;
     const Table ridge(-w.ridge_half, w.ridge_half, [&](double s) {
         const double t = 1.0 - std::abs(s) / w.ridge_half;
         return t > 0.0 ? rh * t : 0.0;
     });
-    stamp(field(ridge_), width_, height_, a, b, n, w.end_reach, ridge, taper_table(w));
+    stamp(field(ridge_), window_, a, b, n, w.end_reach, ridge, taper_table(w));
 }
 
 BoundaryRelief::Vents BoundaryRelief::vents() const {
@@ -339,8 +349,9 @@ BoundaryRelief::Vents BoundaryRelief::vents() const {
             vent.y = (cj + 0.1 + 0.8 * u.b) * v.spacing;
             vent.radius = widths_.vent_radius * (0.8 + 0.4 * u.c);
             const int px = int(std::lround(vent.x)), py = int(std::lround(vent.y));
-            if (px < 0 || py < 0 || px >= width_ || py >= height_) continue;
-            const float act = arc_[std::size_t(py) * std::size_t(width_) + std::size_t(px)];
+            // A vent outside the window stays dormant here: no sample apply() composes reaches it.
+            if (px < window_.x0 || py < window_.y0 || px >= window_.x1() || py >= window_.y1()) continue;
+            const float act = arc_[std::size_t(py - window_.y0) * std::size_t(window_.width) + std::size_t(px - window_.x0)];
             if (!(act > 0.0f)) continue;
             const double u_height = random::uniform(seed, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj)), 1u);
             vent.height = saturate(act, cap) * (1.0 + shape_.jitter * (2.0 * u_height - 1.0));
@@ -349,7 +360,7 @@ BoundaryRelief::Vents BoundaryRelief::vents() const {
 }
 
 float BoundaryRelief::relief_at(int x, int y, const Vents& vents) const {
-    const std::size_t i = std::size_t(y) * std::size_t(width_) + std::size_t(x);
+    const std::size_t i = std::size_t(y - window_.y0) * std::size_t(window_.width) + std::size_t(x - window_.x0);
     const double sat = shape_.saturation;
     const double jitter = shape_.jitter;
     const ReliefWidths& w = widths_;
@@ -405,16 +416,28 @@ float BoundaryRelief::relief_at(int x, int y, const Vents& vents) const {
 }
 
 void BoundaryRelief::apply(GridView terrain, GridView* uplift) const {
-    if (terrain.width != width_ || terrain.height != height_)
+    if (terrain.width != window_.width || terrain.height != window_.height)
         throw BadInput("boundary relief: the terrain grid must be the size the relief was accumulated on");
+    apply(terrain, window_, uplift);
+}
+
+void BoundaryRelief::apply(GridView terrain, TileRect at, GridView* uplift) const {
+    if (terrain.width != at.width || terrain.height != at.height || (uplift && (uplift->width != at.width ||
+                                                                                uplift->height != at.height)))
+        throw BadInput("boundary relief: the terrain grid must be the size of the rectangle it covers");
+    const int m = vent_margin();
+    const bool inside = at.x0 >= (window_.x0 > 0 ? window_.x0 + m : 0) && at.y0 >= (window_.y0 > 0 ? window_.y0 + m : 0) &&
+                        at.x1() <= (window_.x1() < width_ ? window_.x1() - m : width_) &&
+                        at.y1() <= (window_.y1() < height_ ? window_.y1() - m : height_);
+    if (!inside) throw BadInput("boundary relief: the rectangle to compose reaches too near the window's edge");
     if (range_.empty() && trench_.empty() && arc_.empty() && rift_.empty()) return;
     const Vents vent_lattice = vents();
-    parallel_for(0, height_, 4, [&](std::int64_t r0, std::int64_t r1) {
+    parallel_for(0, at.height, 4, [&](std::int64_t r0, std::int64_t r1) {
         for (std::int64_t y = r0; y < r1; ++y) {
             float* row = terrain.row(int(y));
             float* urow = uplift ? uplift->row(int(y)) : nullptr;
-            for (int x = 0; x < width_; ++x) {
-                const float dh = relief_at(x, int(y), vent_lattice);
+            for (int x = 0; x < at.width; ++x) {
+                const float dh = relief_at(at.x0 + x, at.y0 + int(y), vent_lattice);
                 if (dh == 0.0f) continue;
                 row[x] += dh;
                 if (urow) urow[x] += dh;
@@ -424,8 +447,8 @@ void BoundaryRelief::apply(GridView terrain, GridView* uplift) const {
 }
 
 std::vector<float> BoundaryRelief::relief() const {
-    std::vector<float> out(std::size_t(width_) * std::size_t(height_), 0.0f);
-    GridView view{out.data(), width_, height_, 1.0};
+    std::vector<float> out(std::size_t(window_.width) * std::size_t(window_.height), 0.0f);
+    GridView view{out.data(), window_.width, window_.height, 1.0};
     apply(view);
     return out;
 }

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <orogen/grid.hpp>
+#include <orogen/tiles.hpp>
 
 #include <cstdint>
 #include <vector>
@@ -84,6 +85,14 @@ double peak_field(double x, double y, double spacing, double jitter, std::uint64
 class BoundaryRelief {
 public:
     BoundaryRelief(int width, int height, const ReliefShape& shape, std::uint64_t seed);
+    /// The relief of a width × height grid, held only over `window` (global
+    /// sample coordinates, inside the grid): what a rank of a tiled run keeps.
+    /// Every sample of the window gets the bits the whole grid's relief has
+    /// there, except within vent_margin() of the window's edge (a volcano
+    /// there may stand on a vent outside the window): apply() only inside that.
+    BoundaryRelief(int width, int height, TileRect window, const ReliefShape& shape, std::uint64_t seed);
+    /// Samples a window must reach past the samples it composes (two vent lattice cells and rounding).
+    int vent_margin() const;
 
     /// A convergent contact between plates of similar density, along a–b
     /// (sample coordinates): a range straddling the contact.
@@ -99,11 +108,16 @@ public:
     /// `uplift` if non-null). Same size as the constructor's. Deterministic
     /// whatever the thread count.
     void apply(GridView terrain, GridView* uplift = nullptr) const;
+    /// The same for the samples of rectangle `at` (global coordinates; `terrain` and `uplift` hold exactly
+    /// them), which must lie inside the window shrunk by vent_margin() where the window is not the grid's edge.
+    void apply(GridView terrain, TileRect at, GridView* uplift = nullptr) const;
 
     /// The composed relief alone at every sample (m), for tests and figures.
     std::vector<float> relief() const;
 
     const ReliefWidths& widths() const { return widths_; }
+    int width() const { return width_; }   ///< the whole grid
+    int height() const { return height_; }
 
 private:
     struct Vent {
@@ -120,7 +134,8 @@ private:
     float relief_at(int x, int y, const Vents& vents) const;
     std::vector<float>& field(std::vector<float>& f);
 
-    int width_, height_;
+    int width_, height_;  // the whole grid
+    TileRect window_;     // the samples held (the activity fields' extent)
     ReliefShape shape_;
     ReliefWidths widths_;
     std::uint64_t seed_;

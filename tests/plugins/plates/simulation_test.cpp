@@ -338,6 +338,59 @@ TEST(PlatesSimulation, SameSeedGivesIdenticalBytesOnOneAndTwoThreads) {
     EXPECT_GT(h1.collisions.size(), 0u);
 }
 
+// What a tiled run does: the events alone (no grid), encoded and decoded as rank 0 sends them, then drawn into
+// uneven windows of the grid that together cover it. Every sample of every layer gets the whole run's bits, in
+// both range styles (peaks with trenches, volcanoes and rifts; the thesis's Voronoi cells).
+TEST(PlatesSimulation, EventsDrawnIntoWindowsGiveTheWholeGridsBits) {
+    for (const RangeStyle style : {RangeStyle::peaks, RangeStyle::cells}) {
+        SCOPED_TRACE(style == RangeStyle::peaks ? "peaks" : "cells");
+        const int w = 131, h = 97;
+        std::vector<float> base(std::size_t(w) * h);
+        for (std::size_t i = 0; i < base.size(); ++i) base[i] = float(i % 89) * 0.25f;
+        Params p;
+        p.steps = 400;
+        p.rift_threshold = 200.0;
+        p.ranges = style;
+        p.max_plates = max_plates(w, h);
+        const auto start = random_plates(area_size(w, h), 12, 0.5, 1.0, 7);
+        std::vector<float> whole = base, uplift(base.size(), 0.0f), boundary(base.size(), 0.0f), plate(base.size(), 0.0f);
+        const Result r = simulate(start, p, 7, {{whole.data(), w, h, 10.0}, {uplift.data(), w, h, 10.0},
+                                                {boundary.data(), w, h, 10.0}, {plate.data(), w, h, 10.0}});
+        ASSERT_GT(r.replay.stamps.size(), 10u);
+        EXPECT_EQ(std::count_if(r.replay.stamps.begin(), r.replay.stamps.end(),
+                                [](const ReliefStamp& s) { return s.kind == ReliefStamp::Kind::subduction; }) > 0,
+                  true);
+
+        const Result events = simulate_events(start, p, 7, w, h, 10.0);
+        const Replay replay = decode_replay(encode(events.replay));
+        ASSERT_EQ(replay.stamps.size(), r.replay.stamps.size());
+        EXPECT_THROW(decode_replay(encode(events.replay).substr(0, 40)), Error);
+        // Cuts off the powers of two, windows narrower than the volcanoes' reach.
+        const int xs[] = {0, 17, 60, 61, 131}, ys[] = {0, 40, 41, 97};
+        for (int j = 0; j + 1 < 4; ++j)
+            for (int i = 0; i + 1 < 5; ++i) {
+                const TileRect t{xs[i], ys[j], xs[i + 1] - xs[i], ys[j + 1] - ys[j]};
+                std::vector<float> th(std::size_t(t.width) * t.height), tu(th.size(), 0.0f), tb(th.size(), 0.0f),
+                    tp(th.size(), 0.0f);
+                for (int y = 0; y < t.height; ++y)
+                    for (int x = 0; x < t.width; ++x)
+                        th[std::size_t(y) * t.width + x] = base[std::size_t(t.y0 + y) * w + std::size_t(t.x0 + x)];
+                draw_tile(replay, p, 7, {{th.data(), t.width, t.height, 10.0}, {tu.data(), t.width, t.height, 10.0},
+                                         {tb.data(), t.width, t.height, 10.0}, {tp.data(), t.width, t.height, 10.0}},
+                          t);
+                int differ = 0;
+                for (int y = 0; y < t.height; ++y)
+                    for (int x = 0; x < t.width; ++x) {
+                        const std::size_t g = std::size_t(t.y0 + y) * w + std::size_t(t.x0 + x), k = std::size_t(y) * t.width + x;
+                        differ += std::memcmp(&th[k], &whole[g], 4) != 0 || std::memcmp(&tu[k], &uplift[g], 4) != 0 ||
+                                  tb[k] != boundary[g] || tp[k] != plate[g];
+                    }
+                EXPECT_EQ(differ, 0) << "window at (" << t.x0 << ", " << t.y0 << ")";
+            }
+        EXPECT_NE(whole, base);
+    }
+}
+
 TEST(PlatesSimulation, PlateLayerNamesThePlateOverEachSample) {
     Grid g(65);
     const std::vector<PlateSpec> plates = {plate(rect(2, 2, 17, 34), {0, 0}), plate(rect(19, 2, 34, 34), {0, 0})};
