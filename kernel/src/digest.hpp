@@ -42,4 +42,11 @@ void remember_sha256(const std::filesystem::path& file, const std::string& hex);
 /// The remembered digest of `file` if its identity is unchanged, else "".
 std::string remembered_sha256(const std::filesystem::path& file);
 
+/// `file`'s identity (device, inode, size, times) as text, "" if it is not a regular file: what another
+/// process on a machine that sees the same file compares with its own (a tiled run's ranks).
+std::string file_identity(const std::filesystem::path& file);
+/// Remember `hex` as `file`'s digest if `identity` (another process's file_identity()) is the file's now; a
+/// file that differs (changed since, or a file system that shows it otherwise) is simply read when hashed.
+void adopt_sha256(const std::filesystem::path& file, const std::string& hex, const std::string& identity);
+
 }  // namespace orogen::detail

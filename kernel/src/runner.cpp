@@ -1,5 +1,6 @@
 #include "runner.hpp"
 
+#include "digest.hpp"
 #include "json.hpp"
 #include "outputs.hpp"
 #include "tiles.hpp"
@@ -233,6 +234,37 @@ void write_manifest(const Plan& plan, const RunOptions& options, const Staging& 
 std::string cancel_reason(const RunOptions& options) {
     const int sig = options.cancel_signal ? options.cancel_signal->load() : 0;
     return sig == SIGTERM ? "stopped by SIGTERM" : "cancelled by the user";
+}
+
+/// Collective in a tiled run, after the last node: the digests the other ranks took while writing their files
+/// into the staging folder go to rank 0, which adopts those whose file it sees unchanged, so the manifest
+/// does not read them again (a world's engine tiles can be gigabytes). Every rank calls it, failed or not.
+void share_digests(TiledRun& tiled, const fs::path& staging_folder, bool ok) {
+    std::string mine;  // records of three fields, each ended by '\0': path in the folder, digest, identity
+    if (ok && tiled.rank() != 0) {
+        std::error_code ec;
+        for (auto it = fs::recursive_directory_iterator(staging_folder, ec); !ec && it != fs::recursive_directory_iterator();
+             it.increment(ec)) {
+            if (!it->is_regular_file(ec)) continue;
+            const std::string hex = detail::remembered_sha256(it->path());  // "" for files this rank did not write
+            if (hex.empty()) continue;
+            for (const std::string& field :
+                 {fs::relative(it->path(), staging_folder, ec).string(), hex, detail::file_identity(it->path())})
+                mine.append(field).push_back('\0');
+        }
+    }
+    const std::vector<std::string> all = tiled.gather_text(mine);
+    for (const std::string& text : all) {
+        std::vector<std::string> fields;
+        for (std::size_t at = 0; at < text.size();) {
+            const std::size_t end = text.find('\0', at);
+            if (end == std::string::npos) break;
+            fields.push_back(text.substr(at, end - at));
+            at = end + 1;
+        }
+        for (std::size_t k = 0; k + 2 < fields.size(); k += 3)
+            detail::adopt_sha256(staging_folder / fields[k], fields[k + 1], fields[k + 2]);
+    }
 }
 
 /// Collective in a tiled run: every rank learns the worst exit code; only the lowest failing rank keeps its message.
@@ -665,6 +697,7 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         result.exit_code = f.exit_code;
         result.error = f.message;
     }
+    if (options.tiled) share_digests(*options.tiled, staging_folder, result.exit_code == 0);
     if (const auto& store = evaluation.store()) {
         result.cache_summary = "cache: " + std::to_string(evaluation.reused()) + " of " + std::to_string(plan.nodes.size()) +
                                " nodes reused from " + store->folder().string() + " (" +

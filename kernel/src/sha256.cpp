@@ -108,6 +108,20 @@ void remember_sha256(const std::filesystem::path& file, const std::string& hex) 
     r.digests[key] = {id, hex};
 }
 
+std::string file_identity(const std::filesystem::path& file) {
+    FileKey key;
+    Identity id;
+    if (!identify(file, key, id)) return "";
+    return std::to_string(key.first) + ":" + std::to_string(key.second) + ":" + std::to_string(id.size) + ":" +
+           std::to_string(id.mtime_s) + "." + std::to_string(id.mtime_ns) + ":" + std::to_string(id.ctime_s) + "." +
+           std::to_string(id.ctime_ns);
+}
+
+void adopt_sha256(const std::filesystem::path& file, const std::string& hex, const std::string& identity) {
+    if (hex.size() != 64 || identity.empty() || file_identity(file) != identity) return;
+    remember_sha256(file, hex);
+}
+
 std::string remembered_sha256(const std::filesystem::path& file) {
     FileKey key;
     Identity id;

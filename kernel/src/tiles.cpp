@@ -163,7 +163,7 @@ int TiledRun::agree(int exit_code, int* reporter) {
 namespace {
 
 constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagCarry = 15, kTagTile = 20,
-              kTagFetch = 21;
+              kTagFetch = 21, kTagText = 22;
 
 /// Copy the rectangle (x, y, w, h) of `grid` (row length `stride`) into `out`, or back with `to_grid`.
 void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, bool to_grid) {
@@ -332,6 +332,24 @@ void TiledRun::share_from_rank0(std::string& bytes) {
 }
 
 void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
+
+std::vector<std::string> TiledRun::gather_text(const std::string& text) {
+    if (rank_ != 0) {
+        const std::uint64_t n = text.size();
+        mpi::send(&n, sizeof n, 0, kTagText);
+        if (n) mpi::send(text.data(), text.size(), 0, kTagText);
+        return {};
+    }
+    std::vector<std::string> all(static_cast<std::size_t>(ranks()));
+    all[0] = text;
+    for (int r = 1; r < ranks(); ++r) {
+        std::uint64_t n = 0;
+        mpi::recv(&n, sizeof n, r, kTagText);
+        all[std::size_t(r)].resize(std::size_t(n));
+        if (n) mpi::recv(all[std::size_t(r)].data(), std::size_t(n), r, kTagText);
+    }
+    return all;
+}
 
 void TiledRun::min_max(float& lo, float& hi) {
     agree_or_throw();

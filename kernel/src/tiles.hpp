@@ -94,6 +94,8 @@ public:
 
     /// Collective: rank 0's `text` on every rank.
     void broadcast(std::string& text);
+    /// Collective: every rank's `text`, in rank order, on rank 0 (empty elsewhere).
+    std::vector<std::string> gather_text(const std::string& text);
 
     const TileSplit& split() const { return split_; }
 

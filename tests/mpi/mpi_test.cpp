@@ -397,9 +397,16 @@ TEST_P(EngineTilesSeam, EveryRanksEngineTilesEqualOneProcesss) {
     ASSERT_EQ(a, b);
     for (const auto& f : a)
         EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / "many" / f)) << f << " differs on " << GetParam().ranks << " ranks";
-    // The manifest of the tiled run lists every file, hashed.
+    // The manifest of the tiled run lists every file with its SHA-256 (the other ranks' tiles with the
+    // digests they took while writing, which rank 0 adopts: a digest sent for the wrong file shows here).
     const std::string manifest = slurp(dir / "many" / "manifest.json");
-    for (const auto& f : b) EXPECT_NE(manifest.find("\"" + f + "\""), std::string::npos) << f;
+    for (const auto& f : b) {
+        const auto at = manifest.find("\"path\": \"" + f + "\"");
+        ASSERT_NE(at, std::string::npos) << f;
+        const auto hash = manifest.find("\"sha256\": \"", at);
+        ASSERT_NE(hash, std::string::npos) << f;
+        EXPECT_EQ(manifest.substr(hash + 11, 64), orogen::sha256_file(dir / "many" / f)) << f;
+    }
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, EngineTilesSeam,
                          ::testing::Values(Case{2, ""}, Case{3, "3x1"}, Case{4, "1x4"}, Case{4, "2x2"}), kCaseName);
