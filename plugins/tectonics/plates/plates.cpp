@@ -14,9 +14,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
-#include <cstring>
 #include <numbers>
 #include <string>
 
@@ -142,6 +142,22 @@ void draw_stamp(const ReliefStamp& stamp, const Params& params, BoundaryRelief& 
                          uplift);
         break;
     }
+    }
+}
+
+/// The plate and boundary layers of the rectangle `at` of the replay's grid (the whole grid in one process,
+/// a tile in a tiled run): the final plates' ids, then every event's segment, kind as the value.
+void draw_layers(const Replay& replay, const Layers& layers, TileRect at) {
+    if (layers.plate.data) {
+        std::fill(layers.plate.data, layers.plate.data + layers.plate.size(), -1.0f);
+        for (std::size_t i = 0; i < replay.final_polygons.size(); ++i)
+            fill_polygon(layers.plate, at, replay.final_polygons[i], float(replay.final_ids[i]));
+    }
+    if (layers.boundary.data) {
+        const int radius = std::max(0, std::min(replay.width, replay.height) / 512);
+        for (const CollisionEvent& e : replay.boundaries)
+            draw_segment(layers.boundary, at, (1.0 / replay.cell) * e.a, (1.0 / replay.cell) * e.b,
+                         float(int(e.kind)), radius);
     }
 }
 
@@ -527,19 +543,10 @@ private:
             result_.final_plates.push_back(std::move(s));
             result_.final_ids.push_back(p->id);
         }
-        result_.replay.final_polygons = in_samples;
+        result_.replay.final_polygons = std::move(in_samples);
         result_.replay.final_ids = result_.final_ids;
         result_.replay.boundaries = result_.history.collisions;
-        if (layers_.plate.data) {
-            std::fill(layers_.plate.data, layers_.plate.data + layers_.plate.size(), -1.0f);
-            for (std::size_t i = 0; i < in_samples.size(); ++i)
-                fill_polygon(layers_.plate, in_samples[i], float(plates_[i]->id));
-        }
-        if (layers_.boundary.data) {
-            const int radius = std::max(0, std::min(layers_.boundary.width, layers_.boundary.height) / 512);
-            for (const CollisionEvent& e : result_.history.collisions)
-                draw_segment(layers_.boundary, (1.0 / cell_) * e.a, (1.0 / cell_) * e.b, float(int(e.kind)), radius);
-        }
+        draw_layers(result_.replay, layers_, TileRect{0, 0, layers_.terrain.width, layers_.terrain.height});
     }
 
 public:
@@ -715,17 +722,7 @@ void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, c
     GridView* up = uplift.data ? &uplift : nullptr;
     for (const ReliefStamp& stamp : replay.stamps) draw_stamp(stamp, params, relief, layers.terrain, up, tile);
     relief.apply(layers.terrain, tile, up);
-    if (layers.plate.data) {
-        std::fill(layers.plate.data, layers.plate.data + layers.plate.size(), -1.0f);
-        for (std::size_t i = 0; i < replay.final_polygons.size(); ++i)
-            fill_polygon(layers.plate, tile, replay.final_polygons[i], float(replay.final_ids[i]));
-    }
-    if (layers.boundary.data) {
-        const int radius = std::max(0, std::min(w, h) / 512);
-        for (const CollisionEvent& e : replay.boundaries)
-            draw_segment(layers.boundary, tile, (1.0 / replay.cell) * e.a, (1.0 / replay.cell) * e.b,
-                         float(int(e.kind)), radius);
-    }
+    draw_layers(replay, layers, tile);
 }
 
 // ------------------------------------------------------------- the replay's bytes
