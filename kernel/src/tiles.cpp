@@ -10,6 +10,7 @@
 #include <climits>
 #include <cstring>
 #include <sstream>
+#include <utility>
 
 namespace orogen {
 
@@ -275,48 +276,86 @@ std::vector<double> TiledRun::gather_rows(std::span<const double> mine, int per_
     return all;
 }
 
-std::vector<float> TiledRun::fetch(const float* mine, TileRect want) {
-    agree_or_throw();
-    if (want.width < 0 || want.height < 0 || (want.width > 0 && want.height > 0 &&
-                                              (want.x0 < 0 || want.y0 < 0 || want.x1() > grid_width() ||
-                                               want.y1() > grid_height())))
-        throw Error("internal error: fetch of a " + std::to_string(want.width) + "x" + std::to_string(want.height) +
-                    " rectangle at (" + std::to_string(want.x0) + ", " + std::to_string(want.y0) +
-                    ") outside the grid");
-    if (want.width == 0 || want.height == 0) want = {};
-    // Every rank learns every rank's rectangle, so each knows what to send whom without asking.
-    const int n = ranks();
-    std::vector<int> wants(std::size_t(4 * n));
-    const int own_want[4] = {want.x0, want.y0, want.width, want.height};
-    mpi::allgather(own_want, 4, wants.data());
-    auto want_of = [&](int r) {
-        const int* w = &wants[std::size_t(4 * r)];
-        return TileRect{w[0], w[1], w[2], w[3]};
+namespace {
+
+/// The indices [lo, hi) of the positions of `axis` that lie in [a, b).
+std::pair<int, int> samples_within(const AxisSamples& axis, int a, int b) {
+    const auto first_at_least = [&](int v) {  // the positions increase: a binary search over the indices
+        int lo = 0, hi = axis.size();
+        while (lo < hi) {
+            const int mid = lo + (hi - lo) / 2;
+            if (axis.at(mid) < v) lo = mid + 1;
+            else hi = mid;
+        }
+        return lo;
     };
-    auto overlap = [](TileRect a, TileRect b) {
-        const int x0 = std::max(a.x0, b.x0), y0 = std::max(a.y0, b.y0);
-        const int x1 = std::min(a.x1(), b.x1()), y1 = std::min(a.y1(), b.y1());
-        return x1 > x0 && y1 > y0 ? TileRect{x0, y0, x1 - x0, y1 - y0} : TileRect{};
+    const int lo = first_at_least(a), hi = first_at_least(b);
+    return {lo, std::max(lo, hi)};
+}
+
+bool valid_axis(const AxisSamples& axis, int extent) {
+    if (axis.count < 0 || axis.step < 1) return false;
+    std::int64_t end = -1;  // the progression's last position
+    if (axis.count > 0) {
+        end = axis.first + std::int64_t(axis.count - 1) * axis.step;
+        if (axis.first < 0 || end >= extent) return false;
+    }
+    return axis.last < 0 || (axis.last > end && axis.last < extent);
+}
+
+}  // namespace
+
+std::vector<float> TiledRun::fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) {
+    agree_or_throw();
+    if (!valid_axis(columns, grid_width()) || !valid_axis(rows, grid_height()))
+        throw Error("internal error: fetch of samples outside the " + std::to_string(grid_width()) + "x" +
+                    std::to_string(grid_height()) + " grid");
+    if (columns.size() == 0 || rows.size() == 0) columns = rows = {};
+    // Every rank learns every rank's lattice, so each knows what to send whom without asking.
+    const int n = ranks();
+    std::vector<int> wants(std::size_t(8 * n));
+    const int own_want[8] = {columns.first, columns.step, columns.count, columns.last,
+                             rows.first,    rows.step,    rows.count,    rows.last};
+    mpi::allgather(own_want, 8, wants.data());
+    auto want_of = [&](int r) {
+        const int* w = &wants[std::size_t(8 * r)];
+        return std::pair{AxisSamples{w[0], w[1], w[2], w[3]}, AxisSamples{w[4], w[5], w[6], w[7]}};
+    };
+    // The index ranges of a lattice that fall in a tile: [c0, c1) × [r0, r1).
+    struct Part {
+        int c0, c1, r0, r1;
+        std::size_t size() const { return std::size_t(c1 - c0) * std::size_t(r1 - r0); }
+    };
+    auto part = [](const TileRect& t, const AxisSamples& cols, const AxisSamples& rws) {
+        const auto [c0, c1] = samples_within(cols, t.x0, t.x1());
+        const auto [r0, r1] = samples_within(rws, t.y0, t.y1());
+        return Part{c0, c1, r0, r1};
     };
     const TileRect o = owned();
-    std::vector<float> out(std::size_t(want.width) * std::size_t(want.height)), give_buffer, take_buffer;
-    // Round s: send to rank + s what it wants of this tile, receive from rank − s what it holds of `want`.
-    // Both ends of a pair compute the same rectangle, so an empty one is skipped on both.
+    const int ncols = columns.size();
+    std::vector<float> out(std::size_t(ncols) * std::size_t(rows.size())), give_buffer, take_buffer;
+    // Round s: send to rank + s what it wants of this tile, receive from rank − s what it holds of the
+    // lattice. Both ends of a pair compute the same part, so an empty one is skipped on both.
     for (int s = 0; s < n; ++s) {
         const int to = (rank_ + s) % n, from = (rank_ - s + n) % n;
-        const TileRect give = overlap(o, want_of(to)), take = overlap(tile(from), want);
-        give_buffer.resize(std::size_t(give.width) * std::size_t(give.height));
-        copy_rect(const_cast<float*>(mine), o.width, give.x0 - o.x0, give.y0 - o.y0, give.width, give.height,
-                  give_buffer.data(), false);
-        if (s == 0) {
-            take_buffer.swap(give_buffer);  // this rank's own part of its own rectangle
-        } else {
-            take_buffer.resize(std::size_t(take.width) * std::size_t(take.height));
-            mpi::sendrecv(give_buffer.data(), give_buffer.size() * sizeof(float), give.width ? to : -1,
-                          take_buffer.data(), take_buffer.size() * sizeof(float), take.width ? from : -1, kTagFetch);
+        const auto [to_cols, to_rows] = want_of(to);
+        const Part give = part(o, to_cols, to_rows), take = part(tile(from), columns, rows);
+        give_buffer.resize(give.size());
+        std::size_t k = 0;
+        for (int j = give.r0; j < give.r1; ++j) {
+            const float* row = mine + std::size_t(to_rows.at(j) - o.y0) * std::size_t(o.width);
+            for (int i = give.c0; i < give.c1; ++i) give_buffer[k++] = row[to_cols.at(i) - o.x0];
         }
-        copy_rect(out.data(), want.width, take.x0 - want.x0, take.y0 - want.y0, take.width, take.height,
-                  take_buffer.data(), true);
+        if (s == 0) {
+            take_buffer.swap(give_buffer);  // this rank's own part of its own lattice
+        } else {
+            take_buffer.resize(take.size());
+            mpi::sendrecv(give_buffer.data(), give_buffer.size() * sizeof(float), give.size() ? to : -1,
+                          take_buffer.data(), take_buffer.size() * sizeof(float), take.size() ? from : -1, kTagFetch);
+        }
+        k = 0;
+        for (int j = take.r0; j < take.r1; ++j)
+            for (int i = take.c0; i < take.c1; ++i) out[std::size_t(j) * std::size_t(ncols) + std::size_t(i)] = take_buffer[k++];
     }
     return out;
 }

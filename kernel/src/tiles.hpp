@@ -70,7 +70,7 @@ public:
     void carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) override;
     std::vector<double> gather_rows(std::span<const double> mine, int per_row) override;
     double seconds_waiting() const override { return waiting_; }
-    std::vector<float> fetch(const float* mine, TileRect want) override;
+    std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) override;
     double sum_all(double value) override;
     void share_from_rank0(std::string& bytes) override;
 

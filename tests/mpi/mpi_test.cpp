@@ -363,7 +363,8 @@ INSTANTIATE_TEST_SUITE_P(Ranks, PlatesSeam,
 /// Engine tiles (export:tiles), each written by the rank holding its middle sample: 16-bit PNG and
 /// float RAW with their VRTs, in tiles that straddle the ranks' tiles (17 samples every 16 columns and rows,
 /// against cuts at columns 24, 48, 72 or 48 and rows 20, 40 or 30), and 16-bit RAW tiles of 65 samples, which
-/// have their middles at columns 32 and 80 only and so leave some ranks none to write (an empty fetch).
+/// have their middles at columns 32 and 80 only and so leave some ranks none to write (an empty fetch);
+/// and the glTF level-of-detail pyramid, whose coarse chunks fetch lattices spread over several ranks.
 const char* kEngineTilesSpec = R"(orogen 1
 seed 9
 grid 97x61 cell=2
@@ -373,6 +374,7 @@ t = erode:thermal(f, talus=20, iterations=9, hardness=height)
 export:tiles(t, path="png/t.json", tile_size=17)
 export:tiles(t, path="r32/t.json", tile_size=17, format=r32)
 export:tiles(t, path="big/t.json", tile_size=65, format=r16, low=-5, high=4)
+export:tiles(t, path="glb/t.json", tile_size=17, format=glb, texture=16)
 )";
 
 class EngineTilesSeam : public ::testing::TestWithParam<Case> {};
@@ -393,7 +395,8 @@ TEST_P(EngineTilesSeam, EveryRanksEngineTilesEqualOneProcesss) {
         if (e.is_regular_file() && e.path().filename() != "manifest.json") b.push_back(fs::relative(e.path(), dir / "many").string());
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
-    EXPECT_EQ(a.size(), (24u + 2u) + (48u + 2u) + (4u + 2u));
+    // glb/: the level-of-detail pyramid, 6 × 4 + 3 × 2 + 2 × 1 + 1 chunks and the tileset.
+    EXPECT_EQ(a.size(), (24u + 2u) + (48u + 2u) + (4u + 2u) + (33u + 1u));
     ASSERT_EQ(a, b);
     for (const auto& f : a)
         EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / "many" / f)) << f << " differs on " << GetParam().ranks << " ranks";

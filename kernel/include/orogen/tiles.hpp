@@ -34,6 +34,16 @@ struct TileRect {
     bool operator==(const TileRect&) const = default;
 };
 
+/// Sample positions along one axis of the whole grid, increasing: first,
+/// first + step, ..., `count` of them, then `last` when ≥ 0 (beyond them).
+/// A decimated lattice that keeps the grid's far edge: {0, 4, 8, ..., 4096}
+/// or {0, 4, ..., 4092, 4095}.
+struct AxisSamples {
+    int first = 0, step = 1, count = 0, last = -1;
+    int size() const { return count + (last >= 0 ? 1 : 0); }
+    int at(int i) const { return i < count ? first + i * step : last; }
+};
+
 /// Thrown inside a tiled node on the ranks that did not fail when another
 /// rank failed: the failing rank reports the error, the others stop quietly
 /// with its exit code. A node lets it pass (it derives from orogen::Error).
@@ -127,7 +137,14 @@ public:
     /// from the tiles that hold them. `mine`: this rank's tile, owned().width ×
     /// owned().height values, row-major. Opens with the failure agreement
     /// (throws PeerFailed).
-    virtual std::vector<float> fetch(const float* mine, TileRect want) = 0;
+    std::vector<float> fetch(const float* mine, TileRect want) {
+        return fetch_samples(mine, {want.x0, 1, want.width, -1}, {want.y0, 1, want.height, -1});
+    }
+    /// Collective: fetch() of a lattice: the values at every (columns.at(i),
+    /// rows.at(j)), row-major, columns.size() × rows.size() of them (either
+    /// empty: nothing). Every position must lie inside the grid. For a level
+    /// of detail that covers a large area at a fraction of its samples.
+    virtual std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) = 0;
     /// Collective: the sum of every rank's `value`, added in rank order on
     /// every rank (the same bits everywhere; exact for integers below 2^53).
     /// Opens with the failure agreement.

@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <functional>
 #include <future>
 #include <type_traits>
 #include <optional>
@@ -52,6 +53,118 @@ void write_span(std::ostream& out, std::span<const T> data) {
 void write_zeros(std::ostream& out, std::size_t n) {
     static const char zeros[4] = {0, 0, 0, 0};
     out.write(zeros, std::streamsize(n));
+}
+
+int add_view(tinygltf::Model& model, std::size_t off, std::size_t len, int target_kind) {
+    tinygltf::BufferView bv;
+    bv.buffer = 0;
+    bv.byteOffset = off;
+    bv.byteLength = len;
+    bv.target = target_kind;
+    model.bufferViews.push_back(bv);
+    return int(model.bufferViews.size() - 1);
+}
+
+int add_accessor(tinygltf::Model& model, int view, int component, int type, std::size_t count, bool normalized) {
+    tinygltf::Accessor a;
+    a.bufferView = view;
+    a.byteOffset = 0;
+    a.componentType = component;
+    a.type = type;
+    a.count = count;
+    a.normalized = normalized;
+    model.accessors.push_back(a);
+    return int(model.accessors.size() - 1);
+}
+
+/// Material 0: the PNG at [png_offset, + png_size) of the buffer as base colour, rough dielectric.
+void add_splat_material(tinygltf::Model& model, std::size_t png_offset, std::size_t png_size) {
+    tinygltf::Image image;
+    image.name = "splat";
+    image.mimeType = "image/png";
+    image.bufferView = add_view(model, png_offset, png_size, 0);
+    model.images.push_back(image);
+    tinygltf::Sampler sampler;
+    sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+    sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+    sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+    model.samplers.push_back(sampler);
+    tinygltf::Texture texture;
+    texture.sampler = 0;
+    texture.source = 0;
+    model.textures.push_back(texture);
+    tinygltf::Material material;
+    material.name = "terrain";
+    material.pbrMetallicRoughness.baseColorTexture.index = 0;
+    material.pbrMetallicRoughness.metallicFactor = 0.0;
+    material.pbrMetallicRoughness.roughnessFactor = 1.0;
+    model.materials.push_back(material);
+}
+
+/// Write `model` to `target` (.glb, or .gltf with its buffer beside it as <stem>.bin), atomically. The
+/// model's one buffer is left empty: its buffer_length bytes are streamed by `payload_writer` (see the
+/// top of this file).
+void write_document(const tinygltf::Model& model, std::size_t buffer_length, const fs::path& target,
+                    const std::function<void(std::ostream&)>& payload_writer) {
+    const bool binary = target.extension() == ".glb";
+    // Serialise with tinygltf (as a GLB without payload) and take its JSON chunk.
+    std::string json;
+    {
+        tinygltf::TinyGLTF writer;
+        std::ostringstream s(std::ios::binary);
+        tinygltf::Model copy = model;  // WriteGltfSceneToStream takes a non-const model
+        if (!writer.WriteGltfSceneToStream(&copy, s, false, true))
+            throw Error("tinygltf could not serialise the glTF document");
+        const std::string glb = std::move(s).str();
+        std::uint32_t json_length = 0;
+        if (glb.size() < 20) throw Error("tinygltf wrote a truncated GLB header");
+        std::memcpy(&json_length, glb.data() + 12, 4);
+        json = glb.substr(20, json_length);
+        while (!json.empty() && json.back() == ' ') json.pop_back();
+    }
+    const std::string placeholder = "\"buffers\":[{\"byteLength\":0}]";
+    const auto at = json.find(placeholder);
+    if (at == std::string::npos) throw Error("internal error: tinygltf's JSON has no empty buffer to fill in");
+    const fs::path bin_target = fs::path(target).replace_extension(".bin");
+    std::string buffer_json = "\"buffers\":[{\"byteLength\":" + std::to_string(buffer_length);
+    if (!binary) buffer_json += ",\"uri\":\"" + bin_target.filename().string() + "\"";
+    buffer_json += "}]";
+    json.replace(at, placeholder.size(), buffer_json);
+
+    AtomicFile main_file(target);
+    std::optional<AtomicFile> bin_file;
+    std::ostream* payload = &main_file.stream();
+    if (binary) {
+        // GLB: 12-byte header, JSON chunk (padded with spaces), BIN chunk (padded with zeros).
+        const std::size_t json_padded = align4(json.size());
+        json.append(json_padded - json.size(), ' ');
+        const std::size_t total = 12 + 8 + json_padded + 8 + buffer_length;
+        if (total > 0xffffffffu)
+            throw BadInput("the GLB would be " + std::to_string(total >> 20) +
+                           " MiB, over the format's 4 GiB limit; use decimate=2 or more");
+        std::string head;
+        put_u32(head, 0x46546C67);  // "glTF"
+        put_u32(head, 2);
+        put_u32(head, std::uint32_t(total));
+        put_u32(head, std::uint32_t(json_padded));
+        put_u32(head, 0x4E4F534A);  // "JSON"
+        head += json;
+        put_u32(head, std::uint32_t(buffer_length));
+        put_u32(head, 0x004E4942);  // "BIN\0"
+        main_file.stream().write(head.data(), std::streamsize(head.size()));
+    } else {
+        main_file.stream().write(json.data(), std::streamsize(json.size()));
+        bin_file.emplace(bin_target);
+        payload = &bin_file->stream();
+    }
+    payload_writer(*payload);
+    if (bin_file) {
+        AtomicFile* files[] = {&*bin_file, &main_file};  // the .bin in place before the .gltf names it
+        commit_all(files);
+    } else {
+        main_file.commit();
+    }
 }
 
 }  // namespace
@@ -99,51 +212,7 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     model.asset.generator = "orogen export:gltf";
     model.buffers.emplace_back();  // empty here; its length is set in the JSON below
 
-    auto add_view = [&](std::size_t off, std::size_t len, int target_kind) {
-        tinygltf::BufferView bv;
-        bv.buffer = 0;
-        bv.byteOffset = off;
-        bv.byteLength = len;
-        bv.target = target_kind;
-        model.bufferViews.push_back(bv);
-        return int(model.bufferViews.size() - 1);
-    };
-    auto add_accessor = [&](int view, int component, int type, std::size_t count, bool normalized) {
-        tinygltf::Accessor a;
-        a.bufferView = view;
-        a.byteOffset = 0;
-        a.componentType = component;
-        a.type = type;
-        a.count = count;
-        a.normalized = normalized;
-        model.accessors.push_back(a);
-        return int(model.accessors.size() - 1);
-    };
-
-    // Material: the baked splat colour as base colour, rough dielectric.
-    {
-        tinygltf::Image image;
-        image.name = "splat";
-        image.mimeType = "image/png";
-        image.bufferView = add_view(png_offset, png.size(), 0);
-        model.images.push_back(image);
-        tinygltf::Sampler sampler;
-        sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-        sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-        sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-        sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-        model.samplers.push_back(sampler);
-        tinygltf::Texture texture;
-        texture.sampler = 0;
-        texture.source = 0;
-        model.textures.push_back(texture);
-        tinygltf::Material material;
-        material.name = "terrain";
-        material.pbrMetallicRoughness.baseColorTexture.index = 0;
-        material.pbrMetallicRoughness.metallicFactor = 0.0;
-        material.pbrMetallicRoughness.roughnessFactor = 1.0;
-        model.materials.push_back(material);
-    }
+    add_splat_material(model, png_offset, png.size());
 
     tinygltf::Scene scene;
     scene.name = "terrain";
@@ -152,16 +221,16 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
         const auto& v = views[i];
         const auto bounds = terrain::chunk_bounds(mesh, mesh.chunks[i]);
-        const int pos = add_accessor(add_view(v.positions, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+        const int pos = add_accessor(model, add_view(model, v.positions, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
                                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
         model.accessors[std::size_t(pos)].minValues.assign(bounds.min.begin(), bounds.min.end());
         model.accessors[std::size_t(pos)].maxValues.assign(bounds.max.begin(), bounds.max.end());
-        const int nrm = add_accessor(add_view(v.normals, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+        const int nrm = add_accessor(model, add_view(model, v.normals, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
                                      TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
-        const int uv = add_accessor(add_view(v.texcoords, v.vertex_count * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+        const int uv = add_accessor(model, add_view(model, v.texcoords, v.vertex_count * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
                                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, v.vertex_count, true);
         const int idx = add_accessor(
-            add_view(v.indices, v.index_count * (v.index16 ? 2 : 4), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+            model, add_view(model, v.indices, v.index_count * (v.index16 ? 2 : 4), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
             v.index16 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
             TINYGLTF_TYPE_SCALAR, v.index_count, false);
         tinygltf::Primitive prim;
@@ -185,57 +254,6 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     }
     model.scenes.push_back(scene);
     model.defaultScene = 0;
-
-    // Serialise with tinygltf (as a GLB without payload) and take its JSON chunk.
-    std::string json;
-    {
-        tinygltf::TinyGLTF writer;
-        std::ostringstream s(std::ios::binary);
-        if (!writer.WriteGltfSceneToStream(&model, s, false, true))
-            throw Error("tinygltf could not serialise the glTF document");
-        const std::string glb = std::move(s).str();
-        std::uint32_t json_length = 0;
-        if (glb.size() < 20) throw Error("tinygltf wrote a truncated GLB header");
-        std::memcpy(&json_length, glb.data() + 12, 4);
-        json = glb.substr(20, json_length);
-        while (!json.empty() && json.back() == ' ') json.pop_back();
-    }
-    const std::string placeholder = "\"buffers\":[{\"byteLength\":0}]";
-    const auto at = json.find(placeholder);
-    if (at == std::string::npos) throw Error("internal error: tinygltf's JSON has no empty buffer to fill in");
-    const fs::path bin_target = fs::path(target).replace_extension(".bin");
-    std::string buffer_json = "\"buffers\":[{\"byteLength\":" + std::to_string(buffer_length);
-    if (!binary) buffer_json += ",\"uri\":\"" + bin_target.filename().string() + "\"";
-    buffer_json += "}]";
-    json.replace(at, placeholder.size(), buffer_json);
-
-    // ------------------------------------------------------------ files
-    AtomicFile main_file(target);
-    std::optional<AtomicFile> bin_file;
-    std::ostream* payload = &main_file.stream();
-    if (binary) {
-        // GLB: 12-byte header, JSON chunk (padded with spaces), BIN chunk (padded with zeros).
-        const std::size_t json_padded = align4(json.size());
-        json.append(json_padded - json.size(), ' ');
-        const std::size_t total = 12 + 8 + json_padded + 8 + buffer_length;
-        if (total > 0xffffffffu)
-            throw BadInput("the GLB would be " + std::to_string(total >> 20) +
-                           " MiB, over the format's 4 GiB limit; use decimate=2 or more");
-        std::string head;
-        put_u32(head, 0x46546C67);  // "glTF"
-        put_u32(head, 2);
-        put_u32(head, std::uint32_t(total));
-        put_u32(head, std::uint32_t(json_padded));
-        put_u32(head, 0x4E4F534A);  // "JSON"
-        head += json;
-        put_u32(head, std::uint32_t(buffer_length));
-        put_u32(head, 0x004E4942);  // "BIN\0"
-        main_file.stream().write(head.data(), std::streamsize(head.size()));
-    } else {
-        main_file.stream().write(json.data(), std::streamsize(json.size()));
-        bin_file.emplace(bin_target);
-        payload = &bin_file->stream();
-    }
 
     Summary summary;
     summary.meshes = mesh.chunks.size();
@@ -262,24 +280,86 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
             terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
         return bytes;
     };
-    std::future<std::vector<std::uint8_t>> next = std::async(std::launch::async, build, 0);
-    for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
-        std::vector<std::uint8_t> bytes = next.get();
-        if (i + 1 < mesh.chunks.size()) next = std::async(std::launch::async, build, i + 1);
-        summary.vertices += views[i].vertex_count;
-        summary.triangles += mesh.chunks[i].triangle_count();
-        write_span<std::uint8_t>(*payload, bytes);
-    }
-    payload->write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
-    write_zeros(*payload, buffer_length - png_offset - png.size());
-
-    if (bin_file) {
-        AtomicFile* files[] = {&*bin_file, &main_file};  // the .bin in place before the .gltf names it
-        commit_all(files);
-    } else {
-        main_file.commit();
-    }
+    write_document(model, buffer_length, target, [&](std::ostream& payload) {
+        std::future<std::vector<std::uint8_t>> next = std::async(std::launch::async, build, 0);
+        for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
+            std::vector<std::uint8_t> bytes = next.get();
+            if (i + 1 < mesh.chunks.size()) next = std::async(std::launch::async, build, i + 1);
+            summary.vertices += views[i].vertex_count;
+            summary.triangles += mesh.chunks[i].triangle_count();
+            write_span<std::uint8_t>(payload, bytes);
+        }
+        payload.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
+        write_zeros(payload, buffer_length - png_offset - png.size());
+    });
     return summary;
+}
+
+std::size_t write_mesh(const MeshData& mesh, std::span<const std::uint8_t> png, std::array<double, 3> translation,
+                       const std::string& name, const fs::path& target) {
+    const std::string ext = target.extension().string();
+    if (ext != ".glb" && ext != ".gltf")
+        throw BadInput("glTF files end in .glb or .gltf; '" + target.filename().string() + "' has another extension");
+    const std::size_t vertices = mesh.positions.size() / 3;
+    if (mesh.normals.size() != 3 * vertices || mesh.texcoords.size() != 2 * vertices || mesh.indices.size() % 3)
+        throw Error("internal error: a mesh whose attributes disagree on its vertex count");
+    const bool index16 = vertices <= terrain::max_16bit_vertices;
+    const std::size_t pos = 0, nrm = pos + vertices * 12, uv = nrm + vertices * 12, idx = uv + vertices * 4;
+    const std::size_t index_bytes = mesh.indices.size() * (index16 ? 2 : 4);
+    const std::size_t png_offset = align4(idx + index_bytes), buffer_length = align4(png_offset + png.size());
+
+    tinygltf::Model model;
+    model.asset.version = "2.0";
+    model.asset.generator = "orogen export:tiles";
+    model.buffers.emplace_back();  // empty here; its length is set by write_document
+    add_splat_material(model, png_offset, png.size());
+    tinygltf::Primitive prim;
+    prim.attributes["POSITION"] =
+        add_accessor(model, add_view(model, pos, vertices * 12, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                     TINYGLTF_TYPE_VEC3, vertices, false);
+    model.accessors.back().minValues.assign(mesh.min.begin(), mesh.min.end());
+    model.accessors.back().maxValues.assign(mesh.max.begin(), mesh.max.end());
+    prim.attributes["NORMAL"] =
+        add_accessor(model, add_view(model, nrm, vertices * 12, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                     TINYGLTF_TYPE_VEC3, vertices, false);
+    prim.attributes["TEXCOORD_0"] =
+        add_accessor(model, add_view(model, uv, vertices * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, vertices, true);
+    prim.indices = add_accessor(model, add_view(model, idx, index_bytes, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                                index16 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
+                                TINYGLTF_TYPE_SCALAR, mesh.indices.size(), false);
+    prim.material = 0;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    tinygltf::Mesh m;
+    m.name = name;
+    m.primitives.push_back(prim);
+    model.meshes.push_back(m);
+    tinygltf::Node node;
+    node.name = name;
+    node.mesh = 0;
+    node.translation.assign(translation.begin(), translation.end());
+    model.nodes.push_back(node);
+    tinygltf::Scene scene;
+    scene.name = name;
+    scene.nodes.push_back(0);
+    model.scenes.push_back(scene);
+    model.defaultScene = 0;
+
+    write_document(model, buffer_length, target, [&](std::ostream& out) {
+        write_span(out, mesh.positions);
+        write_span(out, mesh.normals);
+        write_span(out, mesh.texcoords);
+        if (index16) {
+            std::vector<std::uint16_t> narrow(mesh.indices.begin(), mesh.indices.end());
+            write_span<std::uint16_t>(out, narrow);
+        } else {
+            write_span(out, mesh.indices);
+        }
+        write_zeros(out, png_offset - idx - index_bytes);
+        out.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
+        write_zeros(out, buffer_length - png_offset - png.size());
+    });
+    return buffer_length;
 }
 
 }  // namespace orogen::gltf

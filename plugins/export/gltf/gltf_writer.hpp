@@ -5,8 +5,12 @@
 
 #include <orogen/grid.hpp>
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 
 namespace orogen::gltf {
 
@@ -28,5 +32,18 @@ struct Summary {
 /// Atomic: a failure leaves any existing file untouched. Throws
 /// orogen::BadInput for a bad extension or options, orogen::Error on I/O failure.
 Summary write_gltf(ConstGridView heights, const Options& options, const std::filesystem::path& target);
+
+/// One textured mesh: a chunk of a tiled terrain (export:tiles format=glb).
+struct MeshData {
+    std::span<const float> positions, normals;  ///< 3 per vertex (m; unit)
+    std::span<const std::uint16_t> texcoords;   ///< 2 per vertex, normalised
+    std::span<const std::uint32_t> indices;     ///< 3 per triangle; written 16-bit when the vertices allow
+    std::array<float, 3> min{}, max{};          ///< of the positions, exactly
+};
+
+/// Write `mesh` with the PNG `png` as its base colour to `target` (.glb or .gltf), as one node named
+/// `name` placed at `translation` (m). Atomic. Returns the binary payload's size in bytes.
+std::size_t write_mesh(const MeshData& mesh, std::span<const std::uint8_t> png, std::array<double, 3> translation,
+                       const std::string& name, const std::filesystem::path& target);
 
 }  // namespace orogen::gltf

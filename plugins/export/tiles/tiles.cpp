@@ -9,8 +9,6 @@
 
 namespace orogen::tiles_export {
 
-namespace {
-
 std::string number(double v) {
     char buffer[40];
     std::snprintf(buffer, sizeof buffer, "%.17g", v);
@@ -26,6 +24,8 @@ std::string json_string(const std::string& s) {
     return out + "\"";
 }
 
+namespace {
+
 std::string xml_text(const std::string& s) {
     std::string out;
     for (char c : s) {
@@ -38,7 +38,9 @@ std::string xml_text(const std::string& s) {
     return out;
 }
 
-const char* format_name(Format f) { return f == Format::png16 ? "png16" : f == Format::r16 ? "r16" : "r32"; }
+const char* format_name(Format f) {
+    return f == Format::png16 ? "png16" : f == Format::r16 ? "r16" : f == Format::r32 ? "r32" : "glb";
+}
 
 }  // namespace
 
@@ -46,11 +48,12 @@ Format format_named(const std::string& name) {
     if (name == "png16") return Format::png16;
     if (name == "r16") return Format::r16;
     if (name == "r32") return Format::r32;
-    throw BadInput("export:tiles: format must be png16, r16 or r32, got \"" + name + "\"");
+    if (name == "glb") return Format::glb;
+    throw BadInput("export:tiles: format must be png16, r16, r32 or glb, got \"" + name + "\"");
 }
 
 const char* extension(Format format) {
-    return format == Format::png16 ? ".png" : format == Format::r16 ? ".r16" : ".r32";
+    return format == Format::png16 ? ".png" : format == Format::r16 ? ".r16" : format == Format::r32 ? ".r32" : ".glb";
 }
 
 std::vector<Tile> layout(int width, int height, int tile_size, const std::string& stem, Format format) {

@@ -20,9 +20,14 @@
 
 namespace orogen::tiles_export {
 
-enum class Format { png16, r16, r32 };
-Format format_named(const std::string& name);  ///< "png16", "r16", "r32"; throws orogen::BadInput
-const char* extension(Format format);           ///< ".png", ".r16", ".r32"
+/// glb: the chunked level-of-detail pyramid of lod.hpp, with a 3D Tiles tileset as the index.
+enum class Format { png16, r16, r32, glb };
+Format format_named(const std::string& name);  ///< "png16", "r16", "r32", "glb"; throws orogen::BadInput
+const char* extension(Format format);           ///< ".png", ".r16", ".r32", ".glb"
+
+/// A double as JSON, exactly (%.17g), and a string as a JSON string.
+std::string number(double v);
+std::string json_string(const std::string& s);
 
 /// One tile: its samples (x0, y0) .. (x0 + width − 1, y0 + height − 1) of the whole grid.
 struct Tile {

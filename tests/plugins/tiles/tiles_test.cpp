@@ -1,5 +1,6 @@
 // export:tiles: the layout covers the grid with shared edges; the files the real binary writes read back
 // (orogen's PNG reader, the RAW bytes, GDAL through the VRT) equal the terrain the same run wrote as one .r16.
+#include "lod.hpp"
 #include "tiles.hpp"
 
 #include "orogen_test.hpp"
@@ -10,6 +11,9 @@
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdlib>
+#include <sys/wait.h>
 #include <cstring>
 
 using namespace orogen;
@@ -164,6 +168,164 @@ TEST(TilesCli, BadParametersAreCheckErrorsThatSayWhere) {
                                     std::string("export:tiles(w, path=\"t.json\", format=r32, low=0, high=9)"),
                                     std::string("export:tiles(w, path=\"t.png\")"),
                                     std::string("export:tiles(w, path=\"t.json\", format=tiff)")}) {
+        const auto spec = dir.write("bad.orogen", spec_head + line + "\n");
+        const RunResult r = run_orogen("check " + q(spec));
+        EXPECT_EQ(r.exit_code, 2) << line << "\n" << r.err;
+        EXPECT_NE(r.err.find("bad.orogen:7:"), std::string::npos) << line << "\n" << r.err;
+    }
+}
+
+// ------------------------------------------------------------ format=glb (lod.hpp)
+
+namespace {
+
+/// A rough synthetic terrain, w × h samples.
+std::vector<float> bumpy(int w, int h) {
+    std::vector<float> g(std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            g[std::size_t(y) * std::size_t(w) + std::size_t(x)] =
+                float(40.0 * std::sin(0.37 * x) * std::cos(0.23 * y) + 7.0 * std::sin(1.9 * x + 0.7 * y));
+    return g;
+}
+
+lod::Samples sample(const std::vector<float>& g, int w, AxisSamples cols, AxisSamples rows) {
+    lod::Samples s;
+    for (int i = 0; i < cols.size(); ++i) s.xs.push_back(cols.at(i));
+    for (int j = 0; j < rows.size(); ++j) s.ys.push_back(rows.at(j));
+    for (int y : s.ys)
+        for (int x : s.xs) s.h.push_back(g[std::size_t(y) * std::size_t(w) + std::size_t(x)]);
+    return s;
+}
+
+lod::Mesh mesh_of(const lod::Chunk& c, const std::vector<float>& g, int w, int h, double skirt) {
+    const auto lat = lod::chunk_lattice(c, w, h);
+    return lod::chunk_mesh(c, sample(g, w, lat[0], lat[1]), w, h, 2.0, 1.0, skirt);
+}
+
+}  // namespace
+
+TEST(TilesLod, PyramidHalvesEachLevelUpToOneChunk) {
+    const auto chunks = lod::pyramid(97, 61, 17, "t");
+    ASSERT_EQ(chunks.size(), 24u + 6u + 2u + 1u);
+    EXPECT_EQ(chunks.back().level, 3);
+    EXPECT_EQ(chunks.back().x1, 96);
+    EXPECT_EQ(chunks.back().y1, 60);
+    // Level 0 is the engine tiles of layout().
+    const auto tiles = layout(97, 61, 17, "t", Format::png16);
+    for (std::size_t i = 0; i < tiles.size(); ++i) {
+        EXPECT_EQ(chunks[i].x0, tiles[i].x0);
+        EXPECT_EQ(chunks[i].x1, tiles[i].x0 + tiles[i].width - 1);
+    }
+}
+
+TEST(TilesLod, NeighboursOfOneLevelShareTheirEdgeVerticesAndNormalsBitForBit) {
+    const int w = 97, h = 61;
+    const auto g = bumpy(w, h);
+    const auto chunks = lod::pyramid(w, h, 17, "t");
+    for (int level = 0; level < 2; ++level) {
+        const lod::Chunk *a = nullptr, *b = nullptr;
+        for (const auto& c : chunks)
+            if (c.level == level && c.row == 0 && c.column == 0) a = &c;
+            else if (c.level == level && c.row == 0 && c.column == 1) b = &c;
+        ASSERT_TRUE(a && b);
+        const lod::Mesh ma = mesh_of(*a, g, w, h, 0.0), mb = mesh_of(*b, g, w, h, 0.0);
+        const std::size_t na = std::size_t(std::lround(ma.max[0] / 2.0)) / (std::size_t(1) << level) + 1;
+        const std::size_t nb = std::size_t(std::lround(mb.max[0] / 2.0)) / (std::size_t(1) << level) + 1;
+        const std::size_t rows = ma.vertex_count() / na;
+        ASSERT_EQ(rows, mb.vertex_count() / nb);
+        for (std::size_t r = 0; r < rows; ++r) {
+            const std::size_t ea = r * na + na - 1, wb = r * nb;  // a's east edge, b's west edge
+            for (int k = 0; k < 3; ++k) EXPECT_EQ(ma.normals[3 * ea + std::size_t(k)], mb.normals[3 * wb + std::size_t(k)]);
+            EXPECT_EQ(ma.positions[3 * ea + 1], mb.positions[3 * wb + 1]);
+            EXPECT_EQ(double(ma.positions[3 * ea]) + a->x0 * 2.0, double(mb.positions[3 * wb]) + b->x0 * 2.0);
+        }
+    }
+}
+
+TEST(TilesLod, DeviationBoundsTheCoarseSurfaceAndSkirtsCoverTheCracks) {
+    const int w = 97, h = 61;
+    const auto g = bumpy(w, h);
+    const auto chunks = lod::pyramid(w, h, 17, "t");
+    const int levels = chunks.back().level + 1;
+    for (const auto& c : chunks) {
+        const auto lat = lod::chunk_lattice(c, w, h);
+        const lod::Samples s = sample(g, w, lat[0], lat[1]);
+        const double dev = lod::deviation(c, s, w, h, 1.0);
+        if (c.level == 0) EXPECT_EQ(dev, 0.0);
+        else EXPECT_GT(dev, 0.0) << "a rough terrain loses detail at level " << c.level;
+        // The skirt is at least the gap between the full-resolution edge and any level's edge along it.
+        const auto e = lod::edge_lattices(c, w, h, levels);
+        const double skirt = lod::skirt_depth(c, sample(g, w, e[0][0], e[0][1]), sample(g, w, e[1][0], e[1][1]), w, h,
+                                              levels, 2.0, 1.0);
+        for (int j = 1; j < levels; ++j) {
+            const int st = 1 << j;
+            for (int x = c.x0; x <= c.x1; ++x) {
+                const int xa = std::min(x / st * st, w - 1), xb = std::min(xa + st, w - 1);
+                if (xa == x) continue;
+                const double va = g[std::size_t(c.y0) * w + xa], vb = g[std::size_t(c.y0) * w + xb];
+                const double line = va + (vb - va) * (x - xa) / double(xb - xa);
+                EXPECT_LE(2.0 * std::abs(g[std::size_t(c.y0) * w + x] - line), skirt + 1e-9);
+            }
+        }
+        // The skirt: a copy of every edge vertex, that depth below it.
+        const lod::Mesh m = lod::chunk_mesh(c, s, w, h, 2.0, 1.0, skirt), bare = mesh_of(c, g, w, h, 0.0);
+        ASSERT_GT(m.vertex_count(), bare.vertex_count());
+        for (std::size_t k = bare.vertex_count(); k < m.vertex_count(); ++k) {
+            bool found = false;
+            for (std::size_t v = 0; v < bare.vertex_count() && !found; ++v)
+                found = bare.positions[3 * v] == m.positions[3 * k] && bare.positions[3 * v + 2] == m.positions[3 * k + 2] &&
+                        std::abs(double(bare.positions[3 * v + 1]) - skirt - double(m.positions[3 * k + 1])) < 1e-3;
+            EXPECT_TRUE(found) << "skirt vertex " << k << " of chunk " << c.file;
+        }
+    }
+}
+
+TEST(TilesCli, GlbChunksPassTheKhronosValidatorAndTheTilesetNestsTheLevels) {
+    TempDir dir;
+    const auto spec = dir.write("t.orogen", spec_head + "export:tiles(w, path=\"g/tileset.json\", tile_size=33, "
+                                                        "format=glb, texture=64)\n");
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " --threads 1");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    ASSERT_EQ(run_orogen("run " + q(spec) + " --out " + q(dir / "two") + " --threads 2").exit_code, 0);
+    // 129² in chunks of 33: 4 × 4, 2 × 2, 1.
+    int files = 0;
+    for (const auto& e : fs::directory_iterator(dir / "one/g")) {
+        ++files;
+        EXPECT_EQ(slurp(e.path()), slurp(dir / "two/g" / e.path().filename())) << e.path().filename();
+    }
+    EXPECT_EQ(files, 16 + 4 + 1 + 1);
+    const std::string tileset = slurp(dir / "one/g/tileset.json");
+    EXPECT_NE(tileset.find("\"version\": \"1.1\""), std::string::npos);
+    EXPECT_NE(tileset.find("tileset_l2_x0_y0.glb"), std::string::npos);
+    EXPECT_NE(tileset.find("tileset_l0_x3_y3.glb"), std::string::npos);
+    // Errors shrink towards the leaves: the root's is the first after "root", and every level-0 chunk's is 0.
+    const auto root = tileset.find("\"geometricError\": ", tileset.find("\"root\""));
+    EXPECT_GT(std::stod(tileset.substr(root + 18)), 0.0);
+    std::size_t zeros = 0;
+    for (auto at = tileset.find("\"geometricError\": 0,"); at != std::string::npos;
+         at = tileset.find("\"geometricError\": 0,", at + 1))
+        ++zeros;
+    EXPECT_EQ(zeros, 16u);
+    const fs::path tool = fs::path(OROGEN_SOURCE_DIR) / "tools" / "gltf-validate";
+    if (std::system("node --version >/dev/null 2>&1") != 0 ||
+        !fs::exists(fs::path(OROGEN_SOURCE_DIR) / "tools/node_modules/gltf-validator"))
+        GTEST_SKIP() << "SKIPPED glTF validation: node or the gltf-validator npm package is missing (npm install --prefix tools)";
+    for (const char* f : {"tileset_l0_x0_y0.glb", "tileset_l0_x3_y2.glb", "tileset_l1_x1_y0.glb", "tileset_l2_x0_y0.glb"}) {
+        const fs::path report = dir / (std::string(f) + ".report");
+        const int status = std::system(("node " + q(tool) + " " + q(dir / "one/g" / f) + " >" + q(report) + " 2>&1").c_str());
+        const std::string text = slurp(report);
+        EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << f << "\n" << text;
+        EXPECT_NE(text.find("errors 0 warnings 0 infos 0"), std::string::npos) << f << "\n" << text;
+    }
+}
+
+TEST(TilesCli, RasterParametersWithGlbAreCheckErrors) {
+    TempDir dir;
+    for (const std::string& line : {std::string("export:tiles(w, path=\"t.json\", format=glb, low=0, high=9)"),
+                                    std::string("export:tiles(w, path=\"t.json\", format=glb, vrt=true)"),
+                                    std::string("export:tiles(w, path=\"t.json\", skirts=false)"),
+                                    std::string("export:tiles(w, path=\"t.json\", format=glb, scale=0)")}) {
         const auto spec = dir.write("bad.orogen", spec_head + line + "\n");
         const RunResult r = run_orogen("check " + q(spec));
         EXPECT_EQ(r.exit_code, 2) << line << "\n" << r.err;
