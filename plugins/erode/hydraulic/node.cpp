@@ -59,16 +59,6 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
             std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
                       held + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox));
     };
-    // Two states (double-buffered): terrain, water, sediment each. The tile's
-    // water and sediment layers are dropped meanwhile (memory about the
-    // single process's per vertex); its heights stay, as `before`.
-    std::vector<float> storage[6];
-    for (auto& g : storage) g.assign(n, 0.0f);
-    auto grid = [&](int k) { return GridView{storage[k].data(), grown.width, grown.height, cell}; };
-    hydraulic::State a{grid(0), grid(1), grid(2)}, b{grid(3), grid(4), grid(5)};
-    to_grown(hm.heights().data(), a.height.data);
-    to_grown(std::as_const(hm).layer("water").data, a.water.data);
-    to_grown(std::as_const(hm).layer("sediment").data, a.sediment.data);
     std::vector<float> held_layer;
     if (layer) {  // the hardness of the halo too, once: it does not change
         held_layer.assign(n, 0.0f);
@@ -76,8 +66,28 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
         tiles.exchange_halo({held_layer.data(), grown.width, grown.height, cell}, kTileHalo);
     }
     const float* hard = layer ? held_layer.data() : nullptr;
-    hm.remove_layer("water");  // after the hardness layer's copy (it may be one of them)
-    hm.remove_layer("sediment");
+    // Two states (double-buffered): terrain, water, sediment each, the tile
+    // grown by the halo. The tile's water and sediment layers (an input's, or
+    // none: zero) move into the first state one at a time, each dropped as
+    // soon as it is copied, after the hardness layer's copy (it may be one of
+    // them): the peak is the tile's heights (kept as `before`) and `eroded`
+    // beside the six grown grids, as one process holds 8 whole grids. Filling
+    // all six first and dropping the two layers after was two grids more per
+    // rank (docs/benchmarks.md, "Tiled Olsen hydraulic erosion").
+    std::vector<float> storage[6];
+    auto grid = [&](int k) { return GridView{storage[k].data(), grown.width, grown.height, cell}; };
+    storage[0].assign(n, 0.0f);
+    to_grown(hm.heights().data(), storage[0].data());
+    for (int k : {1, 2}) {
+        const char* name = k == 1 ? "water" : "sediment";
+        storage[k].assign(n, 0.0f);
+        if (hm.has_layer(name)) {
+            to_grown(std::as_const(hm).layer(name).data, storage[k].data());
+            hm.remove_layer(name);
+        }
+    }
+    for (int k : {3, 4, 5}) storage[k].assign(n, 0.0f);
+    hydraulic::State a{grid(0), grid(1), grid(2)}, b{grid(3), grid(4), grid(5)};
     using clock = std::chrono::steady_clock;
     clock::duration exchanging{}, sweeping{};  // for the info line (docs/benchmarks.md)
     const double waited_before = tiles.seconds_waiting();
@@ -155,17 +165,18 @@ NodeOutputs run(NodeContext& ctx) {
         s.hardness = hydraulic::Hardness::layer;
         if (!hm->has_layer(hardness)) throw BadInput("hardness: the input has no layer '" + hardness + "'");
     }
+    const std::int64_t iterations = ctx.integer("iterations");
+    if (Tiling* tiles = ctx.tiling()) {
+        hm->layer("eroded", 0.0f);
+        if (s.hardness == hydraulic::Hardness::layer) layer = std::as_const(*hm).layer(hardness).data;
+        run_tiled(ctx, *tiles, *hm, s, layer, iterations);  // takes the water and sediment layers itself
+        return hm;
+    }
     // An input that already carries water and sediment continues from them.
     GridView water = hm->layer("water", 0.0f);
     GridView sediment = hm->layer("sediment", 0.0f);
     GridView eroded = hm->layer("eroded", 0.0f);
     if (s.hardness == hydraulic::Hardness::layer) layer = std::as_const(*hm).layer(hardness).data;
-
-    const std::int64_t iterations = ctx.integer("iterations");
-    if (Tiling* tiles = ctx.tiling()) {
-        run_tiled(ctx, *tiles, *hm, s, layer, iterations);
-        return hm;
-    }
     const std::vector<float> before = hm->heights();
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0);  // time = step count
     lapse.record(0, *hm);
