@@ -242,19 +242,38 @@ void TiledRun::max_all(float* values, int count) {
 }
 
 void TiledRun::carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) {
-    const int c = rank_ % split_.cols;
-    const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
-    const int rows = per_row > 0 ? int(carry.size() / std::size_t(per_row)) : 0;
-    // Blocks of 64 rows: small enough that the east neighbour starts soon, large
-    // enough that a 4096-row tile sends 64 messages (a few latencies) a call.
+    this->carry(Toward::east, carry, per_row, advance);
+}
+
+void TiledRun::carry(Toward toward, std::span<double> values, int per_line, const std::function<void(int, int)>& advance) {
+    const int c = rank_ % split_.cols, r = rank_ / split_.cols;
+    int from = -1, to = -1;  // upstream and downstream neighbours
+    switch (toward) {
+        case Toward::east:
+            from = c > 0 ? rank_ - 1 : -1, to = c + 1 < split_.cols ? rank_ + 1 : -1;
+            break;
+        case Toward::west:
+            from = c + 1 < split_.cols ? rank_ + 1 : -1, to = c > 0 ? rank_ - 1 : -1;
+            break;
+        case Toward::south:
+            from = r > 0 ? rank_ - split_.cols : -1, to = r + 1 < split_.rows ? rank_ + split_.cols : -1;
+            break;
+        case Toward::north:
+            from = r + 1 < split_.rows ? rank_ + split_.cols : -1, to = r > 0 ? rank_ - split_.cols : -1;
+            break;
+    }
+    const int lines = per_line > 0 ? int(values.size() / std::size_t(per_line)) : 0;
+    // Blocks of 64 lines: small enough that the downstream neighbour starts soon, large
+    // enough that a 4096-line tile sends 64 messages (a few latencies) a call.
     constexpr int kBlock = 64;
-    for (int first = 0; first < rows; first += kBlock) {
-        const int count = std::min(kBlock, rows - first);
-        double* block = carry.data() + std::size_t(first) * std::size_t(per_row);
-        const std::size_t bytes = std::size_t(count) * std::size_t(per_row) * sizeof(double);
-        if (west >= 0) mpi::recv(block, bytes, west, kTagCarry);
+    const int tag = kTagCarry + 1 + int(toward);  // one tag per direction: a west carry never meets an east one
+    for (int first = 0; first < lines; first += kBlock) {
+        const int count = std::min(kBlock, lines - first);
+        double* block = values.data() + std::size_t(first) * std::size_t(per_line);
+        const std::size_t bytes = std::size_t(count) * std::size_t(per_line) * sizeof(double);
+        if (from >= 0) mpi::recv(block, bytes, from, tag);
         advance(first, count);
-        if (east >= 0) mpi::send(block, bytes, east, kTagCarry);
+        if (to >= 0) mpi::send(block, bytes, to, tag);
     }
 }
 

@@ -68,6 +68,8 @@ public:
     void exchange_halos(std::span<const GridView> held, int halo) override;
     void max_all(float* values, int count) override;
     void carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) override;
+    void carry(Toward toward, std::span<double> values, int per_line,
+               const std::function<void(int, int)>& advance) override;
     std::vector<double> gather_rows(std::span<const double> mine, int per_row) override;
     double seconds_waiting() const override { return waiting_; }
     std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) override;

@@ -157,6 +157,28 @@ public:
     /// Opens with the failure agreement, so rank 0 failing before the call
     /// ends the others with PeerFailed rather than a hang.
     virtual void share_from_rank0(std::string& bytes) = 0;
+
+    // For line solvers whose recurrence runs across the whole grid
+    // (erode:diffusion's tridiagonal sweeps).
+
+    /// Which way carry() goes: along each row of tiles (east: from the west
+    /// neighbour to the east one; west: the reverse), or along each column of
+    /// tiles (south: from the north neighbour to the south one; north: the
+    /// reverse).
+    enum class Toward { east, west, south, north };
+    /// Collective, along each row (east, west) or column (south, north) of
+    /// tiles: carry_east() in any of the four directions. `values` holds
+    /// `per_line` values for each line of this tile: its rows going east or
+    /// west, its columns going south or north. They come in from the upstream
+    /// neighbour (the first tile keeps what the caller put there),
+    /// `advance(first, count)` carries lines [first, first + count) over this
+    /// tile, and they go on downstream, in blocks of lines so that neighbours
+    /// overlap. A Thomas solve along whole rows is a forward carry east (the
+    /// eliminated coefficients) and a backward one west (the solution); with an
+    /// advance that swaps what came in for the tile's own edge, a carry is also
+    /// an edge exchange in one direction. Same caveat as carry_east().
+    virtual void carry(Toward toward, std::span<double> values, int per_line,
+                       const std::function<void(int first, int count)>& advance) = 0;
 };
 
 }  // namespace orogen

@@ -28,7 +28,10 @@
 // at or beyond Sc stay finite.
 #pragma once
 
+#include <orogen/tiles.hpp>
+
 #include <cstddef>
+#include <functional>
 #include <vector>
 
 namespace orogen::diffusion {
@@ -53,29 +56,53 @@ struct Settings {
     double max_factor = 100.0;
 };
 
-/// Diffuses a width × height grid of heights (double, row-major, row 0 = north).
+/// Diffuses a width × height grid of heights (double, row-major, row 0 = north),
+/// or one rank's tile of it in a tiled run (orogen/tiles.hpp).
 /// Holds the scratch memory, so one Solver steps a grid many times without allocating.
 class Solver {
 public:
     Solver(int width, int height, double cell, const Settings& settings);
+    /// This rank's tile of a tiled run: step() takes the tile's heights
+    /// (owned().width × owned().height) and leaves there the bits the whole
+    /// grid's solver gives on them. The sweeps' recurrences run across the
+    /// tiles as Tiling::carry() chains (the eliminated coefficients one way,
+    /// the solution back), and the edges a stencil reads come from the
+    /// neighbours the same way, so step() is collective: every rank calls it
+    /// with the same dt.
+    Solver(Tiling& tiles, double cell, const Settings& settings);
 
     /// One step of `dt` (the time unit of D) on `heights` in place. Same bits
-    /// for any thread count (each row and each column is solved by one thread).
+    /// for any thread count (each row and each column is solved by one thread)
+    /// and any split into tiles.
     void step(double* heights, double dt);
 
-    int width() const { return width_; }
-    int height() const { return height_; }
+    int width() const { return tw_; }
+    int height() const { return th_; }
 
 private:
     void linear_step(double* h, double dt);
     void nonlinear_step(double* h, double dt);
+    /// Tiling::carry() over this solver's tile; with no tiling, the one tile:
+    /// `advance` over every line at once.
+    void carry(Tiling::Toward toward, std::vector<double>& values, int per_line,
+               const std::function<void(int first, int count)>& advance);
+    /// The rows just north and south of the tile (north_, south_) from `g` (the tile's values) on the
+    /// neighbours; only where such a row exists in the whole grid are they read.
+    void edge_rows(const double* g);
+    /// The columns just west and east of the tile (west_, east_), likewise.
+    void edge_columns(const double* g);
 
-    int width_, height_;
+    Tiling* tiles_ = nullptr;
+    int W_, H_;    // the whole grid, vertices
+    int x0_, y0_;  // the tile's first vertex in it
+    int tw_, th_;  // the tile
     double cell_;
     Settings settings_;
-    std::vector<double> scratch_;  // h* between the two sweeps
-    std::vector<double> scratch2_;  // column-sweep forward values / nonlinear coefficients
-    std::vector<double> kx_, ky_;   // nonlinear: per-link diffusivity factors
+    std::vector<double> scratch_;   // h* between the two sweeps
+    std::vector<double> scratch2_;  // nonlinear: the sweeps' eliminated coefficients c'
+    std::vector<double> kx_, ky_;   // nonlinear: per-link diffusivity factors (see nonlinear_step)
+    std::vector<double> carry_;     // the lines' carried values
+    std::vector<double> north_, south_, west_, east_;  // the neighbours' edge lines
 };
 
 /// Σ heights over a grid (fixed order: the same double every time).

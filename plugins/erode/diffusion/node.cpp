@@ -5,6 +5,7 @@
 #include <orogen/plugin.hpp>
 #include <orogen/timelapse.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <sstream>
@@ -48,7 +49,20 @@ NodeOutputs run(NodeContext& ctx) {
     const auto steps = std::int64_t(std::ceil(years / dt * (1.0 - 1e-12)));
     std::vector<double> h(hm->heights().begin(), hm->heights().end());
     const std::vector<float> before = hm->heights();
-    diffusion::Solver solver(hm->width(), hm->height(), hm->cell(), s);
+    // In a tiled run (mpirun) the heightmap is this rank's tile and the solver sweeps across the tiles
+    // (diffusion.hpp): the same bits as one process, the tile's share of the memory.
+    Tiling* tiles = ctx.tiling();
+    diffusion::Solver solver = tiles ? diffusion::Solver(*tiles, hm->cell(), s)
+                                     : diffusion::Solver(hm->width(), hm->height(), hm->cell(), s);
+    // A sample's index in the whole grid, for the messages.
+    auto sample = [&](std::size_t k) {
+        if (!tiles) return std::int64_t(k);
+        const TileRect own = tiles->owned();
+        const auto x = std::int64_t(k % std::size_t(own.width)), y = std::int64_t(k / std::size_t(own.width));
+        return (own.y0 + y) * tiles->grid_width() + own.x0 + x;
+    };
+    using clock = std::chrono::steady_clock;
+    const auto started = clock::now();
     const std::int64_t every = ctx.integer("timelapse_every");
     Timelapse lapse(every, dt * 31'557'600.0);  // the series' clock is in seconds (Julian years)
     lapse.record(0, *hm);
@@ -64,7 +78,7 @@ NodeOutputs run(NodeContext& ctx) {
             for (std::size_t k = 0; k < h.size(); ++k)
                 if (!std::isfinite(h[k])) {
                     std::ostringstream msg;
-                    msg << "non-finite height (" << h[k] << ") at sample " << k << " after step " << i
+                    msg << "non-finite height (" << h[k] << ") at sample " << sample(k) << " after step " << i
                         << "; the simulation became unstable";
                     throw Error(msg.str());
                 }
@@ -78,6 +92,12 @@ NodeOutputs run(NodeContext& ctx) {
     for (std::size_t k = 0; k < out.size(); ++k) eroded.data[k] += out[k] - before[k];
     std::ostringstream msg;
     msg << steps << " steps of " << dt << " yr, D = " << s.diffusivity << " m²/yr";
+    if (tiles) {
+        const TileRect own = tiles->owned();
+        msg << "; rank " << tiles->rank() << " of " << tiles->ranks() << ": tile " << own.width << "x" << own.height
+            << " at (" << own.x0 << ", " << own.y0 << "), "
+            << std::chrono::duration<double>(clock::now() - started).count() << " s in the sweeps";
+    }
     ctx.info(msg.str());
     lapse.finish(steps, *hm);
     NodeOutputs result(hm);
@@ -137,6 +157,9 @@ OROGEN_PLUGIN("erode-diffusion", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"eroded"},
+        // Tiled under mpirun: the sweeps carry their recurrences across the tiles (Tiling::carry) and read one
+        // vertex of each neighbour's edge.
+        .tile_halo = 1,
         .check = check,
         .run = run,
     });
