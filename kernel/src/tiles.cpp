@@ -140,7 +140,7 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
                             std::to_string(narrow ? split.smallest_width() : split.smallest_height()) + " " +
                             (narrow ? "wide" : "high") + "; use fewer " + (narrow ? "columns" : "rows") +
                             " (--tiles), fewer ranks or a larger grid");
-        if (auto it = node.params.find(timelapse_param().name); it != node.params.end())
+        if (auto it = node.params.find(timelapse_param().name); it != node.params.end() && !node.node->tiled_timelapse)
             if (const auto* every = std::get_if<std::int64_t>(&it->second); every && *every > 0)
                 diags.error(node.where, who + ": time-lapses are not recorded in a tiled run yet; set " +
                                             timelapse_param().name + "=0 or run without mpirun");

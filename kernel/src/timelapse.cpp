@@ -50,6 +50,9 @@ void check_timelapse(CheckContext& ctx, std::int64_t steps) {
 
 Timelapse::Timelapse(std::int64_t every, double seconds_per_step) : every_(every), seconds_per_step_(seconds_per_step) {}
 
+Timelapse::Timelapse(std::int64_t every, double seconds_per_step, Tiling& tiles)
+    : every_(every), tiles_(&tiles), seconds_per_step_(seconds_per_step) {}
+
 namespace {
 const float* water_of(const Heightmap& terrain) {
     return terrain.has_layer("water") ? terrain.layer("water").data : nullptr;
@@ -59,20 +62,44 @@ const float* water_of(const Heightmap& terrain) {
 void Timelapse::record(std::int64_t step, const Heightmap& terrain) { record(step, terrain.view(), water_of(terrain)); }
 
 void Timelapse::record(std::int64_t step, ConstGridView heights, const float* water) {
-    if (!enabled()) return;
-    if (last_ < 0 || step / every_ > last_ / every_) take(step, heights, water);
+    if (due(step)) take(step, heights, water);
+}
+
+void Timelapse::record(std::int64_t step, ConstGridView held, const float* water, int x0, int y0) {
+    if (due(step)) take(step, held, water, x0, y0);
 }
 
 void Timelapse::finish(std::int64_t step, const Heightmap& terrain) {
     if (enabled() && step != last_) take(step, terrain.view(), water_of(terrain));
 }
 
-void Timelapse::take(std::int64_t step, ConstGridView heights, const float* water) {
+void Timelapse::take(std::int64_t step, ConstGridView heights, const float* water, int x0, int y0) {
+    last_ = step;
+    if (tiles_) {  // the tile's part of `heights` (and `water`), gathered into a whole-grid frame on rank 0
+        const TileRect own = tiles_->owned();
+        const bool root = tiles_->rank() == 0;
+        const TileRect want = root ? TileRect{0, 0, tiles_->grid_width(), tiles_->grid_height()} : TileRect{};
+        std::vector<float> mine(std::size_t(own.width) * std::size_t(own.height));
+        auto gather = [&](const float* held) {
+            for (int y = 0; y < own.height; ++y)
+                std::copy_n(held + std::size_t(y + y0) * std::size_t(heights.width) + std::size_t(x0), own.width,
+                            mine.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(own.width)));
+            return tiles_->fetch(mine.data(), want);
+        };
+        std::vector<float> whole_heights = gather(heights.data), whole_water;
+        if (water) whole_water = gather(water);  // every rank has the layer or none does (the same node)
+        if (!root) return;
+        auto frame = std::make_shared<Heightmap>(want.width, want.height, heights.cell);
+        frame->heights() = std::move(whole_heights);
+        if (water) frame->set_layer("water", std::move(whole_water));
+        times_.push_back(double(step) * seconds_per_step_);
+        frames_.push_back(Value(std::move(frame)));
+        return;
+    }
     auto frame = std::make_shared<Heightmap>(heights.width, heights.height, heights.cell);
     const std::size_t n = frame->size();
     std::copy(heights.data, heights.data + n, frame->heights().begin());
     if (water) std::copy(water, water + n, frame->layer("water").data);
-    last_ = step;
     times_.push_back(double(step) * seconds_per_step_);
     frames_.push_back(Value(std::move(frame)));
 }

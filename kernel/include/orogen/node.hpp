@@ -292,6 +292,11 @@ struct NodeDescriptor {
     std::function<NodeOutputs(NodeContext&)> run;
     /// Whether its result may come from the cache (plugin API 3).
     CachePolicy cache = CachePolicy::store;
+    /// A tiled node (tile_halo >= 0) that records its time-lapse under mpirun
+    /// too (a Timelapse made with the Tiling: rank 0 gathers the frames). If
+    /// false, the kernel refuses timelapse_every > 0 in a tiled run at check
+    /// time (plugin API 4).
+    bool tiled_timelapse = false;
 
     std::string qualified_name() const { return kind + ":" + name; }
     const Param* find_param(std::string_view n) const;

@@ -27,7 +27,8 @@
 /// Bumped whenever a public header changes in a way that breaks plugins built
 /// against the previous one (layout of a shared type, a virtual function...).
 /// 3: NodeDescriptor::cache (the node cache), NodeDescriptor::tile_halo and NodeContext::tiling() (MPI tiles).
-#define OROGEN_PLUGIN_API_VERSION 3
+/// 4: NodeDescriptor::tiled_timelapse, Timelapse's tiled constructor (its layout), Tiling::carry.
+#define OROGEN_PLUGIN_API_VERSION 4
 
 namespace orogen {
 

@@ -39,6 +39,12 @@ public:
     /// `every` steps between snapshots (0: records nothing); a step lasts
     /// `seconds_per_step` of the series' clock (1 for automata that count steps).
     Timelapse(std::int64_t every, double seconds_per_step);
+    /// In a tiled run (orogen/tiles.hpp): record() and finish() take this
+    /// rank's tile and are collective (every rank calls them with the same
+    /// steps, which the snapshots' choice depends on only); rank 0 gathers each
+    /// snapshot of the whole grid and holds the series, the other ranks hold
+    /// none. The frames are the bytes one process records.
+    Timelapse(std::int64_t every, double seconds_per_step, Tiling& tiles);
 
     bool enabled() const { return every_ > 0; }
     /// Records `terrain` if `step` is 0 or has crossed a multiple of `every`
@@ -48,6 +54,11 @@ public:
     /// The same from views: heights and an optional water layer of the same size
     /// (for solvers whose current state lives in their own buffers).
     void record(std::int64_t step, ConstGridView heights, const float* water = nullptr);
+    /// The same from grids that hold the tile with a margin (a solver's grown
+    /// tile): the tile's first vertex at (x0, y0) of `held` (and of `water`).
+    void record(std::int64_t step, ConstGridView held, const float* water, int x0, int y0);
+    /// Whether record(step, ...) takes a snapshot now.
+    bool due(std::int64_t step) const { return enabled() && (last_ < 0 || step / every_ > last_ / every_); }
     /// Records the final state unless `step` was just recorded.
     void finish(std::int64_t step, const Heightmap& terrain);
     std::size_t size() const { return frames_.size(); }
@@ -55,8 +66,9 @@ public:
     std::shared_ptr<Series> series() const;
 
 private:
-    void take(std::int64_t step, ConstGridView heights, const float* water);
+    void take(std::int64_t step, ConstGridView heights, const float* water, int x0 = 0, int y0 = 0);
     std::int64_t every_;
+    Tiling* tiles_ = nullptr;
     double seconds_per_step_;
     std::int64_t last_ = -1;
     std::vector<double> times_;

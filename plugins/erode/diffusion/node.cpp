@@ -64,7 +64,8 @@ NodeOutputs run(NodeContext& ctx) {
     using clock = std::chrono::steady_clock;
     const auto started = clock::now();
     const std::int64_t every = ctx.integer("timelapse_every");
-    Timelapse lapse(every, dt * 31'557'600.0);  // the series' clock is in seconds (Julian years)
+    // The series' clock is in seconds (Julian years); in a tiled run rank 0 gathers the frames.
+    Timelapse lapse = tiles ? Timelapse(every, dt * 31'557'600.0, *tiles) : Timelapse(every, dt * 31'557'600.0);
     lapse.record(0, *hm);
     std::vector<float> frame;
     for (std::int64_t i = 1; i <= steps; ++i) {
@@ -162,5 +163,6 @@ OROGEN_PLUGIN("erode-diffusion", "0.1.0", registry) {
         .tile_halo = 1,
         .check = check,
         .run = run,
+        .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
     });
 }

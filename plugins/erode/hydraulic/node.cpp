@@ -48,8 +48,8 @@ void check_finite_owned(ConstGridView held, const TileRect& own, int ox, int oy,
 /// travels 3 vertices a step, so after the sweep the owned vertices hold the
 /// single process's bits and only the halo is stale. Once more at the end,
 /// for the `flow` and `hardness` layers (stencils of 2 and 1 vertices).
-void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::Settings& s, const float* layer,
-               std::int64_t iterations) {
+std::shared_ptr<Series> run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::Settings& s,
+                                  const float* layer, std::int64_t iterations) {
     const TileRect own = tiles.owned(), grown = tiles.grown(kTileHalo);
     const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
     const std::size_t n = std::size_t(grown.width) * std::size_t(grown.height);
@@ -88,6 +88,9 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
     }
     for (int k : {3, 4, 5}) storage[k].assign(n, 0.0f);
     hydraulic::State a{grid(0), grid(1), grid(2)}, b{grid(3), grid(4), grid(5)};
+    // Snapshots after every step, as run()'s; rank 0 holds them. The first has the water layer run() makes.
+    Timelapse lapse(ctx.integer("timelapse_every"), 1.0, tiles);  // time = step count
+    lapse.record(0, a.height, a.water.data, ox, oy);
     using clock = std::chrono::steady_clock;
     clock::duration exchanging{}, sweeping{};  // for the info line (docs/benchmarks.md)
     const double waited_before = tiles.seconds_waiting();
@@ -105,6 +108,7 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
             hydraulic::step({a.height, a.water, a.sediment}, b, s, hard);
             std::swap(a, b);
             ++i;
+            lapse.record(i, a.height, a.water.data, ox, oy);
             ctx.check_cancelled();
             if (i % 64 == 0 || i == iterations) {  // as run() checks
                 check_finite_owned(a.height, own, ox, oy, tiles.grid_width(), "height", i);
@@ -146,6 +150,8 @@ void run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::
     hm.set_layer("flow", take(b.height));
     if (steep) hm.set_layer("hardness", take(b.water));
     hm.heights() = std::move(after);
+    lapse.finish(iterations, hm);
+    return lapse.enabled() ? lapse.series() : nullptr;
 }
 
 NodeOutputs run(NodeContext& ctx) {
@@ -169,8 +175,10 @@ NodeOutputs run(NodeContext& ctx) {
     if (Tiling* tiles = ctx.tiling()) {
         hm->layer("eroded", 0.0f);
         if (s.hardness == hydraulic::Hardness::layer) layer = std::as_const(*hm).layer(hardness).data;
-        run_tiled(ctx, *tiles, *hm, s, layer, iterations);  // takes the water and sediment layers itself
-        return hm;
+        auto series = run_tiled(ctx, *tiles, *hm, s, layer, iterations);  // takes the water and sediment layers itself
+        NodeOutputs out(hm);
+        if (series) out.side["timelapse"] = Value(series);
+        return out;
     }
     // An input that already carries water and sediment continues from them.
     GridView water = hm->layer("water", 0.0f);
@@ -261,5 +269,6 @@ OROGEN_PLUGIN("erode-hydraulic", "0.1.0", registry) {
         .tile_halo = kTileHalo,
         .check = check,
         .run = run,
+        .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
     });
 }

@@ -105,11 +105,15 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     const double waited_before = tiles.seconds_waiting();
     const auto t0 = clock::now();
     const double cpu0 = pipe::process_cpu_seconds();
+    // Snapshots as run()'s, rank 0 holding them; the first has the water layer run() makes (0 if new).
+    Timelapse lapse(ctx.integer("timelapse_every"), dt, tiles);  // time in seconds
+    lapse.record(0, st.height, st.water.data, ox, oy);
     {
         pipe::Solver solver(st, s, held_mask.empty() ? nullptr : held_mask.data(), &tiles);
         for (std::int64_t i = 1; i <= steps; ++i) {
             ctx.check_cancelled();
             solver.advance(dt, i);
+            if (i < steps) lapse.record(i, solver.current_height(), st.water.data, ox, oy);
             if (i % 16 == 0 || i == steps) ctx.progress(double(i) / double(steps));
         }
         solver.finish();
@@ -140,7 +144,10 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     GridView eroded = hm->layer("eroded", 0.0f);
     for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm->heights()[i];
     hm->heights() = std::move(after);
-    return hm;
+    lapse.finish(steps, *hm);
+    NodeOutputs out(hm);
+    if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
+    return out;
 }
 
 NodeOutputs run(NodeContext& ctx) {
@@ -319,5 +326,6 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
         .tile_halo = pipe::kTileHalo,
         .check = check,
         .run = run,
+        .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
     });
 }

@@ -58,6 +58,9 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         tiles.exchange_halo({held_layer.data(), grown.width, grown.height, hm->cell()}, kTileHalo);
     }
     const std::int64_t iterations = ctx.integer("iterations");
+    // Snapshots at the ends of the sweeps, as run()'s (erode() calls back once a sweep); rank 0 holds them.
+    Timelapse lapse(ctx.integer("timelapse_every"), 1.0, tiles);
+    lapse.record(0, *hm);
     using clock = std::chrono::steady_clock;
     clock::duration exchanging{}, sweeping{};  // for the figure in the info line (docs/benchmarks.md)
     const double waited_before = tiles.seconds_waiting();
@@ -70,6 +73,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         exchanging += t1 - t0;
         sweeping += clock::now() - t1;
         i += k;
+        lapse.record(i, view, nullptr, ox, oy);
         ctx.check_cancelled();
         if (i % 64 == 0 || i == iterations) {  // as run() does
             for (int y = 0; y < own.height; ++y)
@@ -96,7 +100,10 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     std::vector<float>().swap(held);
     add_layers(*hm, hm->heights().data(), after.data(), s);
     hm->heights() = std::move(after);
-    return hm;
+    lapse.finish(iterations, *hm);
+    NodeOutputs out(hm);
+    if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());
+    return out;
 }
 
 NodeOutputs run(NodeContext& ctx) {
@@ -204,5 +211,6 @@ OROGEN_PLUGIN("erode-thermal", "0.1.0", registry) {
         .tile_halo = kTileHalo,
         .check = check,
         .run = run,
+        .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
     });
 }
