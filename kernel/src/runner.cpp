@@ -733,18 +733,24 @@ RunResult run(const Plan& plan, const RunOptions& options) {
 }
 
 std::string format_timings(const RunResult& result) {
+    // Columns as wide as their longest entry (at least the usual 16 and 26), so a long label or
+    // kind:name (a mapped node's "frames[12]", a plugin's long name) does not push its row askew.
+    std::size_t label_w = 16, node_w = 26;
+    for (const auto& t : result.timings) label_w = std::max(label_w, t.label.size()), node_w = std::max(node_w, t.node.size());
+    const int lw = int(label_w), nw = int(node_w);
     std::ostringstream out;
-    char line[256];
-    std::snprintf(line, sizeof line, "%-16s %-26s %5s %10s %6s\n", "node", "kind:name", "line", "seconds", "share");
-    out << line;
+    std::vector<char> line(label_w + node_w + 64);
+    std::snprintf(line.data(), line.size(), "%-*s %-*s %5s %10s %6s\n", lw, "node", nw, "kind:name", "line", "seconds",
+                  "share");
+    out << line.data();
     for (const auto& t : result.timings) {
-        std::snprintf(line, sizeof line, "%-16s %-26s %5d %10.3f %5.1f%%%s\n", t.label.c_str(), t.node.c_str(), t.line,
-                      t.seconds, result.total_seconds > 0 ? 100.0 * t.seconds / result.total_seconds : 0.0,
+        std::snprintf(line.data(), line.size(), "%-*s %-*s %5d %10.3f %5.1f%%%s\n", lw, t.label.c_str(), nw, t.node.c_str(),
+                      t.line, t.seconds, result.total_seconds > 0 ? 100.0 * t.seconds / result.total_seconds : 0.0,
                       t.cached ? (t.read ? "  cached, read" : "  cached") : "");
-        out << line;
+        out << line.data();
     }
-    std::snprintf(line, sizeof line, "%-16s %-26s %5s %10.3f\n", "total", "", "", result.total_seconds);
-    out << line;
+    std::snprintf(line.data(), line.size(), "%-*s %-*s %5s %10.3f\n", lw, "total", nw, "", "", result.total_seconds);
+    out << line.data();
     if (!result.cache_summary.empty()) out << result.cache_summary << "\n";
     return out.str();
 }

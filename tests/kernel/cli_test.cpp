@@ -294,6 +294,27 @@ TEST(Outputs, TheIssueSpecWritesBothPngsAndAManifestWithTheirHashes) {
     EXPECT_NE(r.out.find("cut              generate:fault                 6"), std::string::npos) << r.out;
 }
 
+TEST(Outputs, TheTimingTableWidensForLongLabels) {
+    TempDir dir;
+    dir.write("s.orogen", "orogen 1\ngrid 33\nthe_mountain_before_any_erosion = generate:fault()\n"
+                          "export:raw(the_mountain_before_any_erosion, path=\"x.r32\")\n");
+    const RunResult r = run_orogen("run s.orogen --out o", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    // Every row's kind:name starts in the header's column, and the line numbers end where "line" does.
+    const auto header = r.out.find("node ");
+    ASSERT_NE(header, std::string::npos) << r.out;
+    const std::string head = r.out.substr(header, r.out.find('\n', header) - header);
+    const auto column = head.find("kind:name"), line_end = head.find("line") + 4;
+    for (const std::string row : {std::string("the_mountain_before_any_erosion "), std::string("export:raw ")}) {
+        const auto at = r.out.find(row, header + head.size());
+        ASSERT_NE(at, std::string::npos) << r.out;
+        const std::string text = r.out.substr(at, r.out.find('\n', at) - at);
+        EXPECT_EQ(text.find_first_not_of(' ', row.size()), column) << r.out;
+        EXPECT_NE(text.find_first_of("0123456789", column + 14), std::string::npos);
+        EXPECT_EQ(text.find(' ', text.find_first_of("0123456789", column + 14)), line_end) << r.out;
+    }
+}
+
 TEST(Outputs, SameSpecAndSeedGiveIdenticalBytesWhateverTheThreadCount) {
     TempDir dir;
     dir.write("s.orogen", issue_spec);
