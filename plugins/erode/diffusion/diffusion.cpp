@@ -32,6 +32,18 @@ struct Line {
 
 constexpr int kColumnBlock = 64;  // columns per task in the north–south sweeps (one 512-byte strip per row)
 
+/// `pass(x0, x1)` over strips of kColumnBlock columns within [first, first + count), in parallel.
+template <typename Pass>
+void strips(int first, int count, const Pass& pass) {
+    const std::int64_t blocks = (count + kColumnBlock - 1) / kColumnBlock;
+    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t blk = b0; blk < b1; ++blk) {
+            const int x0 = first + int(blk) * kColumnBlock;
+            pass(x0, std::min(first + count, x0 + kColumnBlock));
+        }
+    });
+}
+
 }  // namespace
 
 Solver::Solver(int width, int height, double cell, const Settings& settings)
@@ -201,16 +213,6 @@ void Solver::linear_step(double* h, double dt) {
         return;
     }
     if (b != 0.0) edge_columns(hs);
-    // Strips of kColumnBlock columns within [first, first + count), in parallel.
-    auto strips = [&](int first, int count, auto&& pass) {
-        const std::int64_t blocks = (count + kColumnBlock - 1) / kColumnBlock;
-        parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
-            for (std::int64_t blk = b0; blk < b1; ++blk) {
-                const int x0 = first + int(blk) * kColumnBlock;
-                pass(x0, std::min(first + count, x0 + kColumnBlock));
-            }
-        });
-    };
     carry_.assign(w, 0.0);
     carry(Tiling::Toward::south, carry_, 1, [&](int first, int count) {
         strips(first, count, [&](int x0, int x1) {
@@ -352,15 +354,6 @@ void Solver::nonlinear_step(double* h, double dt) {
         std::copy(hs, hs + w * std::size_t(TH), h);
         return;
     }
-    auto strips = [&](int first, int count, auto&& pass) {
-        const std::int64_t blocks = (count + kColumnBlock - 1) / kColumnBlock;
-        parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
-            for (std::int64_t blk = b0; blk < b1; ++blk) {
-                const int x0 = first + int(blk) * kColumnBlock;
-                pass(x0, std::min(first + count, x0 + kColumnBlock));
-            }
-        });
-    };
     carry_.assign(2 * w, 0.0);  // per column: the last c' and solution value
     carry(Tiling::Toward::south, carry_, 2, [&](int first, int count) {
         strips(first, count, [&](int x0, int x1) {
