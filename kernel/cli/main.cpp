@@ -383,6 +383,10 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
             const TileSplit& split = tiled->split();
             std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size, g_mpi->size == 1 ? "" : "s",
                         split.grid_width, split.grid_height, split.rows, split.cols);
+            for (const PlannedNode& node : plan->nodes)
+                if (node.node->tile_halo >= 0 && !TiledRun::runs_tiled(node))
+                    std::printf("  '%s' (%s) ran on rank 0 over the whole grid: %s\n", node.label.c_str(),
+                                node.node->qualified_name().c_str(), TiledRun::untiled_reason(node).c_str());
         }
         std::printf("wrote %zu file%s to %s:\n", result.outputs.size(), result.outputs.size() == 1 ? "" : "s",
                     args.out.c_str());

@@ -122,10 +122,10 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
             const std::string problem =
                 heightmap_memory_problem(split.grid_width, split.grid_height, options.whole_grid_limit);
             if (!problem.empty())
-                diags.error(node.where, who + " cannot be tiled, so it runs on rank 0 over the whole " + grid +
-                                            " grid, which " + problem +
-                                            "; remove it from this spec (run it on the result, in a smaller spec) "
-                                            "or use a smaller grid");
+                diags.error(node.where, who + " runs on rank 0 over the whole " + grid + " grid (" +
+                                            TiledRun::untiled_reason(node) + "), which " + problem +
+                                            "; remove it from this spec (run it on the result, in a smaller spec), "
+                                            "change what keeps it from tiling or use a smaller grid");
             continue;
         }
         const int halo = node.node->tile_halo;
@@ -149,7 +149,16 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
 
 // ------------------------------------------------------------------ one rank
 
-bool TiledRun::runs_tiled(const PlannedNode& node) { return node.node->tile_halo >= 0 && node.mapped_input < 0; }
+bool TiledRun::runs_tiled(const PlannedNode& node) { return untiled_reason(node).empty(); }
+
+std::string TiledRun::untiled_reason(const PlannedNode& node) {
+    if (node.node->tile_halo < 0) return "it cannot be tiled";
+    if (node.mapped_input >= 0) return "it is mapped over a series";
+    if (!node.node->untiled_because) return "";
+    std::vector<bool> given;
+    for (const auto& key : node.inputs) given.push_back(!key.empty());
+    return node.node->untiled_because(node.params, given);
+}
 
 int TiledRun::agree(int exit_code, int* reporter) {
     // One shape of collective for every agreement, so a rank that failed
@@ -188,20 +197,41 @@ void TiledRun::agree_or_throw() {
 void TiledRun::exchange_halo(GridView held, int halo) { exchange_halos(std::span<const GridView>(&held, 1), halo); }
 
 void TiledRun::exchange_halos(std::span<const GridView> grids, int halo) {
-    agree_or_throw();
-    const TileRect o = owned(), g = grown(halo);
-    for (const GridView& held : grids)
-        if (held.width != g.width || held.height != g.height)
+    const TileRect g = grown(halo);
+    std::vector<float*> data;
+    for (const GridView& held : grids) {
+        if (held.width != g.width || held.height != g.height) {
+            agree_or_throw();  // a mismatch is this rank's bug: the others still meet it at the agreement
             throw Error("internal error: exchange_halo got a " + std::to_string(held.width) + "x" +
                         std::to_string(held.height) + " grid for a grown tile of " + std::to_string(g.width) + "x" +
                         std::to_string(g.height));
+        }
+        data.push_back(held.data);
+    }
+    exchange_grids(std::span<float* const>(data), halo);
+}
+
+void TiledRun::exchange_double_halos(std::span<double* const> grids, int halo) { exchange_grids(grids, halo); }
+
+template <typename T>
+void TiledRun::exchange_grids(std::span<T* const> grids, int halo) {
+    agree_or_throw();
+    const TileRect o = owned(), g = grown(halo);
     if (halo == 0 || ranks() == 1 || grids.empty()) return;
     const int r = rank_ / split_.cols, c = rank_ % split_.cols;
     const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
     const int north = r > 0 ? rank_ - split_.cols : -1, south = r + 1 < split_.rows ? rank_ + split_.cols : -1;
     const int ox = o.x0 - g.x0, oy = o.y0 - g.y0;  // the owned part inside each grid
-    const std::size_t count = grids.size();
-    std::vector<float> out, in;
+    const std::size_t count = grids.size(), stride = std::size_t(g.width);
+    std::vector<T> out, in;
+    // Copy the rectangle (x, y, w, h) of a grid into `buf` at `at`, or back.
+    auto copy = [stride](T* grid, int x, int y, int w, int h, T* buf, bool to_grid) {
+        for (int k = 0; k < h; ++k) {
+            T* row = grid + std::size_t(y + k) * stride + std::size_t(x);
+            if (to_grid) std::memcpy(row, buf + std::size_t(k) * std::size_t(w), std::size_t(w) * sizeof(T));
+            else std::memcpy(buf + std::size_t(k) * std::size_t(w), row, std::size_t(w) * sizeof(T));
+        }
+    };
     // East and west: the owned rows only (the corners come with the rows below);
     // grid k's block of halo × o.height values at k·block in each message.
     auto columns = [&](int send_x, int to, int recv_x, int from, int tag) {
@@ -209,31 +239,37 @@ void TiledRun::exchange_halos(std::span<const GridView> grids, int halo) {
         out.resize(to >= 0 ? block * count : 0);
         in.resize(from >= 0 ? block * count : 0);
         if (to >= 0)
-            for (std::size_t k = 0; k < count; ++k)
-                copy_rect(grids[k].data, grids[k].width, send_x, oy, halo, o.height, out.data() + k * block, false);
-        mpi::sendrecv(out.data(), out.size() * sizeof(float), to, in.data(), in.size() * sizeof(float), from, tag);
+            for (std::size_t k = 0; k < count; ++k) copy(grids[k], send_x, oy, halo, o.height, out.data() + k * block, false);
+        mpi::sendrecv(out.data(), out.size() * sizeof(T), to, in.data(), in.size() * sizeof(T), from, tag);
         if (from >= 0)
-            for (std::size_t k = 0; k < count; ++k)
-                copy_rect(grids[k].data, grids[k].width, recv_x, oy, halo, o.height, in.data() + k * block, true);
+            for (std::size_t k = 0; k < count; ++k) copy(grids[k], recv_x, oy, halo, o.height, in.data() + k * block, true);
     };
     columns(ox, west, ox + o.width, east, kTagWest);  // my first columns go west, the east's come in
     columns(ox + o.width - halo, east, ox - halo, west, kTagEast);
     // North and south: whole rows of each grid, halo columns included (the
     // same columns for both, as tiles in one column of the split share their cuts).
     auto rows = [&](int send_y, int to, int recv_y, int from, int tag) {
-        const std::size_t block = std::size_t(halo) * std::size_t(g.width);
+        const std::size_t block = std::size_t(halo) * stride;
         out.resize(to >= 0 ? block * count : 0);
         in.resize(from >= 0 ? block * count : 0);
         if (to >= 0)
             for (std::size_t k = 0; k < count; ++k)
-                std::memcpy(out.data() + k * block, grids[k].row(send_y), block * sizeof(float));
-        mpi::sendrecv(out.data(), out.size() * sizeof(float), to, in.data(), in.size() * sizeof(float), from, tag);
+                std::memcpy(out.data() + k * block, grids[k] + std::size_t(send_y) * stride, block * sizeof(T));
+        mpi::sendrecv(out.data(), out.size() * sizeof(T), to, in.data(), in.size() * sizeof(T), from, tag);
         if (from >= 0)
             for (std::size_t k = 0; k < count; ++k)
-                std::memcpy(grids[k].row(recv_y), in.data() + k * block, block * sizeof(float));
+                std::memcpy(grids[k] + std::size_t(recv_y) * stride, in.data() + k * block, block * sizeof(T));
     };
     rows(oy, north, oy + o.height, south, kTagNorth);
     rows(oy + o.height - halo, south, oy - halo, north, kTagSouth);
+}
+
+template void TiledRun::exchange_grids<float>(std::span<float* const>, int);
+template void TiledRun::exchange_grids<double>(std::span<double* const>, int);
+
+std::vector<std::string> TiledRun::gather_to_rank0(const std::string& bytes) {
+    agree_or_throw();
+    return gather_text(bytes);
 }
 
 void TiledRun::max_all(float* values, int count) {

@@ -75,9 +75,13 @@ public:
     std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) override;
     double sum_all(double value) override;
     void share_from_rank0(std::string& bytes) override;
+    void exchange_double_halos(std::span<double* const> held, int halo) override;
+    std::vector<std::string> gather_to_rank0(const std::string& bytes) override;
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
     static bool runs_tiled(const PlannedNode& node);
+    /// "" if `node` runs tiled, else why it runs on rank 0 (for the messages).
+    static std::string untiled_reason(const PlannedNode& node);
     /// Collective, before `node` runs: gives it what it reads: tiles for a
     /// tiled node (a whole value held on rank 0 is cut and sent out), whole
     /// values on rank 0 for the others (tiles are gathered there). Returns
@@ -104,6 +108,9 @@ public:
 private:
     /// The opening agreement of every collective a tiled node calls: throws PeerFailed if a rank failed.
     void agree_or_throw();
+    /// exchange_halos() over grids of T (float or double), `width` values per row of grown(halo).
+    template <typename T>
+    void exchange_grids(std::span<T* const> grids, int halo);
     enum class Place { tiles, rank0 };
     TileSplit split_;
     int rank_;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Tiled erosion at 4097² on 1, 2 and 4 ranks (docs/benchmarks.md, "MPI").
-# usage: tests/bench/mpi_scaling.sh [BUILD_DIR] [REPEATS] [thermal|pipe|hydraulic] [SIZE]
+# usage: tests/bench/mpi_scaling.sh [BUILD_DIR] [REPEATS] [thermal|pipe|hydraulic|stream-power] [SIZE]
 # Prints, per configuration and repetition: the eroder's seconds (rank 0's
 # timing table), rank 0's info line (its time in the steps, the halo exchange,
 # for pipe the cross-rank reductions, and the wait for the other ranks), every
@@ -11,6 +11,8 @@ reps=${2:-3}
 node=${3:-thermal}
 size=${4:-4097}
 orogen=$(realpath "$build/bin/orogen")
+cell=1 displacement=0.5
+[ "$node" = stream-power ] && cell=30 displacement=1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 case "$node" in
@@ -18,14 +20,16 @@ case "$node" in
   # 6 steps of 0.25 s: 12 CFL sub-steps at 4097² (the count is the same on any number of ranks).
   pipe) step='t = erode:pipe(f, steps=6, dt=0.25, rain=0.001)'; kind=erode:pipe ;;
   hydraulic) step='t = erode:hydraulic(f, iterations=16)'; kind=erode:hydraulic ;;
-  *) echo "unknown node $node (thermal, pipe or hydraulic)" >&2; exit 2 ;;
+  # 4 steps of 10 kyr on fault relief (~100 m): routing with thousands of pits, diffusion, incision.
+  stream-power) step='t = erode:stream-power(f, years=4e4, dt=1e4, diffusivity=0.01)'; kind=erode:stream-power ;;
+  *) echo "unknown node $node (thermal, pipe, hydraulic or stream-power)" >&2; exit 2 ;;
 esac
 cat >"$work/spec.orogen" <<SPEC
 orogen 1
 seed 1
-grid $size cell=1
+grid $size cell=$cell
 
-f = generate:fault(iterations=200, displacement=0.5)
+f = generate:fault(iterations=200, displacement=$displacement)
 $step
 SPEC
 mpirun=(mpirun --oversubscribe --allow-run-as-root)
@@ -38,7 +42,7 @@ one() {  # label, command...
     "$@" run "$work/spec.orogen" --out "$work/out" --threads 1 --no-cache >"$work/log" 2>&1
     local t info rss cpu
     t=$(awk -v k="$kind" '$2==k{print $4}' "$work/log")
-    info=$(grep -o 'rank 0 of [0-9]*: .*' "$work/log" | head -1 || true)
+    info=$(grep -o 'rank 0 of [0-9]*[:,] .*' "$work/log" | head -1 || true)
     rss=$(grep 'Maximum resident' "$work/log" | awk '{printf "%d ", $6/1024}')
     # CPU seconds (user + system) summed over the ranks: what the run costs whatever the machine's load.
     cpu=$(awk '/User time/{u+=$4} /System time/{s+=$4} END{printf "%.2f", u+s}' "$work/log")

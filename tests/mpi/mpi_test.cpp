@@ -187,6 +187,51 @@ TEST_P(DiffusionSeam, DiffusionEqualsOneProcess) {
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, DiffusionSeam, kErosionCases, kCaseName);
 
+/// Stream-power landscape evolution, whose rivers cross the tiles: fault
+/// relief full of pits (filled, then routed across with n = 1.5), uplift from
+/// a layer spread across the seams, hillslope diffusion, chi, every side
+/// closed with the lowest cell of the whole grid as the one outlet, and a
+/// time-lapse; then routing=mfd, which is not tiled and runs on rank 0. A
+/// basin labelled wrongly, a lake filled to another level, a pass reversed
+/// one tile short or an exit's drainage area lost at a seam changes the
+/// heights or the layers (drainage, flow_direction, chi) downstream of it.
+const char* kStreamPowerSpec = R"(orogen 1
+seed 7
+grid 97x61 cell=30
+
+f  = generate:fault(iterations=300, displacement=20)
+t  = erode:thermal(f, talus=30, iterations=3, hardness=height)
+s1 = erode:stream-power(t, years=2e5, dt=1e4, diffusivity=0.01, chi=true, uplift_layer="hardness", uplift_smoothing=200, timelapse_every=4)
+s2 = erode:stream-power(s1, years=1e5, dt=2e4, n=1.5, depressions=route, open="ns", diffusivity=0)
+s3 = erode:stream-power(s2, years=6e4, dt=2e4, open="none", uplift=2, base_level="0")
+s4 = erode:stream-power(s3, years=4e4, dt=2e4, routing=mfd)
+r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
+export:video(r, path="s1.mpg", fps=25, quality=0)
+export:vtk(s1, path="s1.vti")
+export:vtk(s2, path="s2.vti")
+export:vtk(s3, path="s3.vti")
+export:raw(s4, path="s4.r32")
+)";
+
+class StreamPowerSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(StreamPowerSeam, StreamPowerEqualsOneProcess) {
+    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32"}, GetParam());
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, StreamPowerSeam, kErosionCases, kCaseName);
+
+TEST(Mpi, StreamPowerSettingsThatDoNotTileRunOnRankZeroAndSaySo) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", kStreamPowerSpec);
+    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("'s4' (erode:stream-power) ran on rank 0 over the whole grid: routing=mfd is not tiled yet"),
+              std::string::npos)
+        << r.out;
+    // The tiled ones say how many rounds their solves took down rivers that cross tiles.
+    EXPECT_NE(r.err.find("rank 1 of 2, up to "), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find("'s1' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;
+}
+
 /// The lines "NODE: suspended sediment X m, ..." of a run's output, in order.
 std::vector<std::string> suspended_lines(const RunResult& r) {
     std::vector<std::string> lines;

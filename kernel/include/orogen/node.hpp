@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <span>
@@ -297,6 +298,15 @@ struct NodeDescriptor {
     /// false, the kernel refuses timelapse_every > 0 in a tiled run at check
     /// time (plugin API 4).
     bool tiled_timelapse = false;
+    /// A tiled node (tile_halo >= 0) that tiles only some of its settings:
+    /// given the parameters (every one, defaults filled in) and which inputs
+    /// the spec gives, "" when it runs tiled, else why it does not (a few
+    /// words, e.g. "routing=mfd is not tiled yet"): it then runs on rank 0
+    /// over the whole grid, gathered there, as an untiled node does, and the
+    /// run says why. Empty: always tiled (plugin API 5).
+    std::function<std::string(const std::map<std::string, ParamValue, std::less<>>& params,
+                              const std::vector<bool>& inputs_given)>
+        untiled_because;
 
     std::string qualified_name() const { return kind + ":" + name; }
     const Param* find_param(std::string_view n) const;

@@ -28,7 +28,8 @@
 /// against the previous one (layout of a shared type, a virtual function...).
 /// 3: NodeDescriptor::cache (the node cache), NodeDescriptor::tile_halo and NodeContext::tiling() (MPI tiles).
 /// 4: NodeDescriptor::tiled_timelapse, Timelapse's tiled constructor (its layout), Tiling::carry.
-#define OROGEN_PLUGIN_API_VERSION 4
+/// 5: NodeDescriptor::untiled_because, Tiling::exchange_double_halos and Tiling::gather_to_rank0.
+#define OROGEN_PLUGIN_API_VERSION 5
 
 namespace orogen {
 

@@ -179,6 +179,18 @@ public:
     /// an edge exchange in one direction. Same caveat as carry_east().
     virtual void carry(Toward toward, std::span<double> values, int per_line,
                        const std::function<void(int first, int count)>& advance) = 0;
+
+    // For nodes that solve a graph spanning the tiles (erode:stream-power's
+    // drainage: every tile routes its own cells, rank 0 joins the tiles' edges).
+
+    /// Collective: exchange_halos() for grids of doubles (each covering
+    /// grown(halo), row-major): heights a double-precision model carries
+    /// between steps, or whole numbers below 2^53 (cell indices, counts).
+    virtual void exchange_double_halos(std::span<double* const> held, int halo) = 0;
+    /// Collective: every rank's `bytes`, in rank order, on rank 0 (empty
+    /// elsewhere). With share_from_rank0(): rank 0 solves what the tiles sent
+    /// and hands every rank the answer. Opens with the failure agreement.
+    virtual std::vector<std::string> gather_to_rank0(const std::string& bytes) = 0;
 };
 
 }  // namespace orogen

@@ -16,19 +16,9 @@ namespace {
 
 constexpr double kSqrt2 = 1.4142135623730951;
 
-struct Link {
-    double pass;        // max(h_i, h_j): the water level at which the two basins join, m
-    std::int32_t a, b;  // basin graph nodes, a < b (0 = the sea: every outlet basin)
-    std::int32_t i, j;  // the two cells (i in a's basin, j in b's)
-};
+}  // namespace
 
-bool link_before(const Link& l, const Link& r) {
-    if (l.pass != r.pass) return l.pass < r.pass;
-    if (l.a != r.a) return l.a < r.a;
-    if (l.b != r.b) return l.b < r.b;
-    if (l.i != r.i) return l.i < r.i;
-    return l.j < r.j;
-}
+namespace {
 
 std::int32_t find(std::vector<std::int32_t>& parent, std::int32_t v) {
     while (parent[std::size_t(v)] != v) {
@@ -39,6 +29,45 @@ std::int32_t find(std::vector<std::int32_t>& parent, std::int32_t v) {
 }
 
 }  // namespace
+
+BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
+    // A total order, so the tree does not depend on the order the links were collected in.
+    std::sort(links.begin(), links.end(), link_before);
+    // Kruskal: the minimum spanning tree of the basin graph.
+    std::vector<std::int32_t> parent(static_cast<std::size_t>(nodes));
+    for (std::int32_t v = 0; v < nodes; ++v) parent[std::size_t(v)] = v;
+    std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
+    std::int32_t joined = 0;
+    for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
+        const std::int32_t ra = find(parent, links[e].a), rb = find(parent, links[e].b);
+        if (ra == rb) continue;
+        parent[std::size_t(ra)] = rb;
+        ++joined;
+        adjacent[std::size_t(links[e].a)].push_back(std::int32_t(e));
+        adjacent[std::size_t(links[e].b)].push_back(std::int32_t(e));
+    }
+    // Orient the tree from the sea: each pit basin's way out, and its lake level.
+    BasinTree t;
+    t.level.assign(std::size_t(nodes), -std::numeric_limits<double>::infinity());
+    t.out_link.assign(std::size_t(nodes), -1);
+    std::vector<std::uint8_t> seen(static_cast<std::size_t>(nodes), 0);
+    t.order.assign(1, 0);
+    seen[0] = 1;
+    for (std::size_t q = 0; q < t.order.size(); ++q) {
+        const std::int32_t v = t.order[q];
+        for (std::int32_t e : adjacent[std::size_t(v)]) {
+            const Link& l = links[std::size_t(e)];
+            const std::int32_t u = l.a == v ? l.b : l.a;
+            if (seen[std::size_t(u)]) continue;
+            seen[std::size_t(u)] = 1;
+            t.out_link[std::size_t(u)] = e;
+            t.level[std::size_t(u)] = std::max(l.pass, t.level[std::size_t(v)]);
+            t.order.push_back(u);
+        }
+    }
+    if (std::int32_t(t.order.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
+    return t;
+}
 
 FlowRouter::FlowRouter(int width, int height, double cell, OpenSides open, std::int64_t outlet_cell)
     : width_(width), height_(height), size_(std::size_t(width) * std::size_t(height)), cell_(cell), open_(open) {
@@ -79,8 +108,6 @@ int FlowRouter::direction(std::int64_t i) const {
     return -1;
 }
 
-namespace {
-
 /// Steepest-descent direction (0–7, kDx/kDy order; −1: no lower neighbour) of
 /// the inner cells x = 1 … W−2 of one inner row, as doubles: a loop without
 /// branches or integer lanes, which the compiler turns into vector blends (the
@@ -104,7 +131,6 @@ void inner_row_directions(const double* __restrict c, const double* __restrict u
     }
 }
 
-}  // namespace
 
 void FlowRouter::receivers_from(const double* h) {
     // Receivers and donor bits in one pass over rows: first the directions of
@@ -115,7 +141,6 @@ void FlowRouter::receivers_from(const double* h) {
     // bands) it is atomic. OR is commutative, so the bytes do not depend on
     // the split.
     const int W = width_, H = height_;
-    const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
     std::fill(donors_.begin(), donors_.end(), std::uint8_t(0));
     std::int64_t off[8];
     for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
@@ -135,14 +160,12 @@ void FlowRouter::receivers_from(const double* h) {
                 if (inner_row && x > 0 && x < W - 1) {
                     dir = int(dirs[std::size_t(x)]);
                 } else {
-                    const double hi = h[i];
-                    double best = 0.0;
+                    unsigned inside = 0;
                     for (int k = 0; k < 8; ++k) {
                         const int nx = x + kDx[k], ny = int(y) + kDy[k];
-                        if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
-                        const double s = (hi - h[i + off[k]]) * inv[k];
-                        if (s > best) best = s, dir = k;
+                        if (nx >= 0 && nx < W && ny >= 0 && ny < H) inside |= 1u << k;
                     }
+                    dir = steepest(h[i], inside, [&](int k) { return h[i + off[k]]; });
                 }
                 if (dir < 0) {
                     receiver_[std::size_t(i)] = std::int32_t(i);
@@ -231,67 +254,6 @@ void FlowRouter::route(double* h, Depressions mode) {
     if (pits_ > 0) resolve_pits(h, mode);
 }
 
-bool FlowRouter::spill_locally(double* h, Depressions mode, std::int32_t b, const std::vector<std::uint8_t>& drains) {
-    // A priority flood out of the pit, lowest cell first (Barnes et al. 2014),
-    // over at most kMaxLake cells. When every cell below a height P has been
-    // taken, the first cell taken outside the basin is its lowest way out
-    // (any lower link would have been reached first); the cells of the basin
-    // taken below P are its lake. Gives up (false) if the way out leads to a
-    // basin that does not drain yet, or the lake grows too large.
-    constexpr std::size_t kMaxLake = 4096;
-    const int W = width_, H = height_;
-    const std::int32_t c = roots_[std::size_t(b)];
-    if (++epoch_ == 0) std::fill(mark_.begin(), mark_.end(), 0u), epoch_ = 1;
-    using Entry = std::pair<double, std::int32_t>;
-    auto& heap = heap_;  // a binary min-heap on (height, index): a total order, so the flood is deterministic
-    heap.clear();
-    const auto later = std::greater<Entry>();
-    lake_.clear();
-    auto push_around = [&](std::int32_t cell) {
-        const int x = cell % W, y = cell / W;
-        for (int k = 0; k < 8; ++k) {
-            const int nx = x + kDx[k], ny = y + kDy[k];
-            if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
-            const std::int32_t j = std::int32_t(std::int64_t(ny) * W + nx);
-            if (mark_[std::size_t(j)] == epoch_) continue;
-            mark_[std::size_t(j)] = epoch_;
-            pusher_[std::size_t(j)] = cell;
-            heap.emplace_back(h[j], j);
-            std::push_heap(heap.begin(), heap.end(), later);
-        }
-    };
-    mark_[std::size_t(c)] = epoch_;
-    lake_.push_back(c);
-    double level = h[c];
-    push_around(c);
-    std::int32_t exit = -1;
-    while (!heap.empty()) {
-        const auto [hq, q] = heap.front();
-        if (exit >= 0 && hq >= level) break;  // the lake below the spill level is complete
-        std::pop_heap(heap.begin(), heap.end(), later);
-        heap.pop_back();
-        if (basin_[std::size_t(q)] != b) {
-            if (exit < 0) {
-                if (!drains[std::size_t(basin_[std::size_t(q)])]) return false;
-                exit = q;
-                level = std::max(level, hq);
-            }
-            continue;  // cells outside the basin are not part of the lake
-        }
-        if (exit < 0) level = std::max(level, hq);
-        lake_.push_back(q);
-        if (lake_.size() > kMaxLake) return false;
-        push_around(q);
-    }
-    if (exit < 0) return false;
-    if (mode == Depressions::fill)
-        for (const std::int32_t l : lake_)
-            if (h[l] < level) h[l] = level;
-    reroute(pusher_[std::size_t(exit)], exit);
-    resolved_.push_back({b, pusher_[std::size_t(exit)], exit});
-    return true;
-}
-
 void FlowRouter::reroute(std::int32_t inside, std::int32_t across) {
     // Reverse the receivers from the pass cell down to the pit, send the pass
     // cell's water across, and keep the donor bits in step.
@@ -317,39 +279,16 @@ void FlowRouter::reroute(std::int32_t inside, std::int32_t across) {
 void FlowRouter::resolve_pits(double* h, Depressions mode) {
     const int W = width_, H = height_;
     const std::size_t nb = roots_.size();
-    // 1. Most pits (a channel cell left low by diffusion or uneven uplift) spill
-    // over a small lake into a basin that drains: found by a local flood, in
-    // index order, passes repeated while they resolve more.
-    std::vector<std::uint8_t> drains(nb, 0);
-    std::vector<std::int32_t> pending, next;
-    for (std::size_t b = 0; b < nb; ++b) {
-        if (outlet_[std::size_t(roots_[b])])
-            drains[b] = 1;
-        else
-            pending.push_back(std::int32_t(b));
-    }
-    if (mark_.size() != size_) mark_.assign(size_, 0u), pusher_.resize(size_), epoch_ = 0;
+    // Nodes of the basin graph: 0 = the sea (every outlet basin), 1..P = the
+    // pit basins in index order of their pits. Every pit goes to the graph:
+    // its result is then a pure function of the heights (the minimum spanning
+    // tree under link_before's total order), which a tiled run reproduces
+    // from its tiles' links (tiled.hpp).
+    std::vector<std::int32_t> pending;
+    for (std::size_t b = 0; b < nb; ++b)
+        if (!outlet_[std::size_t(roots_[b])]) pending.push_back(std::int32_t(b));
     resolved_.clear();
-    for (int pass = 0; pass < 8 && !pending.empty(); ++pass) {
-        next.clear();
-        for (const std::int32_t b : pending) {
-            if (spill_locally(h, mode, b, drains))
-                drains[std::size_t(b)] = 1;
-            else
-                next.push_back(b);
-        }
-        const bool progress = next.size() < pending.size();
-        pending.swap(next);
-        if (!progress) break;
-    }
     graph_pits_ = std::int64_t(pending.size());
-    if (pending.empty()) {
-        patch_stack();
-        return;
-    }
-
-    // 2. The others over the basin graph. Nodes: 0 = the sea (every basin
-    // that drains), 1..P = the pit basins left.
     std::vector<std::int32_t> node(nb, 0), node_basin{0};
     std::int32_t nodes = 1;
     for (const std::int32_t b : pending) {
@@ -382,11 +321,11 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
                         const std::int32_t j = std::int32_t(std::int64_t(ny) * W + nx);
                         const std::int32_t nj = node[std::size_t(basin_[std::size_t(j)])];
                         if (nj == ni || (nj != 0 && j < i)) continue;
-                        const double pass = std::max(h[i], h[j]);
+                        const double pass = std::max(h[i], h[j]), low = std::min(h[i], h[j]);
                         if (ni < nj)
-                            out.push_back({pass, ni, nj, i, j});
+                            out.push_back({pass, low, ni, nj, i, j});
                         else
-                            out.push_back({pass, nj, ni, j, i});
+                            out.push_back({pass, low, nj, ni, j, i});
                     }
                 }
             }
@@ -408,41 +347,10 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
     links.reserve(total);
     for (const auto& v : per_pit) links.insert(links.end(), v.begin(), v.end());
     per_block.clear();
-    std::sort(links.begin(), links.end(), link_before);  // a total order: the result is independent of collection order
-
-    // Kruskal: the minimum spanning tree of the basin graph.
-    std::vector<std::int32_t> parent(static_cast<std::size_t>(nodes));
-    for (std::int32_t v = 0; v < nodes; ++v) parent[std::size_t(v)] = v;
-    std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
-    std::int32_t joined = 0;
-    for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
-        const std::int32_t ra = find(parent, links[e].a), rb = find(parent, links[e].b);
-        if (ra == rb) continue;
-        parent[std::size_t(ra)] = rb;
-        ++joined;
-        adjacent[std::size_t(links[e].a)].push_back(std::int32_t(e));
-        adjacent[std::size_t(links[e].b)].push_back(std::int32_t(e));
-    }
-
-    // Orient the tree from the sea: each pit basin's way out, and its lake level.
-    std::vector<double> level(static_cast<std::size_t>(nodes), -std::numeric_limits<double>::infinity());
-    std::vector<std::int32_t> out_link(static_cast<std::size_t>(nodes), -1);
-    std::vector<std::uint8_t> seen(static_cast<std::size_t>(nodes), 0);
-    std::vector<std::int32_t> queue{0};
-    seen[0] = 1;
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-        const std::int32_t v = queue[q];
-        for (std::int32_t e : adjacent[std::size_t(v)]) {
-            const Link& l = links[std::size_t(e)];
-            const std::int32_t u = l.a == v ? l.b : l.a;
-            if (seen[std::size_t(u)]) continue;
-            seen[std::size_t(u)] = 1;
-            out_link[std::size_t(u)] = e;
-            level[std::size_t(u)] = std::max(l.pass, level[std::size_t(v)]);
-            queue.push_back(u);
-        }
-    }
-    if (std::int32_t(queue.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
+    const BasinTree tree = solve_basin_graph(links, nodes);
+    const auto& level = tree.level;
+    const auto& out_link = tree.out_link;
+    const auto& queue = tree.order;
 
     // Fill, then carve, parents before children (the order of the walk from
     // the sea), so that each pit basin's way out is already in place.
@@ -450,7 +358,7 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
         const std::int32_t v = queue[q];
         const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
         const Link& l = links[std::size_t(out_link[std::size_t(v)])];
-        const std::int32_t in = l.a == v ? l.i : l.j, across = l.a == v ? l.j : l.i;
+        const auto in = std::int32_t(l.a == v ? l.i : l.j), across = std::int32_t(l.a == v ? l.j : l.i);
         if (mode == Depressions::fill) {
             const double lv = level[std::size_t(v)];
             for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
@@ -548,11 +456,13 @@ void FlowRouter::patch_stack() {
 
 void FlowRouter::accumulate() {
     const double a0 = cell_ * cell_;
-    // Every cell starts with its own area (a sequential fill, not one in stack order)...
+    // Cells, not m²: every cell starts with 1 (a sequential fill, not one in stack order)...
     parallel_for(0, std::int64_t(size_), 1 << 16, [&](std::int64_t b, std::int64_t e) {
-        std::fill(area_.begin() + b, area_.begin() + e, a0);
+        std::fill(area_.begin() + b, area_.begin() + e, 1.0);
     });
     // ... and passes its total to its receiver, donors first (reverse stack order).
+    // Whole numbers below 2^53 add exactly in any order, so a tiled run that adds
+    // its tiles' partial counts gets these bits (floating-point m² would round).
     const std::int64_t groups = std::int64_t(chunks_.size()) - 1;
     const std::int32_t* stack = stack_.data();
     const std::int32_t* rcv = receiver_.data();
@@ -565,6 +475,9 @@ void FlowRouter::accumulate() {
                 if (r != i) area[r] += area[i];
             }
         }
+    });
+    parallel_for(0, std::int64_t(size_), 1 << 16, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i) area[i] *= a0;
     });
 }
 

@@ -51,6 +51,58 @@ enum class Depressions {
 inline constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
 inline constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
 
+/// Steepest-descent direction of the cells x = 1 … W−2 of a row `c` (W
+/// heights) between rows `up` (north) and `dn` (south), into dir_out[x] as a
+/// double: 0–7 (kDx/kDy), −1 with no lower neighbour. The drop per metre is
+/// (h_i − h_k)·(1/distance), ties to the lower k: what steepest() gives.
+void inner_row_directions(const double* c, const double* up, const double* dn, int W, double* dir_out);
+
+/// The same direction for one cell from its neighbours' heights: at(k) is
+/// neighbour k's height, `inside` bit k whether neighbour k exists.
+template <typename At>
+int steepest(double hi, unsigned inside, At at) {
+    constexpr double d = 1.0 / 1.4142135623730951;  // 1/√2
+    constexpr double inv[8] = {1.0, d, 1.0, d, 1.0, d, 1.0, d};
+    double best = 0.0;
+    int dir = -1;
+    for (int k = 0; k < 8; ++k) {
+        if (!((inside >> k) & 1u)) continue;
+        const double s = (hi - at(k)) * inv[k];
+        if (s > best) best = s, dir = k;
+    }
+    return dir;
+}
+
+/// A link of the basin graph: the lowest pass between two basins.
+struct Link {
+    double pass;        ///< max(h_i, h_j): the water level at which the two basins join, m
+    double low;         ///< min(h_i, h_j), m: among equal passes the one from the lowest cell goes first
+    std::int32_t a, b;  ///< basin graph nodes, a < b (0 = the sea: every outlet basin)
+    std::int64_t i, j;  ///< the two cells (i in a's basin, j in b's; whole-grid indices)
+};
+
+/// The total order of links: pass, the lower cell's height, then nodes, then cells.
+inline bool link_before(const Link& l, const Link& r) {
+    if (l.pass != r.pass) return l.pass < r.pass;
+    if (l.low != r.low) return l.low < r.low;
+    if (l.a != r.a) return l.a < r.a;
+    if (l.b != r.b) return l.b < r.b;
+    if (l.i != r.i) return l.i < r.i;
+    return l.j < r.j;
+}
+
+/// The minimum spanning tree of the basin graph oriented from the sea (node 0).
+struct BasinTree {
+    std::vector<double> level;          ///< per node: the highest pass on its way to the sea, m
+    std::vector<std::int32_t> out_link; ///< per node: the link (index into the sorted links) it leaves by; −1 for the sea
+    std::vector<std::int32_t> order;    ///< nodes from the sea outwards (each after the node it spills into)
+};
+
+/// Kruskal over `links` (sorted in place by link_before), nodes 0..nodes−1: the
+/// tree is unique under the total order, whatever order the links came in.
+/// Throws std::logic_error if a node has no way to the sea.
+BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes);
+
 class FlowRouter {
 public:
     /// `outlet_cell` (with every side closed): the one outlet; ignored if a side is open.
@@ -91,14 +143,13 @@ public:
     const std::vector<std::int64_t>& chunks() const { return chunks_; }
     /// Pits found (before resolution) by the last route().
     std::int64_t pits() const { return pits_; }
-    /// Pits the local floods left to the basin graph in the last route().
+    /// Pits resolved over the basin graph in the last route() (all of them).
     std::int64_t graph_pits() const { return graph_pits_; }
 
 private:
     void receivers_from(const double* h);  // and the donor bits
     void build_stack(bool label_basins);
     void resolve_pits(double* h, Depressions mode);
-    bool spill_locally(double* h, Depressions mode, std::int32_t basin, const std::vector<std::uint8_t>& drains);
     void reroute(std::int32_t inside, std::int32_t across);
     void patch_stack();  // after resolve_pits: the stack through the passes
 
@@ -129,11 +180,6 @@ private:
     std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
     std::int64_t pits_ = 0;
     std::int64_t graph_pits_ = 0;
-    std::vector<std::uint32_t> mark_;     // local floods: cells seen in flood number epoch_
-    std::vector<std::int32_t> pusher_;   // local floods: the lake cell that reached each cell
-    std::vector<std::int32_t> lake_;
-    std::vector<std::pair<double, std::int32_t>> heap_;
-    std::uint32_t epoch_ = 0;
 };
 
 }  // namespace orogen::stream_power

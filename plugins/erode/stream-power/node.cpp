@@ -1,5 +1,6 @@
 // erode:stream-power — registers the implicit stream-power landscape model (stream_power.hpp) with the kernel.
 #include "stream_power.hpp"
+#include "tiled.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>
@@ -7,6 +8,10 @@
 
 #include <algorithm>
 #include <charconv>
+#include <chrono>
+#include <cstring>
+#include <map>
+#include <memory>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -49,8 +54,32 @@ std::optional<std::optional<double>> parse_base_level(const std::string& text) {
     return std::optional<double>{v};
 }
 
+/// The largest of every rank's `v` (exact), or `v` itself without tiles.
+double largest(Tiling* tiles, double v) {
+    if (!tiles) return v;
+    const auto all = tiles->gather_to_rank0(std::string(reinterpret_cast<const char*>(&v), sizeof v));
+    std::string answer;
+    if (tiles->rank() == 0) {
+        double m = v;
+        for (const auto& b : all) {
+            double x = 0.0;
+            std::memcpy(&x, b.data(), sizeof x);
+            m = std::max(m, x);
+        }
+        answer.assign(reinterpret_cast<const char*>(&m), sizeof m);
+    }
+    tiles->share_from_rank0(answer);
+    std::memcpy(&v, answer.data(), sizeof v);
+    return v;
+}
+
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
+    // In a tiled run (mpirun) the heightmap is this rank's tile and the model
+    // joins the tiles' rivers (tiled.hpp): the same bits as one process.
+    Tiling* tiles = ctx.tiling();
+    using clock = std::chrono::steady_clock;
+    const auto started = clock::now();
     const std::size_t n = hm->size();
     stream_power::Settings s;
     s.erodibility = ctx.real("erodibility");
@@ -72,13 +101,21 @@ NodeOutputs run(NodeContext& ctx) {
         if (!(sigma > 0.0)) return;
         diffusion::Settings ds;
         ds.diffusivity = 1.0;
-        diffusion::Solver blur(hm->width(), hm->height(), hm->cell(), ds);
+        diffusion::Solver blur = tiles ? diffusion::Solver(*tiles, hm->cell(), ds)
+                                       : diffusion::Solver(hm->width(), hm->height(), hm->cell(), ds);
         for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
     };
-    auto fastest_of = [](const std::vector<double>& rate, double base) {
+    auto fastest_of = [tiles](const std::vector<double>& rate, double base) {
         double fastest = 0.0;
         for (double r : rate) fastest = std::max(fastest, std::abs(r + base));
-        return fastest;
+        return largest(tiles, fastest);
+    };
+    // A sample's index in the whole grid, for the messages.
+    auto sample = [&](std::size_t k) {
+        if (!tiles) return std::int64_t(k);
+        const TileRect own = tiles->owned();
+        const auto x = std::int64_t(k % std::size_t(own.width)), y = std::int64_t(k / std::size_t(own.width));
+        return (own.y0 + y) * tiles->grid_width() + own.x0 + x;
     };
     // Uplift: the uniform rate plus the layer read as metres accumulated over uplift_layer_years.
     const double uniform = ctx.real("uplift") * 1e-3;  // mm/yr → m/yr
@@ -91,7 +128,8 @@ NodeOutputs run(NodeContext& ctx) {
         std::vector<double> rate(n);
         for (std::size_t i = 0; i < n; ++i) {
             if (!std::isfinite(u.data[i]))
-                throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " + std::to_string(i));
+                throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " +
+                               std::to_string(sample(i)));
             rate[i] = double(u.data[i]) / years;
         }
         smooth(rate);
@@ -159,64 +197,89 @@ NodeOutputs run(NodeContext& ctx) {
     }
     const auto base = *parse_base_level(ctx.text("base_level"));
 
-    stream_power::Model model(hm->width(), hm->height(), hm->cell(), std::move(h), std::move(uplift), s);
-    if (history.rate) model.set_uplift_history(std::move(history));
+    std::unique_ptr<stream_power::Model> whole;
+    std::unique_ptr<stream_power::TiledModel> tiled;
+    if (tiles)
+        tiled = std::make_unique<stream_power::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
+    else
+        whole = std::make_unique<stream_power::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
+                                                      std::move(uplift), s);
+    if (history.rate) whole->set_uplift_history(std::move(history));
+    std::vector<double>& heights = tiles ? tiled->heights() : whole->heights();
+    auto is_outlet = [&](std::size_t i) { return tiles ? tiled->is_outlet(i) : whole->flow().is_outlet(std::int64_t(i)); };
     if (base) {
         for (std::size_t i = 0; i < n; ++i)
-            if (model.flow().is_outlet(std::int64_t(i))) model.heights()[i] = *base;
+            if (is_outlet(i)) heights[i] = *base;
     }
     const double years = ctx.real("years"), dt = ctx.real("dt");
     constexpr double kSecondsPerYear = 31'557'600.0;  // the series' clock is in seconds (Julian years)
     const std::int64_t every = ctx.integer("timelapse_every");
-    Timelapse lapse(every, dt * kSecondsPerYear);
+    // In a tiled run rank 0 gathers the frames.
+    Timelapse lapse = tiles ? Timelapse(every, dt * kSecondsPerYear, *tiles) : Timelapse(every, dt * kSecondsPerYear);
     lapse.record(0, *hm);
     std::vector<float> frame;
     std::int64_t pits = 0, last = 0;
+    int rounds = 0;
     double sediment_out = 0.0;  // m³ that left by the outlets (deposition > 0)
-    model.run(years, dt, [&](std::int64_t step, std::int64_t steps) {
+    auto on_step = [&](std::int64_t step, std::int64_t steps) {
         ctx.check_cancelled();
         if (every > 0 && (step % every == 0 || step == steps)) {
-            frame.assign(model.heights().begin(), model.heights().end());
+            frame.assign(heights.begin(), heights.end());
             lapse.record(step, ConstGridView(frame.data(), hm->width(), hm->height(), hm->cell()));
         }
-        pits += model.flow().pits();
-        sediment_out += model.sediment_out();
+        pits += tiles ? tiled->pits() : whole->flow().pits();
+        if (tiles) rounds = std::max(rounds, tiled->rounds());
+        if (whole) sediment_out += whole->sediment_out();
         last = steps;
-        const std::int64_t bad = model.first_non_finite();
+        const std::int64_t bad = tiles ? tiled->first_non_finite() : whole->first_non_finite();
         if (bad >= 0) {
             std::ostringstream msg;
-            msg << "non-finite height (" << model.heights()[std::size_t(bad)] << ") at sample " << bad
+            msg << "non-finite height (" << heights[std::size_t(bad)] << ") at sample " << sample(std::size_t(bad))
                 << " after step " << step << " of " << steps << "; the simulation became unstable";
             throw Error(msg.str());
         }
         ctx.progress(double(step) / double(steps));
-    });
+    };
+    if (tiles)
+        tiled->run(years, dt, on_step);
+    else
+        whole->run(years, dt, on_step);
 
     // Outputs: heights, the last step's flow graph as layers.
     const std::vector<float> before = hm->heights();
     std::vector<float>& out = hm->heights();
-    const auto& hd = model.heights();
-    for (std::size_t i = 0; i < n; ++i) out[i] = float(hd[i]);
+    for (std::size_t i = 0; i < n; ++i) out[i] = float(heights[i]);
     ctx.check_finite(out, "height", last);
-    model.route_only();  // drainage and directions of the final surface
+    // Drainage and directions of the final surface.
+    if (tiles)
+        tiled->route_only();
+    else
+        whole->route_only();
     GridView drainage = hm->layer("drainage", 0.0f);
     GridView direction = hm->layer("flow_direction", -1.0f);
-    const auto& area = model.flow().area();
+    const auto& area = tiles ? tiled->area() : whole->flow().area();
     for (std::size_t i = 0; i < n; ++i) {
         drainage.data[i] = float(area[i]);
-        direction.data[i] = float(model.flow().direction(std::int64_t(i)));
+        direction.data[i] = float(tiles ? tiled->direction(i) : whole->flow().direction(std::int64_t(i)));
     }
     GridView eroded = hm->layer("eroded", 0.0f);
     for (std::size_t i = 0; i < n; ++i) eroded.data[i] += out[i] - before[i];
     if (ctx.flag("chi")) {
-        const std::vector<double> chi = model.chi(1.0);
+        const std::vector<double> chi = tiles ? tiled->chi(1.0) : whole->chi(1.0);
         GridView c = hm->layer("chi", 0.0f);
         for (std::size_t i = 0; i < n; ++i) c.data[i] = float(chi[i]);
     }
-    const auto [lo, hi] = std::minmax_element(out.begin(), out.end());
+    auto [lo, hi] = std::minmax_element(out.begin(), out.end());
+    float low = *lo, high = *hi;
+    if (tiles) tiles->min_max(low, high);
+    const double seconds = std::chrono::duration<double>(clock::now() - started).count();
     std::ostringstream msg;
-    msg << last << " steps of " << dt << " yr; " << pits << " pits resolved; relief " << (*hi - *lo) << " m";
+    msg << last << " steps of " << dt << " yr; " << pits << " pits resolved; relief " << (high - low) << " m";
     if (s.deposition > 0.0) msg << "; " << sediment_out * 1e-9 << " km³ of sediment left by the outlets";
+    if (tiles)
+        msg << "; rank " << tiles->rank() << " of " << tiles->ranks() << ", up to " << rounds
+            << " round(s) a step down rivers crossing tiles; " << seconds << " s in the node, of which joining the tiles "
+            << tiled->seconds_joining() << " s (" << 100.0 * tiled->seconds_joining() / std::max(1e-9, seconds) << " %)";
     ctx.info(msg.str());
     lapse.finish(last, *hm);
     NodeOutputs result(hm);
@@ -298,9 +361,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "dh/dt = U - K A^m S^n + D lap(h): rock uplift U against detachment-limited fluvial incision (drainage "
             "area A, slope S to the receiver) and hillslope diffusion D. Each step of dt years uplifts the land, "
             "routes water D8 (steepest of 8 neighbours; routing=mfd also splits the drainage area among all lower "
-            "neighbours, Freeman 1991) with pits resolved by local priority floods (Barnes et al. "
-            "2014) and, where those do not reach, over the basin graph (Cordonnier et al. 2019): each lake spills at "
-            "its lowest pass (depressions=fill also fills it). It accumulates drainage area, "
+            "neighbours, Freeman 1991) with pits resolved over the basin graph (Cordonnier et al. 2019): each "
+            "lake spills at its lowest pass (depressions=fill also fills it). It accumulates drainage area, "
             "diffuses implicitly and solves the incision implicitly in flow order (Braun & Willett 2013: stable at "
             "any dt; Newton's method for n != 1). Water leaves by the open sides, whose vertices are held at base "
             "level; with every side closed the lowest cell is the outlet. Uplift is `uplift` (mm/yr) plus, with "
@@ -309,7 +371,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "change between its frames over the years they map to (the first frame year 0, the last "
             "uplift_history_years, default the run's years), spread the same way. deposition=G > 0 lets G Qs/A of "
             "the sediment flux Qs settle on its way down (Yuan et al. 2019; solved exactly on the receiver tree). The same "
-            "result on any number of threads. Adds the layers drainage (upstream area, m^2: draw rivers where it "
+            "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
+            "uplift_history; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
             "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"},
@@ -394,7 +457,16 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 timelapse_param(),
             },
         .adds_layers = {"drainage", "flow_direction", "eroded"},
+        .tile_halo = 1,
         .check = check,
         .run = run,
+        .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
+        .untiled_because =
+            [](const std::map<std::string, ParamValue, std::less<>>& p, const std::vector<bool>& given) {
+                stream_power::Settings s;
+                if (std::get<std::string>(p.at("routing")) == "mfd") s.mfd_exponent = 1.0;
+                s.deposition = std::get<double>(p.at("deposition"));
+                return stream_power::untiled_because(s, given.size() > 1 && given[1]);
+            },
     });
 }

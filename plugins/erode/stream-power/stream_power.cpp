@@ -12,10 +12,6 @@ namespace orogen::stream_power {
 namespace {
 
 constexpr double kSqrt2 = 1.4142135623730951;
-/// A^m for drainage areas of fewer than this many cells comes from a table:
-/// areas are exact multiples of cell² (sums of integers), and most cells
-/// drain few cells, so the per-cell pow() becomes a lookup.
-constexpr std::int64_t kPowTable = 1 << 16;
 /// Deposition: iterations in which a cell may start incising again; after them the set of
 /// incising cells only shrinks, so the solve ends.
 constexpr int kFlips = 20;
@@ -167,15 +163,7 @@ void Model::incise(double dt) {
         const double c1 = kdt_l1, c2 = kdt_l2, ia0 = inv_a0, a00 = a0, mm = m;
         const std::int64_t w = W;
         auto factor = [=](std::int32_t i, std::int32_t r) {
-            const double a = ar[i];
-            const double c = a * ia0;
-            double am;
-            if (c < double(kPowTable - 1)) {
-                const auto ci = std::int64_t(c + 0.5);
-                am = double(ci) * a00 == a ? tb[ci] : std::pow(a, mm);
-            } else {
-                am = std::pow(a, mm);
-            }
+            const double am = area_power(ar[i], tb, ia0, a00, mm);
             const std::int64_t d = std::int64_t(r) - i;
             return am * ((d == 1 || d == -1 || d == w || d == -w) ? c1 : c2);
         };
@@ -199,21 +187,7 @@ void Model::incise(double dt) {
                 const std::int32_t i = st[s], r = rv[i];
                 const double hr = hh[r], hi = hh[i];
                 if (r == i || hi <= hr) continue;
-                const double F = factor(i, r), delta = hi - hr;
-                // x − Δ + F·x^n = 0 for x = h_i' − h_r' in (0, Δ].
-                double x = delta;
-                for (int it = 0; it < 60; ++it) {
-                    const double xn1 = std::pow(x, ns - 1.0);
-                    const double gx = x - delta + F * xn1 * x;
-                    const double dg = 1.0 + ns * F * xn1;
-                    double next = x - gx / dg;
-                    if (next <= 0.0) next = 0.5 * x;  // n < 1: the concave residual can overshoot past zero
-                    if (next > delta) next = delta;
-                    const bool done = std::abs(next - x) <= 1e-12 * delta;
-                    x = next;
-                    if (done) break;
-                }
-                hh[i] = hr + x;
+                hh[i] = hr + incised_drop(hi - hr, factor(i, r), ns);
             }
         }
     });
@@ -272,14 +246,7 @@ void Model::incise_with_deposition(double dt) {
     // A^m from the table for whole numbers of cells (as incise() does: the pow is the costly part).
     const double* tab = pow_table_.data();
     const double inv_a0 = 1.0 / a0;
-    auto area_power = [=](double a) {
-        const double c = a * inv_a0;
-        if (c < double(kPowTable - 1)) {
-            const auto ci = std::int64_t(c + 0.5);
-            if (double(ci) * a0 == a) return tab[ci];
-        }
-        return std::pow(a, m);
-    };
+    auto area_pow = [=](double a) { return area_power(a, tab, inv_a0, a0, m); };
     // With D8 the tree's area is the drainage area; with MFD it is summed over the tree.
     const bool d8 = settings_.mfd_exponent <= 0.0;
     chunk_out_.assign(std::size_t(std::max<std::int64_t>(groups, 0)), 0.0);
@@ -328,7 +295,7 @@ void Model::incise_with_deposition(double dt) {
                     double F = 0.0, c = 0.0;
                     if (act[s]) {
                         const std::int64_t d = std::int64_t(r) - i;
-                        const double lin = area_power(area[i]) *
+                        const double lin = area_pow(area[i]) *
                                            ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
                         if (ns == 1.0) {
                             F = lin;

@@ -33,6 +33,7 @@
 
 #include <diffusion.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -131,6 +132,40 @@ private:
     std::vector<int> chunk_passes_;
     int deposition_passes_ = 0;
 };
+
+/// A^m for drainage areas of fewer than this many cells comes from a table:
+/// areas are exact multiples of cell² (whole numbers of cells), and most cells
+/// drain few cells, so the per-cell pow() becomes a lookup.
+inline constexpr std::int64_t kPowTable = 1 << 16;
+
+/// A^m for a drainage area `a` (m²): table[c] = (c·a0)^m when a is c whole
+/// cells of a0 m² (inv_a0 = 1/a0), else pow(a, m).
+inline double area_power(double a, const double* table, double inv_a0, double a0, double m) {
+    const double c = a * inv_a0;
+    if (c < double(kPowTable - 1)) {
+        const auto ci = std::int64_t(c + 0.5);
+        return double(ci) * a0 == a ? table[ci] : std::pow(a, m);
+    }
+    return std::pow(a, m);
+}
+
+/// The implicit incision of one cell for n ≠ 1: x = h_i' − h_r' in (0, Δ]
+/// (Δ = h_i* − h_r' > 0) solving x − Δ + F·x^n = 0, by Newton's method.
+inline double incised_drop(double delta, double F, double n) {
+    double x = delta;
+    for (int it = 0; it < 60; ++it) {
+        const double xn1 = std::pow(x, n - 1.0);
+        const double gx = x - delta + F * xn1 * x;
+        const double dg = 1.0 + n * F * xn1;
+        double next = x - gx / dg;
+        if (next <= 0.0) next = 0.5 * x;  // n < 1: the concave residual can overshoot past zero
+        if (next > delta) next = delta;
+        const bool done = std::abs(next - x) <= 1e-12 * delta;
+        x = next;
+        if (done) break;
+    }
+    return x;
+}
 
 /// The outlet with every side closed: the lowest cell (lowest index among equals).
 std::int64_t lowest_cell(const std::vector<double>& heights);

@@ -1,0 +1,706 @@
+// tiled.cpp — the stream-power model on one rank's tile (see tiled.hpp).
+#include "tiled.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <stdexcept>
+#include <type_traits>
+#include <unordered_map>
+
+namespace orogen::stream_power {
+
+namespace {
+
+constexpr double kSqrt2 = 1.4142135623730951;
+
+// Messages between the ranks: arrays of plain records, back to back.
+template <typename T>
+void put(std::string& out, const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const std::uint64_t n = v.size();
+    out.append(reinterpret_cast<const char*>(&n), sizeof n);
+    out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+
+template <typename T>
+std::vector<T> take(const std::string& in, std::size_t& at) {
+    std::uint64_t n = 0;
+    if (at + sizeof n > in.size()) throw std::logic_error("stream-power: a short message between ranks");
+    std::memcpy(&n, in.data() + at, sizeof n);
+    at += sizeof n;
+    if (at + n * sizeof(T) > in.size()) throw std::logic_error("stream-power: a short message between ranks");
+    std::vector<T> v(static_cast<std::size_t>(n));
+    if (n) std::memcpy(v.data(), in.data() + at, std::size_t(n) * sizeof(T));
+    at += std::size_t(n) * sizeof(T);
+    return v;
+}
+
+struct EdgeRecord {  // an edge cell and the end of its local tree
+    std::int64_t cell, tree, next;
+};
+
+struct LinkRecord {  // a tile's lowest link between a pit basin and a neighbouring basin
+    double pass, low;
+    std::int64_t a, b;        // basins (their pit's whole-grid index; −1 the sea), a < b
+    std::int64_t i, j;        // the cells, i in a's basin
+    std::int64_t tree_i, next_i, tree_j, next_j;  // their local trees' ends (tree −2: not this rank's cell)
+};
+
+struct ExitRecord {  // an exit: the cells it drains (its tile's count) and where they go
+    std::int64_t cell;
+    double count;
+    std::int64_t next;
+};
+
+struct Fill {
+    std::int64_t pit;
+    double level;
+};
+
+struct Piece {  // a piece of a path reversed from a pass to its pit: from `start`, which now drains to `prev`
+    std::int64_t start, prev;
+};
+
+struct ExitBasin {  // an exit and the basin (pit or outlet) its water reaches
+    std::int64_t exit, basin;
+};
+
+struct Lowest {  // a tile's lowest cell
+    double h;
+    std::int64_t cell;
+};
+
+struct Inflow {
+    std::int64_t cell;
+    double count;
+};
+
+/// Whole-grid position (x, y) of neighbour k of (x, y) exists.
+bool inside(int x, int y, int k, int W, int H) {
+    const int nx = x + kDx[k], ny = y + kDy[k];
+    return nx >= 0 && nx < W && ny >= 0 && ny < H;
+}
+
+int direction_to(std::int64_t from, std::int64_t to, int W) {
+    const auto dx = int(to % W - from % W), dy = int(to / W - from / W);
+    for (int k = 0; k < 8; ++k)
+        if (kDx[k] == dx && kDy[k] == dy) return k;
+    throw std::logic_error("stream-power: a re-routed cell's new receiver is not its neighbour");
+}
+
+}  // namespace
+
+std::string untiled_because(const Settings& s, bool uplift_history) {
+    if (s.mfd_exponent > 0.0) return "routing=mfd is not tiled yet";
+    if (s.deposition > 0.0) return "deposition > 0 is not tiled yet";
+    if (uplift_history) return "an uplift_history input is not tiled yet";
+    return "";
+}
+
+TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, std::vector<double> uplift,
+                       const Settings& settings)
+    : tiles_(tiles),
+      own_(tiles.owned()),
+      grown_(tiles.grown(1)),
+      W_(tiles.grid_width()),
+      H_(tiles.grid_height()),
+      cell_(cell),
+      settings_(settings),
+      h_(std::move(heights)),
+      uplift_(std::move(uplift)) {
+    const std::size_t n = std::size_t(own_.width) * std::size_t(own_.height);
+    if (h_.size() != n) throw std::invalid_argument("stream_power::TiledModel: heights are not the tile's size");
+    if (!uplift_.empty() && uplift_.size() != n)
+        throw std::invalid_argument("stream_power::TiledModel: uplift is not the tile's size");
+    if (!untiled_because(settings, false).empty())
+        throw std::invalid_argument("stream_power::TiledModel: " + untiled_because(settings, false));
+    if (!settings.open.any()) {
+        // The lowest cell of the whole grid (lowest index among equals), as lowest_cell().
+        Lowest mine{std::numeric_limits<double>::infinity(), -1};
+        for (std::size_t l = 0; l < n; ++l)
+            if (mine.cell < 0 || h_[l] < mine.h) mine = {h_[l], global(l)};
+        std::string bytes;
+        put(bytes, std::vector<Lowest>{mine});
+        const auto all = joined([&] { return tiles_.gather_to_rank0(bytes); });
+        std::string answer;
+        if (tiles_.rank() == 0) {
+            Lowest best{0.0, -1};
+            for (const auto& b : all) {
+                std::size_t at = 0;
+                for (const Lowest& p : take<Lowest>(b, at))
+                    if (best.cell < 0 || p.h < best.h || (p.h == best.h && p.cell < best.cell)) best = p;
+            }
+            put(answer, std::vector<std::int64_t>{best.cell});
+        }
+        joined([&] { return tiles_.share_from_rank0(answer); });
+        std::size_t at = 0;
+        sink_ = take<std::int64_t>(answer, at).at(0);
+    }
+    outlet_.resize(n);
+    for (std::size_t l = 0; l < n; ++l) outlet_[l] = outlet_at(global(l)) ? 1 : 0;
+    dir_.resize(n);
+    donors_.resize(n);
+    tree_of_.resize(n);
+    stack_.resize(n);
+    count_.resize(n);
+    area_.resize(n);
+    grown_h_.resize(std::size_t(grown_.width) * std::size_t(grown_.height));
+    for (int y = 0; y < own_.height; ++y)
+        for (int x = 0; x < own_.width; ++x)
+            if (y == 0 || y == own_.height - 1 || x == 0 || x == own_.width - 1)
+                edge_.push_back(std::int32_t(std::int64_t(y) * own_.width + x));
+    pow_table_.resize(std::size_t(kPowTable));
+    for (std::int64_t c = 0; c < kPowTable; ++c)
+        pow_table_[std::size_t(c)] = std::pow(double(c) * (cell * cell), settings.area_exponent);
+    if (settings.diffusivity > 0.0) {
+        diffusion::Settings ds;
+        ds.diffusivity = settings.diffusivity;
+        ds.scheme = diffusion::Scheme::implicit;
+        ds.fixed = {settings.open.north, settings.open.east, settings.open.south, settings.open.west};
+        diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, ds);
+    }
+}
+
+std::int64_t TiledModel::global(std::size_t l) const {
+    const auto x = std::int64_t(l % std::size_t(own_.width)), y = std::int64_t(l / std::size_t(own_.width));
+    return (own_.y0 + y) * W_ + own_.x0 + x;
+}
+
+bool TiledModel::outlet_at(std::int64_t g) const {
+    if (!settings_.open.any()) return g == sink_;
+    const auto x = int(g % W_), y = int(g / W_);
+    const OpenSides& o = settings_.open;
+    return (y == 0 && o.north) || (y == H_ - 1 && o.south) || (x == 0 && o.west) || (x == W_ - 1 && o.east);
+}
+
+std::size_t TiledModel::grown_index(std::size_t l) const {
+    const auto x = std::size_t(l % std::size_t(own_.width)), y = std::size_t(l / std::size_t(own_.width));
+    return (y + std::size_t(own_.y0 - grown_.y0)) * std::size_t(grown_.width) + x + std::size_t(own_.x0 - grown_.x0);
+}
+
+std::int64_t TiledModel::owned_neighbour(std::size_t l, int k) const {
+    const int x = int(l % std::size_t(own_.width)) + kDx[k], y = int(l / std::size_t(own_.width)) + kDy[k];
+    if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) return -1;
+    return std::int64_t(y) * own_.width + x;
+}
+
+std::int64_t TiledModel::receiver_global(std::size_t l) const {
+    const int k = dir_[l];
+    if (k < 0) return -1;
+    return global(l) + std::int64_t(kDy[k]) * W_ + kDx[k];
+}
+
+std::int64_t TiledModel::first_non_finite() const {
+    for (std::size_t l = 0; l < h_.size(); ++l)
+        if (!std::isfinite(h_[l])) return std::int64_t(l);
+    return -1;
+}
+
+// ------------------------------------------------------------------ routing
+
+void TiledModel::directions() {
+    // The tile's heights with their halo are in grown_h_. Inner cells of the
+    // whole grid take the vectorised row form, the others the scalar one, as
+    // FlowRouter::receivers_from does (the same arithmetic either way).
+    const int w = own_.width, gw = grown_.width;
+    const int ox = own_.x0 - grown_.x0, oy = own_.y0 - grown_.y0;
+    std::vector<double> dirs(std::size_t(gw), -1.0);
+    for (int y = 0; y < own_.height; ++y) {
+        const int gy = own_.y0 + y;
+        const bool inner_row = gy > 0 && gy < H_ - 1;
+        const double* row = grown_h_.data() + std::size_t(y + oy) * std::size_t(gw);
+        if (inner_row) inner_row_directions(row, row - gw, row + gw, gw, dirs.data());
+        for (int x = 0; x < w; ++x) {
+            const std::size_t l = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            const int gx = own_.x0 + x;
+            if (outlet_[l]) {
+                dir_[l] = -1;
+                continue;
+            }
+            if (inner_row && gx > 0 && gx < W_ - 1) {
+                dir_[l] = std::int8_t(dirs[std::size_t(x + ox)]);
+                continue;
+            }
+            unsigned in = 0;
+            for (int k = 0; k < 8; ++k)
+                if (inside(gx, gy, k, W_, H_)) in |= 1u << k;
+            const double* c = row + x + ox;
+            dir_[l] = std::int8_t(steepest(*c, in, [&](int k) { return c[std::int64_t(kDy[k]) * gw + kDx[k]]; }));
+        }
+    }
+}
+
+void TiledModel::build_trees() {
+    // Donors inside the tile, then a depth-first walk up from each local root
+    // (pit, outlet or exit) in index order: receivers before donors.
+    const std::size_t n = h_.size();
+    std::fill(donors_.begin(), donors_.end(), std::uint8_t(0));
+    trees_.clear();
+    for (std::size_t l = 0; l < n; ++l) {
+        const int k = dir_[l];
+        const std::int64_t r = k < 0 ? -1 : owned_neighbour(l, k);
+        if (r < 0)
+            trees_.push_back(std::int32_t(l));
+        else
+            donors_[std::size_t(r)] |= std::uint8_t(1u << ((k + 4) & 7));
+    }
+    tree_start_.assign(trees_.size() + 1, 0);
+    std::size_t pos = 0;
+    std::vector<std::int32_t> walk;
+    for (std::size_t t = 0; t < trees_.size(); ++t) {
+        tree_start_[t] = std::int64_t(pos);
+        walk.push_back(trees_[t]);
+        while (!walk.empty()) {
+            const std::int32_t c = walk.back();
+            walk.pop_back();
+            if (pos == n) throw std::logic_error("stream-power: the receivers hold a loop");
+            stack_[pos++] = c;
+            tree_of_[std::size_t(c)] = std::int32_t(t);
+            unsigned m = donors_[std::size_t(c)];
+            while (m) {
+                const int k = std::countr_zero(m);
+                m &= m - 1;
+                walk.push_back(std::int32_t(owned_neighbour(std::size_t(c), k)));
+            }
+        }
+    }
+    tree_start_[trees_.size()] = std::int64_t(pos);
+    if (pos != n) throw std::logic_error("stream-power: the receivers hold a loop");
+}
+
+TiledModel::Hop TiledModel::hop(std::size_t l) const {
+    const auto t = std::size_t(trees_[std::size_t(tree_of_[l])]);
+    return {global(t), receiver_global(t)};
+}
+
+std::string TiledModel::edge_hops() const {
+    std::vector<EdgeRecord> rec;
+    rec.reserve(edge_.size());
+    for (const std::int32_t l : edge_) {
+        const Hop hp = hop(std::size_t(l));
+        rec.push_back({global(std::size_t(l)), hp.tree, hp.next});
+    }
+    std::string out;
+    put(out, rec);
+    return out;
+}
+
+namespace {
+
+/// Rank 0: every tile's edge cells and the ends of their local trees.
+using EdgeMap = std::unordered_map<std::int64_t, std::pair<std::int64_t, std::int64_t>>;
+
+void read_edges(const std::string& msg, std::size_t& at, EdgeMap& edges) {
+    for (const EdgeRecord& e : take<EdgeRecord>(msg, at)) edges[e.cell] = {e.tree, e.next};
+}
+
+std::pair<std::int64_t, std::int64_t> edge_of(const EdgeMap& edges, std::int64_t cell) {
+    const auto it = edges.find(cell);
+    if (it == edges.end()) throw std::logic_error("stream-power: an exit drains into a cell no tile has on its edge");
+    return it->second;
+}
+
+}  // namespace
+
+void TiledModel::route(double* h) {
+    const std::size_t gw = std::size_t(grown_.width);
+    const int ox = own_.x0 - grown_.x0, oy = own_.y0 - grown_.y0;
+    for (int y = 0; y < own_.height; ++y)
+        std::copy(h + std::size_t(y) * std::size_t(own_.width), h + std::size_t(y + 1) * std::size_t(own_.width),
+                  grown_h_.begin() + std::ptrdiff_t(std::size_t(y + oy) * gw + std::size_t(ox)));
+    double* grids[] = {grown_h_.data()};
+    joined([&] { return tiles_.exchange_double_halos(grids, 1); });
+    directions();
+    build_trees();
+    std::int64_t pits = 0;
+    for (const std::int32_t t : trees_)
+        if (dir_[std::size_t(t)] < 0 && !outlet_[std::size_t(t)]) ++pits;
+    pits_ = std::int64_t(joined([&] { return tiles_.sum_all(double(pits)); }));
+    if (pits_ > 0) resolve_pits(h);
+}
+
+void TiledModel::resolve_pits(double* h) {
+    const std::size_t n = h_.size();
+    const bool root0 = tiles_.rank() == 0;
+    // 1. Basins: rank 0 follows every exit over the tiles' edges to its pit or outlet.
+    std::vector<std::string> all = joined([&] { return tiles_.gather_to_rank0(edge_hops()); });
+    EdgeMap edges;
+    std::string answer;
+    if (root0) {
+        for (const auto& m : all) {
+            std::size_t at = 0;
+            read_edges(m, at, edges);
+        }
+        std::vector<ExitBasin> exit_basin;
+        std::unordered_map<std::int64_t, std::int64_t> basin_of;  // exit → basin
+        for (const auto& [cell, end] : edges) {
+            if (end.second < 0 || basin_of.count(end.first)) continue;
+            // Follow the exit's water; every exit met on the way gets the same basin.
+            std::vector<std::int64_t> path;
+            std::pair<std::int64_t, std::int64_t> at = end;
+            std::int64_t basin = -1;
+            while (at.second >= 0) {
+                if (auto it = basin_of.find(at.first); it != basin_of.end()) {
+                    basin = it->second;
+                    break;
+                }
+                path.push_back(at.first);
+                if (path.size() > edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
+                at = edge_of(edges, at.second);
+            }
+            if (basin < 0) basin = at.first;
+            for (const std::int64_t e : path) basin_of[e] = basin;
+        }
+        for (const auto& [e, b] : basin_of) exit_basin.push_back({e, b});
+        put(answer, exit_basin);
+    }
+    joined([&] { return tiles_.share_from_rank0(answer); });
+    {
+        std::size_t at = 0;
+        std::unordered_map<std::int64_t, std::int64_t> basin_of;
+        for (const ExitBasin& e : take<ExitBasin>(answer, at)) basin_of[e.exit] = e.basin;
+        std::vector<std::int64_t> tree_basin(trees_.size());
+        for (std::size_t t = 0; t < trees_.size(); ++t) {
+            const auto l = std::size_t(trees_[t]);
+            tree_basin[t] = dir_[l] < 0 ? global(l) : basin_of.at(global(l));
+        }
+        label_.resize(n);
+        for (std::size_t l = 0; l < n; ++l) label_[l] = tree_basin[std::size_t(tree_of_[l])];
+    }
+    // 2. Every tile's lowest link per pair of basins, from its cells in pit basins
+    // (an edge between two pit basins from its lower-index cell only, as FlowRouter).
+    grown_label_.assign(grown_h_.size(), -1.0);
+    for (std::size_t l = 0; l < n; ++l) grown_label_[grown_index(l)] = double(label_[l]);  // exact below 2^53
+    double* grids[] = {grown_label_.data()};
+    joined([&] { return tiles_.exchange_double_halos(grids, 1); });
+    const std::int64_t gw = grown_.width;
+    std::vector<LinkRecord> links;
+    std::vector<std::int64_t> pits;
+    for (std::size_t l = 0; l < n; ++l) {
+        const std::int64_t li = label_[l];
+        if (outlet_at(li)) continue;
+        const std::int64_t i = global(l);
+        if (i == li) pits.push_back(i);
+        const int x = int(i % W_), y = int(i / W_);
+        const std::size_t gl = grown_index(l);
+        for (int k = 0; k < 8; ++k) {
+            if (!inside(x, y, k, W_, H_)) continue;
+            const std::int64_t j = i + std::int64_t(kDy[k]) * W_ + kDx[k];
+            const std::size_t gj = std::size_t(std::int64_t(gl) + std::int64_t(kDy[k]) * gw + kDx[k]);
+            const auto lj = std::int64_t(grown_label_[gj]);
+            if (lj == li) continue;
+            const bool pit_j = !outlet_at(lj);
+            if (pit_j && j < i) continue;
+            const double pass = std::max(grown_h_[gl], grown_h_[gj]), low = std::min(grown_h_[gl], grown_h_[gj]);
+            const std::int64_t bj = pit_j ? lj : -1;  // the sea comes first, then pits by index
+            const Hop hi = hop(l);
+            const std::int64_t nl = owned_neighbour(l, k);
+            const Hop hj = nl >= 0 ? hop(std::size_t(nl)) : Hop{-2, -2};
+            if (bj < li)
+                links.push_back({pass, low, bj, li, j, i, hj.tree, hj.next, hi.tree, hi.next});
+            else
+                links.push_back({pass, low, li, bj, i, j, hi.tree, hi.next, hj.tree, hj.next});
+        }
+    }
+    auto before = [](const LinkRecord& l, const LinkRecord& r) {
+        if (l.a != r.a) return l.a < r.a;
+        if (l.b != r.b) return l.b < r.b;
+        if (l.pass != r.pass) return l.pass < r.pass;
+        if (l.low != r.low) return l.low < r.low;
+        if (l.i != r.i) return l.i < r.i;
+        return l.j < r.j;
+    };
+    auto lowest_per_pair = [&](std::vector<LinkRecord>& v) {
+        std::sort(v.begin(), v.end(), before);
+        std::size_t kept = 0;
+        for (std::size_t e = 0; e < v.size(); ++e)
+            if (kept == 0 || v[e].a != v[kept - 1].a || v[e].b != v[kept - 1].b) v[kept++] = v[e];
+        v.resize(kept);
+    };
+    lowest_per_pair(links);
+    std::string mine;
+    put(mine, pits);
+    put(mine, links);
+    all = joined([&] { return tiles_.gather_to_rank0(mine); });
+    // 3. Rank 0: the basin graph, and the pieces of each pass's path down to its pit.
+    answer.clear();
+    if (root0) {
+        std::vector<std::int64_t> every_pit;
+        std::vector<LinkRecord> every_link;
+        for (const auto& m : all) {
+            std::size_t at = 0;
+            const auto p = take<std::int64_t>(m, at);
+            const auto l = take<LinkRecord>(m, at);
+            every_pit.insert(every_pit.end(), p.begin(), p.end());
+            every_link.insert(every_link.end(), l.begin(), l.end());
+        }
+        std::sort(every_pit.begin(), every_pit.end());
+        if (std::int64_t(every_pit.size()) != pits_) throw std::logic_error("stream-power: the tiles disagree on the pits");
+        std::unordered_map<std::int64_t, std::int32_t> node{{-1, 0}};
+        for (std::size_t p = 0; p < every_pit.size(); ++p) node[every_pit[p]] = std::int32_t(p + 1);
+        lowest_per_pair(every_link);
+        std::map<std::pair<std::int32_t, std::int32_t>, const LinkRecord*> record;
+        std::vector<Link> graph;
+        graph.reserve(every_link.size());
+        for (const LinkRecord& r : every_link) {
+            const std::int32_t a = node.at(r.a), b = node.at(r.b);
+            graph.push_back({r.pass, r.low, a, b, r.i, r.j});
+            record[{a, b}] = &r;
+        }
+        const BasinTree tree = solve_basin_graph(graph, std::int32_t(every_pit.size() + 1));
+        std::vector<Fill> fills;
+        std::vector<Piece> pieces;
+        for (std::size_t q = 1; q < tree.order.size(); ++q) {
+            const std::int32_t v = tree.order[q];
+            const Link& l = graph[std::size_t(tree.out_link[std::size_t(v)])];
+            const LinkRecord& r = *record.at({l.a, l.b});
+            const bool from_i = l.a == v;  // the pit basin's own cell is i
+            const std::int64_t in = from_i ? l.i : l.j, across = from_i ? l.j : l.i;
+            const std::int64_t pit = every_pit[std::size_t(v - 1)];
+            fills.push_back({pit, tree.level[std::size_t(v)]});
+            std::pair<std::int64_t, std::int64_t> end =
+                from_i ? std::pair{r.tree_i, r.next_i} : std::pair{r.tree_j, r.next_j};
+            if (end.first == -2) end = edge_of(edges, in);
+            pieces.push_back({in, across});
+            std::size_t guard = 0;
+            while (end.second >= 0) {
+                pieces.push_back({end.second, end.first});  // the exit's receiver now drains back to the exit
+                end = edge_of(edges, end.second);
+                if (++guard > edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
+            }
+            if (end.first != pit) throw std::logic_error("stream-power: a pass's path does not reach its pit");
+        }
+        put(answer, fills);
+        put(answer, pieces);
+    }
+    joined([&] { return tiles_.share_from_rank0(answer); });
+    // 4. Every rank: fill its lakes, reverse its pieces of the paths.
+    std::size_t at = 0;
+    const auto fills = take<Fill>(answer, at);
+    const auto pieces = take<Piece>(answer, at);
+    if (settings_.depressions == Depressions::fill) {
+        std::unordered_map<std::int64_t, double> level;
+        for (const Fill& f : fills) level[f.pit] = f.level;
+        for (std::size_t l = 0; l < n; ++l) {
+            if (outlet_at(label_[l])) continue;
+            const double lv = level.at(label_[l]);
+            if (h[l] < lv) h[l] = lv;
+        }
+    }
+    for (const Piece& p : pieces) {
+        const int x = int(p.start % W_) - own_.x0, y = int(p.start / W_) - own_.y0;
+        if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) continue;
+        auto c = std::size_t(std::int64_t(y) * own_.width + x);
+        std::int64_t prev = p.prev;
+        for (;;) {
+            const int old = dir_[c];
+            dir_[c] = std::int8_t(direction_to(global(c), prev, W_));
+            if (old < 0) break;  // the pit
+            const std::int64_t next = owned_neighbour(c, old);
+            if (next < 0) break;  // on into the next tile: another piece
+            prev = global(c);
+            c = std::size_t(next);
+        }
+    }
+    build_trees();
+}
+
+void TiledModel::accumulate() {
+    // Cells upstream, as whole numbers (exact in any order: the whole grid's bits).
+    std::vector<Inflow> inflows;
+    auto count = [&] {
+        std::fill(count_.begin(), count_.end(), 1.0);
+        for (const Inflow& f : inflows) {
+            const int x = int(f.cell % W_) - own_.x0, y = int(f.cell / W_) - own_.y0;
+            if (x >= 0 && x < own_.width && y >= 0 && y < own_.height)
+                count_[std::size_t(std::int64_t(y) * own_.width + x)] += f.count;
+        }
+        for (std::size_t s = stack_.size(); s-- > 0;) {
+            const auto l = std::size_t(stack_[s]);
+            const int k = dir_[l];
+            if (k < 0) continue;
+            const std::int64_t r = owned_neighbour(l, k);
+            if (r >= 0) count_[std::size_t(r)] += count_[l];
+        }
+    };
+    count();
+    if (tiles_.ranks() > 1) {
+        std::vector<ExitRecord> exits;
+        for (const std::int32_t t : trees_)
+            if (dir_[std::size_t(t)] >= 0)
+                exits.push_back({global(std::size_t(t)), count_[std::size_t(t)], receiver_global(std::size_t(t))});
+        std::string mine = edge_hops();
+        put(mine, exits);
+        const auto all = joined([&] { return tiles_.gather_to_rank0(mine); });
+        std::string answer;
+        if (tiles_.rank() == 0) {
+            // Each exit's count goes to the edge cell it drains into, and with the
+            // count of that cell's tree on to the tree's own exit (Kahn's order).
+            EdgeMap edges;
+            std::vector<ExitRecord> every;
+            for (const auto& m : all) {
+                std::size_t at = 0;
+                read_edges(m, at, edges);
+                const auto e = take<ExitRecord>(m, at);
+                every.insert(every.end(), e.begin(), e.end());
+            }
+            std::unordered_map<std::int64_t, std::size_t> index;
+            for (std::size_t e = 0; e < every.size(); ++e) index[every[e].cell] = e;
+            std::vector<std::int64_t> downstream(every.size(), -1);
+            std::vector<int> waiting(every.size(), 0);
+            for (std::size_t e = 0; e < every.size(); ++e) {
+                const auto end = edge_of(edges, every[e].next);
+                if (end.second >= 0) {
+                    downstream[e] = std::int64_t(index.at(end.first));
+                    ++waiting[std::size_t(downstream[e])];
+                }
+            }
+            std::vector<std::size_t> ready;
+            for (std::size_t e = 0; e < every.size(); ++e)
+                if (waiting[e] == 0) ready.push_back(e);
+            std::unordered_map<std::int64_t, double> into;
+            for (std::size_t q = 0; q < ready.size(); ++q) {
+                const ExitRecord& e = every[ready[q]];
+                into[e.next] += e.count;
+                const std::int64_t d = downstream[ready[q]];
+                if (d < 0) continue;
+                every[std::size_t(d)].count += e.count;
+                if (--waiting[std::size_t(d)] == 0) ready.push_back(std::size_t(d));
+            }
+            if (ready.size() != every.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
+            std::vector<Inflow> list;
+            for (const auto& [cell, c] : into) list.push_back({cell, c});
+            put(answer, list);
+        }
+        joined([&] { return tiles_.share_from_rank0(answer); });
+        std::size_t at = 0;
+        inflows = take<Inflow>(answer, at);
+        count();
+    }
+    const double a0 = cell_ * cell_;
+    for (std::size_t l = 0; l < count_.size(); ++l) area_[l] = count_[l] * a0;
+}
+
+// ------------------------------------------------------------ down the rivers
+
+void TiledModel::propagate(std::vector<double>& v, const std::function<void(std::size_t, double)>& f) {
+    std::vector<std::uint8_t> done(trees_.size(), 0);
+    auto solve_tree = [&](std::size_t t, double from_outside) {
+        const std::int64_t b = tree_start_[t], e = tree_start_[t + 1];
+        for (std::int64_t s = b; s < e; ++s) {
+            const auto l = std::size_t(stack_[std::size_t(s)]);
+            const int k = dir_[l];
+            if (k < 0) continue;  // a pit or outlet keeps its value
+            f(l, s == b ? from_outside : v[std::size_t(owned_neighbour(l, k))]);
+        }
+        done[t] = 1;
+    };
+    std::vector<std::size_t> waiting;
+    for (std::size_t t = 0; t < trees_.size(); ++t) {
+        if (dir_[std::size_t(trees_[t])] < 0)
+            solve_tree(t, 0.0);
+        else
+            waiting.push_back(t);
+    }
+    rounds_ = 1;
+    double left = tiles_.ranks() > 1 ? joined([&] { return tiles_.sum_all(double(waiting.size())); }) : 0.0;
+    if (left > 0.0) {
+        grown_v_.assign(grown_h_.size(), 0.0);
+        grown_done_.assign(grown_h_.size(), 0.0);
+    }
+    const std::int64_t gw = grown_.width;
+    while (left > 0.0) {
+        ++rounds_;
+        for (const std::int32_t l : edge_) {
+            grown_v_[grown_index(std::size_t(l))] = v[std::size_t(l)];
+            grown_done_[grown_index(std::size_t(l))] = done[std::size_t(tree_of_[std::size_t(l)])];
+        }
+        double* grids[] = {grown_v_.data(), grown_done_.data()};
+        joined([&] { return tiles_.exchange_double_halos(grids, 1); });
+        std::vector<std::size_t> still;
+        for (const std::size_t t : waiting) {
+            const auto l = std::size_t(trees_[t]);
+            const int k = dir_[l];
+            const auto r = std::size_t(std::int64_t(grown_index(l)) + std::int64_t(kDy[k]) * gw + kDx[k]);
+            if (grown_done_[r] != 0.0)
+                solve_tree(t, grown_v_[r]);
+            else
+                still.push_back(t);
+        }
+        waiting.swap(still);
+        const double now = joined([&] { return tiles_.sum_all(double(waiting.size())); });
+        if (now >= left) throw std::logic_error("stream-power: the solve down the rivers made no progress");
+        left = now;
+    }
+}
+
+void TiledModel::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {
+    if (!(years > 0.0) || !(dt > 0.0)) throw std::invalid_argument("stream_power::TiledModel::run: years and dt must be > 0");
+    const auto steps = std::int64_t(std::ceil(years / dt * (1.0 - 1e-12)));
+    for (std::int64_t s = 1; s <= steps; ++s) {
+        step(s < steps ? dt : years - dt * double(steps - 1));
+        if (on_step) on_step(s, steps);
+    }
+}
+
+void TiledModel::route_only() {
+    std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
+    route(copy.data());
+    accumulate();
+}
+
+std::int64_t TiledModel::step(double dt) {
+    const std::size_t n = h_.size();
+    // 1. Uplift (outlets are base level: they stay).
+    if (!uplift_.empty())
+        for (std::size_t l = 0; l < n; ++l)
+            if (!outlet_[l]) h_[l] += uplift_[l] * dt;
+    // 2. Routing, depressions, drainage area.
+    route(h_.data());
+    accumulate();
+    const std::int64_t pits = pits_;
+    // 3. Hillslope diffusion across the tiles (the declared sink stays at base level).
+    if (diffusion_) {
+        std::int64_t sink = -1;
+        double sink_h = 0.0;
+        for (std::size_t l = 0; l < n && !settings_.open.any(); ++l)
+            if (outlet_[l]) sink = std::int64_t(l), sink_h = h_[l];
+        diffusion_->step(h_.data(), dt);
+        if (sink >= 0) h_[std::size_t(sink)] = sink_h;
+    }
+    // 4. Implicit incision, receivers first (Model::incise, the same arithmetic).
+    const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
+    const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
+    const double c1 = K * dt / std::pow(cell_, ns), c2 = K * dt / std::pow(cell_ * kSqrt2, ns);
+    const double* tab = pow_table_.data();
+    propagate(h_, [&](std::size_t l, double hr) {
+        const double hi = h_[l];
+        if (hi <= hr) return;
+        const int k = dir_[l];
+        const double F = area_power(area_[l], tab, inv_a0, a0, m) * ((k & 1) ? c2 : c1);
+        if (ns == 1.0) {
+            const double wt = 1.0 / (1.0 + F);
+            h_[l] = hr + (hi - hr) * wt;
+        } else {
+            h_[l] = hr + incised_drop(hi - hr, F, ns);
+        }
+    });
+    return pits;
+}
+
+std::vector<double> TiledModel::chi(double a0) {
+    std::vector<double> out(h_.size(), 0.0);
+    const double p = settings_.area_exponent / settings_.slope_exponent;
+    propagate(out, [&](std::size_t l, double chi_r) {
+        const double distance = (dir_[l] & 1) ? cell_ * kSqrt2 : cell_;
+        out[l] = chi_r + std::pow(a0 / area_[l], p) * distance;
+    });
+    return out;
+}
+
+}  // namespace orogen::stream_power
