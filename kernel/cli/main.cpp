@@ -316,6 +316,7 @@ std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins,
         const int on_this_machine = std::clamp(local ? std::atoi(local) : g_mpi->size, 1, g_mpi->size);
         options.heightmap_memory_limit = heightmap_memory_limit() / std::uint64_t(on_this_machine) *
                                          std::uint64_t(g_mpi->size);
+        options.tiled_memory_share = double(on_this_machine) / double(g_mpi->size);
     }
     Plan plan = check(parsed, plugins.registry(), path, options, diags);
     if (g_mpi && !diags.has_errors()) {

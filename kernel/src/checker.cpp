@@ -1,6 +1,7 @@
 #include "plan.hpp"
 
 #include "outputs.hpp"
+#include "tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -178,6 +179,8 @@ public:
           spec_folder_(spec_folder), diags_(diags), output_(std::move(output)) {}
 
     const GridSpec& grid() const override { return grid_; }
+    double memory_share() const override { return TiledRun::runs_tiled(node_) ? tiled_share_ : 1.0; }
+    void set_tiled_share(double share) { tiled_share_ = share; }
     const ValueInfo* input(std::size_t i) const override { return i < inputs_.size() ? inputs_[i] : nullptr; }
     bool given(std::string_view param) const override { return node_.given.count(param) > 0; }
     const ParamValue& param(std::string_view name) const override {
@@ -207,6 +210,7 @@ public:
     ValueInfo take_output() { return std::move(output_); }
 
 private:
+    double tiled_share_ = 1.0;
     const GridSpec& grid_;
     std::vector<const ValueInfo*> inputs_;
     const PlannedNode& node_;
@@ -557,6 +561,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             CheckContextImpl ctx(plan.grid, input_infos, planned, param_where, call.where, plan.spec_folder, diags,
                                  std::move(out));
             ctx.set_sides(std::move(sides));
+            ctx.set_tiled_share(options.tiled_memory_share);
             try {
                 node->check(ctx);
             } catch (const std::exception& e) {

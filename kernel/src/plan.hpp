@@ -49,6 +49,8 @@ struct CheckOptions {
     /// --out: every output path must resolve inside it, unless allow_outside_out (--allow-outside-out).
     std::filesystem::path out_dir = "out";
     bool allow_outside_out = false;
+    /// A tiled run: the ranks on this machine over all ranks (CheckContext::memory_share of a tiled node).
+    double tiled_memory_share = 1.0;
 };
 
 /// Check `parsed` against `registry`. Errors go to `diags`; the plan is only

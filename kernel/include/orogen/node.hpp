@@ -161,6 +161,11 @@ class CheckContext {
 public:
     virtual ~CheckContext() = default;
     virtual const GridSpec& grid() const = 0;
+    /// The share of the whole grid this machine holds for this node: in a
+    /// tiled run (mpirun) of a node that runs tiled, its ranks on this machine
+    /// over all ranks; 1 otherwise. For a memory check of the node's own
+    /// model, which each rank holds for its tile only (plugin API 5).
+    virtual double memory_share() const { return 1.0; }
     /// Info of input `i`, or nullptr if an optional input was not given.
     virtual const ValueInfo* input(std::size_t i) const = 0;
     virtual bool given(std::string_view param) const = 0;  ///< set in the spec (not defaulted)

@@ -32,7 +32,7 @@ std::int32_t find(std::vector<std::int32_t>& parent, std::int32_t v) {
 
 BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     // A total order, so the tree does not depend on the order the links were collected in.
-    std::sort(links.begin(), links.end(), link_before);
+    if (!std::is_sorted(links.begin(), links.end(), link_before)) std::sort(links.begin(), links.end(), link_before);
     // Kruskal: the minimum spanning tree of the basin graph.
     std::vector<std::int32_t> parent(static_cast<std::size_t>(nodes));
     for (std::int32_t v = 0; v < nodes; ++v) parent[std::size_t(v)] = v;

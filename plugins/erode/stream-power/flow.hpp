@@ -98,7 +98,7 @@ struct BasinTree {
     std::vector<std::int32_t> order;    ///< nodes from the sea outwards (each after the node it spills into)
 };
 
-/// Kruskal over `links` (sorted in place by link_before), nodes 0..nodes−1: the
+/// Kruskal over `links` (sorted in place by link_before, unless they come sorted), nodes 0..nodes−1: the
 /// tree is unique under the total order, whatever order the links came in.
 /// Throws std::logic_error if a node has no way to the sea.
 BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes);

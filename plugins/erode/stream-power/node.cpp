@@ -333,7 +333,8 @@ void check(CheckContext& ctx) {
     const ValueInfo* in = ctx.input(0);
     const std::int64_t w = in && in->width > 0 ? in->width : ctx.grid().width;
     const std::int64_t hgt = in && in->height > 0 ? in->height : ctx.grid().height;
-    const double need = double(w) * double(hgt) *
+    // In a tiled run each rank holds its tile's model only (memory_share: this machine's share of the grid).
+    const double need = ctx.memory_share() * double(w) * double(hgt) *
                         double(stream_power::kBytesPerCell +
                                (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0));
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
@@ -341,8 +342,9 @@ void check(CheckContext& ctx) {
         std::ostringstream msg;
         msg.setf(std::ios::fixed);
         msg.precision(1);
-        msg << "a " << w << " x " << hgt << " grid needs " << need / 1e9 << " GB for the landscape model, more than "
-            << "half of this machine's " << have / 1e9 << " GB; use a smaller grid";
+        msg << "a " << w << " x " << hgt << " grid needs " << need / 1e9 << " GB for the landscape model"
+            << (ctx.memory_share() < 1.0 ? " (this machine's tiles)" : "") << ", more than half of this machine's "
+            << have / 1e9 << " GB; use a smaller grid" << (ctx.memory_share() < 1.0 ? " or more machines" : "");
         ctx.error("", msg.str());
     }
     check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));

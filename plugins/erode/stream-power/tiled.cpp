@@ -379,35 +379,21 @@ void TiledModel::resolve_pits(double* h) {
     double* grids[] = {grown_label_.data()};
     joined([&] { return tiles_.exchange_double_halos(grids, 1); });
     const std::int64_t gw = grown_.width;
-    std::vector<LinkRecord> links;
-    std::vector<std::int64_t> pits;
-    for (std::size_t l = 0; l < n; ++l) {
-        const std::int64_t li = label_[l];
-        if (outlet_at(li)) continue;
-        const std::int64_t i = global(l);
-        if (i == li) pits.push_back(i);
-        const int x = int(i % W_), y = int(i / W_);
-        const std::size_t gl = grown_index(l);
-        for (int k = 0; k < 8; ++k) {
-            if (!inside(x, y, k, W_, H_)) continue;
-            const std::int64_t j = i + std::int64_t(kDy[k]) * W_ + kDx[k];
-            const std::size_t gj = std::size_t(std::int64_t(gl) + std::int64_t(kDy[k]) * gw + kDx[k]);
-            const auto lj = std::int64_t(grown_label_[gj]);
-            if (lj == li) continue;
-            const bool pit_j = !outlet_at(lj);
-            if (pit_j && j < i) continue;
-            const double pass = std::max(grown_h_[gl], grown_h_[gj]), low = std::min(grown_h_[gl], grown_h_[gj]);
-            const std::int64_t bj = pit_j ? lj : -1;  // the sea comes first, then pits by index
-            const Hop hi = hop(l);
-            const std::int64_t nl = owned_neighbour(l, k);
-            const Hop hj = nl >= 0 ? hop(std::size_t(nl)) : Hop{-2, -2};
-            if (bj < li)
-                links.push_back({pass, low, bj, li, j, i, hj.tree, hj.next, hi.tree, hi.next});
-            else
-                links.push_back({pass, low, li, bj, i, j, hi.tree, hi.next, hj.tree, hj.next});
-        }
-    }
-    auto before = [](const LinkRecord& l, const LinkRecord& r) {
+    // Collected tree by tree (a tree lies in one basin), each tree keeping its
+    // lowest link per neighbouring basin (Link's i, j, a, b here: whole-grid
+    // cells and basins, −1 the sea, which comes first), then the tile's lowest per pair.
+    auto lowest_per_pair = [&](auto& v, auto before) {
+        std::sort(v.begin(), v.end(), before);
+        std::size_t kept = 0;
+        for (std::size_t e = 0; e < v.size(); ++e)
+            if (kept == 0 || v[e].a != v[kept - 1].a || v[e].b != v[kept - 1].b) v[kept++] = v[e];
+        v.resize(kept);
+    };
+    struct Wide {  // Link with whole-grid basins
+        double pass, low;
+        std::int64_t a, b, i, j;
+    };
+    auto wide_before = [](const Wide& l, const Wide& r) {
         if (l.a != r.a) return l.a < r.a;
         if (l.b != r.b) return l.b < r.b;
         if (l.pass != r.pass) return l.pass < r.pass;
@@ -415,17 +401,55 @@ void TiledModel::resolve_pits(double* h) {
         if (l.i != r.i) return l.i < r.i;
         return l.j < r.j;
     };
-    auto lowest_per_pair = [&](std::vector<LinkRecord>& v) {
-        std::sort(v.begin(), v.end(), before);
-        std::size_t kept = 0;
-        for (std::size_t e = 0; e < v.size(); ++e)
-            if (kept == 0 || v[e].a != v[kept - 1].a || v[e].b != v[kept - 1].b) v[kept++] = v[e];
-        v.resize(kept);
+    std::vector<Wide> links, tree_links;
+    std::vector<std::int64_t> pits;
+    for (std::size_t t = 0; t < trees_.size(); ++t) {
+        const std::int64_t li = label_[std::size_t(trees_[t])];
+        if (outlet_at(li)) continue;
+        tree_links.clear();
+        for (std::int64_t s = tree_start_[t]; s < tree_start_[t + 1]; ++s) {
+            const auto l = std::size_t(stack_[std::size_t(s)]);
+            const std::int64_t i = global(l);
+            if (i == li) pits.push_back(i);
+            const int x = int(i % W_), y = int(i / W_);
+            const std::size_t gl = grown_index(l);
+            for (int k = 0; k < 8; ++k) {
+                if (!inside(x, y, k, W_, H_)) continue;
+                const std::size_t gj = std::size_t(std::int64_t(gl) + std::int64_t(kDy[k]) * gw + kDx[k]);
+                const auto lj = std::int64_t(grown_label_[gj]);
+                if (lj == li) continue;
+                const std::int64_t j = i + std::int64_t(kDy[k]) * W_ + kDx[k];
+                const bool pit_j = !outlet_at(lj);
+                if (pit_j && j < i) continue;
+                const double pass = std::max(grown_h_[gl], grown_h_[gj]), low = std::min(grown_h_[gl], grown_h_[gj]);
+                const std::int64_t bj = pit_j ? lj : -1;  // the sea comes first, then pits by index
+                if (bj < li)
+                    tree_links.push_back({pass, low, bj, li, j, i});
+                else
+                    tree_links.push_back({pass, low, li, bj, i, j});
+            }
+        }
+        if (tree_links.size() > 1) lowest_per_pair(tree_links, wide_before);
+        links.insert(links.end(), tree_links.begin(), tree_links.end());
+    }
+    lowest_per_pair(links, wide_before);
+    // The ends of the kept links' cells' local trees, for the paths rank 0 cuts into pieces.
+    std::vector<LinkRecord> records;
+    records.reserve(links.size());
+    auto local_of = [&](std::int64_t g) -> std::int64_t {
+        const int x = int(g % W_) - own_.x0, y = int(g / W_) - own_.y0;
+        if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) return -1;
+        return std::int64_t(y) * own_.width + x;
     };
-    lowest_per_pair(links);
+    for (const Wide& w : links) {
+        const std::int64_t li = local_of(w.i), lj = local_of(w.j);
+        const Hop hi = li >= 0 ? hop(std::size_t(li)) : Hop{-2, -2};
+        const Hop hj = lj >= 0 ? hop(std::size_t(lj)) : Hop{-2, -2};
+        records.push_back({w.pass, w.low, w.a, w.b, w.i, w.j, hi.tree, hi.next, hj.tree, hj.next});
+    }
     std::string mine;
     put(mine, pits);
-    put(mine, links);
+    put(mine, records);
     all = joined([&] { return tiles_.gather_to_rank0(mine); });
     // 3. Rank 0: the basin graph, and the pieces of each pass's path down to its pit.
     answer.clear();
@@ -441,24 +465,32 @@ void TiledModel::resolve_pits(double* h) {
         }
         std::sort(every_pit.begin(), every_pit.end());
         if (std::int64_t(every_pit.size()) != pits_) throw std::logic_error("stream-power: the tiles disagree on the pits");
-        std::unordered_map<std::int64_t, std::int32_t> node{{-1, 0}};
-        for (std::size_t p = 0; p < every_pit.size(); ++p) node[every_pit[p]] = std::int32_t(p + 1);
-        lowest_per_pair(every_link);
-        std::map<std::pair<std::int32_t, std::int32_t>, const LinkRecord*> record;
+        auto node = [&](std::int64_t basin) {  // 0 the sea, 1.. the pits in index order
+            if (basin < 0) return std::int32_t(0);
+            return std::int32_t(std::lower_bound(every_pit.begin(), every_pit.end(), basin) - every_pit.begin() + 1);
+        };
+        // In the graph's total order (basins by index, the sea first, order the nodes as their
+        // numbers do), so that solve_basin_graph finds them sorted and its link indices are
+        // every_link's. A pair of basins may come from two tiles: Kruskal never takes the higher
+        // of two parallel links (the order is strict), as the whole-grid router's groups rely on.
+        std::sort(every_link.begin(), every_link.end(), [](const LinkRecord& l, const LinkRecord& r) {
+            if (l.pass != r.pass) return l.pass < r.pass;
+            if (l.low != r.low) return l.low < r.low;
+            if (l.a != r.a) return l.a < r.a;
+            if (l.b != r.b) return l.b < r.b;
+            if (l.i != r.i) return l.i < r.i;
+            return l.j < r.j;
+        });
         std::vector<Link> graph;
         graph.reserve(every_link.size());
-        for (const LinkRecord& r : every_link) {
-            const std::int32_t a = node.at(r.a), b = node.at(r.b);
-            graph.push_back({r.pass, r.low, a, b, r.i, r.j});
-            record[{a, b}] = &r;
-        }
+        for (const LinkRecord& r : every_link) graph.push_back({r.pass, r.low, node(r.a), node(r.b), r.i, r.j});
         const BasinTree tree = solve_basin_graph(graph, std::int32_t(every_pit.size() + 1));
         std::vector<Fill> fills;
         std::vector<Piece> pieces;
         for (std::size_t q = 1; q < tree.order.size(); ++q) {
             const std::int32_t v = tree.order[q];
             const Link& l = graph[std::size_t(tree.out_link[std::size_t(v)])];
-            const LinkRecord& r = *record.at({l.a, l.b});
+            const LinkRecord& r = every_link[std::size_t(tree.out_link[std::size_t(v)])];
             const bool from_i = l.a == v;  // the pit basin's own cell is i
             const std::int64_t in = from_i ? l.i : l.j, across = from_i ? l.j : l.i;
             const std::int64_t pit = every_pit[std::size_t(v - 1)];
@@ -486,10 +518,14 @@ void TiledModel::resolve_pits(double* h) {
     if (settings_.depressions == Depressions::fill) {
         std::unordered_map<std::int64_t, double> level;
         for (const Fill& f : fills) level[f.pit] = f.level;
-        for (std::size_t l = 0; l < n; ++l) {
-            if (outlet_at(label_[l])) continue;
-            const double lv = level.at(label_[l]);
-            if (h[l] < lv) h[l] = lv;
+        for (std::size_t t = 0; t < trees_.size(); ++t) {  // a tree lies in one basin: one lookup a tree
+            const std::int64_t basin = label_[std::size_t(trees_[t])];
+            if (outlet_at(basin)) continue;
+            const double lv = level.at(basin);
+            for (std::int64_t p = tree_start_[t]; p < tree_start_[t + 1]; ++p) {
+                const auto l = std::size_t(stack_[std::size_t(p)]);
+                if (h[l] < lv) h[l] = lv;
+            }
         }
     }
     for (const Piece& p : pieces) {
