@@ -39,7 +39,7 @@ BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
     std::int32_t joined = 0;
     for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
-        const std::int32_t ra = find(parent, links[e].a), rb = find(parent, links[e].b);
+        const std::int32_t ra = find(parent, std::int32_t(links[e].a)), rb = find(parent, std::int32_t(links[e].b));
         if (ra == rb) continue;
         parent[std::size_t(ra)] = rb;
         ++joined;
@@ -57,7 +57,7 @@ BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
         const std::int32_t v = t.order[q];
         for (std::int32_t e : adjacent[std::size_t(v)]) {
             const Link& l = links[std::size_t(e)];
-            const std::int32_t u = l.a == v ? l.b : l.a;
+            const auto u = std::int32_t(l.a == v ? l.b : l.a);
             if (seen[std::size_t(u)]) continue;
             seen[std::size_t(u)] = 1;
             t.out_link[std::size_t(u)] = e;
@@ -329,11 +329,7 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
                     }
                 }
             }
-            std::sort(out.begin(), out.end(), [](const Link& l, const Link& r) {
-                if (l.a != r.a) return l.a < r.a;
-                if (l.b != r.b) return l.b < r.b;
-                return link_before(l, r);
-            });
+            std::sort(out.begin(), out.end(), pair_then_order);
             std::size_t kept = 0;
             for (std::size_t e = 0; e < out.size(); ++e)
                 if (e == 0 || out[e].a != out[kept - 1].a || out[e].b != out[kept - 1].b) out[kept++] = out[e];

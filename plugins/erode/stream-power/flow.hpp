@@ -77,7 +77,7 @@ int steepest(double hi, unsigned inside, At at) {
 struct Link {
     double pass;        ///< max(h_i, h_j): the water level at which the two basins join, m
     double low;         ///< min(h_i, h_j), m: among equal passes the one from the lowest cell goes first
-    std::int32_t a, b;  ///< basin graph nodes, a < b (0 = the sea: every outlet basin)
+    std::int64_t a, b;  ///< basin graph nodes, a < b (0 = the sea: every outlet basin; a tile's links: pits' cells, −1 the sea)
     std::int64_t i, j;  ///< the two cells (i in a's basin, j in b's; whole-grid indices)
 };
 
@@ -89,6 +89,13 @@ inline bool link_before(const Link& l, const Link& r) {
     if (l.b != r.b) return l.b < r.b;
     if (l.i != r.i) return l.i < r.i;
     return l.j < r.j;
+}
+
+/// Links grouped by pair of basins, each pair's in the total order (its lowest first).
+inline bool pair_then_order(const Link& l, const Link& r) {
+    if (l.a != r.a) return l.a < r.a;
+    if (l.b != r.b) return l.b < r.b;
+    return link_before(l, r);
 }
 
 /// The minimum spanning tree of the basin graph oriented from the sea (node 0).

@@ -39,16 +39,23 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
         throw std::invalid_argument("stream_power::Model: multiple flow directions need Depressions::fill");
     if (!uplift_.empty() && uplift_.size() != h_.size())
         throw std::invalid_argument("stream_power::Model: uplift is not width × height");
-    pow_table_.resize(std::size_t(kPowTable));
-    for (std::int64_t c = 0; c < kPowTable; ++c)
-        pow_table_[std::size_t(c)] = std::pow(double(c) * (cell * cell), settings.area_exponent);
-    if (settings.diffusivity > 0.0) {
-        diffusion::Settings ds;
-        ds.diffusivity = settings.diffusivity;
-        ds.scheme = diffusion::Scheme::implicit;
-        ds.fixed = {settings.open.north, settings.open.east, settings.open.south, settings.open.west};
-        diffusion_ = std::make_unique<diffusion::Solver>(width, height, cell, ds);
-    }
+    pow_table_ = area_power_table(cell, settings.area_exponent);
+    if (settings.diffusivity > 0.0)
+        diffusion_ = std::make_unique<diffusion::Solver>(width, height, cell, hillslope_settings(settings));
+}
+
+std::vector<double> area_power_table(double cell, double m) {
+    std::vector<double> t(static_cast<std::size_t>(kPowTable));
+    for (std::int64_t c = 0; c < kPowTable; ++c) t[std::size_t(c)] = std::pow(double(c) * (cell * cell), m);
+    return t;
+}
+
+diffusion::Settings hillslope_settings(const Settings& settings) {
+    diffusion::Settings ds;
+    ds.diffusivity = settings.diffusivity;
+    ds.scheme = diffusion::Scheme::implicit;
+    ds.fixed = {settings.open.north, settings.open.east, settings.open.south, settings.open.west};
+    return ds;
 }
 
 void Model::set_uplift_history(UpliftHistory history) {

@@ -167,6 +167,11 @@ inline double incised_drop(double delta, double F, double n) {
     return x;
 }
 
+/// (c·cell²)^m for c = 0 … kPowTable − 1 cells: area_power()'s table.
+std::vector<double> area_power_table(double cell, double m);
+/// The hillslope diffusion a step applies: implicit, open sides fixed, closed sides closed.
+diffusion::Settings hillslope_settings(const Settings& settings);
+
 /// The outlet with every side closed: the lowest cell (lowest index among equals).
 std::int64_t lowest_cell(const std::vector<double>& heights);
 

@@ -45,10 +45,8 @@ struct EdgeRecord {  // an edge cell and the end of its local tree
 };
 
 struct LinkRecord {  // a tile's lowest link between a pit basin and a neighbouring basin
-    double pass, low;
-    std::int64_t a, b;        // basins (their pit's whole-grid index; −1 the sea), a < b
-    std::int64_t i, j;        // the cells, i in a's basin
-    std::int64_t tree_i, next_i, tree_j, next_j;  // their local trees' ends (tree −2: not this rank's cell)
+    Link link;  // basins a < b: their pit's whole-grid index, −1 the sea (which sorts first, as node 0)
+    std::int64_t tree_i, next_i, tree_j, next_j;  // the cells' local trees' ends (tree −2: not this rank's cell)
 };
 
 struct ExitRecord {  // an exit: the cells it drains (its tile's count) and where they go
@@ -154,16 +152,8 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
         for (int x = 0; x < own_.width; ++x)
             if (y == 0 || y == own_.height - 1 || x == 0 || x == own_.width - 1)
                 edge_.push_back(std::int32_t(std::int64_t(y) * own_.width + x));
-    pow_table_.resize(std::size_t(kPowTable));
-    for (std::int64_t c = 0; c < kPowTable; ++c)
-        pow_table_[std::size_t(c)] = std::pow(double(c) * (cell * cell), settings.area_exponent);
-    if (settings.diffusivity > 0.0) {
-        diffusion::Settings ds;
-        ds.diffusivity = settings.diffusivity;
-        ds.scheme = diffusion::Scheme::implicit;
-        ds.fixed = {settings.open.north, settings.open.east, settings.open.south, settings.open.west};
-        diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, ds);
-    }
+    pow_table_ = area_power_table(cell, settings.area_exponent);
+    if (settings.diffusivity > 0.0) diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, hillslope_settings(settings));
 }
 
 std::int64_t TiledModel::global(std::size_t l) const {
@@ -389,19 +379,7 @@ void TiledModel::resolve_pits(double* h) {
             if (kept == 0 || v[e].a != v[kept - 1].a || v[e].b != v[kept - 1].b) v[kept++] = v[e];
         v.resize(kept);
     };
-    struct Wide {  // Link with whole-grid basins
-        double pass, low;
-        std::int64_t a, b, i, j;
-    };
-    auto wide_before = [](const Wide& l, const Wide& r) {
-        if (l.a != r.a) return l.a < r.a;
-        if (l.b != r.b) return l.b < r.b;
-        if (l.pass != r.pass) return l.pass < r.pass;
-        if (l.low != r.low) return l.low < r.low;
-        if (l.i != r.i) return l.i < r.i;
-        return l.j < r.j;
-    };
-    std::vector<Wide> links, tree_links;
+    std::vector<Link> links, tree_links;
     std::vector<std::int64_t> pits;
     for (std::size_t t = 0; t < trees_.size(); ++t) {
         const std::int64_t li = label_[std::size_t(trees_[t])];
@@ -429,10 +407,10 @@ void TiledModel::resolve_pits(double* h) {
                     tree_links.push_back({pass, low, li, bj, i, j});
             }
         }
-        if (tree_links.size() > 1) lowest_per_pair(tree_links, wide_before);
+        if (tree_links.size() > 1) lowest_per_pair(tree_links, pair_then_order);
         links.insert(links.end(), tree_links.begin(), tree_links.end());
     }
-    lowest_per_pair(links, wide_before);
+    lowest_per_pair(links, pair_then_order);
     // The ends of the kept links' cells' local trees, for the paths rank 0 cuts into pieces.
     std::vector<LinkRecord> records;
     records.reserve(links.size());
@@ -441,11 +419,11 @@ void TiledModel::resolve_pits(double* h) {
         if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) return -1;
         return std::int64_t(y) * own_.width + x;
     };
-    for (const Wide& w : links) {
+    for (const Link& w : links) {
         const std::int64_t li = local_of(w.i), lj = local_of(w.j);
         const Hop hi = li >= 0 ? hop(std::size_t(li)) : Hop{-2, -2};
         const Hop hj = lj >= 0 ? hop(std::size_t(lj)) : Hop{-2, -2};
-        records.push_back({w.pass, w.low, w.a, w.b, w.i, w.j, hi.tree, hi.next, hj.tree, hj.next});
+        records.push_back({w, hi.tree, hi.next, hj.tree, hj.next});
     }
     std::string mine;
     put(mine, pits);
@@ -473,17 +451,15 @@ void TiledModel::resolve_pits(double* h) {
         // numbers do), so that solve_basin_graph finds them sorted and its link indices are
         // every_link's. A pair of basins may come from two tiles: Kruskal never takes the higher
         // of two parallel links (the order is strict), as the whole-grid router's groups rely on.
-        std::sort(every_link.begin(), every_link.end(), [](const LinkRecord& l, const LinkRecord& r) {
-            if (l.pass != r.pass) return l.pass < r.pass;
-            if (l.low != r.low) return l.low < r.low;
-            if (l.a != r.a) return l.a < r.a;
-            if (l.b != r.b) return l.b < r.b;
-            if (l.i != r.i) return l.i < r.i;
-            return l.j < r.j;
-        });
+        std::sort(every_link.begin(), every_link.end(),
+                  [](const LinkRecord& l, const LinkRecord& r) { return link_before(l.link, r.link); });
         std::vector<Link> graph;
         graph.reserve(every_link.size());
-        for (const LinkRecord& r : every_link) graph.push_back({r.pass, r.low, node(r.a), node(r.b), r.i, r.j});
+        for (const LinkRecord& r : every_link) {
+            graph.push_back(r.link);
+            graph.back().a = node(r.link.a);
+            graph.back().b = node(r.link.b);
+        }
         const BasinTree tree = solve_basin_graph(graph, std::int32_t(every_pit.size() + 1));
         std::vector<Fill> fills;
         std::vector<Piece> pieces;

@@ -414,6 +414,40 @@ TEST(MultipleFlow, SameBitsOnOneAndTwoThreadsAndTheSolverStillFollowsTheSteepest
     EXPECT_THROW(Model(8, 8, 1.0, noise(8, 8, 1, 1.0), {}, bad), std::invalid_argument);
 }
 
+TEST(BasinGraph, TheTreeDoesNotDependOnTheOrderTheLinksCameIn) {
+    // A tiled run collects its links tile by tile and rank 0 joins them: the
+    // tree (each pit's way out and lake level) must not follow that order.
+    // Passes drawn from a few values, so that equal passes (flat lakes) are common.
+    const std::int32_t nodes = 400;
+    std::vector<Link> links;
+    std::uint64_t k = 0;
+    for (std::int32_t b = 1; b < nodes; ++b)
+        for (int e = 0; e < 4; ++e) {
+            const auto a = std::int32_t(random::uniform(9, k++) * b);  // to a lower node (0: the sea)
+            const double pass = std::floor(random::uniform(9, k++) * 5.0), low = pass - std::floor(random::uniform(9, k++) * 2.0);
+            links.push_back({pass, low, a, b, std::int64_t(k), std::int64_t(k + 1)});
+        }
+    std::vector<Link> sorted = links;
+    const BasinTree want = solve_basin_graph(sorted, nodes);
+    for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+        std::vector<Link> shuffled = links;
+        for (std::size_t e = shuffled.size(); e > 1; --e)
+            std::swap(shuffled[e - 1], shuffled[std::size_t(random::below(e, 100 + seed, e))]);
+        const BasinTree got = solve_basin_graph(shuffled, nodes);
+        ASSERT_EQ(got.level, want.level);
+        for (std::int32_t v = 1; v < nodes; ++v) {
+            const Link& g = shuffled[std::size_t(got.out_link[std::size_t(v)])];
+            const Link& w = sorted[std::size_t(want.out_link[std::size_t(v)])];
+            EXPECT_EQ(g.i, w.i) << "node " << v;
+            EXPECT_EQ(g.j, w.j) << "node " << v;
+        }
+    }
+    // Among equal passes the link from the lower cell goes first: water crosses a flat lake from its lowest shore.
+    std::vector<Link> two = {{3.0, 2.0, 0, 1, 10, 11}, {3.0, 1.0, 0, 1, 20, 21}};
+    const BasinTree t = solve_basin_graph(two, 2);
+    EXPECT_EQ(two[std::size_t(t.out_link[1])].i, 20);
+}
+
 TEST(MultipleFlow, ACellSplitsItsWaterBySlopeToThePowerP) {
     // One inner cell 10 m above a row of outlets (3 × 2 map, every side but the
     // north open): its lower neighbours are south (slope 10) and south-west and
