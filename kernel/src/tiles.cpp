@@ -176,12 +176,13 @@ constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTag
               kTagFetch = 21, kTagText = 22;
 
 /// Copy the rectangle (x, y, w, h) of `grid` (row length `stride`) into `out`, or back with `to_grid`.
-void copy_rect(float* grid, int stride, int x, int y, int w, int h, float* out, bool to_grid) {
+template <typename T>
+void copy_rect(T* grid, int stride, int x, int y, int w, int h, T* out, bool to_grid) {
     for (int r = 0; r < h; ++r) {
-        float* g = grid + std::size_t(y + r) * std::size_t(stride) + std::size_t(x);
-        float* o = out + std::size_t(r) * std::size_t(w);
-        if (to_grid) std::memcpy(g, o, std::size_t(w) * sizeof(float));
-        else std::memcpy(o, g, std::size_t(w) * sizeof(float));
+        T* g = grid + std::size_t(y + r) * std::size_t(stride) + std::size_t(x);
+        T* o = out + std::size_t(r) * std::size_t(w);
+        if (to_grid) std::memcpy(g, o, std::size_t(w) * sizeof(T));
+        else std::memcpy(o, g, std::size_t(w) * sizeof(T));
     }
 }
 
@@ -224,14 +225,6 @@ void TiledRun::exchange_grids(std::span<T* const> grids, int halo) {
     const int ox = o.x0 - g.x0, oy = o.y0 - g.y0;  // the owned part inside each grid
     const std::size_t count = grids.size(), stride = std::size_t(g.width);
     std::vector<T> out, in;
-    // Copy the rectangle (x, y, w, h) of a grid into `buf` at `at`, or back.
-    auto copy = [stride](T* grid, int x, int y, int w, int h, T* buf, bool to_grid) {
-        for (int k = 0; k < h; ++k) {
-            T* row = grid + std::size_t(y + k) * stride + std::size_t(x);
-            if (to_grid) std::memcpy(row, buf + std::size_t(k) * std::size_t(w), std::size_t(w) * sizeof(T));
-            else std::memcpy(buf + std::size_t(k) * std::size_t(w), row, std::size_t(w) * sizeof(T));
-        }
-    };
     // East and west: the owned rows only (the corners come with the rows below);
     // grid k's block of halo × o.height values at k·block in each message.
     auto columns = [&](int send_x, int to, int recv_x, int from, int tag) {
@@ -239,10 +232,12 @@ void TiledRun::exchange_grids(std::span<T* const> grids, int halo) {
         out.resize(to >= 0 ? block * count : 0);
         in.resize(from >= 0 ? block * count : 0);
         if (to >= 0)
-            for (std::size_t k = 0; k < count; ++k) copy(grids[k], send_x, oy, halo, o.height, out.data() + k * block, false);
+            for (std::size_t k = 0; k < count; ++k)
+                copy_rect(grids[k], g.width, send_x, oy, halo, o.height, out.data() + k * block, false);
         mpi::sendrecv(out.data(), out.size() * sizeof(T), to, in.data(), in.size() * sizeof(T), from, tag);
         if (from >= 0)
-            for (std::size_t k = 0; k < count; ++k) copy(grids[k], recv_x, oy, halo, o.height, in.data() + k * block, true);
+            for (std::size_t k = 0; k < count; ++k)
+                copy_rect(grids[k], g.width, recv_x, oy, halo, o.height, in.data() + k * block, true);
     };
     columns(ox, west, ox + o.width, east, kTagWest);  // my first columns go west, the east's come in
     columns(ox + o.width - halo, east, ox - halo, west, kTagEast);

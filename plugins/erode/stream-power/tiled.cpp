@@ -168,6 +168,12 @@ bool TiledModel::outlet_at(std::int64_t g) const {
     return (y == 0 && o.north) || (y == H_ - 1 && o.south) || (x == 0 && o.west) || (x == W_ - 1 && o.east);
 }
 
+std::int64_t TiledModel::local_of(std::int64_t g) const {
+    const int x = int(g % W_) - own_.x0, y = int(g / W_) - own_.y0;
+    if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) return -1;
+    return std::int64_t(y) * own_.width + x;
+}
+
 std::size_t TiledModel::grown_index(std::size_t l) const {
     const auto x = std::size_t(l % std::size_t(own_.width)), y = std::size_t(l / std::size_t(own_.width));
     return (y + std::size_t(own_.y0 - grown_.y0)) * std::size_t(grown_.width) + x + std::size_t(own_.x0 - grown_.x0);
@@ -372,8 +378,8 @@ void TiledModel::resolve_pits(double* h) {
     // Collected tree by tree (a tree lies in one basin), each tree keeping its
     // lowest link per neighbouring basin (Link's i, j, a, b here: whole-grid
     // cells and basins, −1 the sea, which comes first), then the tile's lowest per pair.
-    auto lowest_per_pair = [&](auto& v, auto before) {
-        std::sort(v.begin(), v.end(), before);
+    auto lowest_per_pair = [](std::vector<Link>& v) {
+        std::sort(v.begin(), v.end(), pair_then_order);
         std::size_t kept = 0;
         for (std::size_t e = 0; e < v.size(); ++e)
             if (kept == 0 || v[e].a != v[kept - 1].a || v[e].b != v[kept - 1].b) v[kept++] = v[e];
@@ -407,18 +413,13 @@ void TiledModel::resolve_pits(double* h) {
                     tree_links.push_back({pass, low, li, bj, i, j});
             }
         }
-        if (tree_links.size() > 1) lowest_per_pair(tree_links, pair_then_order);
+        if (tree_links.size() > 1) lowest_per_pair(tree_links);
         links.insert(links.end(), tree_links.begin(), tree_links.end());
     }
-    lowest_per_pair(links, pair_then_order);
+    lowest_per_pair(links);
     // The ends of the kept links' cells' local trees, for the paths rank 0 cuts into pieces.
     std::vector<LinkRecord> records;
     records.reserve(links.size());
-    auto local_of = [&](std::int64_t g) -> std::int64_t {
-        const int x = int(g % W_) - own_.x0, y = int(g / W_) - own_.y0;
-        if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) return -1;
-        return std::int64_t(y) * own_.width + x;
-    };
     for (const Link& w : links) {
         const std::int64_t li = local_of(w.i), lj = local_of(w.j);
         const Hop hi = li >= 0 ? hop(std::size_t(li)) : Hop{-2, -2};
@@ -505,9 +506,9 @@ void TiledModel::resolve_pits(double* h) {
         }
     }
     for (const Piece& p : pieces) {
-        const int x = int(p.start % W_) - own_.x0, y = int(p.start / W_) - own_.y0;
-        if (x < 0 || x >= own_.width || y < 0 || y >= own_.height) continue;
-        auto c = std::size_t(std::int64_t(y) * own_.width + x);
+        const std::int64_t start = local_of(p.start);
+        if (start < 0) continue;
+        auto c = std::size_t(start);
         std::int64_t prev = p.prev;
         for (;;) {
             const int old = dir_[c];
@@ -528,9 +529,7 @@ void TiledModel::accumulate() {
     auto count = [&] {
         std::fill(count_.begin(), count_.end(), 1.0);
         for (const Inflow& f : inflows) {
-            const int x = int(f.cell % W_) - own_.x0, y = int(f.cell / W_) - own_.y0;
-            if (x >= 0 && x < own_.width && y >= 0 && y < own_.height)
-                count_[std::size_t(std::int64_t(y) * own_.width + x)] += f.count;
+            if (const std::int64_t l = local_of(f.cell); l >= 0) count_[std::size_t(l)] += f.count;
         }
         for (std::size_t s = stack_.size(); s-- > 0;) {
             const auto l = std::size_t(stack_[s]);
@@ -678,10 +677,8 @@ std::int64_t TiledModel::step(double dt) {
     const std::int64_t pits = pits_;
     // 3. Hillslope diffusion across the tiles (the declared sink stays at base level).
     if (diffusion_) {
-        std::int64_t sink = -1;
-        double sink_h = 0.0;
-        for (std::size_t l = 0; l < n && !settings_.open.any(); ++l)
-            if (outlet_[l]) sink = std::int64_t(l), sink_h = h_[l];
+        const std::int64_t sink = settings_.open.any() ? -1 : local_of(sink_);
+        const double sink_h = sink >= 0 ? h_[std::size_t(sink)] : 0.0;
         diffusion_->step(h_.data(), dt);
         if (sink >= 0) h_[std::size_t(sink)] = sink_h;
     }

@@ -118,6 +118,7 @@ private:
     std::int64_t receiver_global(std::size_t l) const;  // −1 for a root
     std::int64_t owned_neighbour(std::size_t l, int k) const;  // local index, −1 outside the tile
     std::size_t grown_index(std::size_t l) const;
+    std::int64_t local_of(std::int64_t g) const;  // local index of whole-grid cell g, −1 outside the tile
 
     Tiling& tiles_;
     TileRect own_, grown_;
