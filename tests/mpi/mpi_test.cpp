@@ -191,7 +191,9 @@ INSTANTIATE_TEST_SUITE_P(Ranks, DiffusionSeam, kErosionCases, kCaseName);
 /// relief full of pits (filled, then routed across with n = 1.5), uplift from
 /// a layer spread across the seams, hillslope diffusion, chi, every side
 /// closed with the lowest cell of the whole grid as the one outlet, and a
-/// time-lapse; then routing=mfd, which is not tiled and runs on rank 0. A
+/// time-lapse; then routing=mfd, which is not tiled and runs on rank 0; and
+/// rough diamond-square relief with a hundred lakes a step, most of them
+/// settled on their own tile (closed basins) and the rest by rank 0. A
 /// basin labelled wrongly, a lake filled to another level, a pass reversed
 /// one tile short or an exit's drainage area lost at a seam changes the
 /// heights or the layers (drainage, flow_direction, chi) downstream of it.
@@ -205,17 +207,22 @@ s1 = erode:stream-power(t, years=2e5, dt=1e4, diffusivity=0.01, chi=true, uplift
 s2 = erode:stream-power(s1, years=1e5, dt=2e4, n=1.5, depressions=route, open="ns", diffusivity=0)
 s3 = erode:stream-power(s2, years=6e4, dt=2e4, open="none", uplift=2, base_level="0")
 s4 = erode:stream-power(s3, years=4e4, dt=2e4, routing=mfd)
+d  = generate:diamond-square(roughness=0.7, amplitude=300)
+s5 = erode:stream-power(d, years=3e4, dt=1e4, diffusivity=0.01)
+s6 = erode:stream-power(d, years=2e4, dt=1e4, depressions=route, open="we", n=1.5)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
 export:video(r, path="s1.mpg", fps=25, quality=0)
 export:vtk(s1, path="s1.vti")
 export:vtk(s2, path="s2.vti")
 export:vtk(s3, path="s3.vti")
 export:raw(s4, path="s4.r32")
+export:vtk(s5, path="s5.vti")
+export:vtk(s6, path="s6.vti")
 )";
 
 class StreamPowerSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(StreamPowerSeam, StreamPowerEqualsOneProcess) {
-    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32"}, GetParam());
+    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti"}, GetParam());
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, StreamPowerSeam, kErosionCases, kCaseName);
 

@@ -18,17 +18,13 @@ constexpr double kSqrt2 = 1.4142135623730951;
 
 }  // namespace
 
-namespace {
-
-std::int32_t find(std::vector<std::int32_t>& parent, std::int32_t v) {
+std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t v) {
     while (parent[std::size_t(v)] != v) {
         parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
         v = parent[std::size_t(v)];
     }
     return v;
 }
-
-}  // namespace
 
 BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     // A total order, so the tree does not depend on the order the links were collected in.
@@ -39,7 +35,7 @@ BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
     std::int32_t joined = 0;
     for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
-        const std::int32_t ra = find(parent, std::int32_t(links[e].a)), rb = find(parent, std::int32_t(links[e].b));
+        const std::int32_t ra = find_root(parent, std::int32_t(links[e].a)), rb = find_root(parent, std::int32_t(links[e].b));
         if (ra == rb) continue;
         parent[std::size_t(ra)] = rb;
         ++joined;

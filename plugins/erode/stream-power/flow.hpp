@@ -105,6 +105,9 @@ struct BasinTree {
     std::vector<std::int32_t> order;    ///< nodes from the sea outwards (each after the node it spills into)
 };
 
+/// Union-find: the root of v's set (path halving).
+std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t v);
+
 /// Kruskal over `links` (sorted in place by link_before, unless they come sorted), nodes 0..nodes−1: the
 /// tree is unique under the total order, whatever order the links came in.
 /// Throws std::logic_error if a node has no way to the sea.

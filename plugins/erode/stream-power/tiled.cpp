@@ -1,6 +1,8 @@
 // tiled.cpp — the stream-power model on one rank's tile (see tiled.hpp).
 #include "tiled.hpp"
 
+#include "basin_join.hpp"
+
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -11,6 +13,7 @@
 #include <stdexcept>
 #include <type_traits>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace orogen::stream_power {
 
@@ -44,20 +47,10 @@ struct EdgeRecord {  // an edge cell and the end of its local tree
     std::int64_t cell, tree, next;
 };
 
-struct LinkRecord {  // a tile's lowest link between a pit basin and a neighbouring basin
-    Link link;  // basins a < b: their pit's whole-grid index, −1 the sea (which sorts first, as node 0)
-    std::int64_t tree_i, next_i, tree_j, next_j;  // the cells' local trees' ends (tree −2: not this rank's cell)
-};
-
 struct ExitRecord {  // an exit: the cells it drains (its tile's count) and where they go
     std::int64_t cell;
     double count;
     std::int64_t next;
-};
-
-struct Fill {
-    std::int64_t pit;
-    double level;
 };
 
 struct Piece {  // a piece of a path reversed from a pass to its pit: from `start`, which now drains to `prev`
@@ -386,7 +379,6 @@ void TiledModel::resolve_pits(double* h) {
         v.resize(kept);
     };
     std::vector<Link> links, tree_links;
-    std::vector<std::int64_t> pits;
     for (std::size_t t = 0; t < trees_.size(); ++t) {
         const std::int64_t li = label_[std::size_t(trees_[t])];
         if (outlet_at(li)) continue;
@@ -394,7 +386,6 @@ void TiledModel::resolve_pits(double* h) {
         for (std::int64_t s = tree_start_[t]; s < tree_start_[t + 1]; ++s) {
             const auto l = std::size_t(stack_[std::size_t(s)]);
             const std::int64_t i = global(l);
-            if (i == li) pits.push_back(i);
             const int x = int(i % W_), y = int(i / W_);
             const std::size_t gl = grown_index(l);
             for (int k = 0; k < 8; ++k) {
@@ -417,99 +408,92 @@ void TiledModel::resolve_pits(double* h) {
         links.insert(links.end(), tree_links.begin(), tree_links.end());
     }
     lowest_per_pair(links);
-    // The ends of the kept links' cells' local trees, for the paths rank 0 cuts into pieces.
-    std::vector<LinkRecord> records;
-    records.reserve(links.size());
-    for (const Link& w : links) {
-        const std::int64_t li = local_of(w.i), lj = local_of(w.j);
-        const Hop hi = li >= 0 ? hop(std::size_t(li)) : Hop{-2, -2};
-        const Hop hj = lj >= 0 ? hop(std::size_t(lj)) : Hop{-2, -2};
-        records.push_back({w, hi.tree, hi.next, hj.tree, hj.next});
-    }
+    // 3. The lakes settled here: the basins with their pit in this tile and no
+    // cell on its edge have all their links among the tile's (basin_join.hpp).
+    std::unordered_set<std::int64_t> on_edge;
+    for (const std::int32_t l : edge_) on_edge.insert(label_[std::size_t(l)]);
+    const TileForest forest = contract_tile(std::move(links), [&](std::int64_t basin) {
+        return local_of(basin) >= 0 && on_edge.count(basin) == 0;
+    });
+    // Rank 0 gets the rest, with the ends of the local trees of the cells it may cut paths from.
+    std::vector<EdgeRecord> hops;
+    auto hop_of = [&](std::int64_t cell) {
+        if (const std::int64_t l = local_of(cell); l >= 0) {
+            const Hop hp = hop(std::size_t(l));
+            hops.push_back({cell, hp.tree, hp.next});
+        }
+    };
+    for (const Link& l : forest.deferred) hop_of(l.i), hop_of(l.j);
+    for (const ForestEdge& e : forest.edges) hop_of(e.first.i), hop_of(e.first.j);
     std::string mine;
-    put(mine, pits);
-    put(mine, records);
+    put(mine, forest.anchors);
+    put(mine, forest.deferred);
+    put(mine, forest.edges);
+    put(mine, hops);
     all = joined([&] { return tiles_.gather_to_rank0(mine); });
-    // 3. Rank 0: the basin graph, and the pieces of each pass's path down to its pit.
+    // 4. Rank 0: the joined tree's key basins, and the pieces of each anchor's path from its pass down to its pit.
     answer.clear();
     if (root0) {
-        std::vector<std::int64_t> every_pit;
-        std::vector<LinkRecord> every_link;
+        std::vector<std::int64_t> anchors;
+        std::vector<Link> deferred;
+        std::vector<ForestEdge> forest_edges;
         for (const auto& m : all) {
             std::size_t at = 0;
-            const auto p = take<std::int64_t>(m, at);
-            const auto l = take<LinkRecord>(m, at);
-            every_pit.insert(every_pit.end(), p.begin(), p.end());
-            every_link.insert(every_link.end(), l.begin(), l.end());
+            const auto a = take<std::int64_t>(m, at);
+            const auto d = take<Link>(m, at);
+            const auto e = take<ForestEdge>(m, at);
+            for (const EdgeRecord& r : take<EdgeRecord>(m, at)) edges.emplace(r.cell, std::pair{r.tree, r.next});
+            anchors.insert(anchors.end(), a.begin(), a.end());
+            deferred.insert(deferred.end(), d.begin(), d.end());
+            forest_edges.insert(forest_edges.end(), e.begin(), e.end());
         }
-        std::sort(every_pit.begin(), every_pit.end());
-        if (std::int64_t(every_pit.size()) != pits_) throw std::logic_error("stream-power: the tiles disagree on the pits");
-        auto node = [&](std::int64_t basin) {  // 0 the sea, 1.. the pits in index order
-            if (basin < 0) return std::int32_t(0);
-            return std::int32_t(std::lower_bound(every_pit.begin(), every_pit.end(), basin) - every_pit.begin() + 1);
-        };
-        // In the graph's total order (basins by index, the sea first, order the nodes as their
-        // numbers do), so that solve_basin_graph finds them sorted and its link indices are
-        // every_link's. A pair of basins may come from two tiles: Kruskal never takes the higher
-        // of two parallel links (the order is strict), as the whole-grid router's groups rely on.
-        std::sort(every_link.begin(), every_link.end(),
-                  [](const LinkRecord& l, const LinkRecord& r) { return link_before(l.link, r.link); });
-        std::vector<Link> graph;
-        graph.reserve(every_link.size());
-        for (const LinkRecord& r : every_link) {
-            graph.push_back(r.link);
-            graph.back().a = node(r.link.a);
-            graph.back().b = node(r.link.b);
-        }
-        const BasinTree tree = solve_basin_graph(graph, std::int32_t(every_pit.size() + 1));
-        std::vector<Fill> fills;
+        std::sort(anchors.begin(), anchors.end());
+        anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
+        const std::vector<KeyExit> keys = join_tiles(std::move(deferred), forest_edges, anchors);
         std::vector<Piece> pieces;
-        for (std::size_t q = 1; q < tree.order.size(); ++q) {
-            const std::int32_t v = tree.order[q];
-            const Link& l = graph[std::size_t(tree.out_link[std::size_t(v)])];
-            const LinkRecord& r = every_link[std::size_t(tree.out_link[std::size_t(v)])];
-            const bool from_i = l.a == v;  // the pit basin's own cell is i
-            const std::int64_t in = from_i ? l.i : l.j, across = from_i ? l.j : l.i;
-            const std::int64_t pit = every_pit[std::size_t(v - 1)];
-            fills.push_back({pit, tree.level[std::size_t(v)]});
-            std::pair<std::int64_t, std::int64_t> end =
-                from_i ? std::pair{r.tree_i, r.next_i} : std::pair{r.tree_j, r.next_j};
-            if (end.first == -2) end = edge_of(edges, in);
-            pieces.push_back({in, across});
+        for (const KeyExit& k : keys) {
+            if (k.basin < 0 || !std::binary_search(anchors.begin(), anchors.end(), k.basin)) continue;
+            if (k.in < 0) throw std::logic_error("stream-power: an anchor basin's way out is not a link");
+            pieces.push_back({k.in, k.across});
+            std::pair<std::int64_t, std::int64_t> end = edge_of(edges, k.in);
             std::size_t guard = 0;
             while (end.second >= 0) {
                 pieces.push_back({end.second, end.first});  // the exit's receiver now drains back to the exit
                 end = edge_of(edges, end.second);
                 if (++guard > edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
             }
-            if (end.first != pit) throw std::logic_error("stream-power: a pass's path does not reach its pit");
+            if (end.first != k.basin) throw std::logic_error("stream-power: a pass's path does not reach its pit");
         }
-        put(answer, fills);
+        put(answer, keys);
         put(answer, pieces);
     }
     joined([&] { return tiles_.share_from_rank0(answer); });
-    // 4. Every rank: fill its lakes, reverse its pieces of the paths.
+    // 5. Every rank: orient its closed basins, fill its lakes, reverse its pieces of the paths.
     std::size_t at = 0;
-    const auto fills = take<Fill>(answer, at);
+    std::unordered_map<std::int64_t, KeyExit> keys;
+    for (const KeyExit& k : take<KeyExit>(answer, at)) keys.emplace(k.basin, k);
     const auto pieces = take<Piece>(answer, at);
+    const std::vector<BasinExit> closed = orient_tile(forest, keys);
     if (settings_.depressions == Depressions::fill) {
         std::unordered_map<std::int64_t, double> level;
-        for (const Fill& f : fills) level[f.pit] = f.level;
+        level.reserve(closed.size() + keys.size());
+        for (const BasinExit& e : closed) level.emplace(e.basin, e.level);
+        for (const auto& [basin, k] : keys) level.emplace(basin, k.level);
         for (std::size_t t = 0; t < trees_.size(); ++t) {  // a tree lies in one basin: one lookup a tree
             const std::int64_t basin = label_[std::size_t(trees_[t])];
             if (outlet_at(basin)) continue;
-            const double lv = level.at(basin);
+            const auto it = level.find(basin);
+            if (it == level.end()) throw std::logic_error("stream-power: a lake's level did not come");
+            const double lv = it->second;
             for (std::int64_t p = tree_start_[t]; p < tree_start_[t + 1]; ++p) {
                 const auto l = std::size_t(stack_[std::size_t(p)]);
                 if (h[l] < lv) h[l] = lv;
             }
         }
     }
-    for (const Piece& p : pieces) {
-        const std::int64_t start = local_of(p.start);
-        if (start < 0) continue;
+    // Reverse the receivers from `start` (which now drains to `prev`) down to the pit or out of the tile.
+    auto reverse = [&](std::int64_t start, std::int64_t prev) {
         auto c = std::size_t(start);
-        std::int64_t prev = p.prev;
         for (;;) {
             const int old = dir_[c];
             dir_[c] = std::int8_t(direction_to(global(c), prev, W_));
@@ -519,7 +503,10 @@ void TiledModel::resolve_pits(double* h) {
             prev = global(c);
             c = std::size_t(next);
         }
-    }
+    };
+    for (const BasinExit& e : closed) reverse(local_of(e.in), e.across);
+    for (const Piece& p : pieces)
+        if (const std::int64_t start = local_of(p.start); start >= 0) reverse(start, p.prev);
     build_trees();
 }
 

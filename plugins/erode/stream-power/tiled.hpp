@@ -15,11 +15,15 @@
 //   reaches) and sends each rank the basins of its exits; every rank labels
 //   its cells, exchanges the labels of its halo and collects, from its cells
 //   in pit basins, the lowest link to each neighbouring basin (flow.hpp's
-//   links, under the same total order). Rank 0 joins the tiles' links and
-//   solves the basin graph (solve_basin_graph, as the whole-grid router
-//   does): each pit's lake level and pass, and the path from the pass down to
-//   the pit cut into one piece per tile it crosses. Every rank fills its
-//   lakes and reverses its pieces of those paths.
+//   links, under the same total order). Each rank settles the lakes whose
+//   basins lie inside its tile, off its edge (basin_join.hpp: their links
+//   are all its own, so a component of them leaves by its lowest link), and
+//   sends rank 0 only the rest: the links between its components and its
+//   spanning forest reduced to their ends. Rank 0 joins them into the whole
+//   grid's tree (the same as solve_basin_graph's) and sends back the key
+//   basins' levels and ways out, and the path from each edge basin's pass
+//   down to its pit cut into one piece per tile it crosses. Every rank
+//   orients its own lakes from those, fills them and reverses its paths.
 // - Drainage area: every tile counts the cells upstream of each of its cells
 //   (whole numbers: exact in any order); rank 0 passes each exit's count on
 //   to the edge cell it drains into, and on down the tiles, and every rank

@@ -2,6 +2,7 @@
 // state, a 1-D river against the implicit scheme and against the travelling
 // knickpoint of the kinematic wave, depression handling (every cell drains to
 // an outlet, no loops, the outlet's area is the map's), and determinism.
+#include "basin_join.hpp"
 #include "stream_power.hpp"
 
 #include <orogen/random.hpp>
@@ -13,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <numeric>
 #include <vector>
 
@@ -446,6 +448,102 @@ TEST(BasinGraph, TheTreeDoesNotDependOnTheOrderTheLinksCameIn) {
     std::vector<Link> two = {{3.0, 2.0, 0, 1, 10, 11}, {3.0, 1.0, 0, 1, 20, 21}};
     const BasinTree t = solve_basin_graph(two, 2);
     EXPECT_EQ(two[std::size_t(t.out_link[1])].i, 20);
+}
+
+TEST(BasinJoin, TilesThatSettleTheirClosedLakesGiveTheWholeGraphsTree) {
+    // A lattice of basins (96 x 64; the outer ring drains to the sea, and
+    // some inner ones too) cut into tiles of 32 x 32. A basin is closed on its
+    // tile when all its neighbours are there (and 9 in 10 such are); its links
+    // are then all in its tile's list. Links between two open basins go to
+    // one tile or, as across a seam, to both with different cells. Passes
+    // come from a few values, so equal passes are common. Whatever the tiles
+    // settle, every basin must get the whole graph's way out and lake level.
+    const int X = 96, Y = 64, tile = 32;
+    auto node = [&](int x, int y) { return std::int64_t(y) * X + x + 1; };  // 0: the sea
+    auto basin_id = [](std::int64_t v) { return v == 0 ? std::int64_t(-1) : 5 * v + 2; };  // in index order, as pits
+    auto tile_of = [&](int x, int y) { return (y / tile) * (X / tile) + x / tile; };
+    const int tiles = (X / tile) * (Y / tile);
+    for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+        std::uint64_t k = 0;
+        auto uniform = [&] { return random::uniform(seed, k++); };
+        std::vector<std::uint8_t> closed(std::size_t(X * Y + 1), 0);
+        for (int y = 1; y < Y - 1; ++y)
+            for (int x = 1; x < X - 1; ++x) {
+                bool same = true;
+                for (int d = 0; d < 8; ++d) same = same && tile_of(x + kDx[d], y + kDy[d]) == tile_of(x, y);
+                closed[std::size_t(node(x, y))] = same && uniform() < 0.9;
+            }
+        std::vector<std::vector<Link>> per_tile(static_cast<std::size_t>(tiles));
+        std::vector<Link> whole;  // node numbers
+        std::int64_t cell = 0;
+        auto add = [&](std::int64_t u, std::int64_t v, int t) {  // u < v, nodes
+            const double pass = std::floor(uniform() * 6.0), low = pass - std::floor(uniform() * 2.0);
+            const std::int64_t i = cell++, j = cell++;
+            whole.push_back({pass, low, u, v, i, j});
+            per_tile[std::size_t(t)].push_back({pass, low, basin_id(u), basin_id(v), i, j});
+        };
+        for (int y = 0; y < Y; ++y)
+            for (int x = 0; x < X; ++x) {
+                const std::int64_t v = node(x, y);
+                const int t = tile_of(x, y);
+                if (x == 0 || y == 0 || x == X - 1 || y == Y - 1 || uniform() < 0.05) add(0, v, t);
+                for (int d : {0, 1, 2, 3}) {  // east, south-east, south, south-west: each pair once
+                    const int nx = x + kDx[d], ny = y + kDy[d];
+                    if (nx < 0 || nx >= X || ny >= Y) continue;
+                    const std::int64_t u = node(nx, ny);
+                    const int tu = tile_of(nx, ny);
+                    if (closed[std::size_t(v)]) add(v, u, t);
+                    else if (closed[std::size_t(u)]) add(v, u, tu);
+                    else if (t != tu && uniform() < 0.5) add(v, u, t), add(v, u, tu);  // a pair seen by both tiles
+                    else add(v, u, uniform() < 0.5 ? t : tu);
+                }
+            }
+        std::vector<Link> sorted = whole;
+        const BasinTree want = solve_basin_graph(sorted, std::int32_t(X * Y + 1));
+
+        std::vector<TileForest> forests;
+        std::vector<Link> deferred;
+        std::vector<ForestEdge> edges;
+        std::vector<std::int64_t> anchors;
+        std::int64_t settled = 0;
+        for (int t = 0; t < tiles; ++t) {
+            forests.push_back(contract_tile(per_tile[std::size_t(t)], [&](std::int64_t b) {
+                return closed[std::size_t((b - 2) / 5)] != 0;
+            }));
+            const TileForest& f = forests.back();
+            deferred.insert(deferred.end(), f.deferred.begin(), f.deferred.end());
+            edges.insert(edges.end(), f.edges.begin(), f.edges.end());
+            anchors.insert(anchors.end(), f.anchors.begin(), f.anchors.end());
+        }
+        std::sort(anchors.begin(), anchors.end());
+        anchors.erase(std::unique(anchors.begin(), anchors.end()), anchors.end());
+        std::unordered_map<std::int64_t, KeyExit> keys;
+        for (const KeyExit& e : join_tiles(deferred, edges, anchors)) keys.emplace(e.basin, e);
+        std::map<std::int64_t, BasinExit> got;
+        for (const TileForest& f : forests)
+            for (const BasinExit& e : orient_tile(f, keys)) ASSERT_TRUE(got.emplace(e.basin, e).second) << e.basin;
+        for (std::int64_t v = 1; v <= X * Y; ++v) {
+            const Link& w = sorted[std::size_t(want.out_link[std::size_t(v)])];
+            const std::int64_t in = w.a == v ? w.i : w.j, across = w.a == v ? w.j : w.i;
+            const std::int64_t b = basin_id(v);
+            if (closed[std::size_t(v)]) {
+                ASSERT_EQ(got.count(b), 1u) << "seed " << seed << " basin " << v;
+                EXPECT_EQ(got[b].level, want.level[std::size_t(v)]) << "seed " << seed << " basin " << v;
+                EXPECT_EQ(got[b].in, in) << "seed " << seed << " basin " << v;
+                EXPECT_EQ(got[b].across, across) << "seed " << seed << " basin " << v;
+                if (keys.count(b)) EXPECT_EQ(keys[b].level, want.level[std::size_t(v)]) << "seed " << seed << " key " << v;
+                ++settled;
+            } else {
+                ASSERT_EQ(keys.count(b), 1u) << "seed " << seed << " basin " << v;
+                EXPECT_EQ(keys[b].level, want.level[std::size_t(v)]) << "seed " << seed << " basin " << v;
+                EXPECT_EQ(keys[b].in, in) << "seed " << seed << " basin " << v;
+                EXPECT_EQ(keys[b].across, across) << "seed " << seed << " basin " << v;
+            }
+        }
+        EXPECT_EQ(std::int64_t(got.size()), settled);
+        // Rank 0 sees much less than the whole graph.
+        EXPECT_LT(deferred.size() + edges.size(), whole.size() / 2) << "seed " << seed;
+    }
 }
 
 TEST(MultipleFlow, ACellSplitsItsWaterBySlopeToThePowerP) {
