@@ -291,19 +291,49 @@ TEST(Mpi, TilesNarrowerThanPipeOrHydraulicHalosAreRefusedAtTheNode) {
     EXPECT_FALSE(fs::exists(dir / "o" / "h.r32"));
 }
 
-TEST(Mpi, PlatesTimelapseIsRefusedInATiledRun) {
+TEST(Mpi, TimelapseOfATiledNodeThatDoesNotGatherItIsRefused) {
+    // A plugin's tiled node without tiled_timelapse (every node of orogen's own gathers its frames).
     TempDir dir;
     const auto spec = dir.write("s.orogen", "orogen 1\ngrid 33\nf = generate:fault()\n"
-                                            "p = tectonics:plates(f, plates=3, steps=8, timelapse_every=2)\n"
+                                            "p = erode:test-tiled-no-lapse(f, timelapse_every=2)\n"
                                             "export:raw(p, path=\"p.r32\")\n");
-    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "o"));
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("s.orogen:4:5: error: 'p' (tectonics:plates): time-lapses are not recorded in a tiled run "
-                         "yet; set timelapse_every=0 or run without mpirun"),
+    const std::string launcher =
+        std::string(OROGEN_MPIEXEC) + " --oversubscribe --allow-run-as-root -x OROGEN_PLUGIN_PATH -n 2 ";
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "o"),
+                                   "OROGEN_PLUGIN_PATH=" + std::string(OROGEN_FAKE_PLUGIN_DIR) + " " + launcher);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("s.orogen:4:5: error: 'p' (erode:test-tiled-no-lapse): time-lapses are not recorded in a "
+                         "tiled run yet; set timelapse_every=0 or run without mpirun"),
               std::string::npos)
         << r.err;
     EXPECT_FALSE(fs::exists(dir / "o" / "p.r32"));
 }
+
+/// The plates' time-lapse in a tiled run: every rank replays rank 0's Box2D
+/// outcome into its tile up to each frame's step (peaks, rifts and
+/// subduction in the relief's fields, the thesis's Voronoi cells straight
+/// onto the terrain) and rank 0 gathers the frames: a stamp drawn a frame
+/// early or late, or a tile's relief applied over the wrong rectangle,
+/// changes the video's bytes.
+const char* kPlatesTimelapseSpec = R"(orogen 1
+seed 23
+grid 97x61 cell=50
+
+c = generate:fault(iterations=100, displacement=0.5)
+p = tectonics:plates(c, plates=6, steps=120, oceanic_fraction=0.5, rift_threshold=2000, cones=40, timelapse_every=2)
+q = tectonics:plates(p, plates=5, steps=80, ranges=cells, cones=30, drive=thesis, timelapse_every=2)
+rp = render:terrain(p.timelapse, width=96, height=60, exaggeration=2)
+rq = render:terrain(q.timelapse, width=96, height=60, exaggeration=2)
+export:video(rp, path="p.mpg", fps=25, quality=0)
+export:video(rq, path="q.mpg", fps=25, quality=0)
+)";
+
+class PlatesTimelapseSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(PlatesTimelapseSeam, PlatesTimelapseEqualsOneProcess) {
+    expect_same_outputs(kPlatesTimelapseSpec, {"p.mpg", "q.mpg"}, GetParam());
+}
+INSTANTIATE_TEST_SUITE_P(Ranks, PlatesTimelapseSeam, ::testing::Values(Case{2, ""}, Case{3, "1x3"}, Case{4, "2x2"}),
+                         kCaseName);
 
 /// The time-lapses of the tiled eroders (rank 0 gathers each frame from the
 /// tiles): thermal at the ends of its sweeps, hydraulic and pipe after their

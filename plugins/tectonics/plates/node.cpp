@@ -60,7 +60,10 @@ NodeOutputs run(NodeContext& ctx) {
         if (step % 32 == 0) ctx.progress(double(step) / double(params.steps));
     };
     plates::Result result;
-    Timelapse lapse(ctx.integer("timelapse_every"), params.dt);  // time in simulated seconds (refused tiled)
+    const std::int64_t every = ctx.integer("timelapse_every");
+    // Time in simulated seconds; in a tiled run every rank draws its tile of each frame and rank 0 gathers them.
+    Timelapse lapse = tiling ? Timelapse(every, params.dt, *tiling) : Timelapse(every, params.dt);
+    lapse.record(0, *hm);
     if (tiling) {
         std::string replay;
         if (tiling->rank() == 0) {
@@ -69,13 +72,13 @@ NodeOutputs run(NodeContext& ctx) {
         }
         tiling->share_from_rank0(replay);
         if (tiling->rank() != 0) result.replay = plates::decode_replay(replay);
-        plates::draw_tile(result.replay, bounded, ctx.seed(), layers, tiling->owned());
+        plates::draw_tile(result.replay, bounded, ctx.seed(), layers, tiling->owned(), every,
+                          [&](std::int64_t step, ConstGridView tile) { lapse.record(step, tile); });
     } else {
-        lapse.record(0, *hm);
-        result = plates::simulate(start, bounded, ctx.seed(), layers, on_step, ctx.integer("timelapse_every"),
+        result = plates::simulate(start, bounded, ctx.seed(), layers, on_step, every,
                                   [&](std::int64_t step, ConstGridView terrain) { lapse.record(step, terrain); });
-        lapse.finish(params.steps, *hm);
     }
+    lapse.finish(params.steps, *hm);
     ctx.check_finite(hm->heights(), "height", params.steps);
     const auto& s = result.stats;
     ctx.info(std::to_string(s.events[1]) + " convergent (" + std::to_string(s.subductions) + " subducting), " +
@@ -191,5 +194,6 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
         .tile_halo = 0,  // tiled: Box2D on rank 0, its outcome drawn by every rank into its tile
         .check = check,
         .run = run,
+        .tiled_timelapse = true,  // every rank draws its tile of each frame from the replay, rank 0 gathers them
     });
 }

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -433,6 +434,7 @@ private:
             Point2 a = spu_ * e.p0, b = spu_ * e.p1;  // samples
             if (e.kind == BoundaryKind::transform || !clip_segment(a, b, w, h)) continue;
             ReliefStamp stamp;
+            stamp.step = step;
             stamp.a = a;
             stamp.b = b;
             const double contrast = e.a->density - e.b->density;
@@ -706,7 +708,8 @@ Result simulate_events(std::span<const PlateSpec> plates, const Params& params, 
     return run_simulation(plates, params, seed, none, on_step, 0, {});
 }
 
-void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, const Layers& layers, TileRect tile) {
+void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, const Layers& layers, TileRect tile,
+               std::int64_t snapshot_every, const SnapshotFn& on_snapshot) {
     const int w = replay.width, h = replay.height;
     if (!layers.terrain.data || layers.terrain.width != tile.width || layers.terrain.height != tile.height ||
         tile.x0 < 0 || tile.y0 < 0 || tile.x1() > w || tile.y1() > h)
@@ -720,7 +723,24 @@ void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, c
     BoundaryRelief relief(w, h, window, shape, relief_seed);
     GridView uplift = layers.uplift;
     GridView* up = uplift.data ? &uplift : nullptr;
-    for (const ReliefStamp& stamp : replay.stamps) draw_stamp(stamp, params, relief, layers.terrain, up, tile);
+    std::size_t drawn = 0;
+    auto draw_until = [&](std::int64_t step) {  // the stamps come in the order of their steps
+        for (; drawn < replay.stamps.size() && replay.stamps[drawn].step <= step; ++drawn)
+            draw_stamp(replay.stamps[drawn], params, relief, layers.terrain, up, tile);
+    };
+    if (on_snapshot && snapshot_every > 0) {
+        // As Simulation::run: after every snapshot_every-th step but the last, the terrain with the relief so far.
+        std::vector<float> scratch;
+        const GridView& t = layers.terrain;
+        for (std::int64_t step = snapshot_every; step < params.steps; step += snapshot_every) {
+            draw_until(step);
+            scratch.assign(t.data, t.data + t.size());
+            GridView copy{scratch.data(), t.width, t.height, t.cell};
+            relief.apply(copy, tile);
+            on_snapshot(step, copy);
+        }
+    }
+    draw_until(std::numeric_limits<std::int64_t>::max());
     relief.apply(layers.terrain, tile, up);
     draw_layers(replay, layers, tile);
 }
@@ -729,7 +749,7 @@ void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, c
 
 namespace {
 
-constexpr char kReplayMagic[8] = {'o', 'r', 'p', 'l', 'a', 't', 'e', '1'};
+constexpr char kReplayMagic[8] = {'o', 'r', 'p', 'l', 'a', 't', 'e', '2'};
 
 template <typename T>
 void put(std::string& out, const T& v) {
@@ -767,6 +787,7 @@ std::string encode(const Replay& r) {
         put(out, s.a.x), put(out, s.a.y), put(out, s.b.x), put(out, s.b.y);
         put(out, s.toward_light.x), put(out, s.toward_light.y);
         put(out, s.seed);
+        put(out, s.step);
     }
     put(out, std::uint64_t(r.boundaries.size()));
     for (const CollisionEvent& e : r.boundaries) {
@@ -792,12 +813,13 @@ Replay decode_replay(std::string_view bytes) {
     r.width = in.get<std::int32_t>();
     r.height = in.get<std::int32_t>();
     r.cell = in.get<double>();
-    r.stamps.resize(in.count(1 + 6 * 8 + 8));
+    r.stamps.resize(in.count(1 + 6 * 8 + 8 + 8));
     for (ReliefStamp& s : r.stamps) {
         s.kind = ReliefStamp::Kind(in.get<std::uint8_t>());
         s.a.x = in.get<double>(), s.a.y = in.get<double>(), s.b.x = in.get<double>(), s.b.y = in.get<double>();
         s.toward_light.x = in.get<double>(), s.toward_light.y = in.get<double>();
         s.seed = in.get<std::uint64_t>();
+        s.step = in.get<std::int64_t>();
     }
     r.boundaries.resize(in.count(8 + 4 + 4 + 4 * 8 + 1 + 8));
     for (CollisionEvent& e : r.boundaries) {

@@ -158,6 +158,7 @@ struct ReliefStamp {
     Point2 a, b;                ///< samples, clipped to the grid
     Point2 toward_light;        ///< subduction: from the dense plate toward the light one
     std::uint64_t seed = 0;     ///< cells: the RMP range's seed
+    std::int64_t step = 0;      ///< the simulation step whose contact made it (time-lapses replay up to a step)
 };
 
 /// What draws a finished simulation into any rectangle of the grid without
@@ -210,7 +211,10 @@ Result simulate_events(std::span<const PlateSpec> plates, const Params& params, 
 /// exactly the tile's samples (terrain required; uplift, boundary, plate
 /// optional as in simulate()). Every sample gets the bits simulate() gives it
 /// over the whole grid. `params` and `seed` are the simulation's.
-void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, const Layers& layers, TileRect tile);
+/// `on_snapshot` (with `snapshot_every` > 0) is called with the tile's terrain
+/// as simulate()'s on_snapshot gets it over the whole grid, at the same steps.
+void draw_tile(const Replay& replay, const Params& params, std::uint64_t seed, const Layers& layers, TileRect tile,
+               std::int64_t snapshot_every = 0, const SnapshotFn& on_snapshot = {});
 
 /// Draw segment a–b (sample coordinates) into `layer` with `value`, `radius`
 /// samples thick on each side (Bresenham walk, clipped to the grid).
