@@ -473,6 +473,43 @@ TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
     EXPECT_FALSE(fs::exists(dir / "o" / "manifest.json"));
 }
 
+/// Repeated Magnification and Probing and a range between two points: every
+/// rank draws each iteration's diagram (Voronoi cells, or the faces of random
+/// cuts) over the whole grid and raises its tile's part of the chosen
+/// regions; on a flat start and on a base, with jitter and the range's
+/// uplift layer; method=cones (OSMesa over the whole grid) runs on rank 0 and
+/// says so. A cell clipped to the wrong rectangle, a span a row off or a
+/// graph face's vertex raised twice at a seam changes the bytes.
+const char* kRmpSpec = R"(orogen 1
+seed 29
+grid 97x61 cell=10
+
+m = generate:rmp(peaks=[(0.3, 0.4), (0.7, 0.6)], iterations=40, cones=30, height=6, decay=0.98, jitter=0.3)
+g = generate:rmp(m, method=graph, peaks=[(0.5, 0.5), (0.52, 0.5)], iterations=30, cuts=6, regions=3, height=4, jitter=0.2)
+r = generate:range(g, from=(0.1, 0.2), to=(0.9, 0.8), iterations=20, cones=60, height=3, jitter=0.5, uplift=true)
+c = generate:rmp(r, method=cones, iterations=5, cones=20)
+t = erode:thermal(c, talus=30, iterations=4)
+export:vtk(r, path="r.vti")
+export:raw(t, path="t.r32")
+)";
+
+class RmpSeam : public ::testing::TestWithParam<Case> {};
+TEST_P(RmpSeam, RmpEqualsOneProcess) { expect_same_outputs(kRmpSpec, {"r.vti", "t.r32"}, GetParam()); }
+INSTANTIATE_TEST_SUITE_P(Ranks, RmpSeam, kErosionCases, kCaseName);
+
+TEST(Mpi, RmpConesRunOnRankZeroAndSaySo) {
+    TempDir dir;
+    const auto spec = dir.write("s.orogen", kRmpSpec);
+    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("'c' (generate:rmp) ran on rank 0 over the whole grid: method=cones draws the whole grid "
+                         "through OSMesa"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("'m' (generate:rmp) ran on rank 0"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("'r' (generate:range) ran on rank 0"), std::string::npos) << r.out;
+}
+
 /// The plates, twice (peaks with subduction and rifts, then the thesis's Voronoi cells): rank 0 runs Box2D,
 /// every rank draws the outcome into its tile; the heights, the uplift, boundary and plate layers and the
 /// plates' history (a whole value, from rank 0) are the single process's, and a tiled eroder follows.

@@ -41,4 +41,18 @@ void convex_row_spans(std::span<const Point2> v, int width, int height, std::vec
     }
 }
 
+void add_spans(Window w, std::span<const RowSpan> spans, float amount, GridView* also) {
+    const int wx1 = w.x0 + w.view.width, wy1 = w.y0 + w.view.height;
+    for (const RowSpan& sp : spans) {
+        if (sp.y < w.y0 || sp.y >= wy1) continue;
+        const int x0 = std::max(sp.x0, w.x0), x1 = std::min(sp.x1, wx1 - 1);
+        float* row = w.view.row(sp.y - w.y0);
+        for (int x = x0; x <= x1; ++x) row[x - w.x0] += amount;
+        if (also) {
+            float* urow = also->row(sp.y - w.y0);
+            for (int x = x0; x <= x1; ++x) urow[x - w.x0] += amount;
+        }
+    }
+}
+
 }  // namespace orogen::rmp

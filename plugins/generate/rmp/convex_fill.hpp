@@ -21,4 +21,15 @@ struct RowSpan {
 /// vertices on it.
 void convex_row_spans(std::span<const Point2> polygon, int width, int height, std::vector<RowSpan>& out);
 
+/// A rectangle of a grid: `view` holds exactly its samples, its first at (x0, y0) of the grid
+/// (the whole grid in one process, a rank's tile in a tiled run).
+struct Window {
+    GridView view;
+    int x0 = 0, y0 = 0;
+};
+
+/// Adds `amount` to the window's samples among `spans` (whole-grid rows and columns);
+/// `also`, if given, has the window's size and gets the same additions.
+void add_spans(Window w, std::span<const RowSpan> spans, float amount, GridView* also = nullptr);
+
 }  // namespace orogen::rmp

@@ -5,6 +5,7 @@
 
 #include <orogen/plugin.hpp>
 #include <orogen/random.hpp>
+#include <orogen/tiles.hpp>
 
 #include <cmath>
 #include <sstream>
@@ -13,9 +14,22 @@ using namespace orogen;
 
 namespace {
 
+/// The terrain to raise: the input, or the spec's grid flat at 0 m; in a tiled (MPI) run this rank's tile of it.
 std::shared_ptr<Heightmap> base_or_grid(NodeContext& ctx) {
-    return ctx.has_input(0) ? ctx.take_heightmap(0)
-                            : std::make_shared<Heightmap>(ctx.grid().width, ctx.grid().height, ctx.grid().cell);
+    const Tiling* tiles = ctx.tiling();
+    const TileRect area = tiles ? tiles->owned() : TileRect{0, 0, ctx.grid().width, ctx.grid().height};
+    return ctx.has_input(0) ? ctx.take_heightmap(0) : std::make_shared<Heightmap>(area.width, area.height, ctx.grid().cell);
+}
+
+/// Where `hm` lies in the whole grid (all of it in one process), and the whole grid's size.
+struct Placed {
+    rmp::Window window;
+    int width, height;
+};
+Placed placed(NodeContext& ctx, Heightmap& hm) {
+    const Tiling* tiles = ctx.tiling();
+    if (!tiles) return {{hm.view()}, hm.width(), hm.height()};
+    return {{hm.view(), tiles->owned().x0, tiles->owned().y0}, tiles->grid_width(), tiles->grid_height()};
 }
 
 std::string point_text(Point2 p) {
@@ -87,6 +101,7 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
                     .max(1'000'000)
                     .help("polygons raised per peak per iteration, first in depth-first order (graph)"),
             },
+        .tile_halo = 0,  // a sample's raise is a pure function of the seed and its position
         .check =
             [](CheckContext& ctx) {
                 const std::string& method = ctx.text("method");
@@ -134,12 +149,21 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
             };
             const std::string& method = ctx.text("method");
             const std::uint64_t seed = node_seed(ctx);
-            if (method == "voronoi") rmp::rmp_voronoi(hm->view(), p, seed, hook);
-            else if (method == "cones") rmp::rmp_cones(hm->view(), p, seed, hook);
-            else rmp::rmp_graph(hm->view(), p, seed, hook);
+            // In a tiled run every rank draws each iteration's regions over the whole grid and raises its tile.
+            const Placed at = placed(ctx, *hm);
+            if (method == "voronoi") rmp::rmp_voronoi(at.window, at.width, at.height, p, seed, hook);
+            else if (method == "cones") rmp::rmp_cones(hm->view(), p, seed, hook);  // never tiled (untiled_because)
+            else rmp::rmp_graph(at.window, at.width, at.height, p, seed, hook);
             ctx.check_finite(hm->heights(), "height", p.iterations);
             return hm;
         },
+        .untiled_because =
+            [](const std::map<std::string, ParamValue, std::less<>>& params, const std::vector<bool>&) {
+                return std::get<std::string>(params.at("method")) == "cones"
+                           ? std::string("method=cones draws the whole grid through OSMesa (method=voronoi draws "
+                                         "the same mountain and tiles)")
+                           : std::string();
+            },
     });
 
     registry.add({
@@ -175,6 +199,7 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
                           "seed, so variants of a node can share their random regions"),
                 Param::boolean("uplift", false).help("also add the raise to the heightmap's 'uplift' layer (m)"),
             },
+        .tile_halo = 0,  // as generate:rmp: every rank raises its tile of the whole grid's range
         .check =
             [](CheckContext& ctx) {
                 const Point2 a = std::get<Point2>(ctx.param("from")), b = std::get<Point2>(ctx.param("to"));
@@ -185,8 +210,9 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
             },
         .run = [](NodeContext& ctx) -> NodeOutputs {
             auto hm = base_or_grid(ctx);
-            const Point2 a = rmp::to_samples(ctx.point("from"), hm->width(), hm->height());
-            const Point2 b = rmp::to_samples(ctx.point("to"), hm->width(), hm->height());
+            const Placed whole = placed(ctx, *hm);
+            const Point2 a = rmp::to_samples(ctx.point("from"), whole.width, whole.height);
+            const Point2 b = rmp::to_samples(ctx.point("to"), whole.width, whole.height);
             rmp::RangeParams p;
             p.cones = int(ctx.integer("cones"));
             p.height = ctx.real("height");
@@ -195,9 +221,10 @@ OROGEN_PLUGIN("rmp", "0.1.0", registry) {
             GridView uplift;
             if (ctx.flag("uplift")) uplift = hm->layer("uplift");
             const std::uint64_t seed = node_seed(ctx);
+            const Placed at = placed(ctx, *hm);  // in a tiled run, this rank's tile of the whole grid's range
             for (int k = 0; k < iterations; ++k) {
-                rmp::raise_range(hm->view(), a, b, p, rmp::iteration_seed(seed, k),
-                                 ctx.flag("uplift") ? &uplift : nullptr);
+                rmp::raise_range(hm->view(), at.width, at.height, at.window.x0, at.window.y0, a, b, p,
+                                 rmp::iteration_seed(seed, k), ctx.flag("uplift") ? &uplift : nullptr);
                 ctx.check_cancelled();
                 ctx.progress(double(k + 1) / iterations);
             }

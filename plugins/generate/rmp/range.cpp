@@ -138,20 +138,9 @@ int raise_range(GridView terrain, int width, int height, int wx0, int wy0, Point
     std::vector<CellPolygon> polygons;
     const std::vector<int> cells = crossed_cells(index, a, b, &polygons);
     std::vector<SiteIndex::Span> spans;
-    const int wx1 = wx0 + terrain.width, wy1 = wy0 + terrain.height;
     for (std::size_t k = 0; k < cells.size(); ++k) {
-        const float amount = float(cell_amount(params.height, params.jitter, seed, cells[k]));
         index.spans_of(cells[k], polygons[k], spans);
-        for (const auto& sp : spans) {
-            if (sp.y < wy0 || sp.y >= wy1) continue;
-            const int x0 = std::max(sp.x0, wx0), x1 = std::min(sp.x1, wx1 - 1);
-            float* row = terrain.row(sp.y - wy0);
-            for (int x = x0; x <= x1; ++x) row[x - wx0] += amount;
-            if (uplift) {
-                float* urow = uplift->row(sp.y - wy0);
-                for (int x = x0; x <= x1; ++x) urow[x - wx0] += amount;
-            }
-        }
+        add_spans({terrain, wx0, wy0}, spans, float(cell_amount(params.height, params.jitter, seed, cells[k])), uplift);
     }
     return int(cells.size());
 }

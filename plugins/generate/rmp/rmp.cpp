@@ -41,14 +41,19 @@ std::uint64_t iteration_seed(std::uint64_t seed, int iteration) {
 double iteration_height(const RmpParams& p, int iteration) { return p.height * std::pow(p.decay, iteration); }
 
 void rmp_voronoi(GridView terrain, const RmpParams& p, std::uint64_t seed, const IterationHook& hook) {
+    rmp_voronoi(Window{terrain}, terrain.width, terrain.height, p, seed, hook);
+}
+
+void rmp_voronoi(Window window, int width, int height, const RmpParams& p, std::uint64_t seed,
+                 const IterationHook& hook) {
     validate(p);
     std::vector<Point2> peaks;
-    for (const Point2& q : p.peaks) peaks.push_back(peak_vertex(q, terrain.width, terrain.height));
+    for (const Point2& q : p.peaks) peaks.push_back(peak_vertex(q, width, height));
     std::vector<SiteIndex::Span> spans;
     for (int k = 0; k < p.iterations; ++k) {
         const std::uint64_t s = iteration_seed(seed, k);
-        const std::vector<Point2> sites = random_sites(p.cones, terrain.width, terrain.height, s);
-        const SiteIndex index(sites, terrain.width, terrain.height);
+        const std::vector<Point2> sites = random_sites(p.cones, width, height, s);
+        const SiteIndex index(sites, width, height);
         std::vector<int> cells;  // distinct cells under the peaks, in peak order
         for (const Point2& q : peaks) {
             const int c = index.nearest(q.x, q.y);
@@ -56,27 +61,30 @@ void rmp_voronoi(GridView terrain, const RmpParams& p, std::uint64_t seed, const
         }
         const double h = iteration_height(p, k);
         for (int c : cells) {
-            const float amount = float(cell_amount(h, p.jitter, s, c));
             index.spans_of(c, index.cell(c), spans);
-            for (const auto& sp : spans) {
-                float* row = terrain.row(sp.y);
-                for (int x = sp.x0; x <= sp.x1; ++x) row[x] += amount;
-            }
+            add_spans(window, spans, float(cell_amount(h, p.jitter, s, c)));
         }
         if (hook) hook(k);
     }
 }
 
 void rmp_graph(GridView terrain, const RmpParams& p, std::uint64_t seed, const IterationHook& hook) {
+    rmp_graph(Window{terrain}, terrain.width, terrain.height, p, seed, hook);
+}
+
+void rmp_graph(Window window, int width, int height, const RmpParams& p, std::uint64_t seed,
+               const IterationHook& hook) {
     validate(p);
-    const double w = terrain.width - 1, h = terrain.height - 1;
+    const double w = width - 1, h = height - 1;
     if (!(w > 0 && h > 0)) throw BadInput("rmp: the graph method needs a grid of at least 2 × 2 vertices");
     std::vector<Point2> peaks;
-    for (const Point2& q : p.peaks) peaks.push_back(peak_vertex(q, terrain.width, terrain.height));
+    for (const Point2& q : p.peaks) peaks.push_back(peak_vertex(q, width, height));
     // Stamp of the last iteration that raised a vertex: a vertex on the border
     // of two raised faces rises once, by the first face's amount.
-    std::vector<int> stamp(terrain.size(), -1);
+    const GridView& t = window.view;
+    std::vector<int> stamp(t.size(), -1);
     std::vector<RowSpan> spans;
+    const int wx1 = window.x0 + t.width, wy1 = window.y0 + t.height;
     for (int k = 0; k < p.iterations; ++k) {
         const std::uint64_t s = iteration_seed(seed, k);
         const std::vector<Line> cuts = random_cuts(p.cuts, w, h, s);
@@ -96,11 +104,12 @@ void rmp_graph(GridView terrain, const RmpParams& p, std::uint64_t seed, const I
         const double hk = iteration_height(p, k);
         for (int f : faces) {
             const float amount = float(cell_amount(hk, p.jitter, s, f));
-            convex_row_spans(g.polygon(f), terrain.width, terrain.height, spans);
+            convex_row_spans(g.polygon(f), width, height, spans);
             for (const RowSpan& sp : spans) {
-                float* row = terrain.row(sp.y);
-                int* st = stamp.data() + std::size_t(sp.y) * std::size_t(terrain.width);
-                for (int x = sp.x0; x <= sp.x1; ++x)
+                if (sp.y < window.y0 || sp.y >= wy1) continue;
+                float* row = t.row(sp.y - window.y0);
+                int* st = stamp.data() + std::size_t(sp.y - window.y0) * std::size_t(t.width);
+                for (int x = std::max(sp.x0, window.x0) - window.x0, x1 = std::min(sp.x1, wx1 - 1) - window.x0; x <= x1; ++x)
                     if (st[x] != k) {
                         st[x] = k;
                         row[x] += amount;
