@@ -473,6 +473,40 @@ TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
     EXPECT_FALSE(fs::exists(dir / "o" / "manifest.json"));
 }
 
+/// The default pipeline (`make demo`), shortened with --set, on 3 ranks in
+/// a row of tiles and on 2x2: every node that computes terrain is tiled
+/// (diamond-square, plates, RMP, stream power, thermal, pipe), the renders,
+/// the video and the whole-file exports run on rank 0 over gathered grids.
+/// Every file the run writes, the manifest's digests included, must be one
+/// process's bytes.
+TEST(Mpi, DefaultPipelineEqualsOneProcess) {
+    const std::string spec = std::string(OROGEN_SOURCE_DIR) + "/pipelines/default.orogen";
+    const std::string shorter =
+        " --set plates.steps=200 --set range.years=2e5 --set rivers.steps=200 --set beauty.width=320"
+        " --set beauty.height=180 --set beauty.samples=1 --set spin.frames=4 --set spin.width=160 --set spin.height=90";
+    TempDir dir;
+    const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q" + shorter);
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    auto files_of = [](const fs::path& root) {
+        std::vector<std::string> names;
+        for (const auto& e : fs::recursive_directory_iterator(root))
+            if (e.is_regular_file()) names.push_back(fs::relative(e.path(), root).string());
+        std::sort(names.begin(), names.end());
+        return names;
+    };
+    const std::vector<std::string> want = files_of(dir / "one");
+    ASSERT_GT(want.size(), 20u);
+    for (const std::string tiles : {"1x3", "2x2"}) {
+        const int ranks = tiles == "1x3" ? 3 : 4;
+        const RunResult many = run_mpi(ranks, "run " + q(spec) + " --out " + q(dir / tiles) + " --tiles " + tiles + shorter);
+        ASSERT_EQ(many.exit_code, 0) << many.err;
+        EXPECT_EQ(many.out.find("ran on rank 0 over the whole grid"), std::string::npos) << many.out;
+        ASSERT_EQ(files_of(dir / tiles), want) << tiles;
+        for (const std::string& f : want)
+            EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / tiles / f)) << f << " differs on " << tiles;
+    }
+}
+
 /// Repeated Magnification and Probing and a range between two points: every
 /// rank draws each iteration's diagram (Voronoi cells, or the faces of random
 /// cuts) over the whole grid and raises its tile's part of the chosen
