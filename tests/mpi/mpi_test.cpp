@@ -501,6 +501,11 @@ TEST(Mpi, DefaultPipelineEqualsOneProcess) {
         const RunResult many = run_mpi(ranks, "run " + q(spec) + " --out " + q(dir / tiles) + " --tiles " + tiles + shorter);
         ASSERT_EQ(many.exit_code, 0) << many.err;
         EXPECT_EQ(many.out.find("ran on rank 0 over the whole grid"), std::string::npos) << many.out;
+        // The plates' counts come from rank 0's simulation, once (the other ranks only draw its outcome).
+        const std::string all = many.out + many.err;
+        const std::size_t first = all.find("plates at the end");
+        EXPECT_NE(first, std::string::npos) << all;
+        EXPECT_EQ(all.find("plates at the end", first + 1), std::string::npos) << all;
         ASSERT_EQ(files_of(dir / tiles), want) << tiles;
         for (const std::string& f : want)
             EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / tiles / f)) << f << " differs on " << tiles;

@@ -81,9 +81,11 @@ NodeOutputs run(NodeContext& ctx) {
     lapse.finish(params.steps, *hm);
     ctx.check_finite(hm->heights(), "height", params.steps);
     const auto& s = result.stats;
-    ctx.info(std::to_string(s.events[1]) + " convergent (" + std::to_string(s.subductions) + " subducting), " +
-             std::to_string(s.events[2]) + " divergent, " + std::to_string(s.events[3]) + " transform contacts; " +
-             std::to_string(s.rifts) + " rifts; " + std::to_string(result.final_plates.size()) + " plates at the end");
+    if (!tiling || tiling->rank() == 0)  // the simulation's counts are rank 0's (the others only drew its outcome)
+        ctx.info(std::to_string(s.events[1]) + " convergent (" + std::to_string(s.subductions) + " subducting), " +
+                 std::to_string(s.events[2]) + " divergent, " + std::to_string(s.events[3]) + " transform contacts; " +
+                 std::to_string(s.rifts) + " rifts; " + std::to_string(result.final_plates.size()) +
+                 " plates at the end");
 
     NodeOutputs out(hm);
     out.side["plates"] = Value(std::make_shared<PlateHistory>(std::move(result.history)));
