@@ -422,6 +422,11 @@ void TiledRun::share_from_rank0(std::string& bytes) {
 
 void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
 
+std::shared_ptr<Heightmap> TiledRun::scatter_from_rank0(const Heightmap* whole) {
+    agree_or_throw();
+    return scatter(whole);
+}
+
 std::vector<std::string> TiledRun::gather_text(const std::string& text) {
     if (rank_ != 0) {
         const std::uint64_t n = text.size();
@@ -531,7 +536,17 @@ bool TiledRun::prepare_inputs(const PlannedNode& node, std::vector<Value>& input
         if (key.empty()) continue;
         auto it = places_.find(key);
         const Place place = it == places_.end() ? Place::rank0 : it->second;
-        if (tiled && place == Place::rank0) {
+        // A series (time-lapse frames) stays on rank 0, whole: the node reads it there and
+        // cuts what it needs with scatter_from_rank0 (erode:stream-power's uplift_history).
+        // The other ranks get a series of no frames, so that every rank sees the input given.
+        const bool series = i < node.node->inputs.size() && node.node->inputs[i].many == Many::series;
+        if (tiled && place == Place::rank0 && series) {
+            if (rank_ != 0) {
+                auto none = std::make_shared<Series>();
+                none->element = node.node->inputs[i].type;
+                inputs[i] = Value(std::shared_ptr<const Series>(std::move(none)));
+            }
+        } else if (tiled && place == Place::rank0) {
             inputs[i] = Value(scatter(rank_ == 0 ? inputs[i].heightmap().get() : nullptr));
         } else if (!tiled && place == Place::tiles) {
             auto whole = gather(inputs[i].heightmap().get());

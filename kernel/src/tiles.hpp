@@ -77,6 +77,7 @@ public:
     void share_from_rank0(std::string& bytes) override;
     void exchange_double_halos(std::span<double* const> held, int halo) override;
     std::vector<std::string> gather_to_rank0(const std::string& bytes) override;
+    std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) override;
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
     static bool runs_tiled(const PlannedNode& node);

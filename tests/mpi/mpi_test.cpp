@@ -191,9 +191,11 @@ INSTANTIATE_TEST_SUITE_P(Ranks, DiffusionSeam, kErosionCases, kCaseName);
 /// relief full of pits (filled, then routed across with n = 1.5), uplift from
 /// a layer spread across the seams, hillslope diffusion, chi, every side
 /// closed with the lowest cell of the whole grid as the one outlet, and a
-/// time-lapse; then routing=mfd, which is not tiled and runs on rank 0; and
+/// time-lapse; then routing=mfd, which is not tiled and runs on rank 0;
 /// rough diamond-square relief with a hundred lakes a step, most of them
-/// settled on their own tile (closed basins) and the rest by rank 0. A
+/// settled on their own tile (closed basins) and the rest by rank 0; and
+/// uplift from the plates' time-lapse (a series on rank 0, each interval's
+/// frames cut into tiles, smoothed across them), steps spanning frames. A
 /// basin labelled wrongly, a lake filled to another level, a pass reversed
 /// one tile short or an exit's drainage area lost at a seam changes the
 /// heights or the layers (drainage, flow_direction, chi) downstream of it.
@@ -210,6 +212,8 @@ s4 = erode:stream-power(s3, years=4e4, dt=2e4, routing=mfd)
 d  = generate:diamond-square(roughness=0.7, amplitude=300)
 s5 = erode:stream-power(d, years=3e4, dt=1e4, diffusivity=0.01)
 s6 = erode:stream-power(d, years=2e4, dt=1e4, depressions=route, open="we", n=1.5)
+p  = tectonics:plates(d, plates=4, steps=120, cones=30, height=60, timelapse_every=30)
+s7 = erode:stream-power(p, p.timelapse, years=5e4, dt=1.5e4, uplift_history_years=4e4, uplift_smoothing=60, diffusivity=0.01)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
 export:video(r, path="s1.mpg", fps=25, quality=0)
 export:vtk(s1, path="s1.vti")
@@ -218,11 +222,12 @@ export:vtk(s3, path="s3.vti")
 export:raw(s4, path="s4.r32")
 export:vtk(s5, path="s5.vti")
 export:vtk(s6, path="s6.vti")
+export:vtk(s7, path="s7.vti")
 )";
 
 class StreamPowerSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(StreamPowerSeam, StreamPowerEqualsOneProcess) {
-    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti"}, GetParam());
+    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti", "s7.vti"}, GetParam());
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, StreamPowerSeam, kErosionCases, kCaseName);
 
@@ -237,6 +242,7 @@ TEST(Mpi, StreamPowerSettingsThatDoNotTileRunOnRankZeroAndSaySo) {
     // The tiled ones say how many rounds their solves took down rivers that cross tiles.
     EXPECT_NE(r.err.find("rank 1 of 2, up to "), std::string::npos) << r.err;
     EXPECT_EQ(r.out.find("'s1' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("'s7' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;  // uplift_history tiles
 }
 
 /// The lines "NODE: suspended sediment X m, ..." of a run's output, in order.

@@ -29,7 +29,8 @@
 /// 3: NodeDescriptor::cache (the node cache), NodeDescriptor::tile_halo and NodeContext::tiling() (MPI tiles).
 /// 4: NodeDescriptor::tiled_timelapse, Timelapse's tiled constructor (its layout), Tiling::carry.
 /// 5: NodeDescriptor::untiled_because, Tiling::exchange_double_halos and Tiling::gather_to_rank0.
-#define OROGEN_PLUGIN_API_VERSION 5
+/// 6: Tiling::scatter_from_rank0 (a series input of a tiled node stays on rank 0).
+#define OROGEN_PLUGIN_API_VERSION 6
 
 namespace orogen {
 

@@ -19,11 +19,14 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
 
 namespace orogen {
+
+class Heightmap;  // values.hpp
 
 /// A rectangle of vertices in global grid coordinates.
 struct TileRect {
@@ -191,6 +194,14 @@ public:
     /// elsewhere). With share_from_rank0(): rank 0 solves what the tiles sent
     /// and hands every rank the answer. Opens with the failure agreement.
     virtual std::vector<std::string> gather_to_rank0(const std::string& bytes) = 0;
+    // For nodes that read a whole value rank 0 holds: a series input of a
+    // tiled node stays there (the other ranks get a series of no frames), as
+    // erode:stream-power's uplift_history.
+    /// Collective: rank 0's whole-grid heightmap `whole` (its heights and
+    /// layers; ignored on the other ranks) cut into tiles, every rank getting
+    /// its own. Opens with the failure agreement. Throws BadInput if `whole`
+    /// is not the grid's size.
+    virtual std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) = 0;
 };
 
 }  // namespace orogen

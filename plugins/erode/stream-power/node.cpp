@@ -148,41 +148,60 @@ NodeOutputs run(NodeContext& ctx) {
     // between frames k and k+1 the rate is their height change over the years between them.
     stream_power::UpliftHistory history;
     if (ctx.has_input(1)) {
-        const auto series = ctx.input(1).series();
-        const std::size_t frames = series->size();
-        if (frames < 2)
-            throw BadInput("uplift_history: the series has " + std::to_string(frames) +
-                           " frame(s); a rate needs at least two (the start and the end)");
-        const double span = ctx.real("uplift_history_years") > 0.0 ? ctx.real("uplift_history_years") : ctx.real("years");
-        const double t0 = series->times.front(), t1 = series->times.back();
-        if (!(t1 > t0)) throw BadInput("uplift_history: the series' frames do not advance in time");
-        for (std::size_t k = 0; k < frames; ++k) {
-            history.times.push_back((series->times[k] - t0) / (t1 - t0) * span);
-            if (k > 0 && !(history.times[k] > history.times[k - 1]))
-                throw BadInput("uplift_history: frame " + std::to_string(k) + " is not later than frame " +
-                               std::to_string(k - 1));
+        // In a tiled run the series is rank 0's (whole frames): rank 0 checks it and shares its
+        // times, and each interval's two frames are cut into tiles for every rank to make its rate.
+        std::shared_ptr<const Series> series;
+        if (!tiles || tiles->rank() == 0) series = ctx.input(1).series();
+        std::string shared;
+        if (series) {
+            const std::size_t frames = series->size();
+            if (frames < 2)
+                throw BadInput("uplift_history: the series has " + std::to_string(frames) +
+                               " frame(s); a rate needs at least two (the start and the end)");
+            const double span =
+                ctx.real("uplift_history_years") > 0.0 ? ctx.real("uplift_history_years") : ctx.real("years");
+            const double t0 = series->times.front(), t1 = series->times.back();
+            if (!(t1 > t0)) throw BadInput("uplift_history: the series' frames do not advance in time");
+            for (std::size_t k = 0; k < frames; ++k) {
+                history.times.push_back((series->times[k] - t0) / (t1 - t0) * span);
+                if (k > 0 && !(history.times[k] > history.times[k - 1]))
+                    throw BadInput("uplift_history: frame " + std::to_string(k) + " is not later than frame " +
+                                   std::to_string(k - 1));
+            }
+            shared.assign(reinterpret_cast<const char*>(history.times.data()), history.times.size() * sizeof(double));
         }
-        const int W = hm->width(), H = hm->height();
-        auto rate_of = [series, times = history.times, W, H, n, smooth](std::size_t k) {
-            const auto a = series->at(k).heightmap(), b = series->at(k + 1).heightmap();
-            for (const auto* f : {a.get(), b.get()})
-                if (f->width() != W || f->height() != H)
-                    throw BadInput("uplift_history: frame " + std::to_string(k) + " is " + std::to_string(f->width()) +
-                                   " x " + std::to_string(f->height()) + ", the terrain " + std::to_string(W) + " x " +
-                                   std::to_string(H));
+        if (tiles) {
+            tiles->share_from_rank0(shared);
+            history.times.resize(shared.size() / sizeof(double));
+            std::memcpy(history.times.data(), shared.data(), shared.size());
+        }
+        const int W = tiles ? tiles->grid_width() : hm->width(), H = tiles ? tiles->grid_height() : hm->height();
+        auto frame = [series, tiles, W, H](std::size_t k) -> std::shared_ptr<const Heightmap> {  // collective when tiled
+            std::shared_ptr<const Heightmap> f;
+            if (series) {
+                f = series->at(k).heightmap();
+                if (!f || f->width() != W || f->height() != H)
+                    throw BadInput("uplift_history: frame " + std::to_string(k) + " is " +
+                                   (f ? std::to_string(f->width()) + " x " + std::to_string(f->height()) : "not a heightmap") +
+                                   ", the terrain " + std::to_string(W) + " x " + std::to_string(H));
+            }
+            return tiles ? tiles->scatter_from_rank0(f.get()) : f;
+        };
+        auto rate_of = [frame, times = history.times, n, smooth, sample](std::size_t k) {
+            const auto a = frame(k), b = frame(k + 1);
             const double years = times[k + 1] - times[k];
             std::vector<double> rate(n);
             for (std::size_t i = 0; i < n; ++i) {
                 rate[i] = (double(b->heights()[i]) - double(a->heights()[i])) / years;
                 if (!std::isfinite(rate[i]))
                     throw BadInput("uplift_history: frame " + std::to_string(k + 1) +
-                                   " holds a non-finite height at sample " + std::to_string(i));
+                                   " holds a non-finite height at sample " + std::to_string(sample(i)));
             }
             smooth(rate);
             return rate;
         };
         // Refuse an impossible rate before the run (each interval's rate is made again when the run reaches it).
-        for (std::size_t k = 0; k + 1 < frames; ++k) {
+        for (std::size_t k = 0; k + 1 < history.times.size(); ++k) {
             const double fastest = fastest_of(rate_of(k), uniform);
             if (fastest * 1e3 > kMaxUpliftMmYr) {
                 std::ostringstream msg;
@@ -204,7 +223,12 @@ NodeOutputs run(NodeContext& ctx) {
     else
         whole = std::make_unique<stream_power::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
                                                       std::move(uplift), s);
-    if (history.rate) whole->set_uplift_history(std::move(history));
+    if (history.rate) {
+        if (tiles)
+            tiled->set_uplift_history(std::move(history));
+        else
+            whole->set_uplift_history(std::move(history));
+    }
     std::vector<double>& heights = tiles ? tiled->heights() : whole->heights();
     auto is_outlet = [&](std::size_t i) { return tiles ? tiled->is_outlet(i) : whole->flow().is_outlet(std::int64_t(i)); };
     if (base) {
@@ -464,11 +488,11 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
         .run = run,
         .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
         .untiled_because =
-            [](const std::map<std::string, ParamValue, std::less<>>& p, const std::vector<bool>& given) {
+            [](const std::map<std::string, ParamValue, std::less<>>& p, const std::vector<bool>&) {
                 stream_power::Settings s;
                 if (std::get<std::string>(p.at("routing")) == "mfd") s.mfd_exponent = 1.0;
                 s.deposition = std::get<double>(p.at("deposition"));
-                return stream_power::untiled_because(s, given.size() > 1 && given[1]);
+                return stream_power::untiled_because(s);
             },
     });
 }

@@ -58,35 +58,27 @@ diffusion::Settings hillslope_settings(const Settings& settings) {
     return ds;
 }
 
-void Model::set_uplift_history(UpliftHistory history) {
+void check_history(const UpliftHistory& history) {
     for (std::size_t k = 1; k < history.times.size(); ++k)
         if (!(history.times[k] > history.times[k - 1]))
-            throw std::invalid_argument("stream_power::Model: uplift history times must increase");
+            throw std::invalid_argument("stream_power: uplift history times must increase");
+}
+
+void Model::set_uplift_history(UpliftHistory history) {
+    check_history(history);
     history_ = std::move(history);
     history_k_ = std::size_t(-1);
 }
 
 void Model::add_history_uplift(double t0, double t1) {
-    // The rate is piecewise constant in time, so the uplift over [t0, t1] is the sum over the
-    // intervals it overlaps of rate × overlap (years): exact for a step that spans frames.
-    const auto& T = history_.times;
     double* h = h_.data();
     const std::int64_t n = std::int64_t(h_.size());
-    for (std::size_t k = 0; k + 1 < T.size(); ++k) {
-        const double overlap = std::min(t1, T[k + 1]) - std::max(t0, T[k]);
-        if (!(overlap > 0.0)) continue;
-        if (history_k_ != k) {
-            history_rate_ = history_.rate(k);
-            if (history_rate_.size() != h_.size())
-                throw std::invalid_argument("stream_power::Model: an uplift history rate is not width × height");
-            history_k_ = k;
-        }
-        const double* rate = history_rate_.data();
+    for_history_intervals(history_, history_k_, history_rate_, h_.size(), t0, t1, [&](const double* rate, double overlap) {
         parallel_for(0, n, 1 << 15, [&](std::int64_t b, std::int64_t e) {
             for (std::int64_t i = b; i < e; ++i)
                 if (!flow_.is_outlet(i)) h[i] += rate[i] * overlap;
         });
-    }
+    });
 }
 
 void Model::route_only() {

@@ -33,10 +33,12 @@
 
 #include <diffusion.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 namespace orogen::stream_power {
@@ -68,6 +70,30 @@ struct UpliftHistory {
     std::vector<double> times;
     std::function<std::vector<double>(std::size_t)> rate;
 };
+
+/// Throws std::invalid_argument unless the history's times increase.
+void check_history(const UpliftHistory& history);
+
+/// The history's uplift over the years [t0, t1]: the rate is piecewise
+/// constant in time, so it is the sum over the intervals the step overlaps of
+/// rate × overlap (exact for a step that spans frames). Calls add(rate,
+/// overlap) per interval, in order; `rate`/`rate_k` keep the last interval's
+/// rate (n values), asked of history.rate once when the run reaches it.
+template <typename Add>
+void for_history_intervals(const UpliftHistory& history, std::size_t& rate_k, std::vector<double>& rate, std::size_t n,
+                           double t0, double t1, Add&& add) {
+    const auto& T = history.times;
+    for (std::size_t k = 0; k + 1 < T.size(); ++k) {
+        const double overlap = std::min(t1, T[k + 1]) - std::max(t0, T[k]);
+        if (!(overlap > 0.0)) continue;
+        if (rate_k != k) {
+            rate = history.rate(k);
+            if (rate.size() != n) throw std::invalid_argument("stream_power: an uplift history rate is not the grid's size");
+            rate_k = k;
+        }
+        add(rate.data(), overlap);
+    }
+}
 
 /// The state of one landscape: heights (double, m) and the flow graph of the last step.
 class Model {

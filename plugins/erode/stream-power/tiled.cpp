@@ -86,10 +86,9 @@ int direction_to(std::int64_t from, std::int64_t to, int W) {
 
 }  // namespace
 
-std::string untiled_because(const Settings& s, bool uplift_history) {
+std::string untiled_because(const Settings& s) {
     if (s.mfd_exponent > 0.0) return "routing=mfd is not tiled yet";
     if (s.deposition > 0.0) return "deposition > 0 is not tiled yet";
-    if (uplift_history) return "an uplift_history input is not tiled yet";
     return "";
 }
 
@@ -108,8 +107,8 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
     if (h_.size() != n) throw std::invalid_argument("stream_power::TiledModel: heights are not the tile's size");
     if (!uplift_.empty() && uplift_.size() != n)
         throw std::invalid_argument("stream_power::TiledModel: uplift is not the tile's size");
-    if (!untiled_because(settings, false).empty())
-        throw std::invalid_argument("stream_power::TiledModel: " + untiled_because(settings, false));
+    if (!untiled_because(settings).empty())
+        throw std::invalid_argument("stream_power::TiledModel: " + untiled_because(settings));
     if (!settings.open.any()) {
         // The lowest cell of the whole grid (lowest index among equals), as lowest_cell().
         Lowest mine{std::numeric_limits<double>::infinity(), -1};
@@ -652,12 +651,24 @@ void TiledModel::route_only() {
     accumulate();
 }
 
+void TiledModel::set_uplift_history(UpliftHistory history) {
+    check_history(history);
+    history_ = std::move(history);
+    history_k_ = std::size_t(-1);
+}
+
 std::int64_t TiledModel::step(double dt) {
     const std::size_t n = h_.size();
     // 1. Uplift (outlets are base level: they stay).
     if (!uplift_.empty())
         for (std::size_t l = 0; l < n; ++l)
             if (!outlet_[l]) h_[l] += uplift_[l] * dt;
+    if (history_.rate)
+        for_history_intervals(history_, history_k_, history_rate_, n, time_, time_ + dt, [&](const double* rate, double overlap) {
+            for (std::size_t l = 0; l < n; ++l)
+                if (!outlet_[l]) h_[l] += rate[l] * overlap;
+        });
+    time_ += dt;
     // 2. Routing, depressions, drainage area.
     route(h_.data());
     accumulate();

@@ -54,7 +54,7 @@
 namespace orogen::stream_power {
 
 /// Whether these settings run tiled: "" if they do, else why not (for NodeDescriptor::untiled_because).
-std::string untiled_because(const Settings& settings, bool uplift_history);
+std::string untiled_because(const Settings& settings);
 
 class TiledModel {
 public:
@@ -63,6 +63,10 @@ public:
     /// side closed the ranks agree on the lowest cell, the outlet).
     TiledModel(Tiling& tiles, double cell, std::vector<double> heights, std::vector<double> uplift,
                const Settings& settings);
+
+    /// Uplift varying in time (Model::set_uplift_history); its rate(k) gives
+    /// this rank's tile and is called collectively (every rank at the same step).
+    void set_uplift_history(UpliftHistory history);
 
     /// One step of `dt` years. Returns the pits found on the whole grid. Collective.
     std::int64_t step(double dt);
@@ -131,6 +135,10 @@ private:
     Settings settings_;
     std::int64_t sink_ = -1;  // every side closed: the outlet (whole-grid index)
     std::vector<double> h_, uplift_;
+    UpliftHistory history_;
+    std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_
+    std::vector<double> history_rate_;
+    double time_ = 0.0;  // years since the run began
     std::vector<std::uint8_t> outlet_;
     std::vector<std::int8_t> dir_;        // D8 code of the receiver, −1 for a root
     std::vector<std::uint8_t> donors_;    // bit k: owned neighbour k sends its water here
