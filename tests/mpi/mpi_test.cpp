@@ -227,14 +227,20 @@ export:vtk(s7, path="s7.vti")
 
 class StreamPowerSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(StreamPowerSeam, StreamPowerEqualsOneProcess) {
-    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti", "s7.vti"}, GetParam());
+    expect_same_outputs(kStreamPowerSpec, {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti", "s7.vti"},
+                        GetParam());
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, StreamPowerSeam, kErosionCases, kCaseName);
 
-TEST(Mpi, StreamPowerSettingsThatDoNotTileRunOnRankZeroAndSaySo) {
+/// `spec_text` run on 2 ranks (its outputs in a folder removed on return).
+RunResult run_on_two_ranks(const char* spec_text) {
     TempDir dir;
-    const auto spec = dir.write("s.orogen", kStreamPowerSpec);
-    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "out"));
+    const auto spec = dir.write("s.orogen", spec_text);
+    return run_mpi(2, "run " + q(spec) + " --out " + q(dir / "out"));
+}
+
+TEST(Mpi, StreamPowerSettingsThatDoNotTileRunOnRankZeroAndSaySo) {
+    const RunResult r = run_on_two_ranks(kStreamPowerSpec);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("'s4' (erode:stream-power) ran on rank 0 over the whole grid: routing=mfd is not tiled yet"),
               std::string::npos)
@@ -543,9 +549,7 @@ TEST_P(RmpSeam, RmpEqualsOneProcess) { expect_same_outputs(kRmpSpec, {"r.vti", "
 INSTANTIATE_TEST_SUITE_P(Ranks, RmpSeam, kErosionCases, kCaseName);
 
 TEST(Mpi, RmpConesRunOnRankZeroAndSaySo) {
-    TempDir dir;
-    const auto spec = dir.write("s.orogen", kRmpSpec);
-    const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "out"));
+    const RunResult r = run_on_two_ranks(kRmpSpec);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.out.find("'c' (generate:rmp) ran on rank 0 over the whole grid: method=cones draws the whole grid "
                          "through OSMesa"),
