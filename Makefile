@@ -41,7 +41,7 @@ TSAN_BUILD ?= build-tsan
 # the cache's parallel copies and hashes, and the kernel tests that run specs on several threads. Not here: the
 # render passes, export:video and export:paraview (their threads are llvmpipe's, FFmpeg's and ParaView's, not
 # instrumented) — CI's ASan phase covers their code (ASAN_CI).
-TSAN_ONLY  ?= /plugins/(erode|generate|tectonics|import)/[^/]+$$|/plugins/export/(png|raw|gltf|vdb|vtk|geotiff|maps|tiles)$$|/tests/plugins/(thermal|hydraulic|pipe|sph|stream_power|diffusion|plates|diamond_square|fault|rmp|shape|png_export|raw|gltf|vdb|geotiff|maps|tiles)$$|/tests/(cache|kernel)$$
+TSAN_ONLY  ?= /plugins/(erode|generate|tectonics|import)/[^/]+$$|/plugins/export/(png|raw|gltf|vdb|vtk|geotiff|maps|tiles)$$|/tests/plugins/(thermal|hydraulic|pipe|sph|stream_power|diffusion|plates|diamond_square|fault|rmp|shape|png_export|raw|gltf|vdb|geotiff|maps|tiles)$$|/tests/(cache|kernel)$$|/tests/libs/[^/]+$$
 # Tests TSan gains nothing from, left to the other phases (they were half of the TSan phase's test time):
 # check-time diagnostics, which run no thread (the kernel's run under ASan+UBSan in asan-ci, the plugins'
 # in the release suite), and the long physics validations (dam break, hydrostatics, experiment 4.1, the
@@ -50,16 +50,18 @@ TSAN_ONLY  ?= /plugins/(erode|generate|tectonics|import)/[^/]+$$|/plugins/export
 # comparisons (the release and ASan phases check every golden; TSan's share of the same loops is in the
 # thread tests), the cache's bookkeeping (eviction, staleness, damaged entries: one process, one thread; its
 # parallel copies and hashes stay, in CacheRun.ColdAndWarm... and test_cache), the kill/rollback tests
-# (processes, not threads), and GDAL reading orogen's files back (GDAL is not instrumented).
-TSAN_SKIP  ?= ^Specs/BadSpec\.|^Confinement\.|^Cli\.|^Inputs\.|^CacheCommand\.|^Runner\.ExitCodes|^Outputs\.BadPng|Cli\.Bad|CliBadInput|Cli\.TooMany|Node\.BadInput|^Series\.ATimelapseThatWouldNotFit|^SphDamBreak\.|^SphHydrostatics\.|^Experiment41\.|TallColumnBecomesPileAtTalusSlope|RainOnRoughTerrainGivesANetworkNotSpeckle|OrogenyPipelineHasTheStatisticsOfARealRange|ShippedPipelinesKeepTheirGoldenOutputs|^CacheRun\.(Eviction|AnImporter|Series|TheDefaultFolder|Damaged|ANewSeed|AnEntry|WhatACached|ARebuilt|ADownstream|AFolder)|^AllOrNothing\.|GdalReadsTheMosaic|GdalinfoReadsIt|^Outputs\.(A16BitPng|AddingANode)|^Pipe\.(ConservesWaterAndMaterialOver10000Steps|AnyTimeStepStaysFinite)|^SphDitches\.|^SphNode\.BadInput|^PlatesCli\.Bad|^TilesCli\.BadParameters
+# (processes, not threads), GDAL reading orogen's files back (GDAL is not instrumented), and the
+# analysis library's agreement with terrain_stats.py on the reference DEMs (one thread's arithmetic; its
+# FFT's threads are in Figures.TheSameBitsWithOneThreadOrTwo).
+TSAN_SKIP  ?= ^Specs/BadSpec\.|^Confinement\.|^Cli\.|^Inputs\.|^CacheCommand\.|^Runner\.ExitCodes|^Outputs\.BadPng|Cli\.Bad|CliBadInput|Cli\.TooMany|Node\.BadInput|^Series\.ATimelapseThatWouldNotFit|^SphDamBreak\.|^SphHydrostatics\.|^Experiment41\.|TallColumnBecomesPileAtTalusSlope|RainOnRoughTerrainGivesANetworkNotSpeckle|OrogenyPipelineHasTheStatisticsOfARealRange|ShippedPipelinesKeepTheirGoldenOutputs|^CacheRun\.(Eviction|AnImporter|Series|TheDefaultFolder|Damaged|ANewSeed|AnEntry|WhatACached|ARebuilt|ADownstream|AFolder)|^AllOrNothing\.|GdalReadsTheMosaic|GdalinfoReadsIt|^Outputs\.(A16BitPng|AddingANode)|^Pipe\.(ConservesWaterAndMaterialOver10000Steps|AnyTimeStepStaysFinite)|^SphDitches\.|^SphNode\.BadInput|^PlatesCli\.Bad|^TilesCli\.BadParameters|^Reference\.
 # What `make asan` configures: empty = the whole tree. CI (.ci/run) runs ASAN_CI: every plugin, the kernel,
 # the fuzz targets and the cache with their tests, the render passes' tests, and the shipped pipelines end to
 # end at their test sizes (tests/pipelines: every pipeline on 1 and 2 threads against its golden hashes, so
-# every plugin's code runs under ASan+UBSan through a real spec). The plugins' own unit tests run under
+# every plugin's code runs under ASan+UBSan through a real spec), and libs/ with its tests. The plugins' own unit tests run under
 # TSan+UBSan (TSAN_ONLY). Both sanitizers over every test would not fit CI's 30 minutes on 2 cores
 # (docs/hardening.md).
 ASAN_ONLY  ?=
-ASAN_CI     = /tests/(kernel|fuzz|cache|pipelines)|/tests/plugins/render$$|/plugins/[^/]+/[^/]+$$
+ASAN_CI     = /tests/(kernel|fuzz|cache|pipelines)|/tests/plugins/render$$|/tests/libs/[^/]+$$|/plugins/[^/]+/[^/]+$$
 FUZZ_SECONDS ?= 20
 FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000

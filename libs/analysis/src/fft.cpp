@@ -1,0 +1,110 @@
+// Radix-2 Cooley–Tukey and Bluestein's chirp-z transform (fft.hpp).
+#include <orogen/analysis/fft.hpp>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace orogen::analysis {
+
+namespace {
+
+std::size_t next_power_of_two(std::size_t n) {
+    std::size_t p = 1;
+    while (p < n) p <<= 1;
+    return p;
+}
+
+bool is_power_of_two(std::size_t n) { return n != 0 && (n & (n - 1)) == 0; }
+
+}  // namespace
+
+Fft::Fft(std::size_t n) : n_(n) {
+    if (n == 0) throw std::invalid_argument("Fft: length 0");
+    m_ = is_power_of_two(n) ? n : next_power_of_two(2 * n - 1);
+    twiddles_.resize(m_ / 2);
+    for (std::size_t k = 0; k < m_ / 2; ++k)
+        twiddles_[k] = std::polar(1.0, -2.0 * std::numbers::pi * double(k) / double(m_));
+    if (m_ == n_) return;
+    // Bluestein: jk = (j² + k² − (k − j)²)/2, so X[k] = c[k] Σ_j (x[j] c[j]) conj(c[k − j]) with
+    // c[k] = e^{−πi k²/n}: a convolution, done at the power-of-two length m. k² is taken mod 2n
+    // before the angle so large k lose no precision.
+    chirp_.resize(n_);
+    for (std::size_t k = 0; k < n_; ++k) {
+        const std::size_t k2 = (k * k) % (2 * n_);
+        chirp_[k] = std::polar(1.0, -std::numbers::pi * double(k2) / double(n_));
+    }
+    kernel_.assign(m_, {0.0, 0.0});
+    kernel_[0] = std::conj(chirp_[0]);
+    for (std::size_t k = 1; k < n_; ++k) kernel_[k] = kernel_[m_ - k] = std::conj(chirp_[k]);
+    radix2(kernel_, false);
+}
+
+void Fft::radix2(std::span<std::complex<double>> a, bool inverse) const {
+    const std::size_t m = a.size();
+    // Bit-reversal permutation.
+    for (std::size_t i = 1, j = 0; i < m; ++i) {
+        std::size_t bit = m >> 1;
+        for (; j & bit; bit >>= 1) j ^= bit;
+        j ^= bit;
+        if (i < j) std::swap(a[i], a[j]);
+    }
+    for (std::size_t len = 2; len <= m; len <<= 1) {
+        const std::size_t half = len / 2, stride = m / len;
+        for (std::size_t i = 0; i < m; i += len)
+            for (std::size_t k = 0; k < half; ++k) {
+                const std::complex<double> t = twiddles_[k * stride];
+                const std::complex<double> w{t.real(), inverse ? -t.imag() : t.imag()};
+                const std::complex<double> u = a[i + k], v = a[i + k + half] * w;
+                a[i + k] = u + v;
+                a[i + k + half] = u - v;
+            }
+    }
+}
+
+void Fft::transform(std::span<std::complex<double>> data, bool inverse) const {
+    if (data.size() != n_) throw std::invalid_argument("Fft::transform: wrong length");
+    if (m_ == n_) {
+        radix2(data, inverse);
+    } else {
+        // The inverse is the conjugate of the forward transform of the conjugate.
+        std::vector<std::complex<double>> a(m_, {0.0, 0.0});
+        for (std::size_t j = 0; j < n_; ++j) a[j] = (inverse ? std::conj(data[j]) : data[j]) * chirp_[j];
+        radix2(a, false);
+        for (std::size_t k = 0; k < m_; ++k) a[k] *= kernel_[k];
+        radix2(a, true);
+        const double scale = 1.0 / double(m_);
+        for (std::size_t k = 0; k < n_; ++k) {
+            const std::complex<double> x = a[k] * scale * chirp_[k];
+            data[k] = inverse ? std::conj(x) : x;
+        }
+    }
+    if (inverse) {
+        const double scale = 1.0 / double(n_);
+        for (auto& x : data) x *= scale;
+    }
+}
+
+void fft2(std::vector<std::complex<double>>& data, std::size_t width, std::size_t height, bool inverse) {
+    if (data.size() != width * height) throw std::invalid_argument("fft2: data is not width × height");
+    // Each row and each column is transformed by one iteration alone: the same bits for any thread count.
+    const Fft rows(width);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t y = r.begin(); y != r.end(); ++y)
+            rows.transform(std::span(data).subspan(y * width, width), inverse);
+    });
+    const Fft columns(height);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, width, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<std::complex<double>> column(height);
+        for (std::size_t x = r.begin(); x != r.end(); ++x) {
+            for (std::size_t y = 0; y < height; ++y) column[y] = data[y * width + x];
+            columns.transform(column, inverse);
+            for (std::size_t y = 0; y < height; ++y) data[y * width + x] = column[y];
+        }
+    });
+}
+
+}  // namespace orogen::analysis
