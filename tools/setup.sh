@@ -8,6 +8,7 @@ packages=(
   libglm-dev libbox2d-dev libosmesa6-dev libvtk9-dev libopenvdb-dev libtinygltf-dev nlohmann-json3-dev
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
   libgdal-dev gdal-bin
+  libopenexr-dev openexr
   libssl-dev libxxhash-dev libstb-dev libpng-dev libdeflate-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev
