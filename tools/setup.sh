@@ -14,6 +14,7 @@ packages=(
   xvfb xauth libx11-dev
   clang-14 libclang-rt-14-dev
   openmpi-bin libopenmpi-dev
+  gnuplot-nox                 # analyze:terrain's charts (pngcairo)
 )
 
 # ParaView's pvbatch (the export:paraview-state test) is not installed here:

@@ -1,4 +1,4 @@
-// The `orogen` command: run | check | list | help | version | cache.
+// The `orogen` command: run | check | list | help | version | cache | analyze.
 // Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
 // usage), 130 interrupted (SIGINT), 143 terminated (SIGTERM).
 #include "../src/loader.hpp"
@@ -8,6 +8,7 @@
 #include "../src/runner.hpp"
 #include "../src/spec.hpp"
 #include "../src/tiles.hpp"
+#include "analyze.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -48,6 +49,11 @@ const char* usage_text =
     "  orogen run SPEC [--out DIR] [--seed N] [--threads N] [--set NAME.PARAM=VALUE]... [--quiet]\n"
     "                  [--allow-outside-out] [--cache DIR | --no-cache] [--cache-size SIZE] [--tiles RxC]\n"
     "  orogen check SPEC [--out DIR] [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
+    "  orogen analyze FILE... [--against DEM...] [--out DIR] [--cell M] [--heights LOW:HIGH] [--no-render]\n"
+    "                 [--threads N] [--quiet]       measure terrains (slopes, hypsometry, spectrum, rivers...)\n"
+    "                                                  against real DEMs: a table, DIR/analysis.json, charts,\n"
+    "                                                  renderings and DIR/README.md (default DIR: analysis/;\n"
+    "                                                  docs/analysis.md)\n"
     "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
     "  orogen version                                  kernel, plugin API and plugin versions\n"
@@ -279,6 +285,9 @@ std::string tiles_problem(const Args& args, int ranks) {
 }
 
 /// Read, parse and check a spec. Prints diagnostics; returns nullopt on error.
+std::optional<Plan> check_spec_text(const std::string& path, std::string text, const PluginSet& plugins,
+                                    const Args& args);
+
 std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins, const Args& args) {
     std::error_code ec;
     if (!fs::exists(path, ec)) {
@@ -297,6 +306,12 @@ std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins,
         std::fprintf(stderr, "orogen: error: %s\n", e.what());
         return std::nullopt;
     }
+    return check_spec_text(path, std::move(text), plugins, args);
+}
+
+/// Parse and check spec `text` as if read from `path`. Prints diagnostics; returns nullopt on error.
+std::optional<Plan> check_spec_text(const std::string& path, std::string text, const PluginSet& plugins,
+                                    const Args& args) {
     auto source = std::make_shared<spec::Source>(path, std::move(text));
     spec::Diagnostics diags;
     spec::Spec parsed = spec::parse(source, diags);
@@ -347,10 +362,18 @@ int cmd_check(const Args& args, const PluginSet& plugins) {
     return exit_ok;
 }
 
+int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugins, bool summary);
+
 int cmd_run(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() != 1) return usage_error("run needs one spec file");
     auto plan = load_spec(args.positional[0], plugins, args);
     if (!plan) return exit_bad_input;
+    return run_plan(plan, args, plugins, true);
+}
+
+/// Run a checked plan: progress, cancellation, the cache as `args` says. With `summary`, prints the files
+/// written and the timing table.
+int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugins, bool summary) {
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
     const bool speaks = !g_mpi || g_mpi->rank == 0;  // under mpirun, rank 0 shows progress and the summary
@@ -379,7 +402,7 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
         if (result.exit_code == 130 && g_signal.load() == SIGTERM) return 143;
         return result.exit_code;
     }
-    if (!args.quiet && speaks) {
+    if (!args.quiet && speaks && summary) {
         if (g_mpi) {
             const TileSplit& split = tiled->split();
             std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size, g_mpi->size == 1 ? "" : "s",
@@ -397,12 +420,50 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
     return exit_ok;
 }
 
+/// `orogen analyze`: the command line becomes a spec (cli/analyze.cpp), run without the cache; the table
+/// the analyze:terrain node wrote is printed.
+int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
+    cli::AnalyzeArgs a;
+    if (const std::string problem = cli::parse_analyze_args(argc, argv, a); !problem.empty()) return usage_error(problem);
+    const cli::ComposedSpec composed = cli::compose_analyze_spec(a);
+    if (!composed.problem.empty()) {
+        std::fprintf(stderr, "orogen: error: %s\n", composed.problem.c_str());
+        return exit_bad_input;
+    }
+    Args args;
+    args.command = "analyze";
+    args.out = a.out;
+    args.threads = a.threads;
+    args.quiet = a.quiet;
+    args.no_cache = true;  // the files may change under the same names; measuring is quick
+    // The spec's file name only names it in messages: its paths are absolute.
+    auto plan = check_spec_text("orogen-analyze.orogen", composed.text, plugins, args);
+    if (!plan) {
+        std::fprintf(stderr, "(orogen analyze ran the spec above, composed from its command line: a node's cell= is "
+                             "--cell, low= and high= are --heights)\n");
+        return exit_bad_input;
+    }
+    const int rc = run_plan(plan, args, plugins, false);
+    if (rc != exit_ok) return rc;
+    try {
+        const auto table = read_file(fs::path(a.out) / "analysis.txt");
+        std::fwrite(table.data(), 1, table.size(), stdout);
+    } catch (const Error& e) {
+        std::fprintf(stderr, "orogen: error: %s\n", e.what());
+        return exit_failed;
+    }
+    if (!a.quiet)
+        std::printf("\nreport: %s (analysis.json, charts%s)\n", (fs::path(a.out) / "README.md").c_str(),
+                    a.render ? ", renders/" : "");
+    return exit_ok;
+}
+
 int cmd_list(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() > 1) return usage_error("list takes at most one kind");
     const std::string kind = args.positional.empty() ? "" : args.positional[0];
-    static const std::vector<std::string> kinds = {"generate", "erode", "tectonics", "render", "export", "import"};
+    static const std::vector<std::string> kinds = {"generate", "erode", "tectonics", "render", "export", "import", "analyze"};
     if (!kind.empty() && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) {
-        std::string msg = "unknown kind '" + kind + "' (kinds: generate, erode, tectonics, render, export, import)";
+        std::string msg = "unknown kind '" + kind + "' (kinds: generate, erode, tectonics, render, export, import, analyze)";
         const std::string guess = spec::closest(kind, kinds);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
@@ -517,12 +578,26 @@ int main(int argc, char** argv) {
         return exit_ok;
     }
     if (args.command == "--version") args.command = "version";
-    static const std::vector<std::string> commands = {"run", "check", "list", "help", "version", "cache"};
+    static const std::vector<std::string> commands = {"run", "check", "list", "help", "version", "cache", "analyze"};
     if (std::find(commands.begin(), commands.end(), args.command) == commands.end()) {
         std::string msg = "unknown command '" + args.command + "'";
         const std::string guess = spec::closest(args.command, commands);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         return usage_error(msg);
+    }
+    if (args.command == "analyze") {  // its own options (--against FILE...): see cli/analyze.cpp
+        PluginSet plugins;
+        plugins.load_all(self_path(argv[0]));
+        print_problems(plugins);
+        try {
+            return cmd_analyze(argc, argv, plugins);
+        } catch (const Error& e) {
+            std::fprintf(stderr, "orogen: error: %s\n", e.what());
+            return e.kind() == Error::Kind::bad_input ? exit_bad_input : exit_failed;
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "orogen: error: %s\n", e.what());
+            return exit_failed;
+        }
     }
     if (auto rc = parse_args(argc, argv, args)) return *rc;
 

@@ -36,9 +36,9 @@ void Registry::add(NodeDescriptor node) {
     auto refuse = [&](const std::string& why) {
         impl_->errors.push_back(where + ": node '" + qualified + "' refused: " + why);
     };
-    static const char* kinds[] = {"generate", "erode", "tectonics", "render", "export", "import"};
+    static const char* kinds[] = {"generate", "erode", "tectonics", "render", "export", "import", "analyze"};
     if (std::find(std::begin(kinds), std::end(kinds), node.kind) == std::end(kinds))
-        return refuse("unknown kind '" + node.kind + "' (use generate, erode, tectonics, render, export or import)");
+        return refuse("unknown kind '" + node.kind + "' (use generate, erode, tectonics, render, export, import or analyze)");
     if (!is_kebab(node.name)) return refuse("the name must be kebab-case (lowercase letters, digits, '-')");
     if (!node.run) return refuse("it has no run function");
     for (const auto& p : node.params) {

@@ -276,7 +276,7 @@ enum class CachePolicy {
 };
 
 struct NodeDescriptor {
-    std::string kind;     ///< generate | erode | tectonics | render | export | import
+    std::string kind;     ///< generate | erode | tectonics | render | export | import | analyze
     std::string name;     ///< kebab-case, unique within the kind
     std::string summary;  ///< one line, for `orogen list`
     std::string description;  ///< longer text for `orogen help` (optional)

@@ -354,12 +354,20 @@ ReadResult read(const fs::path& path, const ReadOptions& options) {
         }
     }
     ReadResult result;
+    std::vector<float> hole_layer;  // Holes::mask: 1 where the raster had no data
     if (holes == src.size()) throw BadInput(path.string() + " holds no data: every sample is nodata");
     if (holes > 0) {
         if (options.holes == Holes::refuse)
             throw BadInput(path.string() + " has " + std::to_string(holes) + " nodata samples (the first at column " +
                            std::to_string(first_hole % W) + ", row " + std::to_string(first_hole / W) +
                            "); use holes=fill to fill them from their surroundings");
+        if (options.holes == Holes::mask) {
+            if (options.size && (options.size->first != W || options.size->second != H))
+                throw BadInput("holes=mask marks the raster's own samples; read " + path.string() +
+                               " at its own size (resample=none)");
+            hole_layer.resize(valid.size());
+            for (std::size_t i = 0; i < valid.size(); ++i) hole_layer[i] = valid[i] ? 0.0f : 1.0f;
+        }
         result.holes_filled = fill_holes(src, valid, W, H);
     }
 
@@ -415,6 +423,7 @@ ReadResult read(const fs::path& path, const ReadOptions& options) {
             }
         });
     }
+    if (!hole_layer.empty()) terrain->set_layer("nodata", std::move(hole_layer));
     result.terrain = std::move(terrain);
     return result;
 }

@@ -80,7 +80,9 @@ RasterInfo probe(const std::filesystem::path& path, int band = 1);
 
 enum class Resample { nearest, bilinear, cubic };
 Resample parse_resample(const std::string& name);
-enum class Holes { fill, refuse };
+/// What to do with nodata samples: fill them from their surroundings; refuse the file; or fill them and
+/// mark them in a layer `nodata` (1 a hole, 0 data; at the raster's own size only), for analyze:terrain.
+enum class Holes { fill, refuse, mask };
 
 struct ReadOptions {
     int band = 1;

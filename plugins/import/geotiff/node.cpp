@@ -30,7 +30,7 @@ geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band
         o.resample = geotiff::parse_resample(resample);
         o.size = std::make_pair(grid.width, grid.height);
     }
-    o.holes = holes == "refuse" ? geotiff::Holes::refuse : geotiff::Holes::fill;
+    o.holes = holes == "refuse" ? geotiff::Holes::refuse : holes == "mask" ? geotiff::Holes::mask : geotiff::Holes::fill;
     o.cell = cell;
     return o;
 }
@@ -44,7 +44,8 @@ NodeOutputs run(NodeContext& ctx) {
         for (float& h : result.terrain->heights()) h = float(double(h) * scale + offset);
     ctx.check_finite(result.terrain->heights(), "height", 0);
     if (result.holes_filled)
-        ctx.info("filled " + std::to_string(result.holes_filled) + " nodata samples from their surroundings");
+        ctx.info("filled " + std::to_string(result.holes_filled) + " nodata samples from their surroundings" +
+                 (ctx.text("holes") == "mask" ? " and marked them in the layer 'nodata'" : ""));
     std::ostringstream msg;
     msg << result.terrain->width() << "×" << result.terrain->height() << " vertices, cell " << result.terrain->cell()
         << " m";
@@ -70,6 +71,8 @@ void check(CheckContext& ctx) {
                               "cut it down first, e.g. gdal_translate -outsize 25% 25%");
         return;
     }
+    if (ctx.text("holes") == "mask" && ctx.text("resample") != "none")
+        ctx.error("holes", "holes=mask marks the raster's own samples; add resample=none");
     if (ctx.real("cell") <= 0.0 && info.cell_metres <= 0.0)
         ctx.error("cell", "the raster has no georeference to take a cell size from; give cell=METRES");
     const bool resampled = ctx.text("resample") != "none";
@@ -83,6 +86,7 @@ void check(CheckContext& ctx) {
                                               : info.cell_metres;
     }
     out.layers_known = true;
+    if (ctx.text("holes") == "mask") out.layers_known = false;  // 'nodata' only when the raster has holes
 }
 
 }  // namespace
@@ -98,7 +102,7 @@ OROGEN_PLUGIN("import-geotiff", "0.1.0", registry) {
             "resample=none keeps the raster's own size. The cell size comes from the georeference (a geographic "
             "CRS's degrees are converted at the raster's mid latitude) unless cell is given. Nodata samples are "
             "filled from their surroundings (holes=fill: layer by layer inward, each the mean of its valid "
-            "neighbours) or refused (holes=refuse).",
+            "neighbours), refused (holes=refuse), or filled and marked in a layer 'nodata' (holes=mask, 1 = a hole).",
         .inputs = {},
         .output = ValueType::heightmap,
         .params =
@@ -107,7 +111,9 @@ OROGEN_PLUGIN("import-geotiff", "0.1.0", registry) {
                 Param::integer("band", 1).min(1).max(65535).help("band to read"),
                 Param::choice("resample", {"bilinear", "cubic", "nearest", "none"}, "bilinear")
                     .help("how to resample to the spec's grid; none keeps the raster's size"),
-                Param::choice("holes", {"fill", "refuse"}, "fill").help("what to do with nodata samples"),
+                Param::choice("holes", {"fill", "refuse", "mask"}, "fill")
+                    .help("what to do with nodata samples; mask fills them and marks them in a layer 'nodata' "
+                          "(1 = hole) that analyze:terrain leaves out (needs resample=none)"),
                 Param::real("cell", 0.0).min(0.0).max(1e6).unit("m").help("vertex spacing; 0 = from the file"),
                 Param::real("z_scale", 1.0)
                     .min(-1e6)
