@@ -6,6 +6,9 @@
 
 #include <orogen/analysis/fft.hpp>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -27,6 +30,41 @@ std::vector<double> hann(int n) {
 
 /// The signed frequency of unshifted FFT index u (numpy.fft.fftfreq · n): what fftshift puts at u.
 int frequency(int u, int n) { return u < (n + 1) / 2 ? u : u - n; }
+
+/// |F(u, v)|² of the 2-D transform of the real n × n `data` for the columns u = 0 … n/2 (row-major, n/2 + 1
+/// a row); the other columns mirror them (F(n − u, n − v) = conj F(u, v)). Real input halves the work: two
+/// rows go through one complex transform (z = a + ib, then A = (Z[k] + conj Z[n−k])/2 and
+/// B = (Z[k] − conj Z[n−k])/2i), and only the n/2 + 1 columns are transformed.
+std::vector<double> half_power_spectrum(const std::vector<double>& data, int n) {
+    const std::size_t side = std::size_t(n), columns = side / 2 + 1;
+    std::vector<std::complex<double>> half(side * columns);
+    const Fft fft(side);
+    // Each pair of rows, then each column, is one iteration's alone: the same bits for any thread count.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (side + 1) / 2, 8), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<std::complex<double>> z(side);
+        for (std::size_t pair = r.begin(); pair != r.end(); ++pair) {
+            const std::size_t y0 = 2 * pair, y1 = y0 + 1;
+            for (std::size_t x = 0; x < side; ++x)
+                z[x] = {data[y0 * side + x], y1 < side ? data[y1 * side + x] : 0.0};
+            fft.transform(z);
+            for (std::size_t u = 0; u < columns; ++u) {
+                const std::complex<double> zk = z[u], zm = std::conj(z[(side - u) % side]);
+                half[y0 * columns + u] = 0.5 * (zk + zm);
+                if (y1 < side) half[y1 * columns + u] = std::complex<double>(0.0, -0.5) * (zk - zm);
+            }
+        }
+    });
+    std::vector<double> power(side * columns);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, columns, 8), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<std::complex<double>> column(side);
+        for (std::size_t u = r.begin(); u != r.end(); ++u) {
+            for (std::size_t v = 0; v < side; ++v) column[v] = half[v * columns + u];
+            fft.transform(column);
+            for (std::size_t v = 0; v < side; ++v) power[v * columns + u] = std::norm(column[v]);
+        }
+    });
+    return power;
+}
 
 }  // namespace
 
@@ -52,24 +90,28 @@ void measure_spectrum(const Terrain& t, Figures& f) {
     }
     const double mean = sum / double(count);
     const auto window = hann(n);
-    std::vector<std::complex<double>> data(std::size_t(n) * std::size_t(n));
+    std::vector<double> data(std::size_t(n) * std::size_t(n));
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
             const std::size_t i = t.at(x, y);
             const double v = t.valid[i] ? t.z[i] - mean : 0.0;
             data[std::size_t(y) * std::size_t(n) + std::size_t(x)] = v * window[std::size_t(y)] * window[std::size_t(x)];
         }
-    fft2(data, std::size_t(n), std::size_t(n));
+    const std::vector<double> half = half_power_spectrum(data, n);
 
-    // Radial bins as numpy.bincount of int(hypot(kx, ky)); the largest bin is ⌊√2·n/2⌋.
+    // Radial bins as numpy.bincount of int(hypot(kx, ky)); the largest bin is ⌊√2·n/2⌋. Column u of the
+    // half spectrum stands for itself and, unless it is its own mirror (u = 0, or n/2 for even n), for
+    // column n − u, whose power is the same at the mirrored row and falls in the same bin.
     const std::size_t bins = std::size_t(std::hypot(double(n / 2), double(n / 2))) + 1;
+    const std::size_t columns = std::size_t(n / 2 + 1);
     std::vector<double> power(bins, 0.0);
     std::vector<std::size_t> members(bins, 0);
     for (int v = 0; v < n; ++v)
-        for (int u = 0; u < n; ++u) {
+        for (int u = 0; u <= n / 2; ++u) {
+            const std::size_t weight = u == 0 || 2 * u == n ? 1 : 2;
             const std::size_t k = std::size_t(std::hypot(double(frequency(u, n)), double(frequency(v, n))));
-            power[k] += std::norm(data[std::size_t(v) * std::size_t(n) + std::size_t(u)]);
-            ++members[k];
+            power[k] += double(weight) * half[std::size_t(v) * columns + std::size_t(u)];
+            members[k] += weight;
         }
     for (std::size_t k = 0; k < bins; ++k) power[k] /= double(std::max<std::size_t>(members[k], 1));
 
