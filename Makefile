@@ -61,11 +61,11 @@ TSAN_SKIP  ?= ^Specs/BadSpec\.|^Confinement\.|^Cli\.|^Inputs\.|^CacheCommand\.|^
 # TSan+UBSan (TSAN_ONLY). Both sanitizers over every test would not fit CI's 30 minutes on 2 cores
 # (docs/hardening.md).
 ASAN_ONLY  ?=
-ASAN_CI     = /tests/(kernel|fuzz|cache|pipelines)|/tests/plugins/render$$|/tests/libs/[^/]+$$|/plugins/[^/]+/[^/]+$$
+ASAN_CI     = /tests/(kernel|fuzz|cache|pipelines)|/tests/plugins/(render|analyze)$$|/tests/libs/[^/]+$$|/plugins/[^/]+/[^/]+$$
 FUZZ_SECONDS ?= 20
 FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000
-FUZZ_TARGETS  = spec overrides png sidecar cache exr
+FUZZ_TARGETS  = spec overrides png sidecar cache exr f32
 # The sanitizer builds link with lld when it is installed (lld-14: a sanitizer link is 2-3x faster than
 # with bfd, ~70 links a build).
 SAN_LD      := $(if $(shell command -v ld.lld 2>/dev/null),-fuse-ld=lld,)

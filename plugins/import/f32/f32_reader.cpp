@@ -19,7 +19,8 @@ namespace {
 
 /// The number after "key": in flat JSON, or nullopt if the key is absent. Throws if it is not a number.
 std::optional<double> number(std::string_view json, std::string_view key, const std::string& name) {
-    const std::string quoted = "\"" + std::string(key) + "\"";
+    std::string quoted(1, '"');  // (not "\"" + key + "\"": GCC 12 warns falsely of an overlapping memcpy there)
+    quoted.append(key).push_back('"');
     const auto at = json.find(quoted);
     if (at == std::string_view::npos) return std::nullopt;
     std::size_t i = at + quoted.size();
@@ -49,14 +50,15 @@ Description parse_description(std::string_view json, const std::string& name) {
     d.width = side(json, "nx", name);
     d.height = side(json, "ny", name);
     if (const auto dx = number(json, "dx_m", name)) {
-        if (!(*dx > 0.0)) throw BadInput(name + ": 'dx_m' must be a positive number of metres");
+        if (!(*dx > 0.0) || *dx > 1e6) throw BadInput(name + ": 'dx_m' must be a number of metres above 0, at most 1e6");
         d.cell = *dx;
     } else if (const auto lat0 = number(json, "lat0", name), dlat = number(json, "dlat", name),
                dlon = number(json, "dlon", name);
                lat0 && dlat && dlon) {
         const double lat = *lat0 + *dlat * d.height / 2.0;
         d.cell = std::abs(*dlon) * 111320.0 * std::cos(lat * std::numbers::pi / 180.0);
-        if (!(d.cell > 0.0)) throw BadInput(name + ": 'dlon' and the latitude give no positive cell size");
+        if (!(d.cell > 0.0) || d.cell > 1e6)
+            throw BadInput(name + ": 'dlon' and the latitude give no cell size between 0 and 1e6 m");
     }
     return d;
 }
