@@ -1,6 +1,5 @@
-// generate:terrace — rounds heights down to steps, as rice terraces (or mesas) do.
+// terrace.cpp — generate:terrace, cuts a terrain into flat steps
 #include <orogen/plugin.hpp>
-
 #include <cmath>
 
 using namespace orogen;
