@@ -173,7 +173,11 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
         } else if (arg == "--quiet" || arg == "-q") {
             a.quiet = true;
         } else if (arg.size() > 1 && arg[0] == '-') {
-            return usage_error("unknown option '" + arg + "'");
+            static const std::vector<std::string> options = {
+                "--out", "--seed", "--threads", "--set", "--cache-size", "--cache", "--no-cache", "--tiles",
+                "--allow-outside-out", "--quiet"};
+            const std::string guess = spec::closest(arg.substr(0, arg.find('=')), options);
+            return usage_error("unknown option '" + arg + "'" + (guess.empty() ? "" : "; did you mean '" + guess + "'?"));
         } else {
             a.positional.push_back(arg);
         }
@@ -356,9 +360,11 @@ int cmd_check(const Args& args, const PluginSet& plugins) {
     auto plan = load_spec(args.positional[0], plugins, args);
     if (!plan) return exit_bad_input;
     if (g_mpi && g_mpi->rank != 0) return exit_ok;
-    std::printf("%s: ok (%zu node%s, grid %dx%d, cell %g m, seed %llu)\n", args.positional[0].c_str(),
+    // The grid's defaults are said, not left to be discovered: no grid line is 513 x 513, no cell= is 1 m.
+    std::printf("%s: ok (%zu node%s, grid %dx%d%s, cell %g m%s, seed %llu)\n", args.positional[0].c_str(),
                 plan->nodes.size(), plan->nodes.size() == 1 ? "" : "s", plan->grid.width, plan->grid.height,
-                plan->grid.cell, static_cast<unsigned long long>(plan->seed));
+                plan->grid_given ? "" : " (the default: no grid line)", plan->grid.cell,
+                plan->cell_given ? "" : " (the default: no cell=)", static_cast<unsigned long long>(plan->seed));
     return exit_ok;
 }
 

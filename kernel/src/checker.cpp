@@ -249,6 +249,8 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
     plan.grid.width = parsed.grid_width;
     plan.grid.height = parsed.grid_height;
     plan.grid.cell = parsed.grid_cell;
+    plan.grid_given = parsed.has_grid;
+    plan.cell_given = parsed.has_cell;
     if (const std::string problem = heightmap_memory_problem(plan.grid.width, plan.grid.height,
                                                              options.heightmap_memory_limit);
         !problem.empty())
@@ -275,10 +277,27 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
     std::set<std::string, std::less<>> poisoned;                    // names whose node is unknown
     std::vector<std::string> all_nodes;
     for (const auto* n : registry.nodes()) all_nodes.push_back(n->qualified_name());
+    // Where each name is defined, for "'x' is defined later, on line N".
+    std::map<std::string, Location, std::less<>> defined_anywhere;
+    for (const auto& st : parsed.statements)
+        if (!st.name.empty()) defined_anywhere.emplace(st.name, st.name_where);
+    // The value key of each call written where an input goes (its label: kind:node, kind:node#2, ...).
+    std::vector<std::string> nested_key(parsed.statements.size());
+    std::vector<std::string> labels;  // every node's label, for --set's "did you mean"
 
-    for (const auto& st : parsed.statements) {
+    for (std::size_t si = 0; si < parsed.statements.size(); ++si) {
+        const auto& st = parsed.statements[si];
         const auto& call = st.call;
         const NodeDescriptor* node = registry.find(call.qualified());
+        // Unnamed calls (exporters, and calls written where an input goes) are labelled kind:node, then
+        // kind:node#2, #3...: the label seeds the node, and --set reaches it by its label.
+        std::string label = st.name;
+        if (st.name.empty()) {
+            label = call.qualified();
+            if (++unnamed_count[call.qualified()] > 1) label += "#" + std::to_string(unnamed_count[call.qualified()]);
+        }
+        labels.push_back(label);
+        if (st.nested) nested_key[si] = label;
         if (st.name.size()) {
             if (auto it = defined_at.find(st.name); it != defined_at.end()) {
                 diags.error(st.name_where, "'" + st.name + "' is already defined on line " +
@@ -291,21 +310,18 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
             else msg += "; `orogen list` shows the nodes the loaded plugins provide";
             diags.error(call.where, msg);
-            if (!st.name.empty()) {
-                defined_at.emplace(st.name, st.name_where);
-                values.emplace(st.name, ValueInfo{});  // so later uses do not also say "undefined"
-                poisoned.insert(st.name);
+            if (!st.name.empty() || st.nested) {
+                if (!st.name.empty()) defined_at.emplace(st.name, st.name_where);
+                values.emplace(label, ValueInfo{});  // so later uses do not also say "undefined"
+                poisoned.insert(label);
             }
             continue;
         }
 
         PlannedNode planned;
         planned.node = node;
-        planned.value_name = st.name;
-        // Unnamed calls are labelled kind:node, then kind:node#2, #3...: the label seeds the node.
-        planned.label = st.name.empty() ? call.qualified() : st.name;
-        if (st.name.empty() && ++unnamed_count[call.qualified()] > 1)
-            planned.label += "#" + std::to_string(unnamed_count[call.qualified()]);
+        planned.value_name = st.nested ? label : st.name;  // a label holds ':', so it never meets a name
+        planned.label = label;
         planned.where = call.where;
 
         // Inputs
@@ -326,15 +342,21 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
         for (std::size_t i = 0; i < call.inputs.size() && i < node->inputs.size(); ++i) {
             const auto& in = call.inputs[i];
             const auto& want = node->inputs[i];
-            auto it = values.find(in.full());
+            const std::string key = in.statement >= 0 ? nested_key[std::size_t(in.statement)] : in.full();
+            auto it = values.find(key);
             if (it == values.end()) {
                 if (!in.side.empty() && values.count(in.name)) {
                     diags.error(in.where, "'" + in.name + "' has no side value '" + in.side + "'");
                 } else {
                     std::vector<std::string> names;
-                    for (const auto& [k, _] : values) names.push_back(k);
+                    for (const auto& [k, _] : values)
+                        if (k.find(':') == std::string::npos) names.push_back(k);  // not the labels of calls in place
                     std::string msg = "'" + in.full() + "' is not defined";
-                    if (defined_at.count(in.name) == 0) {
+                    if (auto later = defined_anywhere.find(in.name);
+                        later != defined_anywhere.end() && defined_at.count(in.name) == 0) {
+                        msg += " yet: it is defined later, on line " + std::to_string(later->second.line) +
+                               "; move that line above this one (a node reads only values made before it)";
+                    } else if (defined_at.count(in.name) == 0) {
                         const std::string guess = spec::closest(in.full(), names);
                         msg += guess.empty() ? "; define it with `" + in.name + " = kind:node(...)` on an earlier line"
                                              : "; did you mean '" + guess + "'?";
@@ -344,7 +366,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
                 inputs_ok = false;
                 continue;
             }
-            if (poisoned.count(in.name)) {  // its node is unknown: that error was reported already
+            if (poisoned.count(in.statement >= 0 ? key : in.name)) {  // its node is unknown: that error was reported already
                 inputs_ok = false;
                 continue;
             }
@@ -386,7 +408,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             } else {
                 input_infos[i] = &have;
             }
-            planned.inputs[i] = in.full();
+            planned.inputs[i] = key;
         }
         for (std::size_t i = call.inputs.size(); i < node->inputs.size(); ++i) {
             if (node->inputs[i].need == Need::required) {
@@ -425,11 +447,11 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
             param_where[arg.key] = arg.value.where;
         }
         for (auto& o : overrides) {
-            if (st.name.empty() || o.o.target != st.name) continue;
+            if (o.o.target != label) continue;
             o.used = true;
             const Param* p = node->find_param(o.o.param);
             if (!p) {
-                std::string msg = call.qualified() + " ('" + st.name + "') has no parameter '" + o.o.param + "'";
+                std::string msg = call.qualified() + " ('" + label + "') has no parameter '" + o.o.param + "'";
                 const std::string guess = spec::closest(o.o.param, param_names);
                 if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
                 diags.error(o.o.param_where, msg);
@@ -580,7 +602,9 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
         if (!st.name.empty()) {
             defined_at.emplace(st.name, st.name_where);
             values[st.name] = out;
-            for (auto& [side, si] : sides) values[st.name + "." + side] = std::move(si);
+            for (auto& [side, info] : sides) values[st.name + "." + side] = std::move(info);
+        } else if (st.nested) {
+            values[label] = out;
         }
         for (const auto& in : planned.inputs)
             if (!in.empty()) plan.last_use[in] = plan.nodes.size();
@@ -589,12 +613,26 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
 
     for (const auto& o : overrides) {
         if (o.used) continue;
-        std::vector<std::string> names;
-        for (const auto& [k, _] : defined_at) names.push_back(k);
-        std::string msg = "--set names '" + o.o.target + "', but the spec defines no value of that name";
-        const std::string guess = spec::closest(o.o.target, names);
+        std::string msg = "--set names '" + o.o.target + "', but the spec has no value or node of that name";
+        const std::string guess = spec::closest(o.o.target, labels);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+        else msg += "; an unnamed node is set by its label in the timing table (kind:node, then kind:node#2, ...)";
         diags.error(o.o.target_where, msg);
+    }
+
+    // A spec that writes nothing runs, and leaves only manifest.json: say so before it runs.
+    const bool writes = std::any_of(plan.nodes.begin(), plan.nodes.end(),
+                                    [](const PlannedNode& n) { return !n.output_files.empty(); });
+    if (!diags.has_errors() && !writes) {
+        std::string last;  // the last named heightmap or image, for the example
+        for (const auto& n : plan.nodes)
+            if (!n.value_name.empty() && n.value_name.find(':') == std::string::npos &&
+                (n.node->output == ValueType::heightmap || n.node->output == ValueType::image))
+                last = n.value_name;
+        diags.warning(Location{parsed.source, 1, 1, 0},
+                      "this spec writes no files: a run would leave only manifest.json; add an exporter, e.g. " +
+                          (last.empty() ? std::string("export:png(NAME, path=\"NAME.png\")")
+                                        : "export:png(" + last + ", path=\"" + last + ".png\")"));
     }
     return plan;
 }

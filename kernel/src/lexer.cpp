@@ -15,7 +15,7 @@ bool digit(char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; }
 
 }  // namespace
 
-std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics& diags) {
+std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics& diags, bool comments) {
     std::vector<Token> out;
     const std::string& s = source->text;
     std::size_t i = 0;
@@ -62,6 +62,21 @@ std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics&
         }
         if (c == ' ' || c == '\t' || c == '\r') {
             ++i;
+            continue;
+        }
+        if (c == '#' && !comments) {  // kind:node#2: the label's number is digits only ("2." is not a number here)
+            push(Tok::hash, i, i + 1);
+            const std::size_t digits = ++i;
+            while (i < s.size() && digit(s[i])) ++i;
+            if (i > digits) {
+                Token t;
+                t.kind = Tok::number;
+                t.text = s.substr(digits, i - digits);
+                t.integer = true;
+                t.number = std::strtod(t.text.c_str(), nullptr);
+                t.where = here(digits, i);
+                out.push_back(std::move(t));
+            }
             continue;
         }
         if (c == '#') {

@@ -57,7 +57,31 @@ public:
         o.target = name.text;
         o.target_where = name.where;
         ++p_;
-        if (!expect(Tok::dot, "'.' between the value name and the parameter (NAME.PARAM=VALUE)")) return std::nullopt;
+        // An unnamed node, by its label in the timing table: export:video, export:png#2.
+        if (peek().kind == Tok::colon) {
+            ++p_;
+            if (peek().kind != Tok::word) {
+                error(peek(), "expected the node's name after '" + name.text +
+                                  ":' (an unnamed node is set by its label, e.g. --set export:png#2.bits=8)");
+                return std::nullopt;
+            }
+            o.target += ":" + peek().text;
+            ++p_;
+            if (peek().kind == Tok::hash) {
+                ++p_;
+                const Token& n = peek();
+                if (n.kind != Tok::number || !n.integer || n.number < 2 || n.text[0] == '+') {
+                    error(n, "expected the label's number after '#' (kind:node#2 is the second unnamed kind:node)");
+                    return std::nullopt;
+                }
+                o.target += "#" + n.text;
+                ++p_;
+            }
+            o.target_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - name.where.column;
+        }
+        if (!expect(Tok::dot, "'.' between the value name and the parameter (NAME.PARAM=VALUE; an unnamed node by "
+                              "its label, e.g. export:png#2.bits=8)"))
+            return std::nullopt;
         const Token& param = peek();
         if (param.kind != Tok::word) {
             error(param, "expected a parameter name after '.'");
@@ -103,6 +127,20 @@ private:
         if (b == Tok::colon && c == Tok::word && d == Tok::lparen) return true;
         return a.where.column == 1 && (a.text == "orogen" || a.text == "seed" || a.text == "grid");
     }
+    /// Whether the kind:node(...) call starting at token `at` is followed, after its ')', by ',' or ')': then it
+    /// stands where an input goes, else it is a statement of its own.
+    bool call_in_place(std::size_t at) const {
+        if (peek(at - p_ + 1).kind != Tok::colon || peek(at - p_ + 3).kind != Tok::lparen) return false;
+        std::size_t i = at + 3;
+        for (int depth = 0; i < t_.size(); ++i) {
+            if (t_[i].kind == Tok::lparen) ++depth;
+            else if (t_[i].kind == Tok::rparen && --depth == 0) break;
+            else if (t_[i].kind == Tok::eof) return false;
+        }
+        for (++i; i < t_.size() && t_[i].kind == Tok::newline; ++i) {
+        }
+        return i < t_.size() && (t_[i].kind == Tok::comma || t_[i].kind == Tok::rparen);
+    }
     void skip_newlines() {
         while (peek().kind == Tok::newline) ++p_;
     }
@@ -141,14 +179,14 @@ private:
             st.name = first.text;
             st.name_where = first.where;
             p_ += 2;
-            if (auto call = parse_call()) {
+            if (auto call = parse_call(spec)) {
                 st.call = std::move(*call);
                 spec.statements.push_back(std::move(st));
             }
             return;
         }
         if (peek(1).kind == Tok::colon) {  // unnamed call
-            if (auto call = parse_call()) spec.statements.push_back(Statement{"", {}, std::move(*call)});
+            if (auto call = parse_call(spec)) spec.statements.push_back(Statement{"", {}, std::move(*call)});
             return;
         }
         if (first.text == "orogen") {
@@ -253,10 +291,12 @@ private:
             }
             ++p_;
             spec.grid_cell = value.number;
+            spec.has_cell = true;
         }
     }
 
-    std::optional<Call> parse_call() {
+    /// A call; calls written where an input goes are appended to spec.statements first.
+    std::optional<Call> parse_call(Spec& spec) {
         Call call;
         const Token& kind = peek();
         if (kind.kind != Tok::word) {
@@ -281,8 +321,9 @@ private:
             return std::nullopt;
         // Inside ( ) newlines do not end a statement, so a missing ')' shows up lines later:
         // then point at the '(' that was never closed.
+        // (A kind:node(...) on a later line followed by ',' or ')' is an input made in place, not the next statement.)
         auto unclosed = [&](const Token& at) {
-            if (at.kind == Tok::eof || (at.where.line > open.where.line && starts_statement(p_))) {
+            if (at.kind == Tok::eof || (at.where.line > open.where.line && starts_statement(p_) && !call_in_place(p_))) {
                 diags_.error(open.where, "this '(' of the call to " + call.qualified() + " is never closed; add ')'");
                 return true;
             }
@@ -319,9 +360,21 @@ private:
                     error(a, "inputs come first: move input '" + a.text + "' before the key=value parameters");
                     return std::nullopt;
                 }
-                ++p_;
                 Input in{a.text, "", a.where};
-                if (peek().kind == Tok::dot) {
+                if (peek(1).kind == Tok::colon) {  // a call where a value goes: hoisted before this statement
+                    auto inner = parse_call(spec);
+                    if (!inner) return std::nullopt;
+                    if (peek().kind == Tok::dot) {
+                        error(peek(), "to use a side value of " + inner->qualified() + ", name the value first: NAME = " +
+                                          inner->qualified() + "(...) on a line of its own, then NAME." +
+                                          (peek(1).kind == Tok::word ? peek(1).text : "SIDE"));
+                        return std::nullopt;
+                    }
+                    in.name = inner->qualified() + "(...)";
+                    in.where = inner->where;
+                    spec.statements.push_back(Statement{"", {}, std::move(*inner), true});
+                    in.statement = int(spec.statements.size()) - 1;
+                } else if (++p_; peek().kind == Tok::dot) {
                     ++p_;
                     const Token& side = peek();
                     if (side.kind != Tok::word) {
@@ -442,7 +495,7 @@ Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags) {
 }
 
 std::optional<Override> parse_override(const std::shared_ptr<const Source>& source, Diagnostics& diags) {
-    Parser parser(lex(source, diags), diags);
+    Parser parser(lex(source, diags, /*comments=*/false), diags);
     if (diags.has_errors()) return std::nullopt;
     return parser.parse_override();
 }

@@ -35,6 +35,8 @@ struct Plan {
     std::shared_ptr<const spec::Source> source;
     std::uint64_t seed = 0;
     GridSpec grid;
+    bool grid_given = false;  ///< a `grid` line (else 513 x 513)
+    bool cell_given = false;  ///< its cell= (else 1 m)
     std::vector<PlannedNode> nodes;
     std::vector<std::string> overrides;  ///< as given on the command line
     /// For each value key, the index of the last node that reads it.

@@ -8,12 +8,16 @@
 //               | call                              (an exporter, usually)
 //   call       := kind ":" node "(" [ arg { "," arg } ] ")"   newlines allowed inside ( ) and [ ]
 //   arg        := ref                               an input: a value name, or name.side
+//               | call                              an input made in place: export:png(render:bloom(x), ...)
 //               | key "=" literal                   a parameter
 //   literal    := number | "string" | true | false | word | point | list
 //   point      := "(" number "," number ")"
 //   list       := "[" [ literal { "," literal } ] "]"
 //
 // Words and names may contain letters, digits, '_' and '-' (von-neumann).
+// A call written where an input goes is hoisted into a statement of its own
+// just before the one that reads it (Statement::nested): it is an unnamed
+// call, labelled kind:node (#2, #3...) like an exporter.
 #pragma once
 
 #include "diagnostics.hpp"
@@ -24,7 +28,7 @@
 
 namespace orogen::spec {
 
-enum class Tok { word, number, string, lparen, rparen, lbracket, rbracket, comma, equals, colon, dot, newline, eof, bad };
+enum class Tok { word, number, string, lparen, rparen, lbracket, rbracket, comma, equals, colon, dot, hash, newline, eof, bad };
 
 struct Token {
     Tok kind = Tok::eof;
@@ -35,8 +39,9 @@ struct Token {
 };
 
 /// Split `source` into tokens. Lexical errors (a stray character, an unclosed
-/// string) go to `diags` and become Tok::bad tokens.
-std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics& diags);
+/// string) go to `diags` and become Tok::bad tokens. With `comments` false
+/// (an override), '#' is a Tok::hash, as in --set export:png#2.bits=8.
+std::vector<Token> lex(const std::shared_ptr<const Source>& source, Diagnostics& diags, bool comments = true);
 
 struct Literal {
     enum class Kind { number, string, boolean, word, point, list };
@@ -56,6 +61,9 @@ struct Input {
     std::string name;  ///< the value name
     std::string side;  ///< "particles" in sim.particles, else ""
     Location where;
+    /// A call written in place of a value: the index of its (nested) statement in Spec::statements; name is
+    /// then its kind:node, for messages. -1 for a value name.
+    int statement = -1;
     std::string full() const { return side.empty() ? name : name + "." + side; }
 };
 
@@ -77,6 +85,7 @@ struct Statement {
     std::string name;  ///< "" for an unnamed call
     Location name_where;
     Call call;
+    bool nested = false;  ///< a call written where an input goes, hoisted before its reader
 };
 
 struct Spec {
@@ -88,6 +97,7 @@ struct Spec {
     bool has_grid = false;
     int grid_width = 513, grid_height = 513;
     double grid_cell = 1.0;
+    bool has_cell = false;  ///< cell= given (else 1 m)
     Location grid_where;
     std::vector<Statement> statements;
 };
@@ -97,8 +107,10 @@ struct Spec {
 Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags);
 
 /// Parse a command-line override "NAME.PARAM=VALUE" (source name "--set").
+/// NAME is a value name, or an unnamed node's label as the timing table shows
+/// it: kind:node, kind:node#2, ...
 struct Override {
-    std::string target;  ///< NAME
+    std::string target;  ///< NAME, or the label kind:node[#N]
     std::string param;   ///< PARAM
     Location target_where, param_where;
     Literal value;

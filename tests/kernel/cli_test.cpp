@@ -90,7 +90,7 @@ TEST(Cli, OverridesAreCheckedLikeTheSpec) {
               "--set cut.displacment=3:1:5: error: generate:fault ('cut') has no parameter 'displacment'; did you mean 'displacement'?\n"
               "  cut.displacment=3\n"
               "      ^~~~~~~~~~~\n"
-              "--set cutt.iterations=3:1:1: error: --set names 'cutt', but the spec defines no value of that name; did you mean 'cut'?\n"
+              "--set cutt.iterations=3:1:1: error: --set names 'cutt', but the spec has no value or node of that name; did you mean 'cut'?\n"
               "  cutt.iterations=3\n"
               "  ^~~~\n"
               "3 errors in s.orogen\n");
@@ -100,6 +100,100 @@ TEST(Cli, OverridesAreCheckedLikeTheSpec) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(dir / "a/base.png"), slurp(dir / "b/base.png"));  // untouched node: same output
     EXPECT_NE(slurp(dir / "a/cut.png"), slurp(dir / "b/cut.png"));
+}
+
+// Issue 32, item 3: an unnamed node (an exporter) is reached by its label, as the timing table prints it.
+TEST(Cli, OverridesReachUnnamedNodesByTheirLabel) {
+    TempDir dir;
+    dir.write("s.orogen", issue_spec);  // export:png writes cut.png (16 bits), export:png#2 base.png (8 bits)
+    RunResult r = run_orogen("run s.orogen --out a --quiet", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    r = run_orogen("run s.orogen --out b --quiet --set export:png#2.bits=16 --set export:png.bits=8", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto depth = [&](const std::string& file) { return int(std::uint8_t(slurp(dir / file)[24])); };  // IHDR
+    EXPECT_EQ(depth("a/cut.png"), 16);
+    EXPECT_EQ(depth("a/base.png"), 8);
+    EXPECT_EQ(depth("b/cut.png"), 8);
+    EXPECT_EQ(depth("b/base.png"), 16);
+    const std::string manifest = slurp(dir / "b/manifest.json");
+    EXPECT_NE(manifest.find("export:png#2.bits=16"), std::string::npos) << manifest;
+
+    r = run_orogen("check s.orogen --set export:png#3.bits=8", "", dir.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("--set names 'export:png#3', but the spec has no value or node of that name; "
+                         "did you mean 'export:png#2'?"),
+              std::string::npos)
+        << r.err;
+}
+
+// Issue 32, item 2: a call may stand where a value goes; it runs as the same node named would.
+TEST(Cli, ACallWhereAValueGoesRunsAsTheNamedNodeWould) {
+    TempDir dir;
+    dir.write("s.orogen",
+              "orogen 1\nseed 3\ngrid 65 cell=10\n"
+              "base = generate:fault(iterations=20)\n"
+              "worn = erode:thermal(base, iterations=5)\n"
+              "export:png(worn, path=\"named.png\", bits=16)\n"
+              "export:png(erode:thermal(base, iterations=5), path=\"nested.png\", bits=16)\n"
+              "export:png(\n    erode:thermal(erode:thermal(base, iterations=2),\n                  iterations=3),\n"
+              "    path=\"twice.png\", bits=16)\n");
+    const RunResult r = run_orogen("run s.orogen --out out", "", dir.path());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string named = slurp(dir / "out/named.png");
+    ASSERT_GT(named.size(), 100u);
+    EXPECT_EQ(slurp(dir / "out/nested.png"), named);
+    EXPECT_NE(slurp(dir / "out/twice.png"), "");
+    // The timing table names the unnamed nodes by their labels, which --set takes.
+    EXPECT_NE(r.out.find("erode:thermal#2"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("erode:thermal#3"), std::string::npos) << r.out;
+    const RunResult set = run_orogen("check s.orogen --set erode:thermal#3.iterations=7", "", dir.path());
+    EXPECT_EQ(set.exit_code, 0) << set.err;
+    // A side value of a call in place needs a name.
+    dir.write("side.orogen", "orogen 1\ngrid 65\nc = generate:fault()\nexport:vtk-plates(tectonics:plates(c).plates, "
+                             "path=\"p.pvd\")\n");
+    const RunResult side = run_orogen("check side.orogen", "", dir.path());
+    EXPECT_EQ(side.exit_code, 2);
+    EXPECT_NE(side.err.find("to use a side value of tectonics:plates, name the value first: NAME = tectonics:plates(...) "
+                            "on a line of its own, then NAME.plates"),
+              std::string::npos)
+        << side.err;
+}
+
+// The doc errors of issue 32: a value used before its line says where it is; --sed suggests --seed.
+TEST(Cli, AValueUsedBeforeItsLineSaysWhereItIsDefined) {
+    TempDir dir;
+    dir.write("s.orogen", "orogen 1\ngrid 65\nlow = generate:fault()\nexport:png(glow2, path=\"g.png\")\n"
+                          "glow2 = erode:thermal(low)\n");
+    const RunResult r = run_orogen("check s.orogen", "", dir.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(r.err,
+              "s.orogen:4:12: error: 'glow2' is not defined yet: it is defined later, on line 5; move that line above "
+              "this one (a node reads only values made before it)\n"
+              "  export:png(glow2, path=\"g.png\")\n"
+              "             ^~~~~\n"
+              "1 error in s.orogen\n");
+    EXPECT_NE(run_orogen("run s.orogen --sed 3").err.find("unknown option '--sed'; did you mean '--seed'?"),
+              std::string::npos);
+    EXPECT_NE(run_orogen("run s.orogen --quite").err.find("did you mean '--quiet'?"), std::string::npos);
+}
+
+// Issue 32, item 6: the grid's defaults are said, and a spec that writes nothing is warned about.
+TEST(Cli, CheckSaysTheGridDefaultsAndWarnsOnASpecThatWritesNothing) {
+    TempDir dir;
+    dir.write("none.orogen", "orogen 1\nbase = generate:fault()\nworn = erode:thermal(base)\n");
+    RunResult r = run_orogen("check none.orogen", "", dir.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "none.orogen: ok (2 nodes, grid 513x513 (the default: no grid line), cell 1 m (the default: no "
+                     "cell=), seed 0)\n");
+    EXPECT_EQ(r.err, "none.orogen:1:1: warning: this spec writes no files: a run would leave only manifest.json; add an "
+                     "exporter, e.g. export:png(worn, path=\"worn.png\")\n");
+    dir.write("cell.orogen", "orogen 1\ngrid 65\nbase = generate:fault()\nexport:png(base, path=\"b.png\")\n");
+    r = run_orogen("check cell.orogen", "", dir.path());
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    EXPECT_EQ(r.out, "cell.orogen: ok (2 nodes, grid 65x65, cell 1 m (the default: no cell=), seed 0)\n");
+    dir.write("s.orogen", issue_spec);
+    EXPECT_EQ(run_orogen("check s.orogen", "", dir.path()).out, "s.orogen: ok (4 nodes, grid 513x513, cell 30 m, seed 7)\n");
 }
 
 TEST(Cli, UsageErrorsExitWithTwo) {

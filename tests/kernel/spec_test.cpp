@@ -85,9 +85,66 @@ TEST(Parser, OverridesNameValueParamAndValue) {
     Diagnostics d2;
     EXPECT_FALSE(parse_override(std::make_shared<Source>("--set x", "rivers=500"), d2));
     EXPECT_EQ(d2.format(),
-              "--set x:1:7: error: expected '.' between the value name and the parameter (NAME.PARAM=VALUE), found '='\n"
+              "--set x:1:7: error: expected '.' between the value name and the parameter (NAME.PARAM=VALUE; an unnamed "
+              "node by its label, e.g. export:png#2.bits=8), found '='\n"
               "  rivers=500\n"
               "        ^\n");
+}
+
+// An unnamed node is reached by its label, as the timing table prints it (issue 32, item 3).
+TEST(Parser, OverridesReachUnnamedNodesByTheirLabel) {
+    Diagnostics d;
+    auto o = parse_override(std::make_shared<Source>("--set export:video.quality=23", "export:video.quality=23"), d);
+    ASSERT_TRUE(o) << d.format();
+    EXPECT_EQ(o->target, "export:video");
+    EXPECT_EQ(o->target_where.length, 12);
+    EXPECT_EQ(o->param, "quality");
+    EXPECT_EQ(o->value.number, 23.0);
+    o = parse_override(std::make_shared<Source>("--set export:png#2.bits=8", "export:png#2.bits=8"), d);
+    ASSERT_TRUE(o) << d.format();
+    EXPECT_EQ(o->target, "export:png#2");
+    EXPECT_EQ(o->target_where.length, 12);
+    EXPECT_EQ(o->param, "bits");
+    Diagnostics d2;
+    EXPECT_FALSE(parse_override(std::make_shared<Source>("--set x", "export:png#x.bits=8"), d2));
+    EXPECT_NE(d2.format().find("expected the label's number after '#'"), std::string::npos) << d2.format();
+}
+
+// A call where an input goes is hoisted into an unnamed statement just before its reader (issue 32, item 2);
+// a statement on the next line after a '(' that is never closed is still that, not an input.
+TEST(Parser, ACallWhereAnInputGoesBecomesANestedStatement) {
+    Diagnostics d;
+    const Spec s = parse_text(
+        "orogen 1\n"
+        "spin = render:turntable(t, frames=2)\n"
+        "export:video(render:bloom(render:blur(spin, axis=x)), path=\"t.mp4\")\n"
+        "export:png(\n  render:bloom(x),\n  path=\"x.png\")\n",
+        d);
+    ASSERT_FALSE(d.has_errors()) << d.format();
+    ASSERT_EQ(s.statements.size(), 6u);
+    EXPECT_EQ(s.statements[1].call.qualified(), "render:blur");
+    EXPECT_TRUE(s.statements[1].nested);
+    EXPECT_EQ(s.statements[1].call.inputs[0].name, "spin");
+    EXPECT_EQ(s.statements[2].call.qualified(), "render:bloom");
+    EXPECT_TRUE(s.statements[2].nested);
+    ASSERT_EQ(s.statements[2].call.inputs.size(), 1u);
+    EXPECT_EQ(s.statements[2].call.inputs[0].statement, 1);
+    EXPECT_EQ(s.statements[3].call.qualified(), "export:video");
+    EXPECT_FALSE(s.statements[3].nested);
+    EXPECT_EQ(s.statements[3].call.inputs[0].statement, 2);
+    EXPECT_EQ(s.statements[3].call.params[0].value.text, "t.mp4");
+    EXPECT_TRUE(s.statements[4].nested);  // the multi-line call's inner one
+    EXPECT_EQ(s.statements[5].call.inputs[0].statement, 4);
+
+    Diagnostics d2;
+    parse_text("orogen 1\nc = generate:fault(\nexport:png(base, path=\"x.png\")\n", d2);
+    EXPECT_EQ(d2.error_count(), 1) << d2.format();
+    EXPECT_NE(d2.format().find("t.orogen:2:19: error: this '(' of the call to generate:fault is never closed"),
+              std::string::npos)
+        << d2.format();
+    Diagnostics d3;
+    parse_text("orogen 1\nexport:png(generate:fault().plates, path=\"x.png\")\n", d3);
+    EXPECT_NE(d3.format().find("name the value first"), std::string::npos) << d3.format();
 }
 
 TEST(Closest, SuggestsNearMissesOnly) {
