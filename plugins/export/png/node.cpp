@@ -12,40 +12,33 @@ using namespace orogen;
 
 namespace {
 
+// Every mistake at once (orogen check lists them together), not the first.
 void check(CheckContext& ctx) {
     const ValueInfo* in = ctx.input(0);
     if (in && in->type != ValueType::heightmap && in->type != ValueType::image) {
         ctx.error("", "export:png writes a heightmap or an image, but its input is " +
                           std::string(to_string(in->type)));
-        return;
+        return;  // nothing else can be judged without knowing what is written
     }
     if (in && in->type == ValueType::image) {
         for (const char* p : {"bits", "layer", "hillshade", "relief", "azimuth", "elevation"})
-            if (ctx.given(p)) {
+            if (ctx.given(p))
                 ctx.error(p, std::string(p) + "= applies to a heightmap; an image is written as 8-bit sRGB "
                                               "(tonemap= and exposure= set how its linear colours are encoded)");
-                return;
-            }
         return;
     }
-    if (ctx.given("tonemap") || ctx.given("exposure")) {
-        ctx.error(ctx.given("tonemap") ? "tonemap" : "exposure", "tonemap= and exposure= apply to an image input");
-        return;
-    }
+    for (const char* p : {"tonemap", "exposure"})
+        if (ctx.given(p)) ctx.error(p, std::string(p) + "= applies to an image input; a heightmap's PNG holds its heights");
     const auto bits = ctx.integer("bits");
     if (bits != 8 && bits != 16) ctx.error("bits", "bits must be 8 or 16, got " + std::to_string(bits));
     const std::string& layer = ctx.text("layer");
-    if (ctx.flag("relief") && (ctx.flag("hillshade") || !layer.empty() || ctx.given("bits"))) {
+    if (ctx.flag("relief") && (ctx.flag("hillshade") || !layer.empty() || ctx.given("bits")))
         ctx.error("relief", "relief=true writes an 8-bit colour map of the heights; drop hillshade=, layer= and bits=");
-        return;
-    }
-    if (ctx.flag("hillshade") && !layer.empty()) {
+    else if (ctx.flag("hillshade") && !layer.empty())
         ctx.error("layer", "hillshade shades the terrain's heights; give either layer= or hillshade=true, not both");
-        return;
-    }
-    if (!ctx.flag("hillshade") && !ctx.flag("relief") && (ctx.given("azimuth") || ctx.given("elevation")))
-        ctx.error(ctx.given("azimuth") ? "azimuth" : "elevation",
-                  "azimuth and elevation place the light of hillshade=true or relief=true");
+    if (!ctx.flag("hillshade") && !ctx.flag("relief"))
+        for (const char* p : {"azimuth", "elevation"})
+            if (ctx.given(p)) ctx.error(p, "azimuth and elevation place the light of hillshade=true or relief=true");
     if (!layer.empty() && layer != "height")
         ctx.require_layer(0, "layer", layer, "use \"height\" (the default) or the name of an existing layer");
 }

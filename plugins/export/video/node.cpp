@@ -9,6 +9,7 @@ using namespace orogen;
 
 namespace {
 
+// Every mistake at once: a codec that does not match the path, a frame rate the codec refuses, odd sizes.
 void check(CheckContext& ctx) {
     const std::filesystem::path path = ctx.text("path");
     video::Codec codec{};
@@ -16,18 +17,15 @@ void check(CheckContext& ctx) {
         codec = video::codec_for(path);
     } catch (const BadInput& e) {
         ctx.error("path", e.what());
-        return;
+        return;  // no codec to check the rest against
     }
     const std::string& named = ctx.text("codec");
-    if (named != "auto" && video::parse_codec(named) != codec) {
+    if (named != "auto" && video::parse_codec(named) != codec)
         ctx.error("codec", "codec=" + named + " is written to " + std::string(video::extension_for(video::parse_codec(named))) +
                                " files, but path is " + path.filename().string() + "; change one of them");
-        return;
-    }
     const ValueInfo* in = ctx.input(0);
     const int w = in && in->width > 0 ? in->width : 2, h = in && in->height > 0 ? in->height : 2;
-    if (const std::string why = video::why_not(codec, ctx.real("fps"), w, h); !why.empty())
-        ctx.error(why.find("frame rate") != std::string::npos ? "fps" : "", why);
+    for (const video::Problem& p : video::problems(codec, ctx.real("fps"), w, h)) ctx.error(p.param, p.message);
 }
 
 NodeOutputs run(NodeContext& ctx) {

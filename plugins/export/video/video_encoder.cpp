@@ -64,18 +64,27 @@ std::string encoder_name(Codec codec) {
     return c ? c->name : "";
 }
 
-std::string why_not(Codec codec, double fps, int width, int height) {
-    if (!(fps > 0) || fps > 240) return "the frame rate must be above 0 and at most 240 frames per second";
-    if (width % 2 || height % 2)
-        return "the frames are " + std::to_string(width) + " × " + std::to_string(height) +
-               " pixels; video with 4:2:0 colour needs even sizes (use an even width and height)";
-    if (codec == Codec::mpeg2) {
+std::vector<Problem> problems(Codec codec, double fps, int width, int height) {
+    std::vector<Problem> found;
+    if (!(fps > 0) || fps > 240) {
+        found.push_back({"fps", "the frame rate must be above 0 and at most 240 frames per second"});
+    } else if (codec == Codec::mpeg2) {
         bool standard = false;
         for (AVRational r : kMpeg2Rates) standard = standard || rational_matches(fps, r);
-        if (!standard) return "MPEG-2 takes only the frame rates 23.976, 24, 25, 29.97, 30, 50, 59.94 and 60";
-        if (width > 4095 || height > 4095) return "MPEG-2 frames are at most 4095 pixels a side";
+        if (!standard) found.push_back({"fps", "MPEG-2 takes only the frame rates 23.976, 24, 25, 29.97, 30, 50, 59.94 and 60"});
     }
-    return {};
+    if (width % 2 || height % 2)
+        found.push_back({"", "the frames are " + std::to_string(width) + " × " + std::to_string(height) +
+                                 " pixels; video with 4:2:0 colour needs even sizes (use an even width and height)"});
+    if (codec == Codec::mpeg2 && (width > 4095 || height > 4095))
+        found.push_back({"", "MPEG-2 frames are at most 4095 pixels a side"});
+    return found;
+}
+
+std::string why_not(Codec codec, double fps, int width, int height) {
+    std::string all;
+    for (const Problem& p : problems(codec, fps, width, height)) all += (all.empty() ? "" : "; and ") + p.message;
+    return all;
 }
 
 void encode_video(const std::filesystem::path& target, std::size_t count, const std::function<Image(std::size_t)>& frame,

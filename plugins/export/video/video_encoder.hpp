@@ -17,6 +17,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace orogen::video {
 
@@ -30,9 +31,20 @@ std::string_view extension_for(Codec codec);
 /// throws orogen::BadInput for any other extension.
 Codec codec_for(const std::filesystem::path& path);
 
-/// Empty if `codec` can encode at `fps` and width × height, else why not
+/// One reason `codec` cannot encode a video, and the parameter it concerns
+/// ("fps", or "" for the frames' size).
+struct Problem {
+    std::string param;
+    std::string message;
+};
+
+/// Every reason `codec` cannot encode at `fps` and width × height, all at once
 /// (odd sizes: 4:2:0 chroma needs even ones; MPEG-2 takes only the standard
-/// frame rates 23.976, 24, 25, 29.97, 30, 50, 59.94 and 60).
+/// frame rates 23.976, 24, 25, 29.97, 30, 50, 59.94 and 60, and at most 4095
+/// pixels a side). Empty if it can.
+std::vector<Problem> problems(Codec codec, double fps, int width, int height);
+
+/// The problems above in one sentence, "" if none.
 std::string why_not(Codec codec, double fps, int width, int height);
 
 struct VideoSettings {

@@ -102,6 +102,22 @@ TEST(PngExportCli, LayerAndHillshadeMistakesFailAtCheckTime) {
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
 
+// Issue 32, item 7: every contradiction inside one call is reported at once, not the first of them.
+TEST(PngExportCli, EveryContradictionInOneCallIsReportedAtOnce) {
+    TempDir dir;
+    const auto spec = dir.write("bad.orogen",
+                                "orogen 1\ngrid 33\nbase = generate:fault()\n"
+                                "export:png(base, path=\"a.png\", tonemap=aces, exposure=1, relief=true, bits=16, "
+                                "azimuth=10)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want : {"bad.orogen:4:40: error: export:png: tonemap= applies to an image input",
+                             "bad.orogen:4:55: error: export:png: exposure= applies to an image input",
+                             "bad.orogen:4:65: error: export:png: relief=true writes an 8-bit colour map"})
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+    EXPECT_NE(r.err.find("3 errors in"), std::string::npos) << r.err;
+}
+
 // relief=true: the splat colours by height, darker on faces turned from the light.
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>

@@ -107,3 +107,18 @@ TEST(RenderCli, VideoCodecsAndExtensionsAreCheckedBeforeAnythingRuns) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find("even"), std::string::npos) << r.err;
 }
+
+// Issue 32, item 7: a video's codec, frame rate and frame size mistakes are reported together.
+TEST(RenderCli, EveryVideoMistakeIsReportedAtOnce) {
+    TempDir dir;
+    dir.write("v.orogen", std::string(kHeader) +
+                              "spin = render:turntable(hill, frames=2, width=33, height=31)\n"
+                              "export:video(spin, path=\"v.mpg\", codec=h264, fps=17)\n");
+    const RunResult r = run_orogen("check " + q(dir / "v.orogen"), "DISPLAY=");
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want : {"v.orogen:6:40: error: export:video: codec=h264 is written to .mp4 files",
+                             "v.orogen:6:50: error: export:video: MPEG-2 takes only the frame rates",
+                             "v.orogen:6:1: error: export:video: the frames are 33 × 31 pixels"})
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+    EXPECT_NE(r.err.find("3 errors in"), std::string::npos) << r.err;
+}
