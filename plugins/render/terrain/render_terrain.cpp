@@ -316,6 +316,13 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
             throw BadInput("render:terrain: the camera is inside the terrain (at " + std::to_string(int(eye.y / exag)) +
                            " m where the ground is " + std::to_string(int(g)) +
                            " m); raise its elevation, distance or height");
+        // Beside the terrain and below its lowest point (or below the sea): only the underside and the skirt show.
+        const double lowest = st.sea ? std::max(double(m.lo), st.sea_level) : double(m.lo);
+        if (std::isnan(g) && eye.y < lowest * exag)
+            throw BadInput("render:terrain: the camera is below the terrain (at " + std::to_string(int(eye.y / exag)) +
+                           " m, under its lowest point" + (st.sea ? std::string(" or the sea") : std::string()) +
+                           " at " + std::to_string(int(lowest)) +
+                           " m), where it sees only its underside; raise its elevation (above 0° for an orbit) or height");
         // Near and far: around the terrain's bounding sphere.
         const double to_centre = glm::length(centre - eye);
         far_plane = to_centre + radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
@@ -498,7 +505,8 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     // The surface, nearest strips first and its back faces culled (a heightfield seen from above the ground
     // only ever shows its front faces), then the skirt down to below the lowest point (and below the sea).
     // `mirrored`: the matrix mirrors the world (the sea's reflection), which turns the winding over.
-    auto draw_terrain = [&](const glm::mat4& matrix, int mode, bool mirrored) {
+    // `seen`: a query that learns whether any of the surface (not the skirt) reached the frame.
+    auto draw_terrain = [&](const glm::mat4& matrix, int mode, bool mirrored, GLuint seen) {
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
         glDepthMask(GL_TRUE);
@@ -533,7 +541,9 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glCullFace(GL_BACK);
         glFrontFace(mirrored ? GL_CW : GL_CCW);
         set(prog.terrain, "skirt_edge", -1);
+        if (seen) glBeginQuery(GL_ANY_SAMPLES_PASSED, seen);
         glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(m.front_to_back(eye)), GL_UNSIGNED_INT, nullptr);
+        if (seen) glEndQuery(GL_ANY_SAMPLES_PASSED);
         glDisable(GL_CULL_FACE);
         glFrontFace(GL_CCW);
         set(prog.terrain, "floor_height", float(floor_height * exag));
@@ -542,7 +552,21 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
             glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
         }
     };
-    draw_terrain(vp, int(st.output), false);
+    // A camera that sees none of the surface (looking past it, from under it, or from inside its box at the
+    // sky) renders a picture of nothing: refused, as the frustum test above refuses one that looks away.
+    {
+        struct Query {
+            GLuint id = 0;
+            Query() { glGenQueries(1, &id); }
+            ~Query() { glDeleteQueries(1, &id); }
+        } seen;
+        draw_terrain(vp, int(st.output), false, seen.id);
+        GLuint any = 0;
+        glGetQueryObjectuiv(seen.id, GL_QUERY_RESULT, &any);
+        if (!any)
+            throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
+                           "(target, to, azimuth/elevation) or widen the field of view");
+    }
 
     // Particles: lit spheres (points).
     if (shaded && particles && particles->count() > 0) {
@@ -593,7 +617,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         glEnable(GL_CLIP_DISTANCE0);
         for (GLuint p : {prog.shadow, prog.terrain})
             glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
-        draw_terrain(glm::mat4(view_projection * mirror), int(st.output), true);
+        draw_terrain(glm::mat4(view_projection * mirror), int(st.output), true, 0);
         glDisable(GL_CLIP_DISTANCE0);
         for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
         light_eye = eye;
