@@ -15,12 +15,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <iostream>
+#include <map>
 #include <sstream>
 #include <unistd.h>
 
@@ -265,6 +267,37 @@ int cmd_cache(const Args& args) {
     return exit_ok;
 }
 
+/// The files a run wrote, one line each, except that files differing only in their numbers (tiles
+/// alps_x0_y0.png ... alps_x3_y3.png, the steps of a .pvd) make one line with their count: a tiled export's
+/// hundred files read as one. In the order written, each group where its first file was.
+std::vector<std::string> summarise_outputs(const std::vector<fs::path>& outputs) {
+    std::vector<std::string> order;
+    std::map<std::string, std::vector<std::string>> groups;
+    for (const auto& f : outputs) {
+        const std::string name = f.string();
+        std::string pattern = f.parent_path().string() + "/";  // the name with each run of digits as one '#'
+        bool in_number = false;
+        for (char c : f.filename().string()) {
+            const bool digit = std::isdigit(static_cast<unsigned char>(c)) != 0;
+            if (!digit) pattern += c;
+            else if (!in_number) pattern += '#';
+            in_number = digit;
+        }
+        auto [it, fresh] = groups.try_emplace(pattern);
+        if (fresh) order.push_back(pattern);
+        it->second.push_back(name);
+    }
+    constexpr std::size_t kListed = 3;  // groups up to this size list their files
+    std::vector<std::string> lines;
+    for (const auto& pattern : order) {
+        const auto& files = groups[pattern];
+        if (files.size() <= kListed) lines.insert(lines.end(), files.begin(), files.end());
+        else lines.push_back(files.front() + " ... " + fs::path(files.back()).filename().string() + " (" +
+                             std::to_string(files.size()) + " files)");
+    }
+    return lines;
+}
+
 /// The tiles of a run under mpirun: --tiles or automatic.
 TileSplit tiled_split(const Plan& plan, const Args& args) {
     const auto [rows, cols] = args.tiles ? *args.tiles : automatic_tiles(g_mpi->size, plan.grid.width, plan.grid.height);
@@ -420,7 +453,7 @@ int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugi
         }
         std::printf("wrote %zu file%s to %s:\n", result.outputs.size(), result.outputs.size() == 1 ? "" : "s",
                     args.out.c_str());
-        for (const auto& f : result.outputs) std::printf("  %s\n", f.string().c_str());
+        for (const auto& line : summarise_outputs(result.outputs)) std::printf("  %s\n", line.c_str());
         std::printf("\n%s", format_timings(result).c_str());
     }
     return exit_ok;

@@ -82,7 +82,8 @@ void ProgressDisplay::skipped(int index, int total, const std::string& label, co
     std::fflush(out_);
 }
 
-void ProgressDisplay::message(const std::string& text) {
+void ProgressDisplay::message(const std::string& text, Kind kind) {
+    if (quiet_ && kind == Kind::info) return;
     std::lock_guard lock(mutex_);
     if (terminal_) clear_bar();
     std::fprintf(out_, "%s\n", text.c_str());

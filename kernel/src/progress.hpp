@@ -20,7 +20,10 @@ public:
     void finish(double seconds);
     /// A node that does not run: "[3/9] summit (generate:rmp) cached".
     void skipped(int index, int total, const std::string& label, const std::string& node, const std::string& why);
-    void message(const std::string& text);  ///< a log line, keeping the bar intact
+    /// A log line, keeping the bar intact. --quiet drops what a node says for information (a run that succeeds is
+    /// then silent) but never a warning.
+    enum class Kind { info, warning };
+    void message(const std::string& text, Kind kind);
 
 private:
     void draw(bool force);

@@ -103,8 +103,10 @@ public:
     void check_cancelled() override {
         if (options_.cancel && options_.cancel->load()) throw Cancelled();
     }
-    void info(std::string_view message) override { say(node_.label + ": " + std::string(message)); }
-    void warn(std::string_view message) override { say(node_.label + ": warning: " + std::string(message)); }
+    void info(std::string_view message) override { say(node_.label + ": " + std::string(message), ProgressDisplay::Kind::info); }
+    void warn(std::string_view message) override {
+        say(node_.label + ": warning: " + std::string(message), ProgressDisplay::Kind::warning);
+    }
     /// What the node said, for the cache to replay when its result is reused.
     const std::vector<std::string>& said() const { return said_; }
     Tiling* tiling() override {
@@ -112,8 +114,8 @@ public:
     }
 
 private:
-    void say(std::string line) {
-        if (options_.progress) options_.progress->message(line);
+    void say(std::string line, ProgressDisplay::Kind kind) {
+        if (options_.progress) options_.progress->message(line, kind);
         if (!for_entry_) said_.push_back(std::move(line));
     }
 
@@ -361,7 +363,7 @@ private:
 
     void warn(const std::string& line) {
         if (options_.on_warning) options_.on_warning(line);
-        else if (options_.progress) options_.progress->message(line);
+        else if (options_.progress) options_.progress->message(line, ProgressDisplay::Kind::warning);
     }
 
     void compute_key(std::size_t i) {
@@ -394,7 +396,10 @@ private:
     void mark_cached(std::size_t i, const std::string& why, const std::vector<std::string>& said) {
         const PlannedNode& node = plan_.nodes[i];
         if (options_.progress)
-            for (const auto& line : said) options_.progress->message(line);
+            for (const auto& line : said)  // replayed as the node said them: "label: ..." or "label: warning: ..."
+                options_.progress->message(line, line.find(": warning: ") != std::string::npos
+                                                     ? ProgressDisplay::Kind::warning
+                                                     : ProgressDisplay::Kind::info);
         states_[i].status = Status::cached;
         result_.timings[states_[i].row].cached = true;
         if (options_.progress)

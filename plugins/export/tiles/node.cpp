@@ -185,7 +185,12 @@ NodeOutputs run(NodeContext& ctx) {
     }
     index.tiles = layout(index.width, index.height, tile_size, stem, format);
     const Tile& last = index.tiles.back();
-    if (last.width != tile_size || last.height != tile_size)
+    const bool one_small = index.tiles.size() == 1 && (last.width != tile_size || last.height != tile_size);
+    if (one_small)
+        ctx.warn("the grid (" + std::to_string(last.width) + " × " + std::to_string(last.height) +
+                 " samples) is smaller than one tile of " + std::to_string(tile_size) +
+                 ", so it is written as one tile of its own size; a smaller tile_size cuts it into tiles");
+    else if (last.width != tile_size || last.height != tile_size)
         ctx.warn("the last tiles are " + std::to_string(last.width) + " × " + std::to_string(last.height) +
                  " samples where the others are " + std::to_string(tile_size) + "; for equal tiles use a grid of k·" +
                  std::to_string(tile_size - 1) + " + 1 samples a side");
@@ -272,9 +277,14 @@ NodeOutputs run(NodeContext& ctx) {
     const std::string json = index_json(index);
     write_file_atomically(ctx.output_path(index_path.string()),
                           {reinterpret_cast<const std::uint8_t*>(json.data()), json.size()});
-    ctx.info("wrote " + std::to_string(index.tiles.size()) + " tiles of " + std::to_string(tile_size) + " samples (" +
-             std::to_string(last.column + 1) + " × " + std::to_string(last.row + 1) + "), " + index_path.string() +
-             (vrt ? " and " + (folder / (stem + ".vrt")).string() : std::string()));
+    // What was written, in the same words as the warning above: one tile of the grid's size, or the count.
+    const std::string size = std::to_string(last.width) + " × " + std::to_string(last.height);
+    ctx.info((one_small ? "wrote 1 tile of " + size + " samples"
+                        : "wrote " + std::to_string(index.tiles.size()) + (index.tiles.size() == 1 ? " tile" : " tiles") +
+                              " of " + std::to_string(tile_size) + " samples (" + std::to_string(last.column + 1) + " × " +
+                              std::to_string(last.row + 1) + ")" +
+                              (last.width != tile_size || last.height != tile_size ? ", the last ones " + size : "")) +
+             ", " + index_path.string() + (vrt ? " and " + (folder / (stem + ".vrt")).string() : std::string()));
     return {};
 }
 

@@ -11,6 +11,7 @@
 #include <gdal_priv.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sys/wait.h>
@@ -105,6 +106,40 @@ TEST(TilesCli, PngTilesShareTheirEdgesAndMosaicToTheWholeTerrain) {
               std::string::npos);
     for (const char* f : {"engine/alps_x0_y0.png", "engine/alps_x3_y3.png", "engine/alps.json", "engine/alps.vrt"})
         EXPECT_NE(manifest.find(f), std::string::npos) << f;
+}
+
+// Issue 32, item 10: what a run says agrees with itself and stays short. A grid smaller than one tile is
+// written as one tile of its own size, said once; sixteen tiles are one line of the file list; --quiet says
+// nothing when the run succeeds.
+TEST(TilesCli, TheRunSaysWhatItWroteOnceAndQuietSaysNothing) {
+    TempDir dir;
+    auto spec = dir.write("small.orogen", spec_head + "export:tiles(w, path=\"engine/alps.json\", tile_size=257)\n");
+    RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "small"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("export:tiles: warning: the grid (129 × 129 samples) is smaller than one tile of 257"),
+              std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("export:tiles: wrote 1 tile of 129 × 129 samples, engine/alps.json"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("the last tiles are"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("tiles of 257"), std::string::npos) << r.err;
+
+    spec = dir.write("t.orogen", spec_head + "export:tiles(w, path=\"engine/alps.json\", tile_size=33)\n");
+    r = run_orogen("run " + q(spec) + " --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("export:tiles: wrote 16 tiles of 33 samples (4 × 4), engine/alps.json"), std::string::npos)
+        << r.err;
+    // 21 files: whole.r16 and its sidecar, 16 tiles, the index, the VRT, the manifest.
+    EXPECT_NE(r.out.find("wrote 21 files to "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("/out/engine/alps_x0_y0.png ... alps_x3_y3.png (16 files)\n"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("alps_x1_y0.png"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("/out/engine/alps.json\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("/out/manifest.json\n"), std::string::npos) << r.out;
+    EXPECT_LT(std::count(r.out.begin(), r.out.end(), '\n'), 20) << r.out;  // the files in 7 lines, the timings
+
+    r = run_orogen("run " + q(spec) + " --out " + q(dir / "quiet") + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(r.out, "");
+    EXPECT_EQ(r.err, "");
+    EXPECT_TRUE(fs::exists(dir / "quiet/engine/alps_x3_y3.png"));
 }
 
 TEST(TilesCli, GdalReadsTheMosaicThroughTheVrtInMetres) {
