@@ -54,8 +54,9 @@ SPEC
 for pair in "$build/bin/orogen:$work/terrace/build" "$work/home/.local/bin/orogen:$work/terrace/build-installed"; do
     orogen=${pair%%:*} plugin=${pair#*:}
     test -f "$plugin/terrace.so" || { echo "FAIL: the plugin was not built in $plugin"; exit 1; }
-    OROGEN_PLUGIN_PATH="$plugin" "$orogen" version | grep -q "terrace .*1.0.0" ||
-        { echo "FAIL: $orogen version does not show the plugin"; exit 1; }
+    # (captured first: grep -q would close the pipe early, and pipefail would blame orogen's SIGPIPE)
+    version=$(OROGEN_PLUGIN_PATH="$plugin" "$orogen" version)
+    grep -q "terrace .*1.0.0" <<<"$version" || { echo "FAIL: $orogen version does not show the plugin"; exit 1; }
     rm -rf "$work/out"
     OROGEN_PLUGIN_PATH="$plugin" "$orogen" run "$work/spec.orogen" --out "$work/out" --quiet
     test -s "$work/out/steps.png" || { echo "FAIL: no output from $orogen"; exit 1; }
