@@ -349,6 +349,8 @@ public:
         return n;
     }
     const std::optional<cache::Store>& store() const { return store_; }
+    /// The values still held once every node ran (see RunResult::values).
+    std::map<std::string, Value, std::less<>> take_values() { return std::move(values_); }
     /// Files of cached exports that were already in --out with the same bytes (relative to --out).
     const std::vector<fs::path>& kept() const { return kept_; }
 
@@ -702,6 +704,7 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         result.exit_code = f.exit_code;
         result.error = f.message;
     }
+    if (result.exit_code == 0) result.values = evaluation.take_values();
     if (options.tiled) share_digests(*options.tiled, staging_folder, result.exit_code == 0);
     if (const auto& store = evaluation.store()) {
         result.cache_summary = "cache: " + std::to_string(evaluation.reused()) + " of " + std::to_string(plan.nodes.size()) +

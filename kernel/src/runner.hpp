@@ -64,6 +64,10 @@ struct RunResult {
     double total_seconds = 0.0;
     /// "cache: 9 of 14 nodes reused from DIR (312 MiB of 2 GiB)"; empty without the cache.
     std::string cache_summary;
+    /// After a successful run, the values still held: those whose Plan::last_use lies past the last node.
+    /// The CLI wants none; a caller that wants a value back (the Python module) sets its last_use to
+    /// plan.nodes.size() before the run, so it is kept (and never modified in place by a later node).
+    std::map<std::string, Value, std::less<>> values;
 };
 
 /// The seed a node gets: a hash of the spec's seed and the node's label.

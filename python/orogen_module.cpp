@@ -1,0 +1,450 @@
+// orogen._orogen — the kernel driven from Python (pybind11): the same loader, checker and runner as the
+// `orogen` command (kernel/cli/main.cpp), values handed back as numpy arrays. See docs/python.md.
+//
+//   run(spec, seed=None, set={}, threads=None, out=None, progress=False) -> {name: value}
+//   nodes() -> [{"name", "kind", "summary"}];  help(name) -> {...}
+//
+// Bad input (a spec error, a parameter out of range, a file refused at check time) raises ValueError with
+// the CLI's message; a failed run RuntimeError naming the node; Ctrl-C stops the node as on the command
+// line and raises KeyboardInterrupt. The run itself happens on a thread of its own with the GIL released.
+#include "loader.hpp"
+#include "plan.hpp"
+#include "progress.hpp"
+#include "runner.hpp"
+#include "spec.hpp"
+
+#include <orogen/error.hpp>
+#include <orogen/io.hpp>
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <exception>
+#include <future>
+#include <sstream>
+#include <thread>
+
+#include <dlfcn.h>
+#include <unistd.h>
+
+namespace py = pybind11;
+namespace fs = std::filesystem;
+using namespace orogen;
+
+namespace {
+
+/// The plugins, loaded once from the build or install tree (found from this module's own file) and
+/// OROGEN_PLUGIN_PATH; never unloaded (values may hold code of theirs until the interpreter ends).
+PluginSet& plugins() {
+    static PluginSet* set = [] {
+        auto* s = new PluginSet;
+        Dl_info info{};
+        fs::path here = ::dladdr(reinterpret_cast<void*>(&plugins), &info) && info.dli_fname
+                            ? fs::absolute(info.dli_fname)
+                            : fs::current_path() / "orogen";
+        // <build>/python/orogen/_orogen.so → <build>/bin/orogen, whose ../lib/orogen/plugins the loader searches
+        // (an installed module finds the installed plugins through the prefix the kernel was built for).
+        s->load_all(here.parent_path().parent_path().parent_path() / "bin" / "orogen");
+        for (const auto& p : s->problems()) {
+            const std::string text = "orogen: plugin " + p;
+            PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1);
+        }
+        return s;
+    }();
+    return *set;
+}
+
+// ------------------------------------------------------------------ values
+
+/// A read-only numpy view of `data` that keeps `owner` alive: no copy.
+py::array view(const void* data, py::dtype dtype, std::vector<py::ssize_t> shape, std::shared_ptr<const void> owner) {
+    auto* keep = new std::shared_ptr<const void>(std::move(owner));
+    py::capsule base(keep, [](void* p) { delete static_cast<std::shared_ptr<const void>*>(p); });
+    py::array a(dtype, shape, {}, data, base);
+    a.attr("setflags")(py::arg("write") = false);
+    return a;
+}
+
+py::array float_grid(const float* data, int w, int h, std::shared_ptr<const void> owner) {
+    return view(data, py::dtype::of<float>(), {h, w}, std::move(owner));
+}
+
+/// A heightmap: `height` (rows north to south), `layers`, `cell`, all views of orogen's memory.
+struct PyHeightmap {
+    std::shared_ptr<const Heightmap> hm;
+};
+
+struct PySeries {
+    std::shared_ptr<const Series> series;
+};
+
+py::object to_python(const Value& v);
+
+py::object particles_to_python(const std::shared_ptr<const ParticleSeries>& ps) {
+    py::list frames;
+    for (const ParticleFrame& f : ps->frames) {
+        py::dict attributes;
+        const auto n = py::ssize_t(f.count());
+        for (const auto& [name, a] : f.attributes)
+            attributes[py::str(name)] = view(a.data.data(), py::dtype::of<float>(), {n, a.components}, ps);
+        py::dict frame;
+        frame["time"] = f.time;
+        frame["step"] = f.step;
+        frame["attributes"] = attributes;
+        frames.append(frame);
+    }
+    return frames;
+}
+
+py::object plates_to_python(const PlateHistory& p) {
+    py::list snapshots;
+    for (const auto& s : p.snapshots) {
+        py::list plates;
+        for (const auto& st : s.plates) {
+            py::array_t<double> polygon({py::ssize_t(st.polygon.size()), py::ssize_t(2)});
+            auto m = polygon.mutable_unchecked<2>();
+            for (std::size_t i = 0; i < st.polygon.size(); ++i) {
+                m(py::ssize_t(i), 0) = st.polygon[i].x;
+                m(py::ssize_t(i), 1) = st.polygon[i].y;
+            }
+            py::dict d;
+            d["id"] = st.id;
+            d["polygon"] = polygon;
+            d["velocity"] = py::make_tuple(st.velocity.x, st.velocity.y);
+            d["density"] = st.density;
+            plates.append(d);
+        }
+        py::dict d;
+        d["step"] = s.step;
+        d["time"] = s.time;
+        d["plates"] = plates;
+        snapshots.append(d);
+    }
+    py::list collisions;
+    for (const auto& c : p.collisions) {
+        py::dict d;
+        d["step"] = c.step;
+        d["plates"] = py::make_tuple(c.plate_a, c.plate_b);
+        d["a"] = py::make_tuple(c.a.x, c.a.y);
+        d["b"] = py::make_tuple(c.b.x, c.b.y);
+        d["kind"] = c.kind == BoundaryKind::convergent ? "convergent" : c.kind == BoundaryKind::divergent ? "divergent" : "transform";
+        d["impulse"] = c.impulse;
+        collisions.append(d);
+    }
+    py::dict d;
+    d["width"] = p.width;
+    d["height"] = p.height;
+    d["snapshots"] = snapshots;
+    d["collisions"] = collisions;
+    return d;
+}
+
+py::object to_python(const Value& v) {
+    switch (v.type()) {
+        case ValueType::none: return py::none();
+        case ValueType::heightmap: return py::cast(PyHeightmap{v.heightmap()});
+        case ValueType::image: {
+            const auto& img = v.image();
+            if (img->format == Image::Format::rgba8)
+                return view(img->rgba8.data(), py::dtype::of<std::uint8_t>(), {img->height, img->width, 4}, img);
+            return view(img->rgba32f.data(), py::dtype::of<float>(), {img->height, img->width, 4}, img);
+        }
+        case ValueType::particles: return particles_to_python(v.particles());
+        case ValueType::plates: return plates_to_python(*v.plates());
+        case ValueType::series: return py::cast(PySeries{v.series()});
+    }
+    return py::none();
+}
+
+// --------------------------------------------------------------------- run
+
+/// A Python value as `--set` takes it: True → true, 2.5 → 2.5, (1, 2) → (1, 2), [(..), ..], strings as given.
+std::string override_text(const py::handle& v) {
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::int_>(v)) return py::str(v);
+    if (py::isinstance<py::float_>(v)) return py::repr(v);
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::isinstance<py::tuple>(v) || py::isinstance<py::list>(v)) {
+        const py::sequence s = v.cast<py::sequence>();
+        const bool points = s.size() > 0 && (py::isinstance<py::tuple>(s[0]) || py::isinstance<py::list>(s[0]));
+        std::string text = points ? "[" : "(";
+        for (std::size_t i = 0; i < s.size(); ++i) text += (i ? ", " : "") + override_text(s[i]);
+        return text + (points ? "]" : ")");
+    }
+    throw py::value_error("set: cannot give a parameter the Python value " + std::string(py::repr(v)) +
+                          " (give a number, bool, string, (x, y) point or a list of points)");
+}
+
+std::string error_count(const spec::Diagnostics& diags, const std::string& name) {
+    return std::to_string(diags.error_count()) + (diags.error_count() == 1 ? " error" : " errors") + " in " + name + "\n";
+}
+
+std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};
+
+/// A folder for a run without `out`: its files are written there and removed with it.
+struct ScratchFolder {
+    fs::path path;
+    ScratchFolder() {
+        static std::atomic<int> counter{0};
+        path = fs::temp_directory_path() /
+               ("orogen-python-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~ScratchFolder() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    ScratchFolder(const ScratchFolder&) = delete;
+    ScratchFolder& operator=(const ScratchFolder&) = delete;
+};
+
+py::dict run_spec(const std::string& spec, std::optional<std::uint64_t> seed, const py::dict& overrides,
+                  std::optional<int> threads, std::optional<std::string> out, bool progress) {
+    // A path, or the spec's text itself.
+    std::string name, text;
+    fs::path spec_path;
+    std::error_code ec;
+    const bool is_text = spec.find('\n') != std::string::npos;
+    if (!is_text && fs::is_regular_file(spec, ec)) {
+        try {
+            const auto bytes = read_file(spec);
+            text.assign(bytes.begin(), bytes.end());
+        } catch (const std::exception& e) {
+            throw py::value_error(std::string("orogen: error: ") + e.what());
+        }
+        name = spec;
+        spec_path = spec;
+    } else if (!is_text && !spec.empty() && spec.rfind("orogen", 0) != 0) {
+        throw py::value_error("orogen: error: cannot read spec " + spec + ": " +
+                              (fs::exists(spec, ec) ? "it is not a regular file" : "no such file") +
+                              " (give a path to a .orogen file, or the spec's text)");
+    } else {
+        text = spec;
+        name = "<spec>";
+        spec_path = fs::current_path() / name;  // input paths are relative to the current folder
+    }
+    if (threads && (*threads < 1 || *threads > 1024))
+        throw py::value_error("threads must be a number from 1 to 1024, got " + std::to_string(*threads));
+
+    CheckOptions check_options;
+    for (const auto& [k, v] : overrides) check_options.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
+    check_options.seed = seed;
+    std::optional<ScratchFolder> scratch;
+    if (!out) scratch.emplace();
+    const fs::path out_dir = out ? fs::path(*out) : scratch->path;
+    check_options.out_dir = out_dir;
+
+    PluginSet& set = plugins();
+    auto source = std::make_shared<spec::Source>(name, std::move(text));
+    spec::Diagnostics diags;
+    const spec::Spec parsed = spec::parse(source, diags);
+    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, name));
+    Plan plan = check(parsed, set.registry(), spec_path, check_options, diags);
+    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, name));
+    if (!diags.all().empty()) PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1);
+
+    // Every named value (and side value) is wanted back: held past the last node.
+    for (const PlannedNode& n : plan.nodes) {
+        if (n.value_name.empty()) continue;
+        plan.last_use[n.value_name] = plan.nodes.size();
+        for (const auto& side : n.node->side_outputs) plan.last_use[n.value_name + "." + side.name] = plan.nodes.size();
+    }
+
+    ProgressDisplay display(stderr, ::isatty(STDERR_FILENO) != 0, !progress);
+    RunOptions options;
+    options.out_dir = out_dir;
+    options.threads = threads.value_or(0);
+    options.progress = &display;
+    options.plugins = set.plugins();
+    options.cancel = &g_cancel;
+    options.cancel_signal = &g_signal;
+    options.cache = std::nullopt;  // every node runs: a cached node's values would not be at hand
+    g_cancel = false;
+    g_signal = 0;
+
+    // The run on a thread of its own, the GIL released; this thread wakes every 50 ms for Python's signals,
+    // so Ctrl-C asks the node to stop (as SIGINT does on the command line).
+    RunResult result;
+    std::exception_ptr failure;
+    std::promise<void> done;
+    std::future<void> finished = done.get_future();
+    std::thread worker([&] {
+        try {
+            result = run(plan, options);
+        } catch (...) {
+            failure = std::current_exception();
+        }
+        done.set_value();
+    });
+    bool interrupted = false;
+    for (;;) {
+        std::future_status status;
+        {
+            py::gil_scoped_release release;
+            status = finished.wait_for(std::chrono::milliseconds(50));
+        }
+        if (status == std::future_status::ready) break;
+        if (!interrupted && PyErr_CheckSignals() != 0) {
+            interrupted = true;
+            g_signal = 2;
+            g_cancel = true;
+        }
+    }
+    {
+        py::gil_scoped_release release;
+        worker.join();
+    }
+    if (interrupted) throw py::error_already_set();  // KeyboardInterrupt, after the run stopped and cleaned up
+    if (failure) std::rethrow_exception(failure);
+    if (result.exit_code == 2) throw py::value_error(result.error);
+    if (result.exit_code != 0) throw std::runtime_error(result.error);
+
+    py::dict values;
+    for (const auto& [key, v] : result.values) {
+        if (v.type() == ValueType::none) continue;
+        values[py::str(key)] = to_python(v);
+    }
+    return values;
+}
+
+// ------------------------------------------------------------ nodes, help
+
+py::object param_value(const ParamValue& v) {
+    return std::visit(
+        [](const auto& x) -> py::object {
+            using T = std::decay_t<decltype(x)>;
+            if constexpr (std::is_same_v<T, std::monostate>) return py::none();
+            else if constexpr (std::is_same_v<T, Point2>) return py::make_tuple(x.x, x.y);
+            else if constexpr (std::is_same_v<T, std::vector<Point2>>) {
+                py::list l;
+                for (const auto& p : x) l.append(py::make_tuple(p.x, p.y));
+                return l;
+            } else return py::cast(x);
+        },
+        v);
+}
+
+const NodeDescriptor& find_node(const std::string& name) {
+    const Registry& registry = plugins().registry();
+    if (const NodeDescriptor* n = registry.find(name)) return *n;
+    std::vector<std::string> names;
+    const NodeDescriptor* found = nullptr;
+    for (const auto* d : registry.nodes()) {
+        names.push_back(d->qualified_name());
+        if (d->name == name) found = d;  // "fault" is fine too
+    }
+    if (found) return *found;
+    const std::string guess = spec::closest(name, names);
+    throw py::value_error("unknown node '" + name + "'" +
+                          (guess.empty() ? "; orogen.nodes() lists them all" : "; did you mean '" + guess + "'?"));
+}
+
+py::list nodes() {
+    py::list l;
+    for (const auto* n : plugins().registry().nodes()) {
+        py::dict d;
+        d["name"] = n->qualified_name();
+        d["kind"] = n->kind;
+        d["summary"] = n->summary;
+        l.append(d);
+    }
+    return l;
+}
+
+py::dict help(const std::string& name) {
+    const NodeDescriptor& n = find_node(name);
+    py::list inputs;
+    for (const auto& in : n.inputs) {
+        py::dict d;
+        d["name"] = in.name;
+        d["type"] = in.many == Many::either ? describe_type(in.type, false) + " or " + describe_type(in.type, true)
+                                            : describe_type(in.type, in.many == Many::series);
+        d["optional"] = in.need == Need::optional;
+        d["help"] = in.help;
+        inputs.append(d);
+    }
+    py::list params;
+    for (const auto& p : n.params) {
+        py::dict d;
+        d["name"] = p.name;
+        d["type"] = std::string(to_string(p.type));
+        d["default"] = param_value(p.default_value);
+        d["required"] = p.required();
+        d["min"] = p.minimum ? py::cast(*p.minimum) : py::none();
+        d["max"] = p.maximum ? py::cast(*p.maximum) : py::none();
+        d["min_exclusive"] = p.minimum_exclusive;
+        d["max_exclusive"] = p.maximum_exclusive;
+        d["unit"] = p.unit_text;
+        d["help"] = p.help_text;
+        d["choices"] = p.choices;
+        params.append(d);
+    }
+    py::dict d;
+    d["name"] = n.qualified_name();
+    d["summary"] = n.summary;
+    d["description"] = n.description;
+    d["inputs"] = inputs;
+    d["output"] = describe_type(n.output, n.output_series);
+    d["adds_layers"] = n.adds_layers;
+    d["params"] = params;
+    return d;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_orogen, m) {
+    m.doc() = "orogen: mountain terrain from text pipeline specs (docs/python.md)";
+
+    py::class_<PyHeightmap>(m, "Heightmap", "A heightmap: heights and layers as read-only float32 views, rows north to south")
+        .def_property_readonly(
+            "height", [](const PyHeightmap& h) { return float_grid(h.hm->heights().data(), h.hm->width(), h.hm->height(), h.hm); },
+            "heights in metres, a (rows, columns) float32 array, row 0 the north edge")
+        .def_property_readonly(
+            "layers",
+            [](const PyHeightmap& h) {
+                py::dict d;
+                for (const auto& name : h.hm->layer_names())
+                    d[py::str(name)] = float_grid(h.hm->layer(name).data, h.hm->width(), h.hm->height(), h.hm);
+                return d;
+            },
+            "the layers by name, each like height")
+        .def_property_readonly("cell", [](const PyHeightmap& h) { return h.hm->cell(); }, "metres between vertices")
+        .def_property_readonly("shape", [](const PyHeightmap& h) { return py::make_tuple(h.hm->height(), h.hm->width()); })
+        .def("__repr__", [](const PyHeightmap& h) {
+            std::ostringstream s;
+            s << "<orogen.Heightmap " << h.hm->width() << "x" << h.hm->height() << ", cell " << h.hm->cell() << " m";
+            const auto layers = h.hm->layer_names();
+            for (std::size_t i = 0; i < layers.size(); ++i) s << (i ? ", " : "; layers ") << layers[i];
+            return s.str() + ">";
+        });
+
+    py::class_<PySeries>(m, "Series", "A series of values (a time-lapse, a turntable's frames), each made when asked for")
+        .def_property_readonly("times", [](const PySeries& s) { return s.series->times; })
+        .def("__len__", [](const PySeries& s) { return s.series->size(); })
+        .def("__getitem__", [](const PySeries& s, std::int64_t i) {
+            const auto n = std::int64_t(s.series->size());
+            if (i < 0) i += n;
+            if (i < 0 || i >= n) throw py::index_error("series index out of range");
+            Value v;
+            {
+                py::gil_scoped_release release;
+                v = s.series->at(std::size_t(i));
+            }
+            return to_python(v);
+        })
+        .def("__repr__", [](const PySeries& s) {
+            return "<orogen.Series of " + std::to_string(s.series->size()) + " " + std::string(to_string(s.series->element)) + "s>";
+        });
+
+    m.def("run", &run_spec, py::arg("spec"), py::kw_only(), py::arg("seed") = py::none(), py::arg("set") = py::dict(),
+          py::arg("threads") = py::none(), py::arg("out") = py::none(), py::arg("progress") = false,
+          "Run a spec (a path, or the text itself) and return every named value: {name: value}.");
+    m.def("nodes", &nodes, "The nodes the loaded plugins provide: [{'name', 'kind', 'summary'}].");
+    m.def("help", &help, py::arg("name"), "A node's description, inputs and parameters (type, default, range, unit).");
+}

@@ -1,0 +1,225 @@
+"""The Python module against the `orogen` binary: the same bytes, the same messages, the same refusals.
+
+Run by ctest (python_module) with PYTHONPATH=<build>/python and OROGEN_CLI=<build>/bin/orogen.
+"""
+import os
+import pathlib
+import signal
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import orogen
+
+CLI = os.environ["OROGEN_CLI"]
+
+SPEC = """orogen 1
+seed 5
+grid 65 cell=20
+b = generate:fault(iterations=40, displacement=8)
+w = erode:hydraulic(b, iterations=5)
+t = erode:thermal(w, iterations=20, timelapse_every=10)
+export:raw(t, path="t.r32")
+export:raw(w, path="w.r32")
+"""
+
+
+def cli(args, cwd):
+    env = dict(os.environ, OROGEN_NO_CACHE="1", OROGEN_PLUGIN_PATH="")
+    return subprocess.run([CLI] + args, cwd=cwd, env=env, capture_output=True, text=True)
+
+
+def bits(a):
+    return np.ascontiguousarray(a).view(np.uint32)
+
+
+def test_run_gives_the_cli_bytes_and_every_named_value(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.orogen").write_text(SPEC)
+    r = cli(["run", "s.orogen", "--out", "cli", "--quiet"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    values = orogen.run("s.orogen", out="py")
+    assert sorted(values) == ["b", "t", "t.timelapse", "w"]
+    # The files, manifest included, byte for byte.
+    names = sorted(p.name for p in (tmp_path / "cli").iterdir())
+    assert names == sorted(p.name for p in (tmp_path / "py").iterdir())
+    assert "manifest.json" in names
+    for name in names:
+        assert (tmp_path / "cli" / name).read_bytes() == (tmp_path / "py" / name).read_bytes(), name
+    # The arrays are those files' floats, rows north to south.
+    for key in ("t", "w"):
+        raw = np.fromfile(tmp_path / "cli" / f"{key}.r32", dtype="<f4").reshape(65, 65)
+        hm = values[key]
+        assert isinstance(hm, orogen.Heightmap)
+        assert hm.height.dtype == np.float32 and hm.height.shape == (65, 65) == hm.shape
+        assert np.array_equal(bits(hm.height), bits(raw))
+        assert hm.cell == 20.0
+    assert sorted(values["t"].layers) == ["eroded", "flow", "hardness", "sediment", "water"]
+    # A time-lapse is a series of heightmaps: before the first step, every 10 steps and after the last.
+    series = values["t.timelapse"]
+    assert len(series) == 3 and series.times[0] == 0.0 and series.times == sorted(series.times)
+    assert np.array_equal(bits(series[0].height), bits(values["w"].height))
+    assert np.array_equal(bits(series[-1].height), bits(values["t"].height))
+    with pytest.raises(IndexError):
+        series[3]
+
+
+def test_arrays_are_read_only_views_that_outlive_the_result():
+    values = orogen.run("orogen 1\ngrid 17\nb = generate:fault(iterations=5)\n")
+    height = values["b"].height
+    del values
+    assert not height.flags.writeable and not height.flags.owndata  # a view of orogen's memory
+    with pytest.raises(ValueError):
+        height[0, 0] = 1.0
+    assert np.isfinite(height).all() and height.std() > 0  # still alive after the result went
+    copy = height.copy()
+    copy[0, 0] = 1.0
+
+
+def test_the_same_call_gives_the_same_bits_on_any_thread_count():
+    spec = "orogen 1\nseed 3\ngrid 129\nb = generate:diamond-square()\nt = erode:thermal(b, iterations=30)\n"
+    one = orogen.run(spec, threads=1)["t"]
+    two = orogen.run(spec, threads=2)["t"]
+    again = orogen.run(spec)["t"]
+    assert np.array_equal(bits(one.height), bits(two.height))
+    assert np.array_equal(bits(one.height), bits(again.height))
+    assert np.array_equal(bits(one.layers["eroded"]), bits(two.layers["eroded"]))
+
+
+def test_seed_and_set_act_as_the_cli_options(tmp_path):
+    spec = "orogen 1\nseed 1\ngrid 33\nb = generate:fault(iterations=30, displacement=4)\nexport:raw(b, path=\"b.r32\")\n"
+    (tmp_path / "s.orogen").write_text(spec)
+    r = cli(["run", "s.orogen", "--out", "cli", "--quiet", "--seed", "9", "--set", "b.displacement=7.5",
+             "--set", "b.iterations=12"], tmp_path)
+    assert r.returncode == 0, r.stderr
+    hm = orogen.run(str(tmp_path / "s.orogen"), seed=9, set={"b.displacement": 7.5, "b.iterations": 12})["b"]
+    raw = np.fromfile(tmp_path / "cli" / "b.r32", dtype="<f4").reshape(33, 33)
+    assert np.array_equal(bits(hm.height), bits(raw))
+    assert not np.array_equal(bits(hm.height), bits(orogen.run(spec)["b"].height))
+
+
+def test_without_out_nothing_is_written(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    before = set(os.listdir("/tmp"))
+    values = orogen.run("orogen 1\ngrid 17\nb = generate:fault(iterations=5)\nexport:raw(b, path=\"b.r32\")\n")
+    assert "b" in values
+    assert list(tmp_path.iterdir()) == []
+    assert not [n for n in set(os.listdir("/tmp")) - before if n.startswith("orogen-python-")]
+
+
+def test_bad_input_is_a_value_error_with_the_clis_message(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    bad = {
+        "syntax.orogen": "orogen 1\ngrid 33\nb = generate:fault(iterations=\n",
+        "range.orogen": "orogen 1\ngrid 33\nb = generate:fault(iterations=-3)\n",
+        "unknown.orogen": "orogen 1\ngrid 33\nb = generate:faults()\n",
+        "file.orogen": "orogen 1\ngrid 33\nd = import:exr(path=\"missing.exr\")\n",
+    }
+    for name, text in bad.items():
+        (tmp_path / name).write_text(text)
+        r = cli(["check", name], tmp_path)
+        assert r.returncode == 2
+        with pytest.raises(ValueError) as e:
+            orogen.run(name)
+        assert str(e.value) == r.stderr, name
+    # The spec's own text: the same words, at the same line and column, in "<spec>".
+    with pytest.raises(ValueError, match=r"<spec>:3:31: error: 'iterations' of generate:fault is -3, out of range"):
+        orogen.run(bad["range.orogen"])
+    with pytest.raises(ValueError, match="did you mean 'generate:fault'"):
+        orogen.run(bad["unknown.orogen"])
+    with pytest.raises(ValueError, match="unknown parameter|no node named|has no parameter"):
+        orogen.run("orogen 1\ngrid 33\nb = generate:fault()\n", set={"b.nonsense": 3})
+    with pytest.raises(ValueError, match="cannot give a parameter the Python value"):
+        orogen.run("orogen 1\ngrid 33\nb = generate:fault()\n", set={"b.iterations": object()})
+    with pytest.raises(ValueError, match="cannot read spec nowhere.orogen: no such file"):
+        orogen.run("nowhere.orogen")
+    with pytest.raises(ValueError, match="threads must be a number from 1 to 1024"):
+        orogen.run("orogen 1\ngrid 17\nb = generate:fault()\n", threads=0)
+
+
+def test_bad_input_met_while_running_is_a_value_error_and_a_failed_run_a_runtime_error(tmp_path):
+    # A NaN in an imported file is found when the node reads it (exit 2 on the command line).
+    nan = tmp_path / "nan.r32"
+    np.array([1.0, float("nan"), 2.0, 3.0], dtype="<f4").tofile(nan)
+    (tmp_path / "nan.r32.json").write_text('{"format": "r32", "width": 2, "height": 2, "cell_size": 1, '
+                                           '"height_min": 0, "height_max": 3}')
+    with pytest.raises(ValueError, match=r"node 'd' \(import:raw\) failed: .*not a finite number"):
+        orogen.run(f"orogen 1\ngrid 9\nd = import:raw(path=\"{nan}\")\n")
+    # A folder where an output goes: the run fails (exit 1), naming the node.
+    (tmp_path / "out" / "b.r32").mkdir(parents=True)
+    with pytest.raises(RuntimeError, match=r"node 'export:raw' \(export:raw\) failed: cannot write .*a folder has that name"):
+        orogen.run("orogen 1\ngrid 17\nb = generate:fault(iterations=5)\nexport:raw(b, path=\"b.r32\")\n",
+                   out=str(tmp_path / "out"))
+
+
+def test_nodes_and_help_describe_the_loaded_plugins():
+    names = {n["name"]: n for n in orogen.nodes()}
+    for name in ("generate:fault", "erode:thermal", "export:exr", "import:exr", "render:terrain"):
+        assert name in names and names[name]["summary"]
+    h = orogen.help("erode:thermal")
+    assert h["output"] == "heightmap" and h["inputs"][0]["type"] == "heightmap"
+    talus = next(p for p in h["params"] if p["name"] == "talus")
+    assert talus["type"] == "number" and talus["default"] == 35 and talus["unit"] == "°"
+    assert (talus["min"], talus["max"], talus["min_exclusive"], talus["max_exclusive"]) == (0, 90, True, True)
+    assert orogen.help("thermal")["name"] == "erode:thermal"
+    with pytest.raises(ValueError, match="unknown node 'erode:thermle'; did you mean 'erode:thermal'"):
+        orogen.help("erode:thermle")
+
+
+def test_images_are_height_by_width_by_4_arrays():
+    img = orogen.run("orogen 1\ngrid 33 cell=30\nb = generate:fault(iterations=20, displacement=5)\n"
+                     "r = render:terrain(b, width=48, height=32)\n")["r"]
+    assert img.shape == (32, 48, 4) and img.dtype == np.float32  # linear RGBA, as render:terrain makes it
+    assert (img[..., 3] == 1).all() and img[..., :3].std() > 0
+
+
+def test_the_gil_is_released_while_a_node_runs():
+    spec = "orogen 1\ngrid 257\nb = generate:diamond-square()\nt = erode:thermal(b, iterations=8000)\n"
+    ticks = 0
+    done = threading.Event()
+
+    def work():
+        orogen.run(spec, threads=1)
+        done.set()
+
+    t = threading.Thread(target=work)
+    start = time.monotonic()
+    t.start()
+    while not done.is_set():
+        ticks += 1
+        time.sleep(0.001)
+    t.join()
+    elapsed = time.monotonic() - start
+    assert elapsed > 0.2, "the run was too short to tell"
+    assert ticks > 0.2 * elapsed / 0.001, (ticks, elapsed)  # Python kept running beside it
+
+
+def test_ctrl_c_stops_the_node_and_raises_keyboard_interrupt(tmp_path):
+    spec = ("orogen 1\ngrid 513\nb = generate:diamond-square()\nt = erode:thermal(b, iterations=1000000)\n"
+            "export:raw(t, path=\"t.r32\")\n")
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        orogen.run(spec, out=str(tmp_path / "out"))
+    assert time.monotonic() - start < 10
+    assert not (tmp_path / "out" / "t.r32").exists()
+
+
+def test_a_thousand_calls_do_not_grow_memory():
+    spec = "orogen 1\ngrid 33\nb = generate:fault(iterations=10)\nt = erode:thermal(b, iterations=2)\n"
+
+    def rss_kib():
+        with open("/proc/self/status") as f:
+            return next(int(line.split()[1]) for line in f if line.startswith("VmRSS:"))
+
+    for _ in range(100):  # warm up: plugins loaded, allocator pools filled
+        orogen.run(spec)["t"].height.sum()
+    before = rss_kib()
+    for _ in range(1000):
+        orogen.run(spec)["t"].height.sum()
+    grown = rss_kib() - before
+    assert grown < 8 * 1024, f"RSS grew {grown} KiB over 1000 calls"
