@@ -4,6 +4,7 @@
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
 
+#include <gdal_priv.h>
 #include <nlohmann/json.hpp>
 #include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
@@ -23,14 +24,17 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
+#include <memory>
 
 namespace fs = std::filesystem;
 
 namespace orogen::view {
 
 const char* const known_extensions =
-    ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar) and .orogen specs";
+    ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar), .tif/.tiff "
+    "(GeoTIFF), .vrt and the .json index of export:tiles, and .orogen specs";
 
 const float* Terrain::layer(const std::string& name) const {
     for (const auto& l : layers)
@@ -316,6 +320,87 @@ Terrain read_raw(const fs::path& file, bool r16) {
     return t;
 }
 
+/// A raster GDAL reads (export:geotiff's GeoTIFF, export:tiles' VRT): band 1 the height in metres (its
+/// scale and offset applied: a VRT of 16-bit tiles carries them), every further band a layer named by its
+/// description (export:geotiff names them). The cell is the pixel size when the raster is in metres, else 1 m.
+Terrain read_gdal(const fs::path& file) {
+    GDALAllRegister();
+    CPLPushErrorHandler(CPLQuietErrorHandler);  // GDAL's own messages never reach the user: ours do
+    std::unique_ptr<GDALDataset> ds(GDALDataset::Open(file.c_str(), GDAL_OF_RASTER | GDAL_OF_READONLY));
+    const std::string gdal_says = CPLGetLastErrorMsg();
+    CPLPopErrorHandler();
+    if (!ds)
+        throw BadInput("cannot read " + quoted(file) + ": GDAL cannot open it as a raster" +
+                       (gdal_says.empty() ? std::string() : " (" + gdal_says + ")"));
+    const int w = ds->GetRasterXSize(), h = ds->GetRasterYSize(), bands = ds->GetRasterCount();
+    if (bands < 1 || w < 2 || h < 2)
+        throw BadInput("cannot show " + quoted(file) + ": a heightmap needs a band of at least 2 × 2 samples");
+    if (const std::string problem = heightmap_memory_problem(double(w) * bands, h); !problem.empty())
+        throw BadInput("cannot show " + quoted(file) + ": " + std::to_string(w) + " × " + std::to_string(h) + " × " +
+                       std::to_string(bands) + " bands " + problem);
+    double gt[6] = {0, 1, 0, 0, 0, -1};
+    const bool georeferenced = ds->GetGeoTransform(gt) == CE_None;
+    const OGRSpatialReference* srs = ds->GetSpatialRef();
+    const bool metres = !srs || ((srs->IsProjected() || srs->IsLocal()) && std::fabs(srs->GetLinearUnits() - 1.0) < 1e-9);
+    Terrain t;
+    t.file = file;
+    t.width = w;
+    t.height = h;
+    t.cell = georeferenced && metres && std::fabs(gt[1]) > 0 ? std::fabs(gt[1]) : 1.0;
+    const bool south_up = georeferenced && gt[5] > 0;  // rows run south to north: turn them north to south
+    auto read_band = [&](int index, const std::string& name) {
+        GDALRasterBand* band = ds->GetRasterBand(index);
+        auto values = vtkSmartPointer<vtkFloatArray>::New();
+        values->SetName(name.c_str());
+        values->SetNumberOfTuples(vtkIdType(w) * h);
+        float* v = values->GetPointer(0);
+        if (band->RasterIO(GF_Read, 0, 0, w, h, v, w, h, GDT_Float32, 0, 0, nullptr) != CE_None)
+            throw BadInput("cannot read " + quoted(file) + ": band " + std::to_string(index) +
+                           " is damaged or a file it refers to is missing (" + CPLGetLastErrorMsg() + ")");
+        int has = 0;
+        const double scale = band->GetScale(&has), offset = band->GetOffset();
+        const double nodata = band->GetNoDataValue(&has);
+        const bool holes = has != 0;
+        float lowest = std::numeric_limits<float>::max();
+        for (std::size_t i = 0; i < std::size_t(w) * h; ++i) {
+            if (holes && v[i] == float(nodata)) {
+                v[i] = std::numeric_limits<float>::quiet_NaN();
+                continue;
+            }
+            v[i] = float(v[i] * (scale != 0 ? scale : 1.0) + offset);
+            lowest = std::min(lowest, v[i]);
+        }
+        for (std::size_t i = 0; i < std::size_t(w) * h; ++i)  // holes (nodata) shown at the lowest height
+            if (std::isnan(v[i])) v[i] = lowest == std::numeric_limits<float>::max() ? 0.f : lowest;
+        if (south_up)
+            for (int y = 0; y < h / 2; ++y) std::swap_ranges(v + std::size_t(y) * w, v + std::size_t(y + 1) * w, v + std::size_t(h - 1 - y) * w);
+        return values;
+    };
+    t.heights = read_band(1, "height");
+    for (int b = 2; b <= bands; ++b) {
+        const char* description = ds->GetRasterBand(b)->GetDescription();
+        const std::string name = description && *description ? description : "band " + std::to_string(b);
+        t.layers.push_back({name, read_band(b, name)});
+    }
+    return t;
+}
+
+/// The .json index export:tiles writes: the tiles shown as one terrain through the VRT beside it.
+Terrain read_tiles_index(const fs::path& file, const nlohmann::json& index) {
+    const std::string format = index.value("format", "");
+    if (format == "glb")
+        throw BadInput("cannot show " + quoted(file) + ": it indexes glTF chunks (a 3D Tiles tileset, for CesiumJS and "
+                       "other streamers); open one chunk (.glb) or write raster tiles (format=png16, r16, r32)");
+    fs::path vrt = file;
+    vrt.replace_extension(".vrt");
+    if (!fs::exists(vrt))
+        throw BadInput("cannot show " + quoted(file) + ": the tiles are shown through " + quoted(vrt.filename()) +
+                       ", the GDAL mosaic export:tiles writes beside the index (vrt=true, the default), which is missing");
+    Terrain t = read_gdal(vrt);
+    t.file = file;
+    return t;
+}
+
 /// Which part of a frame a .vtp fills, by what it holds (turned into the viewer's frame).
 void place(Frame& frame, vtkSmartPointer<vtkPolyData> poly) {
     if (z_up(poly)) turn_to_y_up(poly);
@@ -385,7 +470,8 @@ Content read_files(std::span<const fs::path> files) {
         }
         const std::string ext = extension(file);
         const bool known = ext == ".vti" || ext == ".vtp" || ext == ".pvd" || ext == ".glb" || ext == ".gltf" ||
-                           ext == ".png" || ext == ".r16" || ext == ".r32";
+                           ext == ".png" || ext == ".r16" || ext == ".r32" || ext == ".tif" || ext == ".tiff" ||
+                           ext == ".vrt" || ext == ".json";
         if (!known)
             throw BadInput("cannot open " + quoted(file) + ": unknown file type '" + ext + "'; orogen-view opens " +
                            known_extensions);
@@ -409,6 +495,20 @@ Content read_files(std::span<const fs::path> files) {
             c.gltf.push_back(file);
         } else if (ext == ".png") {
             c.terrains.push_back(read_png(file));
+        } else if (ext == ".tif" || ext == ".tiff" || ext == ".vrt") {
+            c.terrains.push_back(read_gdal(file));
+        } else if (ext == ".json") {
+            nlohmann::json index;
+            try {
+                std::ifstream in(file);
+                index = nlohmann::json::parse(in);
+            } catch (const std::exception&) {
+                throw BadInput("cannot read " + quoted(file) + ": not valid JSON");
+            }
+            if (!index.is_object() || !index.contains("tile_size"))
+                throw BadInput("cannot show " + quoted(file) + ": orogen-view opens the .json index of export:tiles; "
+                               "for a RAW file's sidecar open the .r16 or .r32 beside it");
+            c.terrains.push_back(read_tiles_index(file, index));
         } else {
             c.terrains.push_back(read_raw(file, ext == ".r16"));
         }
@@ -451,7 +551,8 @@ std::vector<fs::path> pick_outputs(const fs::path& folder) {
         }
     };
     first(ext_is(".vti")) || first(terrain_vtp) || first(ext_is(".r16")) || first(ext_is(".r32")) || first(gray16) ||
-        first(ext_is(".glb")) || first(ext_is(".gltf"));
+        first(ext_is(".tif")) || first(ext_is(".tiff")) || first(ext_is(".vrt")) || first(ext_is(".glb")) ||
+        first(ext_is(".gltf"));
     for (const auto& p : all)
         if (extension(p) == ".pvd") picked.push_back(p);
     return picked;

@@ -3,7 +3,8 @@
 // A terrain is a grid (heights + named layers, row-major, sample (x, y) at
 // index y·width + x, X east = x·cell, Z south = y·cell, Y up, metres: the
 // glTF frame, docs/exporters.md). .vti, the export:vtk .vtp mesh,
-// 16-bit PNG and RAW (.r16/.r32 + <file>.json sidecar) all become one.
+// 16-bit PNG, RAW (.r16/.r32 + <file>.json sidecar), GeoTIFF and GDAL's VRT
+// (export:tiles' mosaic, also reached through its .json index) all become one.
 // .pvd series become frames of plates, collisions or particles; .glb/.gltf
 // are imported by the scene (VTK's glTF importer builds textured actors).
 // VTK files written with up=z (X east, Y north, Z up: export:vtk's default,

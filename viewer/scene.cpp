@@ -75,7 +75,12 @@ LayerStyle style_of(const std::string& name, float lo, float hi) {
     if (name == "plate") return {"id", LayerStyle::categorical};
     if (name == "boundary") return {"1 convergent, 2 divergent, 3 transform", LayerStyle::categorical};
     if (name == "eroded") return {"m", LayerStyle::diverging};
-    const char* unit = name == "flow" ? "m/s" : name == "hardness" ? "0..1" : "m";
+    // The units the nodes write (orogen help NODE): drainage is an area; flow_direction a D8 code.
+    const char* unit = name == "flow"             ? "m/s"
+                       : name == "hardness"       ? "0..1"
+                       : name == "drainage"       ? "m²"
+                       : name == "flow_direction" ? "D8 code"
+                                                  : "m";
     return {unit, lo < 0 && hi > 0 ? LayerStyle::diverging : LayerStyle::sequential};
 }
 
@@ -85,8 +90,10 @@ const unsigned char categorical_colours[][3] = {
     {166, 86, 40},  {247, 129, 191}, {141, 211, 199}, {190, 186, 218}, {128, 177, 211}, {179, 222, 105},
     {252, 205, 229}, {188, 128, 189}, {204, 235, 197}, {255, 237, 111}};
 
-/// A colour map with a control point at each of `colours` (RGB 0..255) spread over lo..hi.
-vtkSmartPointer<vtkLookupTable> ramp(std::initializer_list<std::array<int, 3>> colours, double lo, double hi) {
+/// A colour map with a control point at each of `colours` (RGB 0..255) spread over lo..hi, evenly in the
+/// value or, with `log`, in its logarithm (lo > 0).
+vtkSmartPointer<vtkLookupTable> ramp(std::initializer_list<std::array<int, 3>> colours, double lo, double hi,
+                                     bool log = false) {
     vtkNew<vtkColorTransferFunction> ctf;
     ctf->SetColorSpaceToLab();
     const int n = int(colours.size());
@@ -94,6 +101,7 @@ vtkSmartPointer<vtkLookupTable> ramp(std::initializer_list<std::array<int, 3>> c
     for (const auto& c : colours) ctf->AddRGBPoint(lo + (hi - lo) * i++ / (n - 1), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
     auto lut = vtkSmartPointer<vtkLookupTable>::New();
     lut->SetNumberOfTableValues(256);
+    lut->SetScale(log ? VTK_SCALE_LOG10 : VTK_SCALE_LINEAR);
     lut->SetRange(lo, hi);
     lut->Build();
     for (int k = 0; k < 256; ++k) {
@@ -206,6 +214,13 @@ vtkSmartPointer<vtkLookupTable> lut_for(const std::string& name, const float* v,
         return ramp({{38, 115, 77}, {140, 180, 100}, {210, 190, 130}, {140, 100, 70}, {245, 245, 245}}, lo, hi);
     if (name == "water") return ramp({{247, 251, 255}, {107, 174, 214}, {8, 48, 107}}, std::max(lo, 0.f), top);
     if (name == "sediment") return ramp({{255, 247, 188}, {254, 153, 41}, {102, 37, 6}}, std::max(lo, 0.f), top);
+    // Values that span three or more orders of magnitude (drainage area: from one cell to the whole map) would
+    // be one colour on a linear map: a log scale over the whole range, where the largest values (the rivers)
+    // are the point.
+    if (lo > 0 && double(hi) / double(lo) >= 1e3) {
+        *title = name + " (" + style.unit + ", log scale)";
+        return ramp({{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}, lo, hi, true);
+    }
     // viridis, sampled
     return ramp({{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}, lo,
                 lo >= 0 ? std::max(top, double(lo) + 1e-9) : double(hi));
@@ -252,6 +267,7 @@ struct Scene::Impl {
         std::string title;
         bool categorical = false;
         double lo = 0.0, scale = 0.0;  // sequential/diverging: table index = (v − lo) · scale, clamped
+        bool log = false;              // ... of log10(v) instead of v (lo is then log10 of the range's start)
         long lowest = 0;               // categorical: the colour of id k is table[k − lowest]
         std::vector<std::array<std::uint8_t, 3>> table;
     };
@@ -654,8 +670,9 @@ struct Scene::Impl {
             // MapScalarsThroughTable would give, in one parallel pass.
             const double* range = c.lut->GetRange();
             const vtkIdType count = c.lut->GetNumberOfTableValues();
-            c.lo = range[0];
-            c.scale = double(count) / std::max(range[1] - range[0], 1e-300);
+            c.log = c.lut->GetScale() == VTK_SCALE_LOG10;
+            c.lo = c.log ? std::log10(range[0]) : range[0];
+            c.scale = double(count) / std::max(c.log ? std::log10(range[1]) - c.lo : range[1] - range[0], 1e-300);
             const unsigned char* rgba = c.lut->GetPointer(0);
             for (vtkIdType k = 0; k < count; ++k) c.table.push_back({rgba[4 * k], rgba[4 * k + 1], rgba[4 * k + 2]});
         }
@@ -717,9 +734,11 @@ struct Scene::Impl {
                 });
             } else {
                 const double lo = c.lo, scale = c.scale;
+                const bool log = c.log;
                 parallel_for(0, std::int64_t(tw) * th, grain, [&](std::int64_t a, std::int64_t b) {
                     for (std::int64_t i = a; i < b; ++i) {
-                        const double d = (double(v[i]) - lo) * scale;
+                        // (a value ≤ 0 on a log scale: log10 gives -inf or NaN, the first colour either way)
+                        const double d = ((log ? std::log10(double(v[i])) : double(v[i])) - lo) * scale;
                         lit(i, table[d > 0 ? std::min(long(d), last) : 0].data());
                     }
                 });
@@ -849,6 +868,11 @@ struct Scene::Impl {
         status->SetInput(s.str().c_str());
     }
 
+    /// The band at the window's bottom that the colour scale and the status line take, pixels: the bar's
+    /// offset, its height (11 % of the window, at most 90 pixels) and a margin.
+    static double legend_band(double window_height) { return bar_offset + std::min(0.11 * window_height, 90.0) + 8; }
+    static constexpr double bar_offset = 48;
+
     void camera_from_angles() {
         vtkCamera* cam = renderer->GetActiveCamera();
         double b[6];
@@ -876,9 +900,23 @@ struct Scene::Impl {
             cam->SetViewUp(0, 1, 0);
         cam->SetParallelProjection(top_view);
         renderer->ResetCamera(b);
-        if (top_view)
+        if (top_view) {
             cam->SetParallelScale(cam->GetParallelScale() / 1.35);  // ResetCamera fits the bounding sphere: fit the square
-        else if (angles.distance > 0) {
+            // A map keeps clear of the colour scale and the status line at the window's bottom: it is fitted
+            // into the window above them (smaller by that band, and moved up by half of it).
+            const double window_height = renderer->GetSize()[1];
+            const double band = legend_band(window_height);
+            if (window_height > 2 * band) {
+                const double scale = cam->GetParallelScale() * window_height / (window_height - band);
+                const double shift = band / 2 * (2 * scale / window_height);  // pixels × metres per pixel
+                cam->SetParallelScale(scale);
+                const double* f = cam->GetFocalPoint();
+                const double* p = cam->GetPosition();
+                // Screen down is +Z (north up): moving the camera that way moves the map up.
+                cam->SetFocalPoint(f[0], f[1], f[2] + shift);
+                cam->SetPosition(p[0], p[1], p[2] + shift);
+            }
+        } else if (angles.distance > 0) {
             // vtkCamera::SetDistance would move the focal point; the camera moves instead.
             const double* f = cam->GetFocalPoint();
             const double* d = cam->GetDirectionOfProjection();
@@ -949,7 +987,7 @@ Scene::Scene(vtkRenderWindow* window) : impl_(std::make_unique<Impl>()) {
     bar_anchor->SetValue(0.6, 0.0);
     m.bar->GetPositionCoordinate()->SetCoordinateSystemToDisplay();
     m.bar->GetPositionCoordinate()->SetReferenceCoordinate(bar_anchor);
-    m.bar->GetPositionCoordinate()->SetValue(0, 48);
+    m.bar->GetPositionCoordinate()->SetValue(0, Impl::bar_offset);
     m.bar->SetWidth(0.38);
     m.bar->SetHeight(0.11);
     m.bar->SetMaximumHeightInPixels(90);
@@ -1210,6 +1248,28 @@ std::string Scene::state() const {
       << "particle_attribute=" << m.particle_attribute << "\n";
     const double* p = cam->GetPosition();
     s << "camera=" << p[0] << "," << p[1] << "," << p[2] << "\n";
+    // Where the terrain and the colour scale are in the window (pixels, x0,y0,x1,y1 from the bottom left), so
+    // that a test can see the two apart.
+    s << "legend=" << (m.bar->GetVisibility() ? m.bar->GetTitle() : "none") << "\n";
+    if (m.terrain->GetVisibility() && m.ground()) {
+        double b[6];
+        m.terrain->GetBounds(b);
+        double lo[2] = {1e300, 1e300}, hi[2] = {-1e300, -1e300};
+        for (int c = 0; c < 8; ++c) {
+            m.renderer->SetWorldPoint(b[c & 1], b[2 + ((c >> 1) & 1)], b[4 + ((c >> 2) & 1)], 1.0);
+            m.renderer->WorldToDisplay();
+            const double* d = m.renderer->GetDisplayPoint();
+            for (int k = 0; k < 2; ++k) lo[k] = std::min(lo[k], d[k]), hi[k] = std::max(hi[k], d[k]);
+        }
+        s << "map_box=" << std::lround(lo[0]) << "," << std::lround(lo[1]) << "," << std::lround(hi[0]) << ","
+          << std::lround(hi[1]) << "\n";
+    }
+    if (m.bar->GetVisibility()) {
+        const int* at = m.bar->GetPositionCoordinate()->GetComputedDisplayValue(m.renderer);
+        const int* to = m.bar->GetPosition2Coordinate()->GetComputedDisplayValue(m.renderer);
+        const int height = std::min(to[1] - at[1], m.bar->GetMaximumHeightInPixels());
+        s << "legend_box=" << at[0] << "," << at[1] << "," << to[0] << "," << at[1] + height << "\n";
+    }
     return s.str();
 }
 

@@ -146,8 +146,9 @@ TEST_F(Viewer, ColouringByALayerChangesThePixelsAndUsesItsColourMap) {
     // Flow rises west to east: the colour map's ends differ.
     EXPECT_GT(distance(patch(fl, 70, 160), patch(fl, 250, 160)), 80);
     // One colour per plate: the four quadrants' colours are all different.
-    const std::array<std::array<double, 3>, 4> q{patch(pl, 90, 90), patch(pl, 230, 90), patch(pl, 90, 230),
-                                                 patch(pl, 230, 230)};
+    // (The map is fitted above the colour scale's band: 229 pixels square, its top at the window's.)
+    const std::array<std::array<double, 3>, 4> q{patch(pl, 100, 55), patch(pl, 220, 55), patch(pl, 100, 170),
+                                                 patch(pl, 220, 170)};
     for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j) EXPECT_GT(distance(q[i], q[j]), 40) << "quadrants " << i << " and " << j;
     // Diverging map: negative (west) blue, positive (east) red.
@@ -291,7 +292,7 @@ TEST_F(Viewer, ZUpAndYUpFilesShowTheSamePicture) {
     }
     // The layer is not mirrored: the top of the picture (north) is low on the ramp, the bottom high.
     const Picture z = read_picture(dir / "z_t.vti.png");
-    EXPECT_GT(distance(patch(z, 160, 40), patch(z, 160, 280)), 30.0);
+    EXPECT_GT(distance(patch(z, 160, 20), patch(z, 160, 210)), 30.0);
 }
 
 // ---------------------------------------------------------------------- keys
@@ -530,11 +531,12 @@ TEST_F(Viewer, BadInputGivesOneClearErrorAndExit2) {
     std::ofstream(dir / "notes.txt") << "hello";
     expect("notes.txt",
            "cannot open 'notes.txt': unknown file type '.txt'; orogen-view opens .vti, .vtp, .pvd, .glb, .gltf, .png "
-           "(16-bit heightmap), .r16, .r32 (with their .json sidecar) and .orogen specs");
+           "(16-bit heightmap), .r16, .r32 (with their .json sidecar), .tif/.tiff (GeoTIFF), .vrt and the .json index "
+           "of export:tiles, and .orogen specs");
     fs::create_directories(dir / "empty");
     expect("empty", std::string("cannot open 'empty': the folder holds nothing orogen-view shows (") +
-                        ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar) "
-                        "and .orogen specs)");
+                        ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar), "
+                        ".tif/.tiff (GeoTIFF), .vrt and the .json index of export:tiles, and .orogen specs)");
     const auto h = plain_and_plateau();
     raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
     fs::remove(dir / "t.r16.json");
@@ -581,3 +583,87 @@ TEST_F(Viewer, GltfFromTheExporterOpens) {
 }
 
 }  // namespace
+
+// ------------------------------------------------- legends and GIS files (issue 32, item 9)
+
+namespace {
+
+/// "x0,y0,x1,y1" of a state line as four numbers (pixels from the bottom left).
+std::array<int, 4> box(const std::string& text) {
+    std::array<int, 4> b{};
+    std::sscanf(text.c_str(), "%d,%d,%d,%d", &b[0], &b[1], &b[2], &b[3]);
+    return b;
+}
+
+}  // namespace
+
+TEST_F(Viewer, DrainageIsInSquareMetresOnALogColourScale) {
+    // Drainage area from one 30 m cell (900 m²) to 9·10⁷ m², ten times more every eighth of the way east.
+    const int n = 65;
+    std::vector<float> drainage(std::size_t(n) * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) drainage[std::size_t(y) * n + x] = float(900.0 * std::pow(10.0, 5.0 * x / (n - 1)));
+    write_vti(dir / "t.vti", plain_and_plateau(), n, n, {{"drainage", drainage}});
+    const Result r = view("t.vti --events /dev/null --print-state --layer drainage --screenshot d.png " + top_view);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(state_value(r.out, "legend"), "drainage (m², log scale)");
+    // On a log scale each decade gets its share of the colours: a fifth of the map apart, colours differ
+    // (a linear map puts everything below a tenth of the top, four fifths of this map, in one colour).
+    const auto map = box(state_value(r.out, "map_box"));
+    const Picture p = read_picture(dir / "d.png");
+    const int row = p.height - (map[1] + map[3]) / 2;
+    auto at = [&](double f) { return patch(p, int(map[0] + f * (map[2] - map[0])), row); };
+    EXPECT_GT(distance(at(0.2), at(0.4)), 40);
+    EXPECT_GT(distance(at(0.4), at(0.6)), 40);
+    EXPECT_GT(distance(at(0.6), at(0.8)), 40);
+}
+
+TEST_F(Viewer, TheColourScaleStaysClearOfTheMapInTopView) {
+    std::vector<float> flow(65 * 65);
+    for (std::size_t i = 0; i < flow.size(); ++i) flow[i] = float(i % 65);
+    write_vti(dir / "t.vti", plain_and_plateau(), 65, 65, {{"flow", flow}});
+    for (const char* size : {"320x320", "640x400", "400x640", "1280x800"}) {
+        const Result r = view(std::string("t.vti --events /dev/null --print-state --layer flow --top --size ") + size);
+        ASSERT_EQ(r.code, 0) << r.err;
+        ASSERT_EQ(state_value(r.out, "legend"), "flow (m/s)");
+        const auto map = box(state_value(r.out, "map_box")), legend = box(state_value(r.out, "legend_box"));
+        const bool apart = legend[3] <= map[1] || legend[0] >= map[2] || legend[2] <= map[0];
+        EXPECT_TRUE(apart) << size << ": map " << state_value(r.out, "map_box") << ", legend "
+                           << state_value(r.out, "legend_box");
+        EXPECT_GT(map[3] - map[1], 100) << size;  // and the map is still a map
+    }
+}
+
+TEST_F(Viewer, OpensTheGeoTiffAndTheTilesOfARunAsItsVti) {
+    std::ofstream(dir / "gis.orogen") << "orogen 1\nseed 5\ngrid 65 cell=10\n"
+                                         "t = generate:diamond-square(roughness=0.6, amplitude=200)\n"
+                                         "w = erode:thermal(t, iterations=3)\n"
+                                         "export:vtk(w, path=\"t.vti\")\n"
+                                         "export:geotiff(w, path=\"t.tif\", layers=all)\n"
+                                         "export:tiles(w, path=\"tiles/t.json\", tile_size=33)\n";
+    const std::string run = "cd '" + dir.string() + "' && OROGEN_NO_CACHE=1 '" OROGEN_CLI "' run gis.orogen --out . --quiet";
+    ASSERT_EQ(std::system(run.c_str()), 0);
+    for (const char* input : {"t.vti", "t.tif", "tiles/t.vrt", "tiles/t.json"}) {
+        const Result r = view(std::string(input) + " --screenshot " + fs::path(input).filename().string() + ".png " + top_view);
+        ASSERT_EQ(r.code, 0) << input << ": " << r.err;
+    }
+    // The map (above the status line, which names the file): compared pixel by pixel.
+    auto map_of = [](Picture p) {
+        p.height -= 100;
+        return p;
+    };
+    const Picture vti = map_of(read_picture(dir / "t.vti.png"));
+    EXPECT_EQ(differing_pixels(vti, map_of(read_picture(dir / "t.tif.png")), 0), 0u);  // the same floats
+    // 16-bit tiles: heights within a 65535th of the range, the same picture but for rounding.
+    EXPECT_LT(differing_pixels(vti, map_of(read_picture(dir / "t.vrt.png"))), 200u);
+    EXPECT_EQ(differing_pixels(map_of(read_picture(dir / "t.vrt.png")), map_of(read_picture(dir / "t.json.png")), 0), 0u);
+    // The GeoTIFF's bands are the layers, by name.
+    const Result layer = view("t.tif --events /dev/null --print-state --layer eroded --top --size 200x200");
+    ASSERT_EQ(layer.code, 0) << layer.err;
+    EXPECT_EQ(state_value(layer.out, "legend"), "eroded (m)");
+    // A folder holding only a GeoTIFF shows it.
+    fs::create_directories(dir / "only");
+    fs::copy_file(dir / "t.tif", dir / "only/t.tif");
+    EXPECT_EQ(view("only --screenshot only.png " + top_view).code, 0);
+    EXPECT_EQ(differing_pixels(vti, map_of(read_picture(dir / "only.png")), 0), 0u);
+}
