@@ -183,6 +183,10 @@ std::string table_text(const std::vector<Terrain>& terrains, const Comparison& c
         out << "\nnote: the cell sizes differ (" << format(smallest, 1) << " m to " << format(largest, 1)
             << " m); slopes, pits, curvature and the network's figures depend on the cell size: compare "
                "terrains at the same cell size\n";
+    const auto references = std::count_if(terrains.begin(), terrains.end(), [](const Terrain& t) { return t.reference; });
+    if (references == 1 && std::size_t(references) < terrains.size())
+        out << "\n(one reference: no spread to measure the distance to it by; give two or more to see which a "
+               "terrain resembles most)\n";
     bool any_nearest = false;
     for (std::size_t i = 0; i < terrains.size(); ++i) {
         const auto& n = comparison.nearest[i];

@@ -97,6 +97,8 @@ TEST(AnalyzeCli, RendersTheTerrainsWithOneCamera) {
     EXPECT_TRUE(fs::exists(dir / "out/renders/morocco_rif_27m.png"));
     const std::string page = slurp(dir / "out/README.md");
     EXPECT_NE(page.find("![small](renders/small.png)"), std::string::npos) << page;
+    EXPECT_NE(r.out.find("(one reference: no spread to measure the distance to it by; give two or more"), std::string::npos)
+        << r.out;
 }
 
 TEST(AnalyzeCli, EveryFileKindGivesTheSameFigures) {
