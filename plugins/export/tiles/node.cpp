@@ -32,14 +32,13 @@ void check(CheckContext& ctx) {
         if (ctx.given(mesh))
             ctx.error(mesh, std::string(mesh) + " applies to format=glb (the meshes); the raster formats ignore it");
     const bool low = ctx.given("low"), high = ctx.given("high");
-    if (low != high) {
+    if (low != high)
         ctx.error(low ? "low" : "high", "give both low and high (the heights written as 0 and 65535), or neither "
                                         "to use the terrain's own lowest and highest point");
-        return;
-    }
-    if (low && !(ctx.real("high") > ctx.real("low"))) ctx.error("high", "high must be above low");
-    if (low && ctx.text("format") == "r32")
-        ctx.error("low", "low and high set the 16-bit scale; format=r32 writes metres as they are");
+    else if (low && !(ctx.real("high") > ctx.real("low")))
+        ctx.error("high", "high must be above low");
+    if ((low || high) && ctx.text("format") == "r32")  // reported with the above: every mistake at once
+        ctx.error(low ? "low" : "high", "low and high set the 16-bit scale; format=r32 writes metres as they are");
 }
 
 /// The heights at a lattice of the whole grid: from the ranks that hold them (collective) or, in one

@@ -210,6 +210,20 @@ TEST(TilesCli, BadParametersAreCheckErrorsThatSayWhere) {
     }
 }
 
+// Issue 32, item 7: a call's mistakes are reported together (a missing high no longer hides that format=r32
+// has no 16-bit scale, nor a mesh parameter given to a raster format).
+TEST(TilesCli, EveryMistakeInOneCallIsReportedAtOnce) {
+    TempDir dir;
+    const auto spec = dir.write("bad.orogen", spec_head + "export:tiles(w, path=\"t.json\", format=r32, low=5, scale=2)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    for (const char* want : {"error: export:tiles: scale applies to format=glb",
+                             "error: export:tiles: give both low and high",
+                             "error: export:tiles: low and high set the 16-bit scale; format=r32"})
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+    EXPECT_NE(r.err.find("3 errors in"), std::string::npos) << r.err;
+}
+
 // ------------------------------------------------------------ format=glb (lod.hpp)
 
 namespace {
