@@ -3,6 +3,7 @@
 //
 //   run(spec, seed=None, set={}, threads=None, out=None, progress=False) -> {name: value}
 //   nodes() -> [{"name", "kind", "summary"}];  help(name) -> {...}
+// (orogen.node() is Python, in orogen/__init__.py, over run() and _write_input().)
 //
 // Bad input (a spec error, a parameter out of range, a file refused at check time) raises ValueError with
 // the CLI's message; a failed run RuntimeError naming the node; Ctrl-C stops the node as on the command
@@ -15,6 +16,10 @@
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+
+#ifdef OROGEN_PYTHON_EXR
+#include "exr.hpp"
+#endif
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -247,7 +252,9 @@ py::dict run_spec(const std::string& spec, std::optional<std::uint64_t> seed, co
     if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, name));
     Plan plan = check(parsed, set.registry(), spec_path, check_options, diags);
     if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, name));
-    if (!diags.all().empty()) PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1);
+    // The checker's warnings are about files ("this spec writes no files"): moot when nothing is written.
+    if (!diags.all().empty() && out && PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1) != 0)
+        throw py::error_already_set();  // warnings turned into errors
 
     // Every named value (and side value) is wanted back: held past the last node.
     for (const PlannedNode& n : plan.nodes) {
@@ -396,6 +403,26 @@ py::dict help(const std::string& name) {
     return d;
 }
 
+#ifdef OROGEN_PYTHON_EXR
+/// node()'s way in: heights and layers (2-D float32 C-contiguous arrays of one shape, checked by the caller)
+/// as an uncompressed OpenEXR file import:exr reads back bit for bit.
+void write_input(const std::string& path, const std::string& channel,
+                 const py::array_t<float, py::array::c_style>& height, const py::dict& layers, double cell) {
+    const int h = int(height.shape(0)), w = int(height.shape(1));
+    std::vector<py::array_t<float, py::array::c_style>> keep;
+    std::vector<exr::Plane> planes{{channel, height.data()}};
+    for (const auto& [k, v] : layers) {
+        keep.push_back(v.cast<py::array_t<float, py::array::c_style>>());
+        planes.push_back({k.cast<std::string>(), keep.back().data()});
+    }
+    exr::WriteOptions o;
+    o.compression = exr::Compression::none;
+    o.cell = cell;
+    py::gil_scoped_release release;
+    exr::write(path, w, h, planes, o);
+}
+#endif
+
 }  // namespace
 
 PYBIND11_MODULE(_orogen, m) {
@@ -447,4 +474,8 @@ PYBIND11_MODULE(_orogen, m) {
           "Run a spec (a path, or the text itself) and return every named value: {name: value}.");
     m.def("nodes", &nodes, "The nodes the loaded plugins provide: [{'name', 'kind', 'summary'}].");
     m.def("help", &help, py::arg("name"), "A node's description, inputs and parameters (type, default, range, unit).");
+#ifdef OROGEN_PYTHON_EXR
+    m.def("_write_input", &write_input, py::arg("path"), py::arg("channel"), py::arg("height"), py::arg("layers"),
+          py::arg("cell"));
+#endif
 }

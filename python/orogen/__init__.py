@@ -1,12 +1,110 @@
-"""orogen from Python: run pipeline specs and get their values back as numpy arrays.
+"""orogen from Python: run pipeline specs and single nodes, and get their values back as numpy arrays.
 
     import orogen
-    values = orogen.run("pipelines/default.orogen", seed=7, set={"base.amplitude": 600})
-    terrain = values["worn"]            # orogen.Heightmap: .height, .layers, .cell
+    values = orogen.run("pipelines/default.orogen", seed=7, set={"scree.iterations": 80})
+    terrain = values["scree"]           # orogen.Heightmap: .height, .layers, .cell
     terrain.height                      # float32 (rows, columns), row 0 the north edge
+    worn = orogen.node("erode:thermal", terrain, talus=35, iterations=50)
 
 See docs/python.md.
 """
+import math as _math
+import os as _os
+import shutil as _shutil
+import tempfile as _tempfile
+
+from . import _orogen
 from ._orogen import Heightmap, Series, help, nodes, run
 
-__all__ = ["Heightmap", "Series", "help", "nodes", "run"]
+__all__ = ["Heightmap", "Series", "help", "node", "nodes", "run"]
+
+_HEIGHT_CHANNEL = "orogen:height"  # not a layer name any node uses
+
+
+def _literal(value, where):
+    """A Python value as the spec writes it."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        if not _math.isfinite(value):
+            raise ValueError(f"{where} is {value}; give a finite number")
+        return repr(value)
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
+    if isinstance(value, (tuple, list)):
+        if len(value) > 0 and all(isinstance(v, (tuple, list)) for v in value):
+            return "[" + ", ".join(_literal(tuple(v), where) for v in value) + "]"
+        if len(value) == 2 and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value):
+            return f"({_literal(value[0], where)}, {_literal(value[1], where)})"
+    raise ValueError(f"{where}: cannot give a parameter the Python value {value!r} (give a number, bool, string, "
+                     "(x, y) point or a list of points)")
+
+
+def _grid_of(array, i):
+    import numpy as np
+
+    if not isinstance(array, np.ndarray):
+        raise ValueError(f"input {i} is a {type(array).__name__}; give an orogen.Heightmap or a 2-D numpy array")
+    if array.ndim != 2:
+        raise ValueError(f"input {i} has shape {array.shape}; a heightmap is a 2-D array (rows north to south)")
+    if array.dtype != np.float32:
+        raise ValueError(f"input {i} is {array.dtype}; orogen heightmaps are float32: pass a.astype(np.float32)")
+    if array.shape[0] < 2 or array.shape[1] < 2:
+        raise ValueError(f"input {i} is {array.shape[1]}x{array.shape[0]}; a heightmap needs at least 2 vertices a side")
+    bad = ~np.isfinite(array)
+    if bad.any():
+        row, col = (int(v) for v in np.argwhere(bad)[0])
+        raise ValueError(f"input {i}: sample ({col}, {row}) is {array[row, col]}; heights and layers must be finite "
+                         "numbers")
+    return np.ascontiguousarray(array)
+
+
+def node(name, *inputs, cell=None, grid=None, spec_seed=0, label="result", threads=None, **params):
+    """Run one node on numpy arrays or earlier values and return its result.
+
+    `inputs` are orogen.Heightmap values (from run() or node()) or 2-D float32 numpy arrays (rows north to
+    south; `cell` gives their spacing in metres, default 1). `params` are the node's parameters, checked as
+    the spec checker checks them, with its messages (ValueError). A node without inputs (a generator) runs on
+    a grid of `grid=(width, height)` vertices (default: the first input's size, else 513 x 513). The node's
+    seed comes from `spec_seed` and `label`, as it would in a spec whose seed line is `spec_seed` and where
+    the node is named `label`, so node() gives the same bits as that spec. The inputs cross through an
+    uncompressed OpenEXR file in a scratch folder (a copy, bit for bit, layers included).
+    """
+    if not hasattr(_orogen, "_write_input"):
+        raise RuntimeError("this orogen was built without export:exr, which node() needs for its inputs")
+    if cell is not None and not (isinstance(cell, (int, float)) and _math.isfinite(cell) and cell > 0):
+        raise ValueError(f"cell must be a number of metres above 0, got {cell!r}")
+    if not isinstance(label, str) or not label.isidentifier():
+        raise ValueError(f"label must be a name as a spec writes one (letters, digits, _), got {label!r}")
+    scratch = _tempfile.mkdtemp(prefix="orogen-node-")
+    try:
+        lines = [f"orogen 1", f"seed {int(spec_seed)}"]
+        calls = []
+        size = None
+        for i, value in enumerate(inputs, start=1):
+            if isinstance(value, Heightmap):
+                height, layers, spacing = value.height, value.layers, value.cell
+            else:
+                height, layers, spacing = _grid_of(value, i), {}, (1.0 if cell is None else float(cell))
+            if size is None:
+                size = (height.shape[1], height.shape[0], spacing)
+            path = _os.path.join(scratch, f"in{i}.exr")
+            _orogen._write_input(path, _HEIGHT_CHANNEL, height, layers, spacing)
+            calls.append(f'input{i} = import:exr(path="{path}", channel="{_HEIGHT_CHANNEL}", layers=all)')
+        if grid is not None:
+            if not (isinstance(grid, (tuple, list)) and len(grid) == 2 and all(isinstance(v, int) for v in grid)):
+                raise ValueError(f"grid must be (width, height) in vertices, got {grid!r}")
+            size = (grid[0], grid[1], size[2] if size else (1.0 if cell is None else float(cell)))
+        if size is None:
+            size = (513, 513, 1.0 if cell is None else float(cell))
+        lines.append(f"grid {int(size[0])}x{int(size[1])} cell={float(size[2])!r}")
+        lines += calls
+        args = [f"input{i}" for i in range(1, len(inputs) + 1)]
+        args += [f"{k}={_literal(v, k)}" for k, v in params.items()]
+        lines.append(f"{label} = {name}({', '.join(args)})")
+        values = run("\n".join(lines) + "\n", threads=threads)
+        return values.get(label)
+    finally:
+        _shutil.rmtree(scratch, ignore_errors=True)

@@ -223,3 +223,52 @@ def test_a_thousand_calls_do_not_grow_memory():
         orogen.run(spec)["t"].height.sum()
     grown = rss_kib() - before
     assert grown < 8 * 1024, f"RSS grew {grown} KiB over 1000 calls"
+
+
+NODE_SPEC = """orogen 1
+seed 4
+grid 65x49 cell=10
+b = generate:diamond-square(amplitude=200)
+t = erode:thermal(b, talus=30, iterations=40)
+"""
+
+
+def test_node_on_a_numpy_array_gives_the_same_bits_as_the_node_in_a_spec():
+    values = orogen.run(NODE_SPEC)
+    made_by_numpy = np.array(values["b"].height)  # an ordinary, writable numpy array
+    assert made_by_numpy.flags.owndata
+    t = orogen.node("erode:thermal", made_by_numpy, cell=10, talus=30, iterations=40)
+    assert isinstance(t, orogen.Heightmap) and t.shape == (49, 65) and t.cell == 10
+    assert np.array_equal(bits(t.height), bits(values["t"].height))
+    assert np.array_equal(bits(t.layers["eroded"]), bits(values["t"].layers["eroded"]))
+    # A value from an earlier call, its layers carried through; and a generator on a grid, with the seed a
+    # spec would give it.
+    again = orogen.node("erode:thermal", values["b"], talus=30, iterations=40)
+    assert np.array_equal(bits(again.height), bits(values["t"].height))
+    b = orogen.node("generate:diamond-square", grid=(65, 49), cell=10, spec_seed=4, label="b", amplitude=200)
+    assert np.array_equal(bits(b.height), bits(values["b"].height))
+    # Layers go in and come back: erode:hydraulic on the thermal result keeps 'eroded' and adds its own.
+    h = orogen.node("erode:hydraulic", t, iterations=3)
+    assert {"eroded", "water", "sediment"} <= set(h.layers)
+
+
+def test_node_refuses_what_the_checker_refuses_and_bad_arrays():
+    a = np.zeros((9, 9), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"<spec>:5:38: error: 'talus' of erode:thermal is 95, out of range \(0, 90\)"):
+        orogen.node("erode:thermal", a, talus=95)
+    with pytest.raises(ValueError, match="erode:thermal has no parameter 'nonsense'"):
+        orogen.node("erode:thermal", a, nonsense=1)
+    with pytest.raises(ValueError, match="unknown node|did you mean"):
+        orogen.node("erode:thermle", a)
+    with pytest.raises(ValueError, match="input 1 is float64; orogen heightmaps are float32"):
+        orogen.node("erode:thermal", a.astype(np.float64))
+    with pytest.raises(ValueError, match=r"input 1 has shape \(9,\); a heightmap is a 2-D array"):
+        orogen.node("erode:thermal", a[0])
+    nan = a.copy()
+    nan[2, 5] = np.nan
+    with pytest.raises(ValueError, match=r"input 1: sample \(5, 2\) is nan; heights and layers must be finite"):
+        orogen.node("erode:thermal", nan)
+    with pytest.raises(ValueError, match="cell must be a number of metres above 0"):
+        orogen.node("erode:thermal", a, cell=-1)
+    with pytest.raises(ValueError, match="cannot give a parameter the Python value"):
+        orogen.node("erode:thermal", a, talus=object())
