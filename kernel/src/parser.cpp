@@ -362,7 +362,14 @@ private:
                 }
                 Input in{a.text, "", a.where};
                 if (peek(1).kind == Tok::colon) {  // a call where a value goes: hoisted before this statement
+                    if (nesting_ >= kMaxNesting) {  // (a bound on the recursion, whatever the input)
+                        error(a, "calls are nested more than " + std::to_string(kMaxNesting) +
+                                     " deep here; name some of the values on lines of their own");
+                        return std::nullopt;
+                    }
+                    ++nesting_;
                     auto inner = parse_call(spec);
+                    --nesting_;
                     if (!inner) return std::nullopt;
                     if (peek().kind == Tok::dot) {
                         error(peek(), "to use a side value of " + inner->qualified() + ", name the value first: NAME = " +
@@ -482,8 +489,10 @@ private:
         }
     }
 
+    static constexpr int kMaxNesting = 64;
     std::vector<Token> t_;
     std::size_t p_ = 0;
+    int nesting_ = 0;  ///< calls written where inputs go, around the one being parsed
     Diagnostics& diags_;
 };
 

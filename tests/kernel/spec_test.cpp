@@ -145,6 +145,21 @@ TEST(Parser, ACallWhereAnInputGoesBecomesANestedStatement) {
     Diagnostics d3;
     parse_text("orogen 1\nexport:png(generate:fault().plates, path=\"x.png\")\n", d3);
     EXPECT_NE(d3.format().find("name the value first"), std::string::npos) << d3.format();
+    // Nesting is bounded (the parser recurses): 64 levels parse, 65 are one error.
+    auto nested = [](int depth) {
+        std::string text = "orogen 1\nv = generate:fault()\nexport:png(";
+        for (int i = 0; i < depth; ++i) text += "erode:thermal(";
+        text += "v";
+        for (int i = 0; i < depth; ++i) text += ")";
+        return text + ", path=\"x.png\")\n";
+    };
+    Diagnostics d4;
+    EXPECT_EQ(parse_text(nested(64), d4).statements.size(), 66u) << d4.format();
+    EXPECT_FALSE(d4.has_errors()) << d4.format();
+    Diagnostics d5;
+    parse_text(nested(65), d5);
+    EXPECT_EQ(d5.error_count(), 1) << d5.format();
+    EXPECT_NE(d5.format().find("calls are nested more than 64 deep"), std::string::npos) << d5.format();
 }
 
 TEST(Closest, SuggestsNearMissesOnly) {
