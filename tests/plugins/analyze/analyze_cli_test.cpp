@@ -201,6 +201,20 @@ TEST(AnalyzeCli, BadInputIsOneClearMessageAndWritesNothing) {
     EXPECT_EQ(run_orogen("analyze " + q(plain) + " --cell 25 --no-render --out " + q(dir / "out")).exit_code, 0);
 }
 
+TEST(AnalyzeCli, TheSameBytesOnOneThreadOrTwo) {
+    TempDir dir;
+    const fs::path bumps = write_f32(dir, "bumps", 200, 160, 30.0, [](int x, int y) {
+        return 400.0 * std::sin(x * 0.05) * std::sin(y * 0.07) + 2.0 * x + 50.0 * std::sin(x * y * 0.001);
+    });
+    for (const char* threads : {"1", "2"})
+        ASSERT_EQ(run_orogen("analyze " + q(bumps) + " " + q(rif) + " --threads " + threads + " --no-render --out " +
+                             q(dir / (std::string("t") + threads)))
+                      .exit_code,
+                  0);
+    for (const char* file : {"analysis.json", "analysis.txt", "README.md", "analysis-spectrum.png", "analysis-slope-area.png"})
+        EXPECT_EQ(slurp(dir / "t1" / file), slurp(dir / "t2" / file)) << file;
+}
+
 TEST(AnalyzeCli, HelpCitesEachFiguresSource) {
     const auto r = run_orogen("help analyze:terrain");
     ASSERT_EQ(r.exit_code, 0) << r.err;
