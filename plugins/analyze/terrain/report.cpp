@@ -62,52 +62,27 @@ std::string pad(std::string_view s, std::size_t width, bool right = false) {
     return right ? fill + std::string(s) : std::string(s) + fill;
 }
 
-bool inside(const Band& band, double v) { return band.known && std::isfinite(v) && v >= band.low && v <= band.high; }
+bool inside(const analysis::Band& band, double v) { return band.contains(v); }
 
 }  // namespace
 
 Comparison compare(const std::vector<Terrain>& terrains) {
     Comparison c;
-    c.bands.resize(figure_count);
-    for (std::size_t f = 0; f < figure_count; ++f) {
-        std::vector<double> values;
-        for (const auto& t : terrains)
-            if (t.reference && t.figures.values[f].ok()) values.push_back(t.figures.values[f].value);
-        Band& band = c.bands[f];
-        if (values.empty()) continue;
-        band.known = true;
-        band.low = *std::min_element(values.begin(), values.end());
-        band.high = *std::max_element(values.begin(), values.end());
-        if (values.size() >= 2) {
-            double mean = 0.0;
-            for (double v : values) mean += v;
-            mean /= double(values.size());
-            double var = 0.0;
-            for (double v : values) var += (v - mean) * (v - mean);
-            band.spread = std::sqrt(var / double(values.size()));
-        }
-    }
+    std::vector<const analysis::Figures*> references;
+    for (const auto& t : terrains)
+        if (t.reference) references.push_back(&t.figures);
+    c.bands = analysis::reference_bands(references);
     c.nearest.resize(terrains.size());
     for (std::size_t i = 0; i < terrains.size(); ++i) {
         auto& best = c.nearest[i];
         for (std::size_t r = 0; r < terrains.size(); ++r) {
             if (!terrains[r].reference || r == i) continue;
-            double sum = 0.0;
-            std::size_t used = 0;
-            for (std::size_t f = 0; f < figure_count; ++f) {
-                const auto& a = terrains[i].figures.values[f];
-                const auto& b = terrains[r].figures.values[f];
-                if (!a.ok() || !b.ok() || !(c.bands[f].spread > 0.0)) continue;
-                const double d = (a.value - b.value) / c.bands[f].spread;
-                sum += d * d;
-                ++used;
-            }
-            if (used == 0) continue;
-            const double distance = std::sqrt(sum / double(used));
-            if (!best.reference || distance < best.distance) {
+            const analysis::Distance d = analysis::distance(terrains[i].figures, terrains[r].figures, c.bands);
+            if (d.used == 0) continue;
+            if (!best.reference || d.value < best.distance) {
                 best.reference = r;
-                best.distance = distance;
-                best.figures = used;
+                best.distance = d.value;
+                best.figures = d.used;
             }
         }
     }
@@ -129,7 +104,7 @@ std::string table_text(const std::vector<Terrain>& terrains, const Comparison& c
         std::vector<std::string> row = {std::string(info.label), std::string(info.unit)};
         for (const auto& t : terrains) row.push_back(format(t.figures.values[f].value, info.decimals));
         if (have_references) {
-            const Band& band = comparison.bands[f];
+            const analysis::Band& band = comparison.bands[f];
             row.push_back(band.known ? format(band.low, info.decimals) + "–" + format(band.high, info.decimals) : "-");
             for (const auto& t : terrains) {
                 if (t.reference) continue;
@@ -224,7 +199,7 @@ std::string json_text(const std::vector<Terrain>& terrains, const Comparison& co
             out << "        " << json_string(table[f].key) << ": {\"value\": " << json_number(m.value)
                 << ", \"unit\": " << json_string(table[f].unit);
             if (!m.ok()) out << ", \"why_not\": " << json_string(m.why_not);
-            const Band& band = comparison.bands[f];
+            const analysis::Band& band = comparison.bands[f];
             if (!t.reference && band.known && m.ok())
                 out << ", \"inside_references\": " << (inside(band, m.value) ? "true" : "false");
             out << "}" << (f + 1 < table.size() ? "," : "") << "\n";
@@ -239,7 +214,7 @@ std::string json_text(const std::vector<Terrain>& terrains, const Comparison& co
     out << "  ],\n  \"reference_bands\": {";
     bool first = true;
     for (std::size_t f = 0; f < table.size(); ++f) {
-        const Band& band = comparison.bands[f];
+        const analysis::Band& band = comparison.bands[f];
         if (!band.known) continue;
         out << (first ? "\n" : ",\n") << "    " << json_string(table[f].key) << ": {\"min\": " << json_number(band.low)
             << ", \"max\": " << json_number(band.high) << ", \"sd\": " << json_number(band.spread) << "}";

@@ -5,6 +5,7 @@
 // Plain C++ over analysis::Figures: no kernel types but the atomic files.
 #pragma once
 
+#include <orogen/analysis/compare.hpp>
 #include <orogen/analysis/figures.hpp>
 
 #include <filesystem>
@@ -21,16 +22,9 @@ struct Terrain {
     std::string image;       ///< its rendering, relative to the Markdown page ("" = none)
 };
 
-/// The references' band of one figure and each terrain's place in it.
-struct Band {
-    double low = 0.0, high = 0.0;  ///< min and max over the references that measured it
-    double spread = 0.0;           ///< their standard deviation (0 with fewer than two)
-    bool known = false;            ///< some reference measured it
-};
-
 /// What the references say of the terrains: each figure's band, and each terrain's nearest reference.
 struct Comparison {
-    std::vector<Band> bands;  ///< by FigureId
+    analysis::Bands bands;  ///< by FigureId
     /// For each terrain (in order; references included, compared with the others): the nearest reference's
     /// index and the distance, the root mean square over the figures both measured and the references
     /// spread over (nonzero standard deviation) of the difference in units of that spread.

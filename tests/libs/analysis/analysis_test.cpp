@@ -2,6 +2,7 @@
 // of 1/3, spectral surfaces of prescribed β, rivers at stream-power steady state (θ = m/n,
 // k_s = (U/K)^(1/n)), pits, local relief, nodata and terrains too small for a figure; the FFT
 // against the naive DFT; the same bits for any thread count.
+#include <orogen/analysis/compare.hpp>
 #include <orogen/analysis/fft.hpp>
 #include <orogen/analysis/figures.hpp>
 
@@ -339,6 +340,42 @@ TEST(Figures, TheTableDescribesEveryFigureOnce) {
         EXPECT_EQ(find_figure(row.key), row.id);
     }
     EXPECT_FALSE(find_figure("slope"));
+}
+
+// ------------------------------------------------------------ references
+
+Figures figures_with(double first, double second) {
+    Figures f;
+    for (auto& m : f.values) m.why_not = "not measured here";
+    f.values[0] = {first, ""};
+    f.values[1] = {second, ""};
+    return f;
+}
+
+TEST(Compare, BandsSpanTheReferencesAndTheDistanceIsInTheirSpread) {
+    // Figure 0 over the references 1, 2, 3 (sd √(2/3)); figure 1 over 5, 5, 5 (no spread, left out of
+    // distances); the others measured by none.
+    const Figures a = figures_with(1, 5), b = figures_with(2, 5), c = figures_with(3, 5);
+    const std::vector<const Figures*> refs = {&a, &b, &c};
+    const Bands bands = reference_bands(refs);
+    EXPECT_TRUE(bands[0].known);
+    EXPECT_EQ(bands[0].low, 1.0);
+    EXPECT_EQ(bands[0].high, 3.0);
+    EXPECT_NEAR(bands[0].spread, std::sqrt(2.0 / 3.0), 1e-15);
+    EXPECT_EQ(bands[1].spread, 0.0);
+    EXPECT_FALSE(bands[2].known);
+    EXPECT_TRUE(bands[0].contains(3.0));
+    EXPECT_FALSE(bands[0].contains(3.5));
+    EXPECT_FALSE(bands[0].contains(std::nan("")));
+    EXPECT_FALSE(bands[2].contains(0.0)) << "no reference measured it";
+    const Figures mine = figures_with(4, 9);
+    const Distance d = distance(mine, a, bands);
+    EXPECT_EQ(d.used, 1u) << "only figure 0 has a spread";
+    EXPECT_NEAR(d.value, 3.0 / std::sqrt(2.0 / 3.0), 1e-12);
+    EXPECT_EQ(distance(mine, b, bands).value < d.value, true) << "nearer to 2 than to 1";
+    Figures unmeasured = figures_with(0, 0);
+    unmeasured.values[0] = {std::nan(""), "too small"};
+    EXPECT_EQ(distance(unmeasured, a, bands).used, 0u);
 }
 
 // ---------------------------------------------------------- determinism
