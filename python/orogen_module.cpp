@@ -256,9 +256,10 @@ py::dict run_spec(const std::string& spec, std::optional<std::uint64_t> seed, co
     if (!diags.all().empty() && out && PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1) != 0)
         throw py::error_already_set();  // warnings turned into errors
 
-    // Every named value (and side value) is wanted back: held past the last node.
+    // Every named value (and side value) is wanted back: held past the last node. (A call written where an
+    // input goes is not named: its value is released after its reader, as in the CLI.)
     for (const PlannedNode& n : plan.nodes) {
-        if (n.value_name.empty()) continue;
+        if (n.value_name.empty() || n.in_place) continue;
         plan.last_use[n.value_name] = plan.nodes.size();
         for (const auto& side : n.node->side_outputs) plan.last_use[n.value_name + "." + side.name] = plan.nodes.size();
     }

@@ -321,6 +321,7 @@ Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& s
         PlannedNode planned;
         planned.node = node;
         planned.value_name = st.nested ? label : st.name;  // a label holds ':', so it never meets a name
+        planned.in_place = st.nested;
         planned.label = label;
         planned.where = call.where;
 

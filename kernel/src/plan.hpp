@@ -18,7 +18,8 @@ namespace orogen {
 struct PlannedNode {
     const NodeDescriptor* node = nullptr;
     std::string label;       ///< value name, or kind:node for unnamed calls
-    std::string value_name;  ///< "" if unnamed
+    std::string value_name;  ///< "" if unnamed; a call written where an input goes: its label
+    bool in_place = false;   ///< a call written where an input goes (unnamed, but its value is read)
     spec::Location where;    ///< the call
     std::vector<std::string> inputs;  ///< value keys ("base", "sim.particles"), "" for an optional input not given
     std::map<std::string, ParamValue, std::less<>> params;  ///< every declared parameter, defaults filled in

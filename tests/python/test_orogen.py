@@ -67,6 +67,15 @@ def test_run_gives_the_cli_bytes_and_every_named_value(tmp_path, monkeypatch):
         series[3]
 
 
+def test_a_call_written_where_an_input_goes_is_not_a_named_value(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.orogen").write_text(
+        "orogen 1\ngrid 33 cell=10\nb = generate:fault(iterations=10)\n"
+        "w = erode:thermal(erode:thermal(b, iterations=2), iterations=3)\n")
+    values = orogen.run("s.orogen")
+    assert sorted(values) == ["b", "w"]
+
+
 def test_arrays_are_read_only_views_that_outlive_the_result():
     values = orogen.run("orogen 1\ngrid 17\nb = generate:fault(iterations=5)\n")
     height = values["b"].height
