@@ -1,8 +1,7 @@
 // Radix-2 Cooley–Tukey and Bluestein's chirp-z transform (fft.hpp).
 #include <orogen/analysis/fft.hpp>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include <orogen/parallel.hpp>
 
 #include <cmath>
 #include <numbers>
@@ -92,14 +91,14 @@ void fft2(std::vector<std::complex<double>>& data, std::size_t width, std::size_
     if (data.size() != width * height) throw std::invalid_argument("fft2: data is not width × height");
     // Each row and each column is transformed by one iteration alone: the same bits for any thread count.
     const Fft rows(width);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, height, 16), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t y = r.begin(); y != r.end(); ++y)
+    orogen::parallel_for(0, std::int64_t(height), 16, [&](std::int64_t begin, std::int64_t end) {
+        for (auto y = std::size_t(begin); y < std::size_t(end); ++y)
             rows.transform(std::span(data).subspan(y * width, width), inverse);
     });
     const Fft columns(height);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, width, 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    orogen::parallel_for(0, std::int64_t(width), 16, [&](std::int64_t begin, std::int64_t end) {
         std::vector<std::complex<double>> column(height);
-        for (std::size_t x = r.begin(); x != r.end(); ++x) {
+        for (auto x = std::size_t(begin); x < std::size_t(end); ++x) {
             for (std::size_t y = 0; y < height; ++y) column[y] = data[y * width + x];
             columns.transform(column, inverse);
             for (std::size_t y = 0; y < height; ++y) data[y * width + x] = column[y];

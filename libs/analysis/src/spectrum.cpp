@@ -6,8 +6,7 @@
 
 #include <orogen/analysis/fft.hpp>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
+#include <orogen/parallel.hpp>
 
 #include <cmath>
 #include <complex>
@@ -40,9 +39,9 @@ std::vector<double> half_power_spectrum(const std::vector<double>& data, int n) 
     std::vector<std::complex<double>> half(side * columns);
     const Fft fft(side);
     // Each pair of rows, then each column, is one iteration's alone: the same bits for any thread count.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, (side + 1) / 2, 8), [&](const tbb::blocked_range<std::size_t>& r) {
+    orogen::parallel_for(0, std::int64_t((side + 1) / 2), 8, [&](std::int64_t begin, std::int64_t end) {
         std::vector<std::complex<double>> z(side);
-        for (std::size_t pair = r.begin(); pair != r.end(); ++pair) {
+        for (auto pair = std::size_t(begin); pair < std::size_t(end); ++pair) {
             const std::size_t y0 = 2 * pair, y1 = y0 + 1;
             for (std::size_t x = 0; x < side; ++x)
                 z[x] = {data[y0 * side + x], y1 < side ? data[y1 * side + x] : 0.0};
@@ -55,9 +54,9 @@ std::vector<double> half_power_spectrum(const std::vector<double>& data, int n) 
         }
     });
     std::vector<double> power(side * columns);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, columns, 8), [&](const tbb::blocked_range<std::size_t>& r) {
+    orogen::parallel_for(0, std::int64_t(columns), 8, [&](std::int64_t begin, std::int64_t end) {
         std::vector<std::complex<double>> column(side);
-        for (std::size_t u = r.begin(); u != r.end(); ++u) {
+        for (auto u = std::size_t(begin); u < std::size_t(end); ++u) {
             for (std::size_t v = 0; v < side; ++v) column[v] = half[v * columns + u];
             fft.transform(column);
             for (std::size_t v = 0; v < side; ++v) power[v * columns + u] = std::norm(column[v]);

@@ -8,7 +8,8 @@
 // `shared/realism/README.md` and its `terrain_stats.py` exactly, so the numbers
 // agree with that script on the reference DEMs; docs/analysis.md cites each
 // figure's source. Deterministic whatever the thread count: parallel loops
-// write each element from one iteration and every sum runs in index order.
+// (the kernel's orogen::parallel_for) write each element from one iteration
+// and every sum runs in index order.
 //
 //   orogen::analysis::Grid grid{heights.data(), width, height, 30.0};
 //   const auto figures = orogen::analysis::measure(grid);
