@@ -203,7 +203,9 @@ def test_the_gil_is_released_while_a_node_runs():
     t.join()
     elapsed = time.monotonic() - start
     assert elapsed > 0.2, "the run was too short to tell"
-    assert ticks > 0.2 * elapsed / 0.001, (ticks, elapsed)  # Python kept running beside it
+    # Held, the GIL would let this loop tick once or twice at most; released, it ticks all along (hundreds of
+    # times; at least 10 on the busiest machine).
+    assert ticks >= 10, (ticks, elapsed)
 
 
 def test_ctrl_c_stops_the_node_and_raises_keyboard_interrupt(tmp_path):

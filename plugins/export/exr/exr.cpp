@@ -9,6 +9,7 @@
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <openexr.h>
 
 #include <algorithm>
@@ -17,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <mutex>
 #include <sstream>
 
 #include <fcntl.h>
@@ -73,8 +75,15 @@ void write(const fs::path& path, int width, int height, std::span<const Plane> p
                                            sizeof(float), row));
     }
     try {
-        // No threads: the library's pool is process-wide, and the bytes are the same either way.
-        Imf::OutputFile file(path.c_str(), header, 0);
+        // Blocks are compressed on OpenEXR's process-wide pool, grown (never shrunk) to what is asked for; they
+        // are written in row order whatever the thread count, so the bytes do not depend on it (tested).
+        const int threads = std::clamp(options.threads, 1, 256);
+        if (threads > 1) {
+            static std::mutex pool;
+            const std::lock_guard lock(pool);
+            if (Imf::globalThreadCount() < threads) Imf::setGlobalThreadCount(threads);
+        }
+        Imf::OutputFile file(path.c_str(), header, threads > 1 ? threads : 0);
         file.setFrameBuffer(frame);
         file.writePixels(height);
     } catch (const std::exception& e) {

@@ -48,6 +48,7 @@ struct WriteOptions {
     Compression compression = Compression::zip;
     double cell = 1.0;                ///< written as the cellSize attribute (metres)
     std::string layer;                ///< written as orogenLayer if not empty (one-layer files)
+    int threads = 1;                  ///< compression threads (OpenEXR's pool); the bytes do not depend on it
 };
 
 /// Writes `planes` (each width × height floats) as FLOAT channels of one scanline EXR at `path` (a temporary

@@ -3,6 +3,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/parallel.hpp>
 #include <orogen/plugin.hpp>
 
 #include <memory>
@@ -52,6 +53,7 @@ NodeOutputs run(NodeContext& ctx) {
     exr::WriteOptions o;
     o.compression = exr::parse_compression(ctx.text("compression"));
     o.cell = hm->cell();
+    o.threads = thread_count();
     const int w = hm->width(), h = hm->height();
 
     if (!ctx.flag("split")) {
