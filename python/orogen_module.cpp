@@ -51,9 +51,14 @@ PluginSet& plugins() {
         fs::path here = ::dladdr(reinterpret_cast<void*>(&plugins), &info) && info.dli_fname
                             ? fs::absolute(info.dli_fname)
                             : fs::current_path() / "orogen";
-        // <build>/python/orogen/_orogen.so → <build>/bin/orogen, whose ../lib/orogen/plugins the loader searches
-        // (an installed module finds the installed plugins through the prefix the kernel was built for).
-        s->load_all(here.parent_path().parent_path().parent_path() / "bin" / "orogen");
+        // The loader searches <bin>/../lib/orogen/plugins for the binary's path it is given: from the build
+        // tree's <build>/python/orogen/_orogen.so that is <build>/bin/orogen, from an installed
+        // <prefix>/lib/python3/dist-packages/orogen/_orogen.so <prefix>/bin/orogen (and the kernel's own
+        // install prefix in either case).
+        const fs::path build = here.parent_path().parent_path().parent_path();
+        const fs::path installed = build.parent_path().parent_path();
+        std::error_code ec;
+        s->load_all((fs::is_directory(build / "lib" / "orogen" / "plugins", ec) ? build : installed) / "bin" / "orogen");
         for (const auto& p : s->problems()) {
             const std::string text = "orogen: plugin " + p;
             PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1);

@@ -283,3 +283,22 @@ def test_node_refuses_what_the_checker_refuses_and_bad_arrays():
         orogen.node("erode:thermal", a, cell=-1)
     with pytest.raises(ValueError, match="cannot give a parameter the Python value"):
         orogen.node("erode:thermal", a, talus=object())
+
+
+def test_plates_and_particles_come_back_frame_by_frame():
+    values = orogen.run("orogen 1\nseed 2\ngrid 65 cell=100\nc = generate:fault(iterations=10)\n"
+                        "p = tectonics:plates(c, plates=4, steps=60, record_every=20)\n"
+                        "s = erode:sph(c, steps=12, particles=2000, rain=20, record_every=4)\n")
+    plates = values["p.plates"]
+    assert plates["width"] > 0 and plates["height"] > 0 and len(plates["snapshots"]) >= 2
+    first = plates["snapshots"][0]["plates"][0]
+    assert first["polygon"].shape[1] == 2 and first["polygon"].shape[0] >= 3
+    assert isinstance(first["velocity"], tuple) and len(first["velocity"]) == 2
+    frames = values["s.particles"]
+    assert len(frames) >= 3
+    last = frames[-1]
+    position = last["attributes"]["position"]
+    assert position.dtype == np.float32 and position.ndim == 2 and position.shape[1] == 3 and position.shape[0] > 0
+    assert not position.flags.writeable
+    assert all(a.shape[0] == position.shape[0] for a in last["attributes"].values())
+    assert [f["step"] for f in frames] == sorted(f["step"] for f in frames)
