@@ -2,7 +2,7 @@
 // (Barnes, Lehman & Mulla 2014) from every edge sample (and every sample beside a hole), D8 steepest
 // descent on the filled heights (O'Callaghan & Mark 1984), drainage area accumulated from the highest
 // cell down. On it: concavity θ and steepness k_sn (slope–area), Hack's exponent, drainage density,
-// the network's share and hillslope length.
+// the network's share, hillslope length and channel sinuosity.
 #include "detail.hpp"
 
 #include <algorithm>
@@ -123,7 +123,8 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
         const std::string why = "the terrain (" + std::to_string(t.width) + "x" + std::to_string(t.height) +
                                 ") is too small to route water over (needs at least 3x3)";
         for (FigureId id : {FigureId::concavity, FigureId::steepness, FigureId::hack_exponent,
-                            FigureId::drainage_density, FigureId::network_share, FigureId::hillslope_length})
+                            FigureId::drainage_density, FigureId::network_share, FigureId::hillslope_length,
+                            FigureId::channel_sinuosity})
             f[id].why_not = why;
         return;
     }
@@ -170,6 +171,36 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
         f.hack_fit = fit_line(la, ll);
         f[FigureId::hack_exponent].value = f.hack_fit.slope;
         f.hack = log_bins(ca, cl, 10, 3);
+    }
+
+    // Channel sinuosity: from each channel cell, follow the receivers until the flow path is at least
+    // sinuosity_reach long; its length over the straight distance between its ends. Reaches that leave the
+    // map (or end in a hole) sooner are not counted.
+    {
+        double sum = 0.0;
+        std::size_t reaches = 0;
+        const std::size_t w = std::size_t(t.width);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!t.valid[i] || !(area[i] > o.channel_area)) continue;
+            std::size_t j = i;
+            double along = 0.0;
+            while (along < o.sinuosity_reach && r.receiver[j] >= 0) {
+                along += r.distance[j];
+                j = std::size_t(r.receiver[j]);
+            }
+            if (along < o.sinuosity_reach) continue;
+            const double dx = double(j % w) - double(i % w), dy = double(j / w) - double(i / w);
+            const double straight = std::hypot(dx, dy) * t.cell;
+            if (!(straight > 0.0)) continue;
+            sum += along / straight;
+            ++reaches;
+        }
+        if (reaches == 0)
+            f[FigureId::channel_sinuosity].why_not = "no channel (draining more than " + area_text(o.channel_area) +
+                                                     ") runs " + number(o.sinuosity_reach) +
+                                                     " m before it leaves the terrain";
+        else
+            f[FigureId::channel_sinuosity].value = sum / double(reaches);
     }
 
     // The network: cells draining more than 0.1 km².

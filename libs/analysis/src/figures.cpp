@@ -71,6 +71,10 @@ constexpr FigureInfo table[] = {
      "standard deviation of the Laplacian curvature d²z/dx² + d²z/dy² (5-point stencil) over interior samples",
      "Zevenbergen & Thorne 1987, Earth Surf. Proc. Landf. 12:47; Hurst et al. 2012, J. Geophys. Res. "
      "117:F02017", 2},
+    {channel_sinuosity, "channel_sinuosity", "sinuosity", "",
+     "mean over the channel cells (A > 1 km²) of the D8 flow length along the next 1 km of flow path over the "
+     "straight distance between its ends (D8 reads a straight channel as 1.00–1.08, by its direction)",
+     "Mueller 1968, Ann. Assoc. Am. Geogr. 58:371; Schumm 1963, Geol. Soc. Am. Bull. 74:1089", 3},
 };
 static_assert(std::size(table) == figure_count, "one row per FigureId");
 

@@ -220,9 +220,41 @@ TEST(Figures, ParallelRiversAtSteadyStateGiveTheirConcavityAndSteepness) {
     EXPECT_NEAR(f[network_share].value, 100.0 * 118.0 / 120.0, 1e-9);
     // Off the network: rows 0 (400 m to row 2) and 1 (200 m).
     EXPECT_NEAR(f[hillslope_length].value, 300.0, 1e-9);
+    // Every 1 km reach of these channels is straight.
+    EXPECT_NEAR(f[channel_sinuosity].value, 1.0, 1e-12);
     ASSERT_FALSE(f.slope_area.x.empty());
     for (std::size_t b = 0; b < f.slope_area.x.size(); ++b)
         EXPECT_GT(f.slope_area.y[b], 0.0);
+}
+
+TEST(Figures, AWindingChannelIsSinuousAndAStraightOneIsNot) {
+    // One channel winding down a maze: east along row 1, down at the east end, west along row 3, down at
+    // the west end, ... (the rows between are walls 5 km high), falling 1 m a cell, out at the bottom right
+    // corner. D8 cuts each bend's corners with diagonals, but a 1 km reach over a bend still doubles back.
+    const int w = 41, h = 21;
+    std::vector<float> z(std::size_t(w) * h, 5000.0f);
+    std::vector<std::pair<int, int>> path;
+    for (int row = 1; row < h; row += 2) {
+        const bool east = (row / 2) % 2 == 0;
+        for (int k = 0; k < w - 2; ++k) path.emplace_back(east ? 1 + k : w - 2 - k, row);
+        if (row + 2 < h) path.emplace_back(east ? w - 2 : 1, row + 1);
+    }
+    path.emplace_back(w - 1, path.back().second);  // the outlet, on the east edge
+    for (std::size_t k = 0; k < path.size(); ++k)
+        z[std::size_t(path[k].second) * w + std::size_t(path[k].first)] = float(2000.0 - double(k));
+    const Figures winding = measure({z.data(), w, h, 100.0});
+    ASSERT_TRUE(winding[channel_sinuosity].ok()) << winding[channel_sinuosity].why_not;
+    EXPECT_GT(winding[channel_sinuosity].value, 1.2);
+    EXPECT_LT(winding[channel_sinuosity].value, 3.0);
+    // The same channel's last row alone, straight: sinuosity 1.
+    std::vector<float> straight(std::size_t(w) * h, 5000.0f);
+    for (int x = 0; x < w; ++x) straight[std::size_t(h / 2) * w + std::size_t(x)] = float(1000.0 - 20.0 * x);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (y != h / 2) straight[std::size_t(y) * w + std::size_t(x)] = float(1000.0 - 20.0 * x + 300.0 * std::abs(y - h / 2));
+    const Figures line = measure({straight.data(), w, h, 100.0});
+    ASSERT_TRUE(line[channel_sinuosity].ok()) << line[channel_sinuosity].why_not;
+    EXPECT_NEAR(line[channel_sinuosity].value, 1.0, 1e-12);
 }
 
 #ifdef OROGEN_HAVE_STREAM_POWER

@@ -47,6 +47,7 @@ struct Options {
     double reference_concavity = 0.45;  ///< θ_ref of the normalised steepness k_sn = S·A^θ_ref (Wobus et al. 2006)
     double network_area = 1e5;  ///< m²: drainage area above which a cell is on the drainage network (density, hillslopes)
     double relief_radius = 1000.0;  ///< m: half-width of the square window of the local relief
+    double sinuosity_reach = 1000.0;  ///< m: length of flow path over which a channel's sinuosity is taken
 };
 
 /// Every figure, in the order of figure_table() (and of the report's columns).
@@ -67,6 +68,7 @@ enum class FigureId : std::size_t {
     local_relief,
     hillslope_length,
     curvature_spread,
+    channel_sinuosity,
     count_
 };
 inline constexpr std::size_t figure_count = std::size_t(FigureId::count_);
