@@ -210,7 +210,7 @@ s2 = erode:stream-power(s1, years=1e5, dt=2e4, n=1.5, depressions=route, open="n
 s3 = erode:stream-power(s2, years=6e4, dt=2e4, open="none", uplift=2, base_level="0")
 s4 = erode:stream-power(s3, years=4e4, dt=2e4, routing=mfd)
 d  = generate:diamond-square(roughness=0.7, amplitude=300)
-s5 = erode:stream-power(d, years=3e4, dt=1e4, diffusivity=0.01)
+s5 = erode:stream-power(d, years=3e4, dt=1e4, diffusivity=0.01, channel_area=2e4)
 s6 = erode:stream-power(d, years=2e4, dt=1e4, depressions=route, open="we", n=1.5)
 p  = tectonics:plates(d, plates=4, steps=120, cones=30, height=60, timelapse_every=30)
 s7 = erode:stream-power(p, p.timelapse, years=5e4, dt=1.5e4, uplift_history_years=4e4, uplift_smoothing=60, diffusivity=0.01)

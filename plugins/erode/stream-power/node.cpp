@@ -86,6 +86,7 @@ NodeOutputs run(NodeContext& ctx) {
     s.area_exponent = ctx.real("m");
     s.slope_exponent = ctx.real("n");
     s.diffusivity = ctx.real("diffusivity");
+    s.channel_area = ctx.real("channel_area");
     s.open = *parse_sides(ctx.text("open"));
     s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
@@ -462,6 +463,13 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(10.0)
                     .unit("m²/yr")
                     .help("D of hillslope diffusion applied each step (1e-3 to 1e-1; 0 = none)"),
+                Param::real("channel_area", 0.0)
+                    .min(0.0)
+                    .max(1e10)
+                    .unit("m²")
+                    .help("drainage area where rivers take over from hillslopes: incision is scaled by "
+                          "1 - exp(-A/channel_area), so smaller catchments are shaped by creep (channel heads "
+                          "at 1e3-1e5 m², Montgomery & Dietrich 1988); 0 = every cell is a river"),
                 Param::string("open", "nesw")
                     .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
                           "level. none: the lowest cell is the one outlet"),

@@ -39,14 +39,14 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
         throw std::invalid_argument("stream_power::Model: multiple flow directions need Depressions::fill");
     if (!uplift_.empty() && uplift_.size() != h_.size())
         throw std::invalid_argument("stream_power::Model: uplift is not width × height");
-    pow_table_ = area_power_table(cell, settings.area_exponent);
+    pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
     if (settings.diffusivity > 0.0)
         diffusion_ = std::make_unique<diffusion::Solver>(width, height, cell, hillslope_settings(settings));
 }
 
-std::vector<double> area_power_table(double cell, double m) {
+std::vector<double> area_power_table(double cell, double m, double inv_ac) {
     std::vector<double> t(static_cast<std::size_t>(kPowTable));
-    for (std::int64_t c = 0; c < kPowTable; ++c) t[std::size_t(c)] = std::pow(double(c) * (cell * cell), m);
+    for (std::int64_t c = 0; c < kPowTable; ++c) t[std::size_t(c)] = channel_area_power(double(c) * (cell * cell), m, inv_ac);
     return t;
 }
 
@@ -159,10 +159,10 @@ void Model::incise(double dt) {
         const std::int32_t* __restrict const rv = rcv;
         const std::int32_t* __restrict const st = stack;
         double* __restrict const hh = h;
-        const double c1 = kdt_l1, c2 = kdt_l2, ia0 = inv_a0, a00 = a0, mm = m;
+        const double c1 = kdt_l1, c2 = kdt_l2, ia0 = inv_a0, a00 = a0, mm = m, iac = inverse_channel_area(settings_);
         const std::int64_t w = W;
         auto factor = [=](std::int32_t i, std::int32_t r) {
-            const double am = area_power(ar[i], tb, ia0, a00, mm);
+            const double am = area_power(ar[i], tb, ia0, a00, mm, iac);
             const std::int64_t d = std::int64_t(r) - i;
             return am * ((d == 1 || d == -1 || d == w || d == -w) ? c1 : c2);
         };
@@ -245,7 +245,8 @@ void Model::incise_with_deposition(double dt) {
     // A^m from the table for whole numbers of cells (as incise() does: the pow is the costly part).
     const double* tab = pow_table_.data();
     const double inv_a0 = 1.0 / a0;
-    auto area_pow = [=](double a) { return area_power(a, tab, inv_a0, a0, m); };
+    const double inv_ac = inverse_channel_area(settings_);
+    auto area_pow = [=](double a) { return area_power(a, tab, inv_a0, a0, m, inv_ac); };
     // With D8 the tree's area is the drainage area; with MFD it is summed over the tree.
     const bool d8 = settings_.mfd_exponent <= 0.0;
     chunk_out_.assign(std::size_t(std::max<std::int64_t>(groups, 0)), 0.0);

@@ -59,6 +59,12 @@ struct Settings {
     /// 0: detachment-limited (every grain leaves the map; the old solver, unchanged). At steady state
     /// Qs = U·A, so channels carry (1 + G)·U of incision: S = ((1 + G)·U/K)^(1/n)·A^(−m/n).
     double deposition = 0.0;
+    /// A_c, m² (0: none): the drainage area at which rivers take over from hillslopes. Incision is
+    /// K·A^m·(1 − e^(−A/A_c))·S^n: below about A_c the water runs over the slope as sheet wash and
+    /// hardly cuts (channel heads at 10³–10⁵ m², Montgomery & Dietrich 1988, 1992), so hillslopes are
+    /// shaped by creep (and, after the run, by landslides: erode:thermal) rather than by D8 lines one cell wide; above a few A_c the
+    /// factor is 1 and the law is unchanged.
+    double channel_area = 0.0;
 };
 
 /// Uplift that varies in time as well as in space: a piecewise-constant rate
@@ -164,15 +170,21 @@ private:
 /// drain few cells, so the per-cell pow() becomes a lookup.
 inline constexpr std::int64_t kPowTable = 1 << 16;
 
-/// A^m for a drainage area `a` (m²): table[c] = (c·a0)^m when a is c whole
-/// cells of a0 m² (inv_a0 = 1/a0), else pow(a, m).
-inline double area_power(double a, const double* table, double inv_a0, double a0, double m) {
+/// A^m·(1 − e^(−A/A_c)) (Settings::channel_area; inv_ac = 1/A_c, 0 for none) for one area.
+inline double channel_area_power(double a, double m, double inv_ac) {
+    const double am = std::pow(a, m);
+    return inv_ac > 0.0 ? am * -std::expm1(-a * inv_ac) : am;
+}
+
+/// A^m·(1 − e^(−A/A_c)) for a drainage area `a` (m²): table[c] is the value for c
+/// whole cells of a0 m² (inv_a0 = 1/a0), else channel_area_power().
+inline double area_power(double a, const double* table, double inv_a0, double a0, double m, double inv_ac) {
     const double c = a * inv_a0;
     if (c < double(kPowTable - 1)) {
         const auto ci = std::int64_t(c + 0.5);
-        return double(ci) * a0 == a ? table[ci] : std::pow(a, m);
+        return double(ci) * a0 == a ? table[ci] : channel_area_power(a, m, inv_ac);
     }
-    return std::pow(a, m);
+    return channel_area_power(a, m, inv_ac);
 }
 
 /// The implicit incision of one cell for n ≠ 1: x = h_i' − h_r' in (0, Δ]
@@ -193,8 +205,10 @@ inline double incised_drop(double delta, double F, double n) {
     return x;
 }
 
-/// (c·cell²)^m for c = 0 … kPowTable − 1 cells: area_power()'s table.
-std::vector<double> area_power_table(double cell, double m);
+/// channel_area_power(c·cell², m, inv_ac) for c = 0 … kPowTable − 1 cells: area_power()'s table.
+std::vector<double> area_power_table(double cell, double m, double inv_ac);
+/// 1/A_c of the settings, or 0 without a channel area.
+inline double inverse_channel_area(const Settings& s) { return s.channel_area > 0.0 ? 1.0 / s.channel_area : 0.0; }
 /// The hillslope diffusion a step applies: implicit, open sides fixed, closed sides closed.
 diffusion::Settings hillslope_settings(const Settings& settings);
 

@@ -144,7 +144,7 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
         for (int x = 0; x < own_.width; ++x)
             if (y == 0 || y == own_.height - 1 || x == 0 || x == own_.width - 1)
                 edge_.push_back(std::int32_t(std::int64_t(y) * own_.width + x));
-    pow_table_ = area_power_table(cell, settings.area_exponent);
+    pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
     if (settings.diffusivity > 0.0) diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, hillslope_settings(settings));
 }
 
@@ -685,11 +685,12 @@ std::int64_t TiledModel::step(double dt) {
     const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
     const double c1 = K * dt / std::pow(cell_, ns), c2 = K * dt / std::pow(cell_ * kSqrt2, ns);
     const double* tab = pow_table_.data();
+    const double inv_ac = inverse_channel_area(settings_);
     propagate(h_, [&](std::size_t l, double hr) {
         const double hi = h_[l];
         if (hi <= hr) return;
         const int k = dir_[l];
-        const double F = area_power(area_[l], tab, inv_a0, a0, m) * ((k & 1) ? c2 : c1);
+        const double F = area_power(area_[l], tab, inv_a0, a0, m, inv_ac) * ((k & 1) ? c2 : c1);
         if (ns == 1.0) {
             const double wt = 1.0 / (1.0 + F);
             h_[l] = hr + (hi - hr) * wt;

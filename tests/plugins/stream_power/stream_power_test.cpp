@@ -89,6 +89,40 @@ INSTANTIATE_TEST_SUITE_P(StreamPower, SteadyState, ::testing::Values(SteadyCase{
                              return "n" + std::to_string(int(info.param.n * 10));
                          });
 
+TEST(StreamPower, AChannelAreaScalesIncisionByOneMinusExpOfAreaOverIt) {
+    // Settings::channel_area A_c: at steady state U = K·A^m·(1 − e^(−A/A_c))·S, so
+    // S = (U/K)·(A^m·(1 − e^(−A/A_c)))^(−1): channels near their heads (A ~ A_c) are steeper than the
+    // plain law's, large rivers (A ≫ A_c) obey it. No creep, so nothing else sets the slopes.
+    const int w = 81, h = 61;
+    const double cell = 50.0, U = 1e-3;
+    Settings s;
+    s.erodibility = 1e-5;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.0;
+    s.channel_area = 20 * cell * cell;
+    s.open = {true, false, true, false};
+    Model model(w, h, cell, noise(w, h, 1, 10.0), std::vector<double>(std::size_t(w) * h, U), s);
+    model.run(6e7, 2e5);
+    const auto& f = model.flow();
+    const auto& hh = model.heights();
+    double worst = 0.0, steepest_ratio = 0.0;
+    int cells = 0;
+    for (std::size_t i = 0; i < hh.size(); ++i) {
+        const double a = f.area()[i];
+        const std::int32_t r = f.receivers()[i];
+        if (r == std::int32_t(i) || a < 2 * cell * cell) continue;
+        const double slope = (hh[i] - hh[std::size_t(r)]) / f.distance(std::int64_t(i));
+        const double plain = U / s.erodibility * std::pow(a, -s.area_exponent);
+        const double expected = plain / (1.0 - std::exp(-a / s.channel_area));
+        worst = std::max(worst, std::abs(slope / expected - 1.0));
+        steepest_ratio = std::max(steepest_ratio, slope / plain);
+        ++cells;
+    }
+    ASSERT_GT(cells, 500);
+    EXPECT_LT(worst, 0.02) << "largest relative deviation from S = (U/K)(A^m (1 - exp(-A/A_c)))^-1";
+    EXPECT_GT(steepest_ratio, 5.0) << "small catchments must be steeper than the plain law's";
+}
+
 // A river along one row: outlet at the west end, every cell drains all the
 // cells east of it. Settings for the 1-D tests.
 Settings river_settings(double n) {
