@@ -487,14 +487,14 @@ TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
 
 /// The default pipeline (`make demo`), shortened with --set, on 3 ranks in
 /// a row of tiles and on 2x2: every node that computes terrain is tiled
-/// (diamond-square, plates, RMP, stream power, thermal, pipe), the renders,
+/// (diamond-square, plates, the range, stream power, thermal, diffusion), the renders,
 /// the video and the whole-file exports run on rank 0 over gathered grids.
 /// Every file the run writes, the manifest's digests included, must be one
 /// process's bytes.
 TEST(Mpi, DefaultPipelineEqualsOneProcess) {
     const std::string spec = std::string(OROGEN_SOURCE_DIR) + "/pipelines/default.orogen";
     const std::string shorter =
-        " --set plates.steps=200 --set range.years=2e5 --set rivers.steps=200 --set beauty.width=320"
+        " --set plates.steps=200 --set range.years=2e5 --set beauty.width=320"
         " --set beauty.height=180 --set beauty.samples=1 --set spin.frames=4 --set spin.width=160 --set spin.height=90";
     TempDir dir;
     const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q" + shorter);

@@ -34,9 +34,9 @@ constexpr bool sanitized_build = false;
 
 const Case cases[] = {
     {"default",
-     "--set range.dt=2e5 --set rivers.steps=400 --set beauty.width=320 --set beauty.height=180 --set beauty.samples=1 "
+     "--set range.dt=3e5 --set beauty.width=320 --set beauty.height=180 --set beauty.samples=1 "
      "--set spin.frames=4 --set spin.width=160 --set spin.height=90",
-     "--set plates.steps=200 --set rivers.steps=60 --set spin.frames=2"},
+     "--set plates.steps=200 --set range.dt=1e6 --set scree.iterations=10 --set spin.frames=2"},
     {"erosion-pipe-rain", "--set storm.steps=300 --set after.steps=50", "--set storm.steps=40 --set after.steps=10"},
     {"erosion-shapes-4.1", "",
      "--set olsen_crooked.iterations=40 --set olsen_pyramid.iterations=40 --set olsen_hemisphere.iterations=40 "
