@@ -2,6 +2,7 @@
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/parallel.hpp>
 
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
@@ -452,6 +453,40 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
                           std::to_string(spans[i].first) + ")");
 }
 
+/// Decodes chunk `c` into its rows of `planes` (the wanted channels, `w` samples a row) with `dec`, set up on
+/// its first chunk and updated after. Throws orogen::BadInput naming the chunk.
+void decode_chunk(const Source& s, const Opened& o, const Chunk& c, Decoder& dec, std::vector<std::vector<float>>& planes,
+                  int w) {
+    exr_const_context_t ctx = dec.ctx;
+    exr_result_t rv = dec.pipe.channels ? exr_decoding_update(ctx, 0, &c.info, &dec.pipe)
+                                        : exr_decoding_initialize(ctx, 0, &c.info, &dec.pipe);
+    if (rv != EXR_ERR_SUCCESS)
+        refuse(s, "chunk at row " + std::to_string(c.y) + " cannot be decoded (OpenEXR: " + core_message(rv) + ")");
+    const bool first = dec.pipe.unpack_and_convert_fn == nullptr;
+    for (int k = 0; k < dec.pipe.channel_count; ++k) {
+        exr_coding_channel_info_t& out = dec.pipe.channels[k];
+        out.decode_to_ptr = nullptr;
+        const auto it = std::find(o.wanted.begin(), o.wanted.end(), std::string(out.channel_name));
+        if (it == o.wanted.end()) continue;
+        if (out.width != c.info.width || out.height != c.info.height)
+            refuse(s, "it is damaged: channel '" + *it + "' does not fill its chunks");
+        out.decode_to_ptr = reinterpret_cast<std::uint8_t*>(planes[std::size_t(it - o.wanted.begin())].data() +
+                                                            std::size_t(c.y) * std::size_t(w) + std::size_t(c.x));
+        out.user_pixel_stride = sizeof(float);
+        out.user_line_stride = std::int32_t(std::size_t(w) * sizeof(float));
+        out.user_bytes_per_element = sizeof(float);
+        out.user_data_type = EXR_PIXEL_FLOAT;
+    }
+    if (first) {
+        rv = exr_decoding_choose_default_routines(ctx, 0, &dec.pipe);
+        if (rv != EXR_ERR_SUCCESS) refuse(s, "its channels cannot be decoded (OpenEXR: " + core_message(rv) + ")");
+    }
+    rv = exr_decoding_run(ctx, 0, &dec.pipe);
+    if (rv != EXR_ERR_SUCCESS)
+        refuse(s, "it is damaged: the chunk at row " + std::to_string(c.y) + ", column " + std::to_string(c.x) +
+                      " does not decode (OpenEXR: " + core_message(rv) + ")");
+}
+
 std::shared_ptr<Heightmap> read_source(Source& s, const ReadOptions& options) {
     Opened o;
     open_checked(s, options, o);
@@ -466,41 +501,40 @@ std::shared_ptr<Heightmap> read_source(Source& s, const ReadOptions& options) {
     std::vector<std::vector<float>> planes(o.wanted.size());
     for (auto& p : planes) p.resize(n);  // every sample is written below: each chunk's rows are decoded in full
 
-    // OpenEXR's buffers for one chunk at a time (packed, unpacked and the codec's scratch).
-    AllocCap cap(std::size_t(o.largest_chunk) * 2 + (1u << 22));
+    // The chunks decode in parallel, each worker with its own pipeline (OpenEXRCore reads one context from
+    // several threads; source_read is pread or memcpy). Each writes its own rows of the planes; a damaged
+    // chunk is reported by the lowest index, so the message does not depend on the threads.
     exr_const_context_t ctx = o.context.ctx;
-    Decoder dec;
-    dec.ctx = ctx;
-    for (const Chunk& c : o.chunks) {
-        exr_result_t rv = dec.pipe.channels ? exr_decoding_update(ctx, 0, &c.info, &dec.pipe)
-                                            : exr_decoding_initialize(ctx, 0, &c.info, &dec.pipe);
-        if (rv != EXR_ERR_SUCCESS)
-            refuse(s, "chunk at row " + std::to_string(c.y) + " cannot be decoded (OpenEXR: " + core_message(rv) + ")");
-        const bool first = dec.pipe.unpack_and_convert_fn == nullptr;
-        for (int k = 0; k < dec.pipe.channel_count; ++k) {
-            exr_coding_channel_info_t& out = dec.pipe.channels[k];
-            out.decode_to_ptr = nullptr;
-            const auto it = std::find(o.wanted.begin(), o.wanted.end(), std::string(out.channel_name));
-            if (it == o.wanted.end()) continue;
-            if (out.width != c.info.width || out.height != c.info.height)
-                refuse(s, "it is damaged: channel '" + *it + "' does not fill its chunks");
-            out.decode_to_ptr = reinterpret_cast<std::uint8_t*>(planes[std::size_t(it - o.wanted.begin())].data() +
-                                                                std::size_t(c.y) * std::size_t(w) + std::size_t(c.x));
-            out.user_pixel_stride = sizeof(float);
-            out.user_line_stride = std::int32_t(std::size_t(w) * sizeof(float));
-            out.user_bytes_per_element = sizeof(float);
-            out.user_data_type = EXR_PIXEL_FLOAT;
+    std::mutex failure_mutex;
+    std::size_t failed_at = o.chunks.size();
+    std::string failure;
+    auto decode = [&](std::int64_t lo, std::int64_t hi) {
+        // OpenEXR's buffers for one chunk at a time (packed, unpacked and the codec's scratch).
+        AllocCap cap(std::size_t(o.largest_chunk) * 2 + (1u << 22));
+        Decoder dec;
+        dec.ctx = ctx;
+        for (std::int64_t i = lo; i < hi; ++i) {
+            const Chunk& c = o.chunks[std::size_t(i)];
+            try {
+                decode_chunk(s, o, c, dec, planes, w);
+            } catch (const BadInput& e) {
+                const std::lock_guard lock(failure_mutex);
+                if (std::size_t(i) < failed_at) {
+                    failed_at = std::size_t(i);
+                    failure = e.what();
+                }
+                // A pipeline that failed half way is not reused.
+                if (dec.pipe.channels) exr_decoding_destroy(ctx, &dec.pipe);
+                dec.pipe = EXR_DECODE_PIPELINE_INITIALIZER;
+            }
         }
-        if (first) {
-            rv = exr_decoding_choose_default_routines(ctx, 0, &dec.pipe);
-            if (rv != EXR_ERR_SUCCESS)
-                refuse(s, "its channels cannot be decoded (OpenEXR: " + core_message(rv) + ")");
-        }
-        rv = exr_decoding_run(ctx, 0, &dec.pipe);
-        if (rv != EXR_ERR_SUCCESS)
-            refuse(s, "it is damaged: the chunk at row " + std::to_string(c.y) + ", column " + std::to_string(c.x) +
-                          " does not decode (OpenEXR: " + core_message(rv) + ")");
-    }
+    };
+    // Small images (and the fuzz target's) on this thread: waking workers would cost more than it saves.
+    if (o.chunks.size() >= 8 && n * planes.size() >= (std::size_t(1) << 20))
+        parallel_for(0, std::int64_t(o.chunks.size()), 1, decode);
+    else
+        decode(0, std::int64_t(o.chunks.size()));
+    if (failed_at < o.chunks.size()) throw BadInput(failure);
 
     for (std::size_t p = 0; p < planes.size(); ++p) {
         const auto bad = std::find_if(planes[p].begin(), planes[p].end(), [](float v) { return !std::isfinite(v); });

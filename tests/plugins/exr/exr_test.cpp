@@ -289,6 +289,37 @@ TEST(Exr, TheBytesAreTheSameEveryTime) {
     }
 }
 
+TEST(ExrImport, BigImagesDecodeInParallelBitForBitAndNameTheFirstDamagedChunk) {
+    TempDir dir;
+    const Heightmap t = special_terrain(1100, 1000);  // 1.1 M samples, 63 zip chunks: decoded on the pool
+    for (auto c : {exr::Compression::zip, exr::Compression::piz}) {
+        write_terrain(t, dir / "t.exr", c);
+        exr::ReadOptions o;
+        o.all_layers = true;
+        const auto back = exr::read(dir / "t.exr", o);
+        EXPECT_TRUE(same_bits(back->heights().data(), t.heights().data(), t.size()));
+        EXPECT_TRUE(same_bits(back->layer("water").data, t.layer("water").data, t.size()));
+        EXPECT_TRUE(same_bits(back->layer("eroded").data, t.layer("eroded").data, t.size()));
+    }
+    // Two zip chunks made undecodable (their deflate streams zeroed): the lower one is named, every time.
+    write_terrain(t, dir / "t.exr", exr::Compression::zip);
+    auto bytes = bytes_of(dir / "t.exr");
+    const std::size_t table = parse_header(bytes).header_end;
+    for (std::size_t chunk : {40u, 10u}) {
+        const std::size_t at = std::size_t(u64(bytes, table + 8 * chunk));
+        const std::size_t size = std::size_t(i32(bytes, at + 4));
+        std::fill(bytes.begin() + std::ptrdiff_t(at + 8), bytes.begin() + std::ptrdiff_t(at + 8 + size), 0);
+    }
+    put(dir / "damaged.exr", bytes);
+    exr::ReadOptions o;
+    o.all_layers = true;
+    EXPECT_NO_THROW(exr::probe(dir / "damaged.exr", o));  // the layout is whole; the contents are not
+    for (int i = 0; i < 5; ++i)
+        EXPECT_NE(refusal(dir / "damaged.exr", o).find("it is damaged: the chunk at row 160, column 0 does not decode"),
+                  std::string::npos)
+            << refusal(dir / "damaged.exr", o);
+}
+
 TEST(ExrImport, TiledMipmappedAndHalfFilesFromOpenExrsToolsReadExactly) {
     TempDir dir;
     const Heightmap t = special_terrain(70, 50);
