@@ -9,6 +9,8 @@
 #include <orogen/io.hpp>
 
 #include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfStringAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
@@ -197,6 +199,24 @@ void write_with_imf(const fs::path& p, Imf::PixelType type, Imf::Compression com
     out.writePixels(h);
 }
 
+/// A FLOAT channel Y over the data window (x0, y0)-(x0 + w - 1, y0 + h - 1), with a cellSize and heightUnits.
+void write_windowed(const fs::path& p, int x0, int y0, int w, int h, const std::vector<float>& values,
+                    const std::string& units) {
+    const Imath::Box2i window(Imath::V2i(x0, y0), Imath::V2i(x0 + w - 1, y0 + h - 1));
+    Imf::Header header(window, window);
+    header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    header.insert("cellSize", Imf::DoubleAttribute(2.5));
+    header.insert("heightUnits", Imf::StringAttribute(units));
+    Imf::FrameBuffer fb;
+    // OpenEXR addresses a slice by absolute pixel coordinates: the base is moved back to (0, 0).
+    char* base = reinterpret_cast<char*>(const_cast<float*>(values.data())) -
+                 (std::ptrdiff_t(y0) * w + x0) * std::ptrdiff_t(sizeof(float));
+    fb.insert("Y", Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * std::size_t(w)));
+    Imf::OutputFile out(p.c_str(), header);
+    out.setFrameBuffer(fb);
+    out.writePixels(h);
+}
+
 std::vector<std::string> entries(const fs::path& dir) {
     std::vector<std::string> names;
     for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
@@ -348,6 +368,18 @@ TEST(ExrImport, TiledMipmappedAndHalfFilesFromOpenExrsToolsReadExactly) {
     o.cell = 1.0;
     const auto back = exr::read(dir / "half.exr", o);
     EXPECT_TRUE(same_bits(back->heights().data(), v.data(), v.size()));
+}
+
+TEST(ExrImport, ADataWindowAwayFromTheOriginIsReadAsIs) {
+    TempDir dir;
+    std::vector<float> v(23 * 17);
+    for (std::size_t i = 0; i < v.size(); ++i) v[i] = float(i) * 0.25f - 40.0f;
+    write_windowed(dir / "w.exr", -10, 7, 23, 17, v, "m");
+    const auto back = exr::read(dir / "w.exr", {});
+    ASSERT_EQ(back->width(), 23);
+    ASSERT_EQ(back->height(), 17);
+    EXPECT_EQ(back->cell(), 2.5);
+    EXPECT_TRUE(same_bits(back->heights().data(), v.data(), v.size()));  // the window's first row is row 0
 }
 
 TEST(ExrImport, WrongChannelsAndLossyOrNonFiniteDataAreRefusedByName) {
@@ -517,13 +549,15 @@ TEST(ExrCli, BadParametersAndFilesFailAtCheckTimeNamingTheParameter) {
     TempDir dir;
     write_terrain(special_terrain(9, 9), dir / "t.exr");
     dir.write("text.exr", "not an image");
+    write_windowed(dir / "feet.exr", 0, 0, 4, 4, std::vector<float>(16, 1.0f), "ft");
     dir.write("s.orogen", "orogen 1\ngrid 33\nb = generate:fault()\n"
                           "export:exr(b, path=\"a.exr\", layers=\"snow\")\n"
                           "export:exr(b, path=\"b.exr\", channel=\"\")\n"
                           "export:exr(b, path=\"c.tif\")\n"
                           "d = import:exr(path=\"text.exr\")\n"
                           "e = import:exr(path=\"t.exr\", channel=Z)\n"
-                          "f = import:exr(path=\"t.exr\", layers=\"water, snow\")\n");
+                          "f = import:exr(path=\"t.exr\", layers=\"water, snow\")\n"
+                          "g = import:exr(path=\"feet.exr\")\n");
     const RunResult r = run_orogen("check s.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
     for (const char* m :
@@ -533,6 +567,8 @@ TEST(ExrCli, BadParametersAndFilesFailAtCheckTimeNamingTheParameter) {
                                               "OpenEXR file",
           "s.orogen:8:38: error: import:exr: cannot read t.exr: it has no channel 'Z' (its channels are: Y, eroded, "
           "water); give channel=NAME",
-          "s.orogen:9:37: error: import:exr: cannot read t.exr: it has no channel 'snow'"})
+          "s.orogen:9:37: error: import:exr: cannot read t.exr: it has no channel 'snow'",
+          "s.orogen:10:21: error: import:exr: the file says its heights are in 'ft' (its heightUnits attribute); "
+          "import:exr reads metres: convert the file first"})
         EXPECT_NE(r.err.find(m), std::string::npos) << m << "\nin:\n" << r.err;
 }
