@@ -6,6 +6,7 @@ import os
 import pathlib
 import signal
 import subprocess
+import tempfile
 import threading
 import time
 
@@ -112,11 +113,11 @@ def test_seed_and_set_act_as_the_cli_options(tmp_path):
 
 def test_without_out_nothing_is_written(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    before = set(os.listdir("/tmp"))
+    before = set(os.listdir(tempfile.gettempdir()))
     values = orogen.run("orogen 1\ngrid 17\nb = generate:fault(iterations=5)\nexport:raw(b, path=\"b.r32\")\n")
     assert "b" in values
     assert list(tmp_path.iterdir()) == []
-    assert not [n for n in set(os.listdir("/tmp")) - before if n.startswith("orogen-python-")]
+    assert not [n for n in set(os.listdir(tempfile.gettempdir())) - before if n.startswith("orogen-python-")]
 
 
 def test_bad_input_is_a_value_error_with_the_clis_message(tmp_path, monkeypatch):
