@@ -8,6 +8,11 @@
 #include <orogen/io.hpp>
 #include <orogen/plugin.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
 using namespace orogen;
 
 namespace {
@@ -21,7 +26,7 @@ void check(CheckContext& ctx) {
         return;  // nothing else can be judged without knowing what is written
     }
     if (in && in->type == ValueType::image) {
-        for (const char* p : {"bits", "layer", "hillshade", "relief", "azimuth", "elevation"})
+        for (const char* p : {"bits", "layer", "scale", "hillshade", "relief", "azimuth", "elevation"})
             if (ctx.given(p))
                 ctx.error(p, std::string(p) + "= applies to a heightmap; an image is written as 8-bit sRGB "
                                               "(tonemap= and exposure= set how its linear colours are encoded)");
@@ -41,6 +46,21 @@ void check(CheckContext& ctx) {
             if (ctx.given(p)) ctx.error(p, "azimuth and elevation place the light of hillshade=true or relief=true");
     if (!layer.empty() && layer != "height")
         ctx.require_layer(0, "layer", layer, "use \"height\" (the default) or the name of an existing layer");
+    if (ctx.text("scale") == "log" && (ctx.flag("hillshade") || ctx.flag("relief")))
+        ctx.error("scale", "scale=log maps the heights or a layer= to grey; hillshade= and relief= have their own scale");
+}
+
+/// log10 of each positive sample; zero, negative and NaN samples become the smallest positive one's log
+/// (black), so a layer such as drainage area (m², 10³–10⁹) spreads its orders of magnitude over the greys.
+std::vector<float> log_scaled(ConstGridView grid) {
+    float smallest = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < grid.size(); ++i)
+        if (grid.data[i] > 0.0f) smallest = std::min(smallest, grid.data[i]);
+    const float floor = std::isfinite(smallest) ? std::log10(smallest) : 0.0f;
+    std::vector<float> out(grid.size());
+    for (std::size_t i = 0; i < grid.size(); ++i)
+        out[i] = grid.data[i] > 0.0f && std::isfinite(grid.data[i]) ? std::log10(grid.data[i]) : floor;
+    return out;
 }
 
 /// Splat colour (sand, grass, rock, snow by height and slope, as the glTF
@@ -78,7 +98,12 @@ NodeOutputs run(NodeContext& ctx) {
     if (ctx.flag("hillshade")) {
         samples = png_export::hillshade(hm.view(), bits, ctx.real("azimuth"), ctx.real("elevation"));
     } else {
-        const ConstGridView grid = layer.empty() || layer == "height" ? hm.view() : hm.layer(layer);
+        ConstGridView grid = layer.empty() || layer == "height" ? hm.view() : hm.layer(layer);
+        std::vector<float> logs;
+        if (ctx.text("scale") == "log") {
+            logs = log_scaled(grid);
+            grid = ConstGridView(logs.data(), grid.width, grid.height, grid.cell);
+        }
         samples = png_export::quantise(grid, bits, png_export::range_of(grid));
     }
     AtomicFile file(ctx.output_path(ctx.text("path")));
@@ -112,6 +137,9 @@ OROGEN_PLUGIN("png-export", "0.1.0", registry) {
                     "deflate level (libdeflate): 0 stores, 1 is fastest (4x libpng's speed, files 1/4 larger), "
                     "12 smallest; 6 writes libpng's size about twice as fast"),
                 Param::string("layer", "").help("write this layer instead of the heights (\"\" or \"height\": the heights)"),
+                Param::choice("scale", {"linear", "log"}, "linear")
+                    .help("how values map to grey: linear (min black, max white) or log (log10 of the positive "
+                          "values; zero and below black): for layers spanning orders of magnitude, e.g. drainage"),
                 Param::boolean("hillshade", false).help("write the hillshade of the heights instead"),
                 Param::boolean("relief", false).help(
                     "write a colour relief map instead: sand, grass, rock and snow by height and slope (the thesis's "

@@ -84,6 +84,40 @@ TEST(PngExportCli, SixteenBitHeightsLayersAndHillshadeRoundTrip) {
     EXPECT_EQ(shade.samples, png_export::hillshade({h.data(), 97, 97, 15.0}, 8, 135, 35));
 }
 
+TEST(PngExportCli, ALogScaleSpreadsALayersOrdersOfMagnitudeOverTheGreys) {
+    // scale=log: grey = (log10 v - log10 v_min) / (log10 v_max - log10 v_min) over the positive values. On a
+    // drainage layer (one cell's area to the whole map's: three orders of magnitude here) the linear map
+    // leaves nearly every sample black; the log map gives a cell draining 10x more area one third of the
+    // range more.
+    TempDir dir;
+    const auto spec = dir.write("log.orogen",
+                                "orogen 1\nseed 3\ngrid 65 cell=30\n"
+                                "base = generate:fault(iterations=60, displacement=4)\n"
+                                "river = erode:stream-power(base, years=1e5, dt=5e4)\n"
+                                "export:png(river, path=\"lin.png\", bits=16, layer=\"drainage\")\n"
+                                "export:png(river, path=\"log.png\", bits=16, layer=\"drainage\", scale=\"log\")\n"
+                                "export:raw(river, path=\"h.r32\")\n");
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const GrayImage lin = read_gray_png(dir / "out" / "lin.png"), log = read_gray_png(dir / "out" / "log.png");
+    ASSERT_EQ(log.samples.size(), std::size_t(65 * 65));
+    // The same order (a monotone map of the same values), the ends at black and white.
+    std::size_t lin_bright = 0, log_bright = 0;
+    for (std::size_t a = 0; a < lin.samples.size(); ++a) {
+        lin_bright += lin.samples[a] > 32767;
+        log_bright += log.samples[a] > 32767;
+        for (std::size_t b = a + 1; b < lin.samples.size(); b += 97)
+            if (lin.samples[a] < lin.samples[b]) ASSERT_LE(log.samples[a], log.samples[b]) << a << " " << b;
+    }
+    EXPECT_EQ(*std::min_element(log.samples.begin(), log.samples.end()), 0);
+    EXPECT_EQ(*std::max_element(log.samples.begin(), log.samples.end()), 65535);
+    // Linear: only the trunk rivers are brighter than mid-grey. Log: every cell draining more than about
+    // the square root of the largest area is, a whole tributary network.
+    EXPECT_LT(lin_bright, lin.samples.size() / 100);
+    EXPECT_GT(log_bright, 5 * std::max<std::size_t>(lin_bright, 1));
+    EXPECT_GT(log_bright, lin.samples.size() / 100);
+}
+
 TEST(PngExportCli, LayerAndHillshadeMistakesFailAtCheckTime) {
     TempDir dir;
     const auto spec = dir.write("bad.orogen",
