@@ -214,8 +214,19 @@ struct ScratchFolder {
     ScratchFolder& operator=(const ScratchFolder&) = delete;
 };
 
-py::dict run_spec(const std::string& spec, std::optional<std::uint64_t> seed, const py::dict& overrides,
-                  std::optional<int> threads, std::optional<std::string> out, bool progress) {
+/// A str, or any os.PathLike (pathlib.Path) as its path; a TypeError naming `what` otherwise.
+std::string path_text(const py::handle& v, const char* what) {
+    if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+    if (py::hasattr(v, "__fspath__")) return py::str(py::module_::import("os").attr("fspath")(v)).cast<std::string>();
+    throw py::type_error(std::string(what) + " must be a str or a path (pathlib.Path), got " +
+                         std::string(py::str(py::type::of(v).attr("__name__"))));
+}
+
+py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed, const py::dict& overrides,
+                  std::optional<int> threads, const py::object& out_arg, bool progress) {
+    const std::string spec = path_text(spec_arg, "spec");
+    std::optional<std::string> out;
+    if (!out_arg.is_none()) out = path_text(out_arg, "out");
     // A path, or the spec's text itself.
     std::string name, text;
     fs::path spec_path;

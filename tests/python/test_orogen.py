@@ -42,7 +42,7 @@ def test_run_gives_the_cli_bytes_and_every_named_value(tmp_path, monkeypatch):
     (tmp_path / "s.orogen").write_text(SPEC)
     r = cli(["run", "s.orogen", "--out", "cli", "--quiet"], tmp_path)
     assert r.returncode == 0, r.stderr
-    values = orogen.run("s.orogen", out="py")
+    values = orogen.run(pathlib.Path("s.orogen"), out=pathlib.Path("py"))  # paths as str or pathlib.Path
     assert sorted(values) == ["b", "t", "t.timelapse", "w"]
     # The files, manifest included, byte for byte.
     names = sorted(p.name for p in (tmp_path / "cli").iterdir())
@@ -146,6 +146,8 @@ def test_bad_input_is_a_value_error_with_the_clis_message(tmp_path, monkeypatch)
         orogen.run("orogen 1\ngrid 33\nb = generate:fault()\n", set={"b.iterations": object()})
     with pytest.raises(ValueError, match="cannot read spec nowhere.orogen: no such file"):
         orogen.run("nowhere.orogen")
+    with pytest.raises(TypeError, match="spec must be a str or a path"):
+        orogen.run(42)
     with pytest.raises(ValueError, match="threads must be a number from 1 to 1024"):
         orogen.run("orogen 1\ngrid 17\nb = generate:fault()\n", threads=0)
 
