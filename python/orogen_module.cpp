@@ -53,7 +53,7 @@ PluginSet& plugins() {
                             : fs::current_path() / "orogen";
         // The loader searches <bin>/../lib/orogen/plugins for the binary's path it is given: from the build
         // tree's <build>/python/orogen/_orogen.so that is <build>/bin/orogen, from an installed
-        // <prefix>/lib/python3/dist-packages/orogen/_orogen.so <prefix>/bin/orogen (and the kernel's own
+        // <prefix>/lib/python3.X/dist-packages/orogen/_orogen.so <prefix>/bin/orogen (and the kernel's own
         // install prefix in either case).
         const fs::path build = here.parent_path().parent_path().parent_path();
         const fs::path installed = build.parent_path().parent_path();
