@@ -9,13 +9,16 @@
 // `orogen analyze` measures them (docs/realism.md's table; the DEMs' sources
 // and licences are in ../shared/realism/README.md). Terrain that drifts out of
 // a band (a default changed, a process that roughens or steepens) fails here.
+#include <orogen/analysis/compare.hpp>
 #include <orogen/analysis/figures.hpp>
 
 #include <gtest/gtest.h>
 
 #include "orogen_test.hpp"
 
+#include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -70,5 +73,82 @@ TEST_P(DefaultPipeline, LiesInsideRealRangesFiguresAtThirtyMetres) {
 
 INSTANTIATE_TEST_SUITE_P(Seeds, DefaultPipeline, testing::Values(42, 1, 2, 3, 4, 5),
                          [](const auto& info) { return "seed" + std::to_string(info.param); });
+
+}  // namespace
+
+namespace {
+
+/// A reference DEM of ../shared/realism/dems (float32 rows north to south, and a .json with nx, ny, dx_m).
+struct Reference {
+    std::string name;
+    std::vector<float> heights;
+    int width = 0, height = 0;
+    double cell = 0.0;
+};
+
+std::optional<Reference> read_reference(const fs::path& dems, const std::string& name) {
+    const std::string json = slurp(dems / (name + ".json")), data = slurp(dems / (name + ".f32"));
+    auto number = [&](const std::string& key) {
+        const std::size_t at = json.find("\"" + key + "\"");
+        if (at == std::string::npos) return 0.0;
+        return std::stod(json.substr(json.find(':', at) + 1));
+    };
+    Reference r{name, {}, int(number("nx")), int(number("ny")), number("dx_m")};
+    if (r.width <= 0 || r.height <= 0 || data.size() != std::size_t(r.width) * std::size_t(r.height) * 4) return std::nullopt;
+    r.heights.resize(data.size() / 4);
+    std::memcpy(r.heights.data(), data.data(), data.size());
+    return r;
+}
+
+struct Preset {
+    const char* pipeline;   ///< pipelines/<name>.orogen
+    const char* namesake;   ///< the reference DEM it is named after
+};
+
+class RangePreset : public testing::TestWithParam<Preset> {};
+
+TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
+    // The distance `orogen analyze --against` prints: RMS over every figure of the difference in units of
+    // the four 27–30 m references' spread (libs/analysis compare.hpp).
+    const fs::path dems = fs::path(OROGEN_SOURCE_DIR) / ".." / "shared" / "realism" / "dems";
+    if (!fs::exists(dems / "himalaya_baspa_30m.f32")) GTEST_SKIP() << "no reference DEMs at " << dems;
+    std::vector<Reference> refs;
+    for (const char* name : {"himalaya_baspa_30m", "morocco_rif_27m", "nz_kahurangi_30m", "nz_raukumara_30m"}) {
+        auto r = read_reference(dems, name);
+        ASSERT_TRUE(r) << name;
+        refs.push_back(std::move(*r));
+    }
+    std::vector<orogen::analysis::Figures> ref_figures;
+    for (const auto& r : refs) ref_figures.push_back(orogen::analysis::measure({r.heights.data(), r.width, r.height, r.cell}));
+    std::vector<const orogen::analysis::Figures*> pointers;
+    for (const auto& f : ref_figures) pointers.push_back(&f);
+    const auto bands = orogen::analysis::reference_bands(pointers);
+
+    TempDir dir;
+    const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / (std::string(GetParam().pipeline) + ".orogen");
+    const RunResult r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()) +
+                                   " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const std::string raw = slurp(dir / "terrain.r32");
+    const int n = 1025;
+    ASSERT_EQ(raw.size(), std::size_t(n) * n * sizeof(float));
+    std::vector<float> h(std::size_t(n) * n);
+    std::memcpy(h.data(), raw.data(), raw.size());
+    const auto mine = orogen::analysis::measure({h.data(), n, n, 30.0});
+    std::string nearest;
+    double best = 1e300;
+    for (std::size_t i = 0; i < refs.size(); ++i) {
+        const auto d = orogen::analysis::distance(mine, ref_figures[i], bands);
+        ASSERT_GT(d.used, 10u) << refs[i].name;
+        std::printf("%s: %s at %.2f\n", GetParam().pipeline, refs[i].name.c_str(), d.value);
+        if (d.value < best) best = d.value, nearest = refs[i].name;
+    }
+    EXPECT_EQ(nearest, GetParam().namesake);
+}
+
+INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
+                         testing::Values(Preset{"himalaya", "himalaya_baspa_30m"}, Preset{"rif", "morocco_rif_27m"},
+                                         Preset{"raukumara", "nz_raukumara_30m"}),
+                         [](const auto& info) { return std::string(info.param.pipeline); });
 
 }  // namespace
