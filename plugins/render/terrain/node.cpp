@@ -37,7 +37,7 @@ std::vector<Param> camera_params() {
         Param::real("azimuth", 200.0).min(0).max(360).unit("°").help(
             "orbit: where the camera stands seen from the target, clockwise from north (180: south, looking north)"),
         Param::real("elevation", 20.0).min(-89).max(89).unit("°").help("orbit: camera height angle above the horizontal"),
-        Param::real("distance", 0.0).min(0).unit("m").help("orbit: camera distance from the target (0: fit the terrain)"),
+        Param::real("distance", 0.0).min(0).unit("m").help("orbit: camera distance from the target (0: fit the land above any sea, centred in the frame when the target is the middle)"),
         Param::point("target", Point2{0.5, 0.5}).help("orbit: the point looked at, as a fraction of the terrain (x east, y south)"),
         Param::point("from", Point2{0.5, 1.3}).help("look-at: the camera's place, as a fraction of the terrain"),
         Param::real("from_height", 2000.0).unit("m").help("look-at: camera height above the terrain's lowest point"),
@@ -221,6 +221,7 @@ NodeOutputs run_turntable(NodeContext& ctx) {
     base.distance = ctx.real("distance");
     base.target = ctx.point("target");
     base.fov = ctx.real("fov");
+    base.centre_land = false;  // one pivot for the whole turn
     const int width = int(ctx.integer("width")), height = int(ctx.integer("height"));
     const auto frames = std::size_t(ctx.integer("frames"));
     const double turns = ctx.real("turns"), fps = ctx.real("fps"), start_time = ctx.real("time");

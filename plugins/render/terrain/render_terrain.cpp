@@ -285,22 +285,72 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
             double distance = camera.distance;
             const glm::dvec3 back = direction(camera.azimuth, camera.elevation);
             if (distance <= 0) {
-                // The nearest distance at which every corner of the terrain's box is in the frame
-                // (with a 4 % margin), by bisection: nearer than the bounding sphere's fit.
+                // The nearest distance at which all of the land is in the frame (with a 4 % margin), by
+                // bisection. What must fit is the surface itself (a lattice of at most 65 × 65 of its samples at
+                // their heights) and its skirt's foot along the edges, not the box around them: the box's top
+                // corners stand at the highest summit's height over every corner. With a sea, what lies under
+                // it is sea to the horizon, so only the land above it counts (the skirt down to the water):
+                // fitting the drowned corners and the skirt's foot under the water left the land a small slab
+                // in a wide frame.
+                std::vector<glm::dvec3> outline;
+                const ConstGridView g = m.terrain->view();
+                const double cell = m.terrain->cell();
+                const int stride = std::max(1, (std::max(m.width, m.height) - 1) / 64);
+                std::vector<int> xs, ys;  // every stride-th sample, and the last
+                for (int x = 0; x < m.width - 1; x += stride) xs.push_back(x);
+                for (int y = 0; y < m.height - 1; y += stride) ys.push_back(y);
+                xs.push_back(m.width - 1);
+                ys.push_back(m.height - 1);
+                const double foot = st.sea ? st.sea_level * exag : box_min.y;
+                for (int y : ys)
+                    for (int x : xs) {
+                        const double h = g.at(x, y);
+                        if (st.sea && !(h > st.sea_level)) continue;
+                        outline.emplace_back(x * cell, h * exag, y * cell);
+                        if (x == 0 || y == 0 || x == m.width - 1 || y == m.height - 1)
+                            outline.emplace_back(x * cell, foot, y * cell);
+                    }
+                if (outline.empty())  // all under the sea: the terrain's box, as a frame for the sea floor
+                    for (int c = 0; c < 8; ++c)
+                        outline.emplace_back(c & 1 ? box_max.x : box_min.x, c & 2 ? box_max.y : box_min.y,
+                                             c & 4 ? box_max.z : box_min.z);
                 const glm::dmat4 proj = glm::perspective(camera.fov * kDegree, aspect, radius * 1e-3, radius * 100);
                 auto fits = [&](double d) {
                     const glm::dvec3 e = target + back * d;
                     const glm::dmat4 vp = proj * glm::lookAt(e, target, std::abs(back.y) > 0.9999 ? glm::dvec3(0, 0, -1) : up);
-                    for (int c = 0; c < 8; ++c) {
-                        const glm::dvec4 p = vp * glm::dvec4(c & 1 ? box_max.x : box_min.x, c & 2 ? box_max.y : box_min.y,
-                                                             c & 4 ? box_max.z : box_min.z, 1.0);
+                    for (const glm::dvec3& q : outline) {
+                        const glm::dvec4 p = vp * glm::dvec4(q, 1.0);
                         if (p.w <= 0 || std::abs(p.x / p.w) > 0.96 || std::abs(p.y / p.w) > 0.96) return false;
                     }
                     return true;
                 };
-                double lo = 0, hi = radius / std::sin(std::min(camera.fov, 179.0) * 0.5 * kDegree) * 4 + radius;
-                for (int i = 0; i < 40; ++i) (fits(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
-                distance = hi;
+                auto fit = [&] {
+                    double lo = 0, hi = radius / std::sin(std::min(camera.fov, 179.0) * 0.5 * kDegree) * 4 + radius;
+                    for (int i = 0; i < 40; ++i) (fits(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
+                    return hi;
+                };
+                distance = fit();
+                // Looking at the terrain's middle (the default target), the land is centred in the frame and
+                // fitted again: a few rounds of moving the target by the land's offset from the frame's middle
+                // (its extent at the target's distance), so the land fills the frame instead of leaving a band
+                // of sky above it.
+                if (camera.centre_land && camera.target.x == 0.5 && camera.target.y == 0.5 && std::abs(back.y) < 0.9999) {
+                    const glm::dvec3 right = glm::normalize(glm::cross(up, back)), upward = glm::cross(back, right);
+                    for (int round = 0; round < 4; ++round) {
+                        const glm::dvec3 e = target + back * distance;
+                        const glm::dmat4 vp = proj * glm::lookAt(e, target, up);
+                        glm::dvec2 lo(1e300), hi(-1e300);
+                        for (const glm::dvec3& q : outline) {
+                            const glm::dvec4 p = vp * glm::dvec4(q, 1.0);
+                            lo = glm::min(lo, glm::dvec2(p) / p.w);
+                            hi = glm::max(hi, glm::dvec2(p) / p.w);
+                        }
+                        const glm::dvec2 off = 0.5 * (lo + hi);  // the land's middle, in the frame's -1..1
+                        const double half_height = distance * std::tan(camera.fov * 0.5 * kDegree);
+                        target += right * (off.x * half_height * aspect) + upward * (off.y * half_height);
+                        distance = fit();
+                    }
+                }
             }
             eye = target + back * distance;
         } else {

@@ -27,8 +27,11 @@ struct Camera {
     /// from north (180: the camera stands south of the target, looking north).
     double azimuth = 200.0;
     double elevation = 20.0;  ///< orbit: degrees above the horizontal
-    double distance = 0.0;    ///< orbit: metres from the target; 0 fits the whole terrain in view
+    double distance = 0.0;    ///< orbit: metres from the target; 0 fits the land (above any sea) in view
     Point2 target{0.5, 0.5};  ///< orbit: the point looked at (fraction of the extent), at mid height
+    /// orbit with distance 0 and the default target: look at the land's middle in the frame rather than the
+    /// terrain's (a picture filled with land); a turntable keeps one pivot instead, so it turns steadily.
+    bool centre_land = true;
     Point2 from{0.5, 1.2}, to{0.5, 0.5};  ///< look_at: eye and target (fractions of the extent) ...
     double from_height = 2000.0, to_height = 0.0;  ///< ... and their heights above the terrain's lowest point, m
     double fov = 40.0;        ///< vertical field of view, degrees, in (0, 180)

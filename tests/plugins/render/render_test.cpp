@@ -243,6 +243,55 @@ TEST(Shadows, AKeptShadowMapGivesTheFrameAFreshOneWould) {
     EXPECT_FALSE(moved.render(96, 64, b).rgba32f == second.rgba32f);
 }
 
+// Issue 32, item 5: the default orbit fills the frame with the land, centred, not a slab in a wide frame of
+// sky; with a sea, what lies under it does not count (it is sea to the horizon).
+TEST(Camera, TheDefaultOrbitFillsTheFrameWithTheLand) {
+    const int n = 97;
+    auto hm = std::make_shared<Heightmap>(n, n, 20.0);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const double r = std::hypot(x / double(n - 1) - 0.5, y / double(n - 1) - 0.5);
+            hm->view().at(x, y) = float(std::max(0.0, 600.0 * (1.0 - r / 0.5)));  // a cone on a plain at 0 m
+        }
+    // The pixels of the surface in the normal pass: their box, as fractions, and whether any is on the border.
+    auto land_box = [](const Image& img) {
+        double x0 = 1, y0 = 1, x1 = 0, y1 = 0;
+        bool border = false;
+        for (int y = 0; y < img.height; ++y)
+            for (int x = 0; x < img.width; ++x) {
+                const float* p = &img.rgba32f[(std::size_t(y) * img.width + x) * 4];
+                // A unit normal n is drawn n·0.5 + 0.5, so |2c − 1| is 1 on the terrain; the sky behind it is a
+                // greyish blue, far from that.
+                if (std::hypot(2 * p[0] - 1, 2 * p[1] - 1, 2 * p[2] - 1) < 0.7f) continue;
+                x0 = std::min(x0, (x + 0.5) / img.width), x1 = std::max(x1, (x + 0.5) / img.width);
+                y0 = std::min(y0, (y + 0.5) / img.height), y1 = std::max(y1, (y + 0.5) / img.height);
+                border = border || x == 0 || y == 0 || x == img.width - 1 || y == img.height - 1;
+            }
+        return std::make_pair(std::array<double, 4>{x0, y0, x1, y1}, border);
+    };
+    Style s;
+    s.output = Style::Output::normal;
+    const auto [whole, cut] = land_box(TerrainRenderer(hm, s).render(160, 96, Camera{}));
+    EXPECT_FALSE(cut) << "the terrain runs out of the frame";
+    EXPECT_GE(std::max(whole[2] - whole[0], whole[3] - whole[1]), 0.88)
+        << "the terrain fills " << whole[2] - whole[0] << " of the width, " << whole[3] - whole[1] << " of the height";
+    EXPECT_NEAR(0.5 * (whole[0] + whole[2]), 0.5, 0.06);
+    EXPECT_NEAR(0.5 * (whole[1] + whole[3]), 0.5, 0.06);
+    // Under a sea at 300 m only the cone's top half is land: the camera comes closer to frame it.
+    s.sea = true;
+    s.sea_level = 300;
+    s.output = Style::Output::beauty;
+    const Image sea = TerrainRenderer(hm, s).render(160, 96, Camera{});
+    s.sea = false;
+    Camera near = Camera{};
+    const Image plain = TerrainRenderer(hm, s).render(160, 96, near);
+    EXPECT_FALSE(sea.rgba32f == plain.rgba32f);
+    s.output = Style::Output::normal;
+    s.sea = true;  // the normal pass draws no water: the whole cone shows, larger than the frame
+    const auto [drowned, drowned_cut] = land_box(TerrainRenderer(hm, s).render(160, 96, Camera{}));
+    EXPECT_TRUE(drowned_cut) << "the camera framed the drowned plain too";
+}
+
 TEST(Camera, BadCamerasAreRefusedWithTheReason) {
     auto hm = grid(33, 10.0, 100.0f);
     TerrainRenderer r(hm, Style{});
