@@ -76,8 +76,13 @@ uniform float sun_disc;       // 1 draws the disc, 0 only its glow (reflections,
 vec3 sky_colour(vec3 dir, float with_disc) {
     float up = max(dir.y, 0.0);
     vec3 sky = mix(sky_horizon, sky_zenith, pow(up, 0.35));
-    // below the horizon: the haze continues, a little darker
-    if (dir.y < 0.0) sky = sky_horizon * (1.0 - 0.25 * min(-dir.y * 3.0, 1.0));
+    // Below the horizon the haze lies over the ground or the sea, not the bright sky: darker and a little
+    // bluer from the horizon down (over a tenth of a degree, so the horizon is a line, not a step of pixels),
+    // so that a far sea reads as sea under the sky rather than melting into it.
+    if (dir.y < 0.0) {
+        vec3 below = sky_horizon * vec3(0.70, 0.76, 0.84) * (1.0 - 0.2 * min(-dir.y * 3.0, 1.0));
+        sky = mix(sky_horizon, below, smoothstep(0.0, 0.002, -dir.y));
+    }
     float mu = max(dot(dir, sun_direction), 0.0);
     vec3 glow = sun_colour * (0.25 * pow(mu, 8.0) + 0.6 * pow(mu, 64.0) + 0.3 * pow(mu, 600.0));
     vec3 disc = sun_colour * 40.0 * smoothstep(0.99996, 0.99999, mu) * with_disc;

@@ -292,6 +292,41 @@ TEST(Camera, TheDefaultOrbitFillsTheFrameWithTheLand) {
     EXPECT_TRUE(drowned_cut) << "the camera framed the drowned plain too";
 }
 
+// Issue 32, item 5: a far sea reads as sea under the sky: below the horizon the haze is darker than the sky
+// just above it, so the horizon is a line rather than the sea melting into the sky.
+TEST(Sea, TheHorizonSeparatesTheSeaFromTheSky) {
+    const int n = 65;
+    auto hm = std::make_shared<Heightmap>(n, n, 20.0);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const double r = std::hypot(x / double(n - 1) - 0.5, y / double(n - 1) - 0.5);
+            hm->view().at(x, y) = float(std::max(0.0, 300.0 * (1.0 - r / 0.3)));  // an island
+        }
+    Style s;
+    s.sea = true;
+    s.sea_level = 20;
+    Camera c;
+    c.elevation = 4;  // the horizon 4° above the frame's middle: row (1 − tan 4° / tan 20°) / 2 of the height
+    const int w = 160, h = 96;
+    const Image img = TerrainRenderer(hm, s).render(w, h, c);
+    const double horizon = (1.0 - std::tan(4.0 * std::numbers::pi / 180) / std::tan(20.0 * std::numbers::pi / 180)) / 2 * h;
+    // Mean luminance of a row's first and last eighth (the island stands in the middle).
+    auto luminance = [&](int row) {
+        double sum = 0;
+        int count = 0;
+        for (int x = 0; x < w; ++x) {
+            if (x > w / 8 && x < w - w / 8) continue;
+            const float* p = &img.rgba32f[(std::size_t(row) * w + x) * 4];
+            sum += 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+            ++count;
+        }
+        return sum / count;
+    };
+    // (Before: the sea just below the horizon 7 % brighter than the sky above it, the two one haze.)
+    const double sky = luminance(int(horizon) - 3), sea = luminance(int(horizon) + 4);
+    EXPECT_LT(sea, 0.95 * sky) << "sky " << sky << ", sea " << sea << " (horizon at row " << horizon << ")";
+}
+
 TEST(Camera, BadCamerasAreRefusedWithTheReason) {
     auto hm = grid(33, 10.0, 100.0f);
     TerrainRenderer r(hm, Style{});
