@@ -1,6 +1,6 @@
-// The report's charts, drawn by gnuplot (pngcairo, from Debian's gnuplot-nox) run as a child process: a
-// script with the data inline (datablocks) goes to its standard input; it writes each PNG to an
-// AtomicFile's temporary name, and the files are renamed into place together once all are drawn.
+// The report's charts, drawn by gnuplot (pngcairo, from Debian's gnuplot-nox) run as a child process on a
+// script with the data inline (datablocks); it writes each PNG to an AtomicFile's temporary name, and the
+// files are renamed into place together once all are drawn.
 #include "report.hpp"
 
 #include <orogen/error.hpp>
@@ -84,44 +84,45 @@ std::string plot(const std::vector<Terrain>& terrains, const std::string& name,
     return blocks.str() + command.str() + "\n";
 }
 
-/// Runs gnuplot on `script` (fed on standard input). "" or what went wrong.
-std::string run_gnuplot(const std::string& script, const std::filesystem::path& errors) {
-    int in[2];
-    if (::pipe(in) != 0) return std::string("cannot make a pipe: ") + std::strerror(errno);
+/// Runs gnuplot on `script`, written to a hidden file in `folder` (not fed through a pipe: a gnuplot that
+/// stops early would leave us writing into a closed pipe, and SIGPIPE would end the run). "" or what went wrong.
+std::string run_gnuplot(const std::string& script, const std::filesystem::path& folder) {
+    const std::string tag = ".orogen-gnuplot-" + std::to_string(::getpid());
+    const std::filesystem::path script_file = folder / (tag + ".gp"), errors = folder / (tag + ".err");
+    struct Remove {
+        std::filesystem::path a, b;
+        ~Remove() {
+            std::error_code ec;
+            std::filesystem::remove(a, ec);
+            std::filesystem::remove(b, ec);
+        }
+    } remove{script_file, errors};
+    {
+        std::ofstream out(script_file, std::ios::binary);
+        out << script;
+        if (!out.flush()) return "cannot write the chart script " + script_file.string();
+    }
     posix_spawn_file_actions_t actions;
     posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_adddup2(&actions, in[0], 0);
-    posix_spawn_file_actions_addclose(&actions, in[1]);
+    posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
     posix_spawn_file_actions_addopen(&actions, 2, errors.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    std::string arg1 = script_file.string();
     char arg0[] = "gnuplot";
-    char* argv[] = {arg0, nullptr};
+    char* argv[] = {arg0, arg1.data(), nullptr};
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
-    ::close(in[0]);
-    if (spawned != 0) {
-        ::close(in[1]);
-        return "gnuplot is not installed (apt-get install gnuplot-nox): " + std::string(std::strerror(spawned));
-    }
-    std::size_t done = 0;
-    while (done < script.size()) {
-        const ssize_t n = ::write(in[1], script.data() + done, script.size() - done);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) break;
-        done += std::size_t(n);
-    }
-    ::close(in[1]);
+    if (spawned != 0) return "gnuplot is not installed (apt-get install gnuplot-nox): " + std::string(std::strerror(spawned));
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
-    std::ifstream err(errors);
-    std::stringstream text;
-    text << err.rdbuf();
-    std::error_code ec;
-    std::filesystem::remove(errors, ec);
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || done < script.size())
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        std::ifstream err(errors);
+        std::stringstream text;
+        text << err.rdbuf();
         return "gnuplot failed: " + text.str();
+    }
     return {};
 }
 
@@ -242,7 +243,7 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
         written.charts.push_back(p.chart);
     }
     if (files.empty()) return written;
-    const std::string problem = run_gnuplot(script, folder / ".orogen-gnuplot-errors.txt");
+    const std::string problem = run_gnuplot(script, folder);
     if (!problem.empty()) {
         written.charts.clear();
         written.problem = problem;

@@ -215,6 +215,18 @@ TEST(AnalyzeCli, TheSameBytesOnOneThreadOrTwo) {
         EXPECT_EQ(slurp(dir / "t1" / file), slurp(dir / "t2" / file)) << file;
 }
 
+TEST(AnalyzeCli, WithoutGnuplotTheReportComesWithoutCharts) {
+    TempDir dir;
+    const auto r = run_orogen("analyze " + q(rif) + " --no-render --out " + q(dir / "out"), "PATH=/nonexistent");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("no charts: gnuplot is not installed (apt-get install gnuplot-nox)"), std::string::npos) << r.err;
+    EXPECT_TRUE(fs::exists(dir / "out/analysis.json"));
+    EXPECT_FALSE(fs::exists(dir / "out/analysis-slopes.png"));
+    EXPECT_EQ(slurp(dir / "out/README.md").find("## Charts"), std::string::npos);
+    for (const auto& e : fs::directory_iterator(dir / "out"))
+        EXPECT_NE(e.path().filename().string().rfind(".orogen-gnuplot", 0), 0u) << "left behind: " << e.path();
+}
+
 TEST(AnalyzeCli, HelpCitesEachFiguresSource) {
     const auto r = run_orogen("help analyze:terrain");
     ASSERT_EQ(r.exit_code, 0) << r.err;
