@@ -287,8 +287,16 @@ NodeOutputs run(NodeContext& ctx) {
         drainage.data[i] = float(area[i]);
         direction.data[i] = float(tiles ? tiled->direction(i) : whole->flow().direction(std::int64_t(i)));
     }
+    // eroded: what the surface processes did (m; negative where rock was removed, positive where sediment
+    // settled), as the other eroders' layer; the rock uplift is kept apart in uplifted, so that on a rising
+    // range `eroded` does not read +400 m where the rivers removed 100 m of 500 m of uplift.
+    const std::vector<double>& rock_uplift = tiles ? tiled->uplifted() : whole->uplifted();
     GridView eroded = hm->layer("eroded", 0.0f);
-    for (std::size_t i = 0; i < n; ++i) eroded.data[i] += out[i] - before[i];
+    GridView uplifted = hm->layer("uplifted", 0.0f);
+    for (std::size_t i = 0; i < n; ++i) {
+        eroded.data[i] += float(double(out[i]) - double(before[i]) - rock_uplift[i]);
+        uplifted.data[i] += float(rock_uplift[i]);
+    }
     if (ctx.flag("chi")) {
         const std::vector<double> chi = tiles ? tiled->chi(1.0) : whole->chi(1.0);
         GridView c = hm->layer("chi", 0.0f);
@@ -373,7 +381,7 @@ void check(CheckContext& ctx) {
         ctx.error("", msg.str());
     }
     check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));
-    for (const char* l : {"drainage", "flow_direction", "eroded"}) ctx.output().layers.insert(l);
+    for (const char* l : {"drainage", "flow_direction", "eroded", "uplifted"}) ctx.output().layers.insert(l);
     if (ctx.flag("chi")) ctx.output().layers.insert("chi");
 }
 
@@ -401,7 +409,9 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
             "uplift_history; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
-            "outlet), eroded (net change, m, added to an earlier eroder's) and, with chi=true, chi (m).",
+            "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; added to "
+            "an earlier eroder's), uplifted (the rock uplift it received, m; eroded + uplifted is the net change) and, "
+            "with chi=true, chi (m).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"},
                    {"uplift_history", ValueType::heightmap, Need::optional,
                     "heights over time (e.g. plates.timelapse): the height change between two frames is rock uplift "
@@ -490,7 +500,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 Param::boolean("chi", false).help("also write the layer chi (m; reference area 1 m^2)"),
                 timelapse_param(),
             },
-        .adds_layers = {"drainage", "flow_direction", "eroded"},
+        .adds_layers = {"drainage", "flow_direction", "eroded", "uplifted"},
         .tile_halo = 1,
         .check = check,
         .run = run,

@@ -40,6 +40,7 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
     if (!uplift_.empty() && uplift_.size() != h_.size())
         throw std::invalid_argument("stream_power::Model: uplift is not width × height");
     pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
+    uplifted_.assign(h_.size(), 0.0);
     if (settings.diffusivity > 0.0)
         diffusion_ = std::make_unique<diffusion::Solver>(width, height, cell, hillslope_settings(settings));
 }
@@ -76,7 +77,10 @@ void Model::add_history_uplift(double t0, double t1) {
     for_history_intervals(history_, history_k_, history_rate_, h_.size(), t0, t1, [&](const double* rate, double overlap) {
         parallel_for(0, n, 1 << 15, [&](std::int64_t b, std::int64_t e) {
             for (std::int64_t i = b; i < e; ++i)
-                if (!flow_.is_outlet(i)) h[i] += rate[i] * overlap;
+                if (!flow_.is_outlet(i)) {
+                    h[i] += rate[i] * overlap;
+                    uplifted_[std::size_t(i)] += rate[i] * overlap;
+                }
         });
     });
 }
@@ -101,7 +105,10 @@ std::int64_t Model::step(double dt) {
     if (!uplift_.empty()) {
         parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
             for (std::int64_t i = b; i < e; ++i)
-                if (!flow_.is_outlet(i)) h[i] += uplift_[std::size_t(i)] * dt;
+                if (!flow_.is_outlet(i)) {
+                    h[i] += uplift_[std::size_t(i)] * dt;
+                    uplifted_[std::size_t(i)] += uplift_[std::size_t(i)] * dt;
+                }
         });
     }
     if (history_.rate) add_history_uplift(time_, time_ + dt);

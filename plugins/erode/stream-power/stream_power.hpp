@@ -128,6 +128,8 @@ public:
     void route_only();
 
     const std::vector<double>& heights() const { return h_; }
+    /// Rock uplift each cell received so far (m): the uplift rates and the history times the years (0 for outlets).
+    const std::vector<double>& uplifted() const { return uplifted_; }
     std::vector<double>& heights() { return h_; }
     const FlowRouter& flow() const { return flow_; }
     /// χ (m) of every cell for reference area a0 (m²): ∫ (a0/A)^(m/n) dx from the outlet upstream.
@@ -145,7 +147,7 @@ private:
     int width_, height_;
     double cell_;
     Settings settings_;
-    std::vector<double> h_, uplift_;
+    std::vector<double> h_, uplift_, uplifted_;
     FlowRouter flow_;
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
@@ -216,7 +218,7 @@ diffusion::Settings hillslope_settings(const Settings& settings);
 std::int64_t lowest_cell(const std::vector<double>& heights);
 
 /// Bytes per cell a Model needs (heights, uplift, flow graph, diffusion scratch), for the memory check.
-inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
+inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
 /// Extra bytes per cell with deposition > 0 (seven doubles, a position and a flag of scratch).
 inline constexpr std::size_t kBytesPerCellDeposition = 7 * 8 + 4 + 1;
 

@@ -145,6 +145,7 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
             if (y == 0 || y == own_.height - 1 || x == 0 || x == own_.width - 1)
                 edge_.push_back(std::int32_t(std::int64_t(y) * own_.width + x));
     pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
+    uplifted_.assign(n, 0.0);
     if (settings.diffusivity > 0.0) diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, hillslope_settings(settings));
 }
 
@@ -662,11 +663,17 @@ std::int64_t TiledModel::step(double dt) {
     // 1. Uplift (outlets are base level: they stay).
     if (!uplift_.empty())
         for (std::size_t l = 0; l < n; ++l)
-            if (!outlet_[l]) h_[l] += uplift_[l] * dt;
+            if (!outlet_[l]) {
+                h_[l] += uplift_[l] * dt;
+                uplifted_[l] += uplift_[l] * dt;
+            }
     if (history_.rate)
         for_history_intervals(history_, history_k_, history_rate_, n, time_, time_ + dt, [&](const double* rate, double overlap) {
             for (std::size_t l = 0; l < n; ++l)
-                if (!outlet_[l]) h_[l] += rate[l] * overlap;
+                if (!outlet_[l]) {
+                    h_[l] += rate[l] * overlap;
+                    uplifted_[l] += rate[l] * overlap;
+                }
         });
     time_ += dt;
     // 2. Routing, depressions, drainage area.

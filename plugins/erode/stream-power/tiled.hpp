@@ -76,6 +76,8 @@ public:
     void route_only();
 
     const std::vector<double>& heights() const { return h_; }
+    /// Rock uplift this tile's cells received so far (m), as Model::uplifted().
+    const std::vector<double>& uplifted() const { return uplifted_; }
     std::vector<double>& heights() { return h_; }
     /// Whether local cell `l` (row-major in the tile) is an outlet.
     bool is_outlet(std::size_t l) const { return outlet_[l] != 0; }
@@ -134,7 +136,7 @@ private:
     double cell_;
     Settings settings_;
     std::int64_t sink_ = -1;  // every side closed: the outlet (whole-grid index)
-    std::vector<double> h_, uplift_;
+    std::vector<double> h_, uplift_, uplifted_;
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_
     std::vector<double> history_rate_;

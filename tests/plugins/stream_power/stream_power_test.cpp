@@ -123,6 +123,34 @@ TEST(StreamPower, AChannelAreaScalesIncisionByOneMinusExpOfAreaOverIt) {
     EXPECT_GT(steepest_ratio, 5.0) << "small catchments must be steeper than the plain law's";
 }
 
+TEST(StreamPower, TheRockUpliftIsCountedApartFromTheErosion) {
+    // uplifted(): U·t on every cell but the outlets (held at base level), whatever the rivers did; the
+    // node writes it as the layer 'uplifted' and the surface's own change, heights − start − uplifted,
+    // as 'eroded' (negative where the rivers and creep removed rock).
+    const int w = 41, h = 31;
+    const double cell = 30.0, U = 2e-3, years = 1e5;
+    Settings s;
+    s.erodibility = 5e-5;
+    s.diffusivity = 0.01;
+    s.open = {true, false, true, false};
+    const std::vector<double> start = noise(w, h, 7, 5.0);
+    Model model(w, h, cell, start, std::vector<double>(std::size_t(w) * h, U), s);
+    model.run(years, 1e4);
+    const auto& up = model.uplifted();
+    const auto& z = model.heights();
+    ASSERT_EQ(up.size(), z.size());
+    double removed = 0.0;
+    for (std::size_t i = 0; i < z.size(); ++i) {
+        if (model.flow().is_outlet(std::int64_t(i))) {
+            EXPECT_EQ(up[i], 0.0) << i;
+            continue;
+        }
+        EXPECT_NEAR(up[i], U * years, 1e-9) << i;
+        removed += z[i] - start[i] - up[i];
+    }
+    EXPECT_LT(removed, -100.0) << "the rivers must have removed rock: the surface's own change is negative";
+}
+
 // A river along one row: outlet at the west end, every cell drains all the
 // cells east of it. Settings for the 1-D tests.
 Settings river_settings(double n) {
