@@ -42,7 +42,7 @@ const Case cases[] = {
      "--set olsen_crooked.iterations=40 --set olsen_pyramid.iterations=40 --set olsen_hemisphere.iterations=40 "
      "--set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 --set pipe_hemisphere.steps=60"},
     {"erosion-thermal-4.3", ""},
-    {"orogeny", "--set range.dt=2e5 --set storm.steps=60"},
+    {"orogeny", "--set range.dt=3e5", "--set plates.steps=200 --set range.dt=1e6 --set scree.iterations=10"},
     {"erosion-sph-4.1", "--set sph_crooked.steps=8 --set sph_pyramid.steps=8 --set sph_hemisphere.steps=8 "
                         "--set olsen_crooked.iterations=30 --set olsen_pyramid.iterations=30 "
                         "--set olsen_hemisphere.iterations=30 --set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 "

@@ -44,17 +44,11 @@ const Band kBands[] = {
     {FigureId::concavity, 0.49, 1.07},
 };
 
-class DefaultPipeline : public testing::TestWithParam<int> {};
-
-TEST_P(DefaultPipeline, LiesInsideRealRangesFiguresAtThirtyMetres) {
-    const int seed = GetParam();
+/// Runs `spec_name` (pipelines/) with `extra` arguments and checks its terrain.r32 (1025², 30 m) against kBands.
+void expect_inside_the_bands(const std::string& spec_name, const std::string& extra) {
     TempDir dir;
-    const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / "default.orogen";
-    // The terrain exactly as `make demo` makes it; only the pictures are made smaller.
-    const RunResult r = run_orogen("run " + q(spec) + " --quiet --seed " + std::to_string(seed) + " --out " +
-                                   q(dir.path()) +
-                                   " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1"
-                                   " --set spin.frames=2 --set spin.width=64 --set spin.height=36");
+    const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / (spec_name + ".orogen");
+    const RunResult r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()) + " " + extra);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::string raw = slurp(dir / "terrain.r32");
     const int n = 1025;
@@ -65,10 +59,24 @@ TEST_P(DefaultPipeline, LiesInsideRealRangesFiguresAtThirtyMetres) {
     for (const Band& b : kBands) {
         const auto& info = orogen::analysis::info(b.figure);
         const double v = figures[b.figure].value;
-        RecordProperty(std::string(info.key), std::to_string(v));
-        EXPECT_GE(v, b.low) << info.key << " (seed " << seed << ")";
-        EXPECT_LE(v, b.high) << info.key << " (seed " << seed << ")";
+        testing::Test::RecordProperty(std::string(info.key), std::to_string(v));
+        EXPECT_GE(v, b.low) << info.key << " (" << spec_name << " " << extra << ")";
+        EXPECT_LE(v, b.high) << info.key << " (" << spec_name << " " << extra << ")";
     }
+}
+
+class DefaultPipeline : public testing::TestWithParam<int> {};
+
+TEST_P(DefaultPipeline, LiesInsideRealRangesFiguresAtThirtyMetres) {
+    // The terrain exactly as `make demo` makes it; only the pictures are made smaller.
+    expect_inside_the_bands("default", "--seed " + std::to_string(GetParam()) +
+                                           " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1"
+                                           " --set spin.frames=2 --set spin.width=64 --set spin.height=36");
+}
+
+TEST(Orogeny, LiesInsideRealRangesFiguresAtThirtyMetres) {
+    // pipelines/orogeny.orogen, docs/landscape.md's walkthrough, as users run it.
+    expect_inside_the_bands("orogeny", "");
 }
 
 INSTANTIATE_TEST_SUITE_P(Seeds, DefaultPipeline, testing::Values(42, 1, 2, 3, 4, 5),

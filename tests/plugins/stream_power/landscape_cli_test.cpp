@@ -2,7 +2,6 @@
 // check-time errors, their layers, and the realism check on the output of
 // pipelines/orogeny.orogen against published statistics of real ranges
 // (docs/landscape.md cites the bands).
-#include "landscape_stats.hpp"
 #include "orogen_test.hpp"
 
 #include <gtest/gtest.h>
@@ -189,31 +188,5 @@ TEST(LandscapeCli, TimelapseRecordsEveryKStepsOnAClockOfYears) {
     EXPECT_EQ(read("d.txt").size(), 3u);  // the input, step 2, the last (3)
 }
 #endif
-
-TEST(LandscapeCli, OrogenyPipelineHasTheStatisticsOfARealRange) {
-    // The shipped pipeline as users run it; the bands and their sources are in docs/landscape.md.
-    TempDir dir;
-    const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / "orogeny.orogen";
-    const RunResult r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()));
-    ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::string raw = slurp(dir / "terrain.r32");
-    ASSERT_EQ(raw.size(), std::size_t(513 * 513 * 4));
-    std::vector<float> h(513 * 513);
-    std::memcpy(h.data(), raw.data(), raw.size());
-    const auto s = orogen::landscape::measure(h.data(), 513, 513, 30.0);
-    RecordProperty("median_slope_deg", std::to_string(s.median_slope_deg));
-    std::printf("median slope %.1f°, >40°: %.1f %%, pits %.3f %%, concavity %.2f (%d bins), Hack %.2f (%d bins), relief %.0f m\n",
-                s.median_slope_deg, 100 * s.steeper_than_40, 100 * s.pit_share, s.concavity, s.concavity_bins, s.hack,
-                s.hack_bins, s.relief);
-    EXPECT_GE(s.median_slope_deg, 15.0);  // Montgomery & Brandon 2002: 20-30° medians, threshold ~30-35° means
-    EXPECT_LE(s.median_slope_deg, 35.0);
-    EXPECT_GE(s.concavity, 0.3);  // Tucker & Whipple 2002, Kirby & Whipple 2012: 0.35-0.6, most 0.4-0.6
-    EXPECT_LE(s.concavity, 0.7);
-    EXPECT_GE(s.concavity_bins, 5);
-    EXPECT_LE(s.pit_share, 0.01);  // real terrain drains: closed depressions are rare outside lakes and karst
-    EXPECT_GE(s.hack, 0.45);  // Hack 1957: 0.6; Rigon et al. 1996: 0.5-0.6; Montgomery & Dietrich 1992
-    EXPECT_LE(s.hack, 0.7);
-    EXPECT_GE(s.relief, 800.0);  // a mountain range, not hills
-}
 
 }  // namespace
