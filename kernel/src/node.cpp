@@ -1,6 +1,7 @@
 #include <orogen/error.hpp>
 #include <orogen/node.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -131,6 +132,19 @@ void NodeContext::check_finite(std::span<const float> data, std::string_view wha
             throw Error(msg.str());
         }
     }
+}
+
+std::vector<std::string> split_names(std::string_view text) {
+    std::vector<std::string> names;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const std::size_t comma = std::min(text.find(',', start), text.size());
+        const std::string_view item = text.substr(start, comma - start);
+        const auto a = item.find_first_not_of(" \t"), b = item.find_last_not_of(" \t");
+        if (a != std::string_view::npos) names.emplace_back(item.substr(a, b - a + 1));
+        start = comma + 1;
+    }
+    return names;
 }
 
 }  // namespace orogen

@@ -1,6 +1,7 @@
 // The kernel's support code: random numbers, hashing, atomic files, PNG codec.
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/node.hpp>
 #include <orogen/parallel.hpp>
 #include <orogen/random.hpp>
 #include <orogen/values.hpp>
@@ -321,4 +322,14 @@ TEST(Heightmap, MissingLayerNamesTheOnesThatExist) {
     } catch (const BadInput& e) {
         EXPECT_STREQ(e.what(), "the heightmap has no layer 'sediment' (it has water)");
     }
+}
+
+TEST(SplitNames, ItemsLoseTheirSpacesAndEmptyOnesAreDropped) {
+    using V = std::vector<std::string>;
+    EXPECT_EQ(orogen::split_names(""), V{});
+    EXPECT_EQ(orogen::split_names(" , \t,"), V{});
+    EXPECT_EQ(orogen::split_names("water"), V{"water"});
+    EXPECT_EQ(orogen::split_names("water, eroded"), V({"water", "eroded"}));
+    EXPECT_EQ(orogen::split_names("\twater ,,eroded ,  flow_x\t"), V({"water", "eroded", "flow_x"}));
+    EXPECT_EQ(orogen::split_names("a b, c"), V({"a b", "c"}));  // inner spaces stay: the item's name says what is wrong
 }

@@ -44,18 +44,27 @@ const Band kBands[] = {
     {FigureId::concavity, 0.49, 1.07},
 };
 
+constexpr int kSide = 1025;  ///< the shipped pipelines' grid
+
+/// The float32 heights export:raw wrote (kSide² of them), or false (and a test failure naming the size).
+bool read_terrain(const fs::path& path, std::vector<float>& heights) {
+    const std::string raw = slurp(path);
+    EXPECT_EQ(raw.size(), std::size_t(kSide) * kSide * sizeof(float)) << path;
+    if (raw.size() != std::size_t(kSide) * kSide * sizeof(float)) return false;
+    heights.resize(raw.size() / sizeof(float));
+    std::memcpy(heights.data(), raw.data(), raw.size());
+    return true;
+}
+
 /// Runs `spec_name` (pipelines/) with `extra` arguments and checks its terrain.r32 (1025², 30 m) against kBands.
 void expect_inside_the_bands(const std::string& spec_name, const std::string& extra) {
     TempDir dir;
     const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / (spec_name + ".orogen");
     const RunResult r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()) + " " + extra);
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::string raw = slurp(dir / "terrain.r32");
-    const int n = 1025;
-    ASSERT_EQ(raw.size(), std::size_t(n) * n * sizeof(float));
-    std::vector<float> h(std::size_t(n) * n);
-    std::memcpy(h.data(), raw.data(), raw.size());
-    const auto figures = orogen::analysis::measure({h.data(), n, n, 30.0});
+    std::vector<float> h;
+    ASSERT_TRUE(read_terrain(dir / "terrain.r32", h));
+    const auto figures = orogen::analysis::measure({h.data(), kSide, kSide, 30.0});
     for (const Band& b : kBands) {
         const auto& info = orogen::analysis::info(b.figure);
         const double v = figures[b.figure].value;
@@ -137,12 +146,9 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
     const RunResult r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir.path()) +
                                    " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::string raw = slurp(dir / "terrain.r32");
-    const int n = 1025;
-    ASSERT_EQ(raw.size(), std::size_t(n) * n * sizeof(float));
-    std::vector<float> h(std::size_t(n) * n);
-    std::memcpy(h.data(), raw.data(), raw.size());
-    const auto mine = orogen::analysis::measure({h.data(), n, n, 30.0});
+    std::vector<float> h;
+    ASSERT_TRUE(read_terrain(dir / "terrain.r32", h));
+    const auto mine = orogen::analysis::measure({h.data(), kSide, kSide, 30.0});
     std::string nearest;
     double best = 1e300;
     for (std::size_t i = 0; i < refs.size(); ++i) {

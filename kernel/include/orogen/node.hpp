@@ -193,6 +193,10 @@ public:
 /// "the input has no layers" or "the input's layers are: a, b, c".
 std::string describe_layers(const ValueInfo& info);
 
+/// A comma-separated list parameter, e.g. layers="water, eroded" → {"water", "eroded"}: each item
+/// without its surrounding spaces and tabs; empty items dropped ("" → {}).
+std::vector<std::string> split_names(std::string_view text);
+
 // -------------------------------------------------------------- run context
 
 /// Handed to a node when it runs.

@@ -13,17 +13,6 @@ namespace {
 
 using namespace orogen;
 
-/// "water, eroded" → {"water", "eroded"}; "" → {}.
-std::vector<std::string> split_names(const std::string& text) {
-    std::vector<std::string> names;
-    std::string name;
-    std::istringstream in(text);
-    while (std::getline(in, name, ',')) {
-        const auto a = name.find_first_not_of(" \t"), b = name.find_last_not_of(" \t");
-        if (a != std::string::npos) names.push_back(name.substr(a, b - a + 1));
-    }
-    return names;
-}
 
 bool is_all(const std::vector<std::string>& names) { return names.size() == 1 && names[0] == "all"; }
 
