@@ -35,7 +35,7 @@ static_assert(std::endian::native == std::endian::little, "cache entries are lit
 namespace {
 
 constexpr char magic[8] = {'O', 'R', 'G', 'N', 'C', 'A', 'C', 'H'};
-constexpr std::uint32_t format_version = 2;  // 2: the payload sealed by XXH3-128 instead of SHA-256
+constexpr std::uint32_t format_version = 3;  // 2: the payload sealed by XXH3-128 instead of SHA-256; 3: recorded files
 constexpr std::size_t header_size = 192;  // a multiple of 64, so arrays aligned in the payload are aligned in the file
 constexpr std::size_t max_message_bytes = std::size_t(1) << 20;
 constexpr std::size_t array_alignment = 64;
@@ -471,6 +471,12 @@ void write_payload(Writer& w, const Contents& c) {
         w.str(path);
         w.array(bytes);
     }
+    w.u32(std::uint32_t(c.recorded.size()));
+    for (const auto& f : c.recorded) {
+        w.str(f.path);
+        w.u64(f.bytes);
+        w.str(f.sha256);
+    }
 }
 
 std::vector<std::string> read_messages(std::span<const std::uint8_t> block, const Header& h) {
@@ -784,6 +790,7 @@ std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
     std::size_t reserve = header_size + 1024;
     for (const auto& [name, v] : contents.values) reserve += estimate(v) + name.size();
     for (const auto& [path, bytes] : contents.files) reserve += bytes.size() + path.size() + 128;
+    for (const auto& f : contents.recorded) reserve += f.path.size() + f.sha256.size() + 32;
     for (const auto& m : contents.messages) reserve += m.size() + 8;
     Writer w(reserve);
     w.buffer().resize(header_size, 0);
@@ -806,7 +813,7 @@ std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
     std::memcpy(h + 56, ph.data(), 32);
     std::memcpy(h + 88, key.data(), 32);
     put<std::uint32_t>(h + 120, std::uint32_t(contents.messages.size()));
-    put<std::uint32_t>(h + 124, std::uint32_t(contents.files.size()));
+    put<std::uint32_t>(h + 124, std::uint32_t(contents.files.size() + contents.recorded.size()));
     put<std::uint64_t>(h + 128, message_bytes);
     unsigned int len = 0;
     EVP_Digest(buf.data() + header_size, message_bytes, h + 136, &len, EVP_sha256(), nullptr);
@@ -823,15 +830,30 @@ void parse_payload(std::span<const std::uint8_t> entry, std::size_t offset, Cont
         std::string name = r.str();
         c.values.emplace_back(std::move(name), read_value(r));
     }
-    const std::uint32_t files = r.count32(16);  // a path's length and an array's count at least
-    c.files.resize(files);  // sized first: deferred copies write into these vectors where they stand
-    for (auto& [path, bytes] : c.files) {
-        path = r.str();
+    const auto check_path = [](const std::string& path) {
         const fs::path rel(path);
         if (rel.empty() || rel.is_absolute() ||
             std::any_of(rel.begin(), rel.end(), [](const fs::path& part) { return part.empty() || part == ".." || part == "."; }))
             throw CorruptEntry("a kept file has a bad path ('" + path + "')");
+    };
+    const std::uint32_t files = r.count32(16);  // a path's length and an array's count at least
+    c.files.resize(files);  // sized first: deferred copies write into these vectors where they stand
+    for (auto& [path, bytes] : c.files) {
+        path = r.str();
+        check_path(path);
         r.array(bytes);
+    }
+    const std::uint32_t recorded = r.count32(24);  // a path's length, a size and a digest's length at least
+    c.recorded.resize(recorded);
+    for (auto& f : c.recorded) {
+        f.path = r.str();
+        check_path(f.path);
+        f.bytes = r.u64();
+        f.sha256 = r.str();
+        if (f.sha256.size() != 64 || !std::all_of(f.sha256.begin(), f.sha256.end(), [](char ch) {
+                return (ch >= '0' && ch <= '9') || (ch >= 'a' && ch <= 'f');
+            }))
+            throw CorruptEntry("a recorded file's SHA-256 is not 64 hex digits");
     }
     if (!r.at_end()) throw CorruptEntry("bytes left over after its contents");
 }

@@ -92,8 +92,17 @@ struct Contents {
     /// Output name ("" the main value, else the side value's name) → value. Series are never stored:
     /// they are made on demand by a function, and a 300-frame film would cost gigabytes to keep.
     std::vector<std::pair<std::string, Value>> values;
-    /// Files the node wrote, relative to the output folder, and their bytes.
+    /// Files the node wrote, relative to the output folder, and their bytes (small files: see `recorded`).
     std::vector<std::pair<std::string, std::vector<std::uint8_t>>> files;
+    /// Files the node wrote that are too large to be worth a copy in the cache (docs/cache.md): only their
+    /// path, size and SHA-256 are kept. A re-run finds them in --out or runs the node again.
+    struct Recorded {
+        std::string path;     ///< relative to the output folder
+        std::uint64_t bytes = 0;
+        std::string sha256;   ///< 64 lowercase hex digits
+        bool operator==(const Recorded&) const = default;
+    };
+    std::vector<Recorded> recorded;
     /// What the node said while it ran ("warning: ..."), replayed when its result is reused.
     std::vector<std::string> messages;
 };
@@ -126,7 +135,7 @@ struct OtherVersion : std::runtime_error {
 struct EntryInfo {
     std::uint64_t bytes = 0;     ///< whole file
     std::uint32_t messages = 0;  ///< messages the node printed
-    std::uint32_t files = 0;     ///< files it wrote
+    std::uint32_t files = 0;     ///< files it wrote (kept or recorded)
     std::vector<std::string> texts;  ///< the messages (read and checked with the header: no payload needed)
 };
 
@@ -171,6 +180,8 @@ public:
 
     bool usable() const { return usable_; }
     const std::filesystem::path& folder() const { return settings_.folder; }
+    /// The size limit of this run (--cache-size).
+    std::uint64_t max_bytes() const { return settings_.max_bytes; }
     std::filesystem::path path(const Digest& key) const;
 
     /// The entry's header, if an entry of this orogen version exists (one small read). An entry left

@@ -327,6 +327,7 @@ public:
             if (s.key && !s.rerun) {
                 if (const auto info = store_->probe(*s.key, node.label)) {
                     // Files and messages are this node's effects: they are put back now. Values wait for a reader.
+                    // A node whose large files are recorded, not kept, runs again if they are not in --out.
                     if (info->files == 0) {
                         mark_cached(i, "cached", info->texts);
                     } else if (restore(i)) {
@@ -423,13 +424,24 @@ private:
         if (it != plan_.last_use.end() && it->second >= current_) values_[key] = std::move(v);
     }
 
-    /// Put node j's files back into the staging folder and its values at hand; false if its entry failed.
+    /// Put node j's files back into the staging folder and its values at hand; false if its entry failed, or
+    /// if a file it recorded (too large to keep, docs/cache.md) is not in --out with its bytes: it runs again.
     bool restore(std::size_t j) {
         const PlannedNode& node = plan_.nodes[j];
         const auto t0 = std::chrono::steady_clock::now();
         auto contents = store_->load(*states_[j].key, node.label);
         if (!contents) return false;
         try {
+            // Recorded files first: if one is missing or differs, nothing is staged and the node runs.
+            std::vector<fs::path> recorded_in_place;
+            for (const auto& f : contents->recorded) {
+                if (!recorded_in_place_at(fs::path(f.path), f.bytes, f.sha256)) {
+                    result_.timings[states_[j].row].seconds += seconds_since(t0);
+                    return false;
+                }
+                recorded_in_place.emplace_back(f.path);
+            }
+            kept_.insert(kept_.end(), recorded_in_place.begin(), recorded_in_place.end());
             int written = 0;
             for (const auto& [relative, bytes] : contents->files) {
                 const fs::path rel(relative);
@@ -456,6 +468,22 @@ private:
         for (auto& [name, v] : contents->values) keep(name.empty() ? node.value_name : node.value_name + "." + name, std::move(v));
         result_.timings[states_[j].row].seconds += seconds_since(t0);
         return true;
+    }
+
+    /// True if `--out/rel` is a regular file inside --out of `size` bytes whose SHA-256 is `sha256` (a file
+    /// recorded by its digest). The digest is remembered, so the manifest does not read the file again.
+    bool recorded_in_place_at(const fs::path& rel, std::uint64_t size, const std::string& sha256) const {
+        const OutputPlace place = place_output(options_.out_dir, rel.string());
+        if (!place.inside) return false;
+        const fs::path target = options_.out_dir / place.relative;
+        std::error_code ec;
+        if (!fs::is_regular_file(fs::symlink_status(target, ec)) || fs::file_size(target, ec) != size || ec) return false;
+        std::string hex = detail::remembered_sha256(target);
+        if (hex.empty()) {
+            hex = sha256_file(target);
+            detail::remember_sha256(target, hex);
+        }
+        return hex == sha256;
     }
 
     /// True if `--out/rel` is a regular file inside --out holding exactly `bytes` (a re-run whose export
@@ -623,10 +651,34 @@ private:
             for (const auto& [side, v] : out.side)
                 if (cache::storable(v.type())) c.values.emplace_back(side, v);
             if (!node.output_files.empty()) {
-                const std::vector<fs::path> after = staging_->files();
-                for (const auto& f : after)
-                    if (!std::binary_search(files_before.begin(), files_before.end(), f))
-                        c.files.emplace_back(f.generic_string(), read_file(staging_folder_ / f));
+                // Small files are kept whole, so a re-run into another folder puts them back. Files that
+                // would take more than 1/64 of the cache's limit together are recorded by size and SHA-256
+                // only (the manifest needs that digest anyway, and remembers it): copying them would cost
+                // the run as much time and memory again, and the cache its room. A re-run finds them in
+                // --out or runs the node again.
+                std::vector<fs::path> made;
+                std::uint64_t total = 0;
+                for (const auto& f : staging_->files())
+                    if (!std::binary_search(files_before.begin(), files_before.end(), f)) {
+                        made.push_back(f);
+                        std::error_code ec;
+                        const auto size = fs::file_size(staging_folder_ / f, ec);
+                        total += ec ? 0 : size;
+                    }
+                const bool keep_bytes = total <= store_->max_bytes() / 64;
+                for (const auto& f : made) {
+                    const fs::path full = staging_folder_ / f;
+                    if (keep_bytes) {
+                        c.files.emplace_back(f.generic_string(), read_file(full));
+                        continue;
+                    }
+                    std::string hex = detail::remembered_sha256(full);
+                    if (hex.empty()) {
+                        hex = sha256_file(full);
+                        detail::remember_sha256(full, hex);
+                    }
+                    c.recorded.push_back({f.generic_string(), std::uint64_t(fs::file_size(full)), hex});
+                }
             }
             c.messages = said;
             store_->save(*states_[j].key, c);

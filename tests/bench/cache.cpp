@@ -9,9 +9,16 @@
 
 #include <benchmark/benchmark.h>
 
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fcntl.h>
+#include <string>
 #include <sys/resource.h>
+#include <sys/wait.h>
 #include <unistd.h>
+#include <vector>
 
 using namespace orogen;
 namespace fs = std::filesystem;
@@ -106,3 +113,121 @@ static void BM_PayloadHash(benchmark::State& state) {
     state.SetBytesProcessed(std::int64_t(bytes.size()) * state.iterations());
 }
 BENCHMARK(BM_PayloadHash)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// ------------------------------------------------------------ exports and the cache (issue 30)
+//
+// The whole CLI on a 4097² grid, `export:tiles(format=glb, tile_size=513)` (85 GLB chunks and a tileset,
+// ~1.1 GB), without the cache, with a cold cache, warm into the same --out, and warm into a new --out;
+// then a plain `cp -r` of the same files, in the same process run, so the figures share the machine's
+// load. Each iteration is one child process; the counters are its peak RSS (MiB) and its CPU (user +
+// system, every thread). The scratch folder is under /tmp, on the same disk as the cache folder.
+
+namespace {
+
+const fs::path& glb_scratch() {
+    static const fs::path& f = *[] {  // never destroyed: the atexit handler below still reads it
+        auto* p = new fs::path(fs::temp_directory_path() / ("orogen-bench-cache-glb-" + std::to_string(::getpid())));
+        fs::create_directories(*p);
+        std::FILE* spec = std::fopen((*p / "glb.orogen").c_str(), "w");
+        std::fputs("orogen 1\nseed 7\ngrid 4097 cell=10\n"
+                   "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
+                   "export:tiles(t, path=\"tiles/t.json\", tile_size=513, format=glb)\n",
+                   spec);
+        std::fclose(spec);
+        std::atexit([] { std::error_code ec; fs::remove_all(glb_scratch(), ec); });  // whichever benchmarks ran
+        return p;
+    }();
+    return f;
+}
+
+struct Child {
+    double seconds = 0, cpu_seconds = 0, peak_mib = 0;
+    int status = -1;
+};
+
+/// Run argv to completion; its own peak RSS and CPU from wait4.
+Child run_child(const std::vector<std::string>& args) {
+    std::vector<char*> argv;
+    for (const auto& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    const auto t0 = std::chrono::steady_clock::now();
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        const int null = ::open("/dev/null", O_WRONLY);
+        ::dup2(null, 1);
+        ::execv(argv[0], argv.data());
+        ::_exit(127);
+    }
+    Child c;
+    rusage u{};
+    ::wait4(pid, &c.status, 0, &u);
+    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    c.cpu_seconds = double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+    c.peak_mib = double(u.ru_maxrss) / 1024.0;
+    return c;
+}
+
+std::vector<std::string> orogen_run(const fs::path& out, const char* cache_mode) {
+    std::vector<std::string> a{OROGEN_CLI, "run", (glb_scratch() / "glb.orogen").string(), "--out", out.string(),
+                               "--threads", "2", "--quiet"};
+    if (std::string(cache_mode) == "none") a.push_back("--no-cache");
+    else a.insert(a.end(), {"--cache", (glb_scratch() / "cache").string()});
+    return a;
+}
+
+void report(benchmark::State& state, const std::vector<Child>& runs) {
+    double cpu = 0, peak = 0;
+    for (const auto& r : runs) {
+        if (r.status != 0) state.SkipWithError("the child failed");
+        cpu += r.cpu_seconds;
+        peak = std::max(peak, r.peak_mib);
+    }
+    state.counters["child_cpu_s"] = cpu / double(std::max<std::size_t>(1, runs.size()));
+    state.counters["peak_rss_MiB"] = peak;
+}
+
+}  // namespace
+
+/// 0: --no-cache; 1: a cold cache (emptied before each run); 2: warm, into the same --out (files in place);
+/// 3: warm, into a new --out (the recorded GLB files are missing: the exporter runs again).
+static void BM_Glb4097Run(benchmark::State& state) {
+    const int mode = int(state.range(0));
+    const fs::path out = glb_scratch() / "out", cache_dir = glb_scratch() / "cache";
+    std::vector<Child> runs;
+    if (mode >= 2) {  // warm the cache (and --out) once
+        fs::remove_all(cache_dir);
+        fs::remove_all(out);
+        if (run_child(orogen_run(out, "cache")).status != 0) state.SkipWithError("warming failed");
+    }
+    for (auto _ : state) {
+        state.PauseTiming();
+        if (mode == 1) fs::remove_all(cache_dir);
+        if (mode != 2) fs::remove_all(out);
+        ::sync();
+        state.ResumeTiming();
+        runs.push_back(run_child(orogen_run(out, mode == 0 ? "none" : "cache")));
+    }
+    report(state, runs);
+    state.SetLabel(mode == 0 ? "--no-cache" : mode == 1 ? "cold cache" : mode == 2 ? "warm, same --out" : "warm, new --out");
+}
+BENCHMARK(BM_Glb4097Run)->DenseRange(0, 3)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+/// `cp -r` of the files the run above wrote (its --out), to a fresh folder on the same disk.
+static void BM_Glb4097PlainCopy(benchmark::State& state) {
+    const fs::path out = glb_scratch() / "out", copy = glb_scratch() / "copy";
+    if (!fs::exists(out / "manifest.json")) run_child(orogen_run(out, "none"));
+    std::vector<Child> runs;
+    for (auto _ : state) {
+        state.PauseTiming();
+        fs::remove_all(copy);
+        ::sync();
+        state.ResumeTiming();
+        runs.push_back(run_child({"/bin/cp", "-r", out.string(), copy.string()}));
+    }
+    report(state, runs);
+    std::uint64_t bytes = 0;
+    for (const auto& e : fs::recursive_directory_iterator(out))
+        if (e.is_regular_file()) bytes += e.file_size();
+    state.counters["MiB"] = double(bytes) / double(1 << 20);
+}
+BENCHMARK(BM_Glb4097PlainCopy)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -170,6 +170,7 @@ TEST(CacheEntry, EveryStorableValueTypeRoundTripsBitForBit) {
     cache::Contents c;
     c.values = {{"", Value(hm)}, {"img8", Value(img8)}, {"imgf", Value(imgf)}, {"particles", Value(ps)}, {"plates", Value(ph)}};
     c.files = {{"sub/a.png", {9, 8, 7}}, {"empty.txt", {}}};
+    c.recorded = {{"tiles/t_l0_x0_y0.glb", 875u << 20, std::string(64, 'c')}};
     c.messages = {"scree: warning: steep"};
     cache::Hasher kh;
     const cache::Digest key = kh.text("k").finish();
@@ -201,6 +202,7 @@ TEST(CacheEntry, EveryStorableValueTypeRoundTripsBitForBit) {
     EXPECT_EQ(p2.collisions[0].kind, BoundaryKind::transform);
     EXPECT_EQ(p2.collisions[0].b, (Point2{3, 4}));
     EXPECT_EQ(d.files, c.files);
+    EXPECT_EQ(d.recorded, c.recorded);
     EXPECT_EQ(d.messages, c.messages);
     // Encoding is a function of the contents: the same bytes twice.
     EXPECT_EQ(cache::encode(key, d), bytes);
@@ -287,9 +289,10 @@ std::string refusal(const cache::Contents& c, const std::function<void(std::vect
     return "accepted";
 }
 
-/// Replace the first occurrence of `from` in `bytes` by `to` (the same length).
+/// Replace the first occurrence of `from` after the 192-byte header in `bytes` by `to` (the same length). (Not
+/// in the header: its format version, 3, is a little-endian int like the sizes these tests edit.)
 void replace_bytes(std::vector<std::uint8_t>& bytes, const std::vector<std::uint8_t>& from, const std::vector<std::uint8_t>& to) {
-    const auto it = std::search(bytes.begin(), bytes.end(), from.begin(), from.end());
+    const auto it = std::search(bytes.begin() + 192, bytes.end(), from.begin(), from.end());
     ASSERT_NE(it, bytes.end());
     std::copy(to.begin(), to.end(), it);
 }
@@ -326,6 +329,12 @@ TEST(CacheEntry, ASealedButInvalidPayloadIsRefusedNamingWhatIsWrong) {
     EXPECT_EQ(refusal(cf, path("abc/x.png")), "accepted");
     EXPECT_EQ(refusal(cf, path("../../x.p")), "a kept file has a bad path ('../../x.p')");
     EXPECT_EQ(refusal(cf, path("/etc/x.pn")), "a kept file has a bad path ('/etc/x.pn')");
+    cache::Contents cr;
+    cr.recorded = {{"abc/x.png", 3, std::string(64, 'a')}};
+    EXPECT_EQ(refusal(cr, [](auto&) {}), "accepted");
+    EXPECT_EQ(refusal(cr, path("../../x.p")), "a kept file has a bad path ('../../x.p')");
+    EXPECT_EQ(refusal(cr, [](auto& b) { replace_bytes(b, {'a', 'a', 'a', 'a'}, {'a', 'A', 'a', 'a'}); }),
+              "a recorded file's SHA-256 is not 64 hex digits");
 
     auto hm = std::make_shared<Heightmap>(3, 2, 4.0, 1.0f);
     hm->layer("water");
@@ -487,6 +496,58 @@ TEST(CacheRun, ColdAndWarmRunsWriteTheSameBytesAsARunWithoutTheCache) {
     EXPECT_EQ(disk_hashes(f.dir / "cold"), reference);
 }
 
+TEST(CacheRun, LargeFilesAreRecordedByDigestAndTheirExportRunsAgainWhenTheyAreMissingOrDiffer) {
+    // A node's files are copied into its entry only if together they take at most 1/64 of the cache's limit;
+    // larger ones (a 4097² glTF pyramid: 1.1 GB) are recorded by size and SHA-256. With a 640 KiB limit (10 KiB
+    // a node), scree.png (16 KB) and the .r32 with its sidecar (38 KB) are recorded, base.png (6 KB) is kept.
+    Fixture f;
+    const std::string limit = "--cache-size 640K";
+    const test::RunResult plain = f.run("plain", "--no-cache");
+    ASSERT_EQ(plain.exit_code, 0) << plain.err;
+    const auto reference = disk_hashes(f.dir / "plain");
+    const test::RunResult cold = f.cached("a", limit);
+    ASSERT_EQ(cold.exit_code, 0) << cold.err;
+    EXPECT_EQ(slurp(f.dir / "a" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
+    int small = 0;
+    for (const auto& e : entries(f.cache)) small += fs::file_size(e) < 2048;
+    EXPECT_EQ(small, 2);  // export:png(scree) and export:raw: a path, a size and a digest a file
+
+    // Into the same --out: the files are there with their bytes, so every node is cached and nothing moves.
+    const test::RunResult warm = f.cached("a", limit);
+    ASSERT_EQ(warm.exit_code, 0) << warm.err;
+    EXPECT_EQ(count_rows(cache_column(warm.out), "cached"), 6) << warm.out;
+    EXPECT_EQ(slurp(f.dir / "a" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
+    EXPECT_EQ(disk_hashes(f.dir / "a"), reference);
+
+    // A deleted file, then an edited one (same size): their export runs again and writes them, and only it.
+    for (const auto& damage : {0, 1}) {
+        const fs::path victim = f.dir / "a" / "raw" / "scree.r32";
+        if (damage == 0) fs::remove(victim);
+        else {
+            std::fstream io(victim, std::ios::in | std::ios::out | std::ios::binary);
+            io.seekp(100);
+            io.write("x", 1);
+        }
+        const test::RunResult r = f.cached("a", limit);
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const auto rows = cache_column(r.out);
+        EXPECT_EQ(count_rows(rows, ""), 1) << r.out;               // export:raw
+        EXPECT_EQ(row(rows, "scree"), "cached, read") << r.out;    // what it exports
+        EXPECT_EQ(disk_hashes(f.dir / "a"), reference) << damage;
+        EXPECT_EQ(slurp(f.dir / "a" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
+    }
+
+    // Into a new --out: the exports whose files were recorded run again; base.png's, kept whole, is put back.
+    const test::RunResult fresh = f.cached("b", limit);
+    ASSERT_EQ(fresh.exit_code, 0) << fresh.err;
+    const auto rows = cache_column(fresh.out);
+    EXPECT_EQ(count_rows(rows, ""), 2) << fresh.out;
+    EXPECT_EQ(row(rows, "base"), "cached") << fresh.out;
+    EXPECT_EQ(row(rows, "scree"), "cached, read") << fresh.out;
+    EXPECT_EQ(disk_hashes(f.dir / "b"), reference);
+    EXPECT_EQ(slurp(f.dir / "b" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
+}
+
 TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
     Fixture f;
     ASSERT_EQ(f.cached("a").exit_code, 0);
@@ -610,8 +671,10 @@ TEST(CacheRun, EvictionKeepsTheFolderUnderItsLimitAndKeepsTheRecentEntries) {
         ASSERT_EQ(r.exit_code, 0) << r.err;
         EXPECT_LE(entry_bytes(f.cache), limit) << "after seed " << seed;
     }
-    // The last seed's results are all there; the first seed's are gone.
-    const test::RunResult last = f.cached("again14", "--seed 14 --cache-size " + std::to_string(limit));
+    // The last seed's results are all there; the first seed's are gone. (Into the last run's own --out: with a
+    // limit this small, the exports' files take more than 1/64 of it, so their entries record them by digest
+    // instead of copying them, and a new --out would make the exports run again.)
+    const test::RunResult last = f.cached("s14", "--seed 14 --cache-size " + std::to_string(limit));
     EXPECT_EQ(count_rows(cache_column(last.out), ""), 0) << last.out;
     const test::RunResult first = f.cached("again10", "--seed 10 --cache-size " + std::to_string(limit));
     EXPECT_EQ(count_rows(cache_column(first.out), ""), 6) << first.out;

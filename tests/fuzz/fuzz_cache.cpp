@@ -51,11 +51,18 @@ void check_valid(const cache::Contents& c) {
             default: __builtin_trap();  // none and series are never kept
         }
     }
-    for (const auto& [path, bytes] : c.files) {  // put back under --out: never outside it
+    const auto check_path = [](const std::string& path) {  // put back or looked for under --out: never outside it
         const std::filesystem::path rel(path);
         if (rel.empty() || rel.is_absolute()) __builtin_trap();
         for (const auto& part : rel)
             if (part == ".." || part.empty()) __builtin_trap();
+    };
+    for (const auto& [path, bytes] : c.files) check_path(path);
+    for (const auto& f : c.recorded) {
+        check_path(f.path);
+        if (f.sha256.size() != 64) __builtin_trap();
+        for (char ch : f.sha256)
+            if (!((ch >= '0' && ch <= '9') || (ch >= 'a' && ch <= 'f'))) __builtin_trap();
     }
 }
 
