@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <regex>
+#include <sstream>
 
 using namespace orogen;
 using namespace orogen::test;
@@ -226,7 +227,30 @@ TEST(Cli, ListHelpAndVersionDescribeThePlugins) {
     r = run_orogen("version");
     ASSERT_EQ(r.exit_code, 0);
     EXPECT_NE(r.out.find("(plugin API " + std::to_string(OROGEN_PLUGIN_API_VERSION) + ")"), std::string::npos);
-    EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  fault +0\\.1\\.0 +.*orogen_generate_fault\\.so\n")));
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  generate-fault +0\\.1\\.0 +.*orogen_generate_fault\\.so\n")));
+}
+
+// Every plugin's id is `kind-name`, the folder plugins/<kind>/<name> it is built
+// from (its library is orogen_<kind>_<name>.so, with '_' for '-').
+TEST(Cli, EveryPluginIdIsKindDashName) {
+    auto r = run_orogen("version");
+    ASSERT_EQ(r.exit_code, 0);
+    const std::regex line("^  (\\S+) +\\S+ +\\S*/orogen_([a-z0-9_]+)\\.so$");
+    const std::regex pattern("^(generate|erode|tectonics|render|export|import|analyze)-[a-z0-9]+(-[a-z0-9]+)*$");
+    std::istringstream in(r.out);
+    std::string l;
+    int plugins = 0;
+    while (std::getline(in, l)) {
+        std::smatch m;
+        if (!std::regex_match(l, m, line)) continue;
+        ++plugins;
+        const std::string id = m[1], stem = m[2];
+        EXPECT_TRUE(std::regex_match(id, pattern)) << id;
+        std::string expected = stem;
+        std::replace(expected.begin(), expected.end(), '_', '-');
+        EXPECT_EQ(id, expected) << l;
+    }
+    EXPECT_GE(plugins, 20) << r.out;
 }
 
 // ------------------------------------------------------------- plugin seam
@@ -251,7 +275,7 @@ TEST(PluginSeam, BrokenPluginsAreRefusedOneByOneAndTheRestStillLoad) {
     EXPECT_NE(r.err.find(w + (dir / "not-a-library.so").string() + ": cannot load this library ("), std::string::npos)
         << r.err;
     EXPECT_TRUE(std::regex_search(
-        r.err, std::regex(w + "node 'generate:fault' is registered twice: by plugin 'fault' \\(.*/orogen_generate_fault\\.so\\) "
+        r.err, std::regex(w + "node 'generate:fault' is registered twice: by plugin 'generate-fault' \\(.*/orogen_generate_fault\\.so\\) "
                               "and by plugin 'fault-clone' \\(" + fake_plugins + "/duplicate_node\\.so\\); keeping the first\\. "
                               "Duplicate library\\? Remove one of them from the plugin path\\.\n")))
         << r.err;
@@ -260,8 +284,8 @@ TEST(PluginSeam, BrokenPluginsAreRefusedOneByOneAndTheRestStillLoad) {
               std::string::npos)
         << r.err;
     // The good ones, real and fake, are all there.
-    EXPECT_NE(r.out.find("  fault "), std::string::npos);
-    EXPECT_NE(r.out.find("  diamond-square "), std::string::npos);
+    EXPECT_NE(r.out.find("  generate-fault "), std::string::npos);
+    EXPECT_NE(r.out.find("  generate-diamond-square "), std::string::npos);
     EXPECT_NE(r.out.find("  test-throwing "), std::string::npos);
     EXPECT_EQ(r.out.find("future-plugin"), std::string::npos);
 }
@@ -383,7 +407,7 @@ TEST(Outputs, TheIssueSpecWritesBothPngsAndAManifestWithTheirHashes) {
     EXPECT_NE(manifest.find("\"sha256\": \"" + sha256_file(dir / "out/cut.png") + "\""), std::string::npos);
     EXPECT_NE(manifest.find("\"sha256\": \"" + sha256_file(dir / "out/base.png") + "\""), std::string::npos);
     EXPECT_NE(manifest.find("\"seed\": 7,"), std::string::npos);
-    EXPECT_NE(manifest.find("\"name\": \"diamond-square\""), std::string::npos);
+    EXPECT_NE(manifest.find("\"name\": \"generate-diamond-square\""), std::string::npos);
     // The per-node timing table.
     EXPECT_NE(r.out.find("cut              generate:fault                 6"), std::string::npos) << r.out;
 }

@@ -10,7 +10,7 @@
 // Write a plugin with the macro:
 //
 //   #include <orogen/plugin.hpp>
-//   OROGEN_PLUGIN("my-plugin", "1.0.0", registry) {
+//   OROGEN_PLUGIN("generate-my-node", "1.0.0", registry) {  // id: kind-name
 //       registry.add({ .kind = "generate", .name = "my-node", ... });
 //   }
 #pragma once

@@ -114,7 +114,7 @@ NodeOutputs run(NodeContext& ctx) {
 
 }  // namespace
 
-OROGEN_PLUGIN("png-export", "0.1.0", registry) {
+OROGEN_PLUGIN("export-png", "0.1.0", registry) {
     registry.add({
         .kind = "export",
         .name = "png",

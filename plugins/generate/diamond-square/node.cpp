@@ -6,7 +6,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("diamond-square", "0.1.0", registry) {
+OROGEN_PLUGIN("generate-diamond-square", "0.1.0", registry) {
     registry.add({
         .kind = "generate",
         .name = "diamond-square",

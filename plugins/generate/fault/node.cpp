@@ -5,7 +5,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("fault", "0.1.0", registry) {
+OROGEN_PLUGIN("generate-fault", "0.1.0", registry) {
     registry.add({
         .kind = "generate",
         .name = "fault",

@@ -48,7 +48,7 @@ std::uint64_t node_seed(NodeContext& ctx) {
 
 }  // namespace
 
-OROGEN_PLUGIN("rmp", "0.1.0", registry) {
+OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
     registry.add({
         .kind = "generate",
         .name = "rmp",

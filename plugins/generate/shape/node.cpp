@@ -5,7 +5,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("shape", "0.1.0", registry) {
+OROGEN_PLUGIN("generate-shape", "0.1.0", registry) {
     registry.add({
         .kind = "generate",
         .name = "shape",

@@ -7,7 +7,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("f32-import", "0.1.0", registry) {
+OROGEN_PLUGIN("import-f32", "0.1.0", registry) {
     registry.add({
         .kind = "import",
         .name = "f32",

@@ -5,7 +5,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("png-import", "0.1.0", registry) {
+OROGEN_PLUGIN("import-png", "0.1.0", registry) {
     registry.add({
         .kind = "import",
         .name = "png",

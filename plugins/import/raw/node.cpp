@@ -6,7 +6,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("raw-import", "0.1.0", registry) {
+OROGEN_PLUGIN("import-raw", "0.1.0", registry) {
     registry.add({
         .kind = "import",
         .name = "raw",

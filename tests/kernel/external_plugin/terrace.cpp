@@ -4,7 +4,7 @@
 
 using namespace orogen;
 
-OROGEN_PLUGIN("terrace", "1.0.0", registry) {
+OROGEN_PLUGIN("generate-terrace", "1.0.0", registry) {
     registry.add({
         .kind = "generate",
         .name = "terrace",
