@@ -18,7 +18,7 @@
 #include <orogen/io.hpp>
 
 #ifdef OROGEN_PYTHON_EXR
-#include "exr.hpp"
+#include <orogen/exr/exr.hpp>
 #endif
 
 #include <pybind11/numpy.h>

@@ -1,6 +1,6 @@
 // libFuzzer target: the OpenEXR reader (import:exr): magic, OpenEXRCore's header parse under an allocation
 // cap, the channel, size and chunk-layout checks, then the decode of every channel as heights or layers.
-#include "exr.hpp"
+#include <orogen/exr/exr.hpp>
 
 #include <orogen/error.hpp>
 

@@ -1,5 +1,5 @@
 // export:exr — registers the OpenEXR writer (exr.hpp) with the kernel.
-#include "exr.hpp"
+#include <orogen/exr/exr.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -1,6 +1,6 @@
 // import:exr — one channel of an OpenEXR file (what export:exr writes, or Houdini's, Nuke's, Gaea's) as a
 // heightmap, other channels as layers.
-#include "exr.hpp"
+#include <orogen/exr/exr.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>

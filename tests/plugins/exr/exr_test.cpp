@@ -2,7 +2,7 @@
 // small independent parser of the uncompressed layout below; round trips that keep every bit (negative,
 // denormal, huge, -0); determinism; and the hostile files: cut, forged sizes, overlapping chunks, wrong
 // channel types, lossy compression, NaN, not an EXR — each refused with its message, before allocating.
-#include "exr.hpp"
+#include <orogen/exr/exr.hpp>
 #include "orogen_test.hpp"
 
 #include <orogen/error.hpp>

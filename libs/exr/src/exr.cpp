@@ -1,4 +1,4 @@
-#include "exr.hpp"
+#include <orogen/exr/exr.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
