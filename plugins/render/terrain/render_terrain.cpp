@@ -173,6 +173,22 @@ struct TerrainRenderer::Impl {
         return dx > 0 ? columns_westward : columns_eastward;
     }
 
+    // ---- the steps of one frame (render() runs them in this order)
+    struct Frame;
+    Frame frame_box(int frame_width, int frame_height, const Style& st) const;
+    void place_camera(Frame& f, const Camera& camera, const Style& st) const;
+    std::vector<glm::dvec3> land_outline(const Frame& f, const Style& st) const;
+    void fit_orbit(Frame& f, const Camera& camera, glm::dvec3 back, double& distance, const Style& st) const;
+    void set_clip_planes(Frame& f, const Style& st) const;
+    void refuse_a_view_of_nothing(const Frame& f) const;
+    void set_grid(GLuint program, const glm::mat4& view_projection, double exaggeration) const;
+    void prepare_shadow_map(const Frame& f, const Style& st);
+    void draw_sky(const Frame& f) const;
+    void draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored, GLuint seen);
+    void draw_particles(const Frame& f, const Style& st, const Camera& camera, const ParticleFrame& particles);
+    gl::Target draw_reflection(const Frame& f, const Style& st, GLuint scene_fbo);
+    void draw_water(const Frame& f, const Style& st, const gl::Target& reflection, bool reflect);
+
     double extent_x() const { return double(width - 1) * terrain->cell(); }
     double extent_z() const { return double(height - 1) * terrain->cell(); }
 
@@ -250,6 +266,503 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
 
 TerrainRenderer::~TerrainRenderer() = default;
 
+namespace {
+
+/// The sun, the sky and the haze of one frame: the uniforms every lit pass shares.
+struct Light {
+    glm::dvec3 sun;          // unit, towards the sun
+    glm::vec3 sun_colour;    // linear, times the intensity
+    glm::vec3 zenith, horizon, ambient;  // linear
+    float fog_density = 0;   // 1/m
+
+    Light(const Style& st, double radius) {
+        sun = direction(st.sun_azimuth, st.sun_elevation);
+        sun_colour = glm::vec3(1.0f, 0.93f, 0.82f) * float(st.sun_intensity);
+        // Sky: bluer at the zenith, warmer and paler at the horizon when the sun is low.
+        const float low = float(std::clamp(1.0 - st.sun_elevation / 45.0, 0.0, 1.0));
+        zenith = glm::mix(glm::vec3(0.05f, 0.14f, 0.42f), glm::vec3(0.08f, 0.16f, 0.38f), low);
+        horizon = glm::mix(glm::vec3(0.42f, 0.52f, 0.68f), glm::vec3(0.62f, 0.52f, 0.46f), low * 0.5f);
+        ambient = (zenith * 0.6f + horizon * 0.4f) * 0.9f;
+        fog_density = float(st.haze / std::max(2.0 * radius, 1e-6));
+    }
+
+    /// The light's uniforms on `p`, seen from `eye`; `disc` 1 draws the sun's disc (the sky pass only).
+    void set_on(GLuint p, float disc, const glm::dvec3& eye) const {
+        set(p, "sun_direction", glm::vec3(sun));
+        set(p, "sun_colour", sun_colour);
+        set(p, "sky_zenith", zenith);
+        set(p, "sky_horizon", horizon);
+        set(p, "sun_disc", disc);
+        set(p, "fog_density", fog_density);
+        set(p, "ambient_colour", ambient);
+        set(p, "eye", glm::vec3(eye));
+    }
+};
+
+/// The sun's orthographic view around the terrain's box (box_min..box_max), for the shadow map.
+glm::dmat4 light_matrix(const glm::dvec3& sun, const glm::dvec3& centre, double radius, const glm::dvec3& box_min,
+                        const glm::dvec3& box_max) {
+    const glm::dvec3 light_up = std::abs(sun.y) > 0.999 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
+    const glm::dmat4 light_view = glm::lookAt(centre + sun * radius * 2.0, centre, light_up);
+    glm::dvec3 lo(1e300), hi(-1e300);
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 p = glm::dvec3(light_view * glm::dvec4(c & 1 ? box_max.x : box_min.x,
+                                                                c & 2 ? box_max.y : box_min.y,
+                                                                c & 4 ? box_max.z : box_min.z, 1.0));
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    return glm::ortho(lo.x, hi.x, lo.y, hi.y, -hi.z - 1.0, -lo.z + 1.0) * light_view;
+}
+
+/// The multisampled half-float colour and float depth the scene is drawn into, deleted with it.
+struct SceneTarget {
+    GLuint fbo = 0, colour = 0, depth = 0;
+    SceneTarget(int width, int height, int samples) {
+        glGenFramebuffers(1, &fbo);
+        glGenRenderbuffers(1, &colour);
+        glGenRenderbuffers(1, &depth);
+        glBindRenderbuffer(GL_RENDERBUFFER, colour);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_RGBA16F, width, height);
+        glBindRenderbuffer(GL_RENDERBUFFER, depth);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_DEPTH_COMPONENT32F, width,
+                                         height);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+            release();
+            throw Error("render:terrain: OSMesa could not set up a " + std::to_string(width) + " × " +
+                        std::to_string(height) + " framebuffer with " + std::to_string(samples) + " samples");
+        }
+    }
+    ~SceneTarget() { release(); }
+    SceneTarget(const SceneTarget&) = delete;
+    SceneTarget& operator=(const SceneTarget&) = delete;
+
+private:
+    void release() {
+        glDeleteFramebuffers(1, &fbo);
+        glDeleteRenderbuffers(1, &colour);
+        glDeleteRenderbuffers(1, &depth);
+        fbo = colour = depth = 0;
+    }
+};
+
+}  // namespace
+
+/// What one frame is drawn from: the terrain's box, the camera's matrices and the light.
+struct TerrainRenderer::Impl::Frame {
+    int width = 0, height = 0;     // pixels
+    double exag = 1;               // vertical exaggeration
+    double floor_height = 0;       // m, unexaggerated: the skirt's foot
+    glm::dvec3 box_min, box_max, centre;
+    double radius = 0, aspect = 1;
+    glm::dvec3 eye, target, up{0, 1, 0};
+    double near_plane = 1, far_plane = 1;
+    glm::dmat4 projection{1.0}, view_projection{1.0};
+    glm::dmat4 light_view_projection{1.0};
+    std::optional<Light> light;
+    bool shaded = true;            // the beauty output (not albedo or normals)
+};
+
+TerrainRenderer::Impl::Frame TerrainRenderer::Impl::frame_box(int frame_width, int frame_height,
+                                                              const Style& st) const {
+    Frame f;
+    f.width = frame_width;
+    f.height = frame_height;
+    f.exag = st.exaggeration;
+    const double skirt = 0.08 * std::max(double(hi - lo), 1.0);  // m below the lowest point (and the sea)
+    f.floor_height = st.sea ? std::min(double(lo), st.sea_level) - skirt : lo - skirt;
+    f.box_min = glm::dvec3(0, f.floor_height * f.exag, 0);
+    f.box_max = glm::dvec3(extent_x(), hi * f.exag, extent_z());
+    f.centre = (f.box_min + f.box_max) * 0.5;
+    f.radius = glm::length(f.box_max - f.box_min) * 0.5;
+    f.aspect = double(frame_width) / double(std::max(frame_height, 1));
+    f.shaded = st.output == Style::Output::beauty;
+    f.light.emplace(st, f.radius);
+    return f;
+}
+
+/// What must fit in an orbit's frame: the surface itself (a lattice of at most 65 × 65 of its samples at
+/// their heights) and its skirt's foot along the edges, not the box around them: the box's top corners stand
+/// at the highest summit's height over every corner. With a sea, what lies under it is sea to the horizon,
+/// so only the land above it counts (the skirt down to the water): fitting the drowned corners and the
+/// skirt's foot under the water left the land a small slab in a wide frame.
+std::vector<glm::dvec3> TerrainRenderer::Impl::land_outline(const Frame& f, const Style& st) const {
+    std::vector<glm::dvec3> outline;
+    const ConstGridView g = terrain->view();
+    const double cell = terrain->cell();
+    const int step = std::max(1, (std::max(width, height) - 1) / 64);
+    std::vector<int> xs, ys;  // every step-th sample, and the last
+    for (int x = 0; x < width - 1; x += step) xs.push_back(x);
+    for (int y = 0; y < height - 1; y += step) ys.push_back(y);
+    xs.push_back(width - 1);
+    ys.push_back(height - 1);
+    const double foot = st.sea ? st.sea_level * f.exag : f.box_min.y;
+    for (int y : ys)
+        for (int x : xs) {
+            const double h = g.at(x, y);
+            if (st.sea && !(h > st.sea_level)) continue;
+            outline.emplace_back(x * cell, h * f.exag, y * cell);
+            if (x == 0 || y == 0 || x == width - 1 || y == height - 1) outline.emplace_back(x * cell, foot, y * cell);
+        }
+    if (outline.empty())  // all under the sea: the terrain's box, as a frame for the sea floor
+        for (int c = 0; c < 8; ++c)
+            outline.emplace_back(c & 1 ? f.box_max.x : f.box_min.x, c & 2 ? f.box_max.y : f.box_min.y,
+                                 c & 4 ? f.box_max.z : f.box_min.z);
+    return outline;
+}
+
+/// An orbit with distance 0: the nearest distance at which all of the land is in the frame (with a 4 %
+/// margin), by bisection; looking at the terrain's middle, the land is also centred in the frame.
+void TerrainRenderer::Impl::fit_orbit(Frame& f, const Camera& camera, glm::dvec3 back, double& distance,
+                                      const Style& st) const {
+    const std::vector<glm::dvec3> outline = land_outline(f, st);
+    const glm::dmat4 proj = glm::perspective(camera.fov * kDegree, f.aspect, f.radius * 1e-3, f.radius * 100);
+    auto fits = [&](double d) {
+        const glm::dvec3 e = f.target + back * d;
+        const glm::dmat4 vp = proj * glm::lookAt(e, f.target, std::abs(back.y) > 0.9999 ? glm::dvec3(0, 0, -1) : f.up);
+        for (const glm::dvec3& q : outline) {
+            const glm::dvec4 p = vp * glm::dvec4(q, 1.0);
+            if (p.w <= 0 || std::abs(p.x / p.w) > 0.96 || std::abs(p.y / p.w) > 0.96) return false;
+        }
+        return true;
+    };
+    auto fit = [&] {
+        double near = 0, far = f.radius / std::sin(std::min(camera.fov, 179.0) * 0.5 * kDegree) * 4 + f.radius;
+        for (int i = 0; i < 40; ++i) (fits(0.5 * (near + far)) ? far : near) = 0.5 * (near + far);
+        return far;
+    };
+    distance = fit();
+    // Looking at the terrain's middle (the default target), the land is centred in the frame and fitted
+    // again: a few rounds of moving the target by the land's offset from the frame's middle (its extent at the
+    // target's distance), so the land fills the frame instead of leaving a band of sky above it.
+    if (!(camera.centre_land && camera.target.x == 0.5 && camera.target.y == 0.5 && std::abs(back.y) < 0.9999))
+        return;
+    const glm::dvec3 right = glm::normalize(glm::cross(f.up, back)), upward = glm::cross(back, right);
+    for (int round = 0; round < 4; ++round) {
+        const glm::dvec3 e = f.target + back * distance;
+        const glm::dmat4 vp = proj * glm::lookAt(e, f.target, f.up);
+        glm::dvec2 low(1e300), high(-1e300);
+        for (const glm::dvec3& q : outline) {
+            const glm::dvec4 p = vp * glm::dvec4(q, 1.0);
+            low = glm::min(low, glm::dvec2(p) / p.w);
+            high = glm::max(high, glm::dvec2(p) / p.w);
+        }
+        const glm::dvec2 off = 0.5 * (low + high);  // the land's middle, in the frame's -1..1
+        const double half_height = distance * std::tan(camera.fov * 0.5 * kDegree);
+        f.target += right * (off.x * half_height * f.aspect) + upward * (off.y * half_height);
+        distance = fit();
+    }
+}
+
+/// The eye, the target and the projection; refuses a camera inside or under the terrain.
+void TerrainRenderer::Impl::place_camera(Frame& f, const Camera& camera, const Style& st) const {
+    if (camera.mode == Camera::Mode::top) {
+        f.target = f.centre;
+        f.eye = {f.centre.x, f.box_max.y + f.radius, f.centre.z};
+        f.up = {0, 0, -1};  // north up
+        double half_w = extent_x() * 0.5, half_h = extent_z() * 0.5;
+        if (half_w / half_h > f.aspect) half_h = half_w / f.aspect;
+        else half_w = half_h * f.aspect;
+        f.near_plane = f.radius * 0.5;
+        f.far_plane = f.eye.y - f.box_min.y + f.radius * 0.5;
+        f.projection = glm::ortho(-half_w, half_w, -half_h, half_h, f.near_plane, f.far_plane);
+    } else {
+        if (camera.mode == Camera::Mode::orbit) {
+            f.target = {camera.target.x * extent_x(), f.centre.y, camera.target.y * extent_z()};
+            double distance = camera.distance;
+            const glm::dvec3 back = direction(camera.azimuth, camera.elevation);
+            if (distance <= 0) fit_orbit(f, camera, back, distance, st);
+            f.eye = f.target + back * distance;
+        } else {
+            f.eye = {camera.from.x * extent_x(), (lo + camera.from_height) * f.exag, camera.from.y * extent_z()};
+            f.target = {camera.to.x * extent_x(), (lo + camera.to_height) * f.exag, camera.to.y * extent_z()};
+            if (glm::length(f.target - f.eye) < 1e-6)
+                throw BadInput("render:terrain: the camera's from and to are the same point; move one of them");
+        }
+        const glm::dvec3 forward = glm::normalize(f.target - f.eye);
+        if (std::abs(forward.y) > 0.9999) f.up = {0, 0, -1};
+        const double g = ground(f.eye.x, f.eye.z);
+        if (!std::isnan(g) && f.eye.y <= g * f.exag)
+            throw BadInput("render:terrain: the camera is inside the terrain (at " + std::to_string(int(f.eye.y / f.exag)) +
+                           " m where the ground is " + std::to_string(int(g)) +
+                           " m); raise its elevation, distance or height");
+        // Beside the terrain and below its lowest point (or below the sea): only the underside and the skirt show.
+        const double lowest = st.sea ? std::max(double(lo), st.sea_level) : double(lo);
+        if (std::isnan(g) && f.eye.y < lowest * f.exag)
+            throw BadInput("render:terrain: the camera is below the terrain (at " + std::to_string(int(f.eye.y / f.exag)) +
+                           " m, under its lowest point" + (st.sea ? std::string(" or the sea") : std::string()) +
+                           " at " + std::to_string(int(lowest)) +
+                           " m), where it sees only its underside; raise its elevation (above 0° for an orbit) or height");
+        set_clip_planes(f, st);
+        f.projection = glm::perspective(camera.fov * kDegree, f.aspect, f.near_plane, f.far_plane);
+    }
+    f.view_projection = f.projection * glm::lookAt(f.eye, f.target, f.up);
+}
+
+/// Near and far around the terrain's bounding sphere (out to the horizon with a sea).
+void TerrainRenderer::Impl::set_clip_planes(Frame& f, const Style& st) const {
+    const double to_centre = glm::length(f.centre - f.eye);
+    f.far_plane = to_centre + f.radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
+    f.near_plane = std::max(std::max(to_centre - f.radius, 0.0) * 0.8, f.far_plane * 2e-5);
+    // The sea comes up to the camera: a ray at most 60° off the view axis meets it no nearer (along the
+    // axis) than half the camera's height above it, so keep the near plane inside that.
+    if (st.sea && f.eye.y > st.sea_level * f.exag)
+        f.near_plane = std::max(std::min(f.near_plane, 0.5 * (f.eye.y - st.sea_level * f.exag)), f.far_plane * 2e-6);
+}
+
+/// Looking at nothing: every corner of the terrain's box outside one clip plane.
+void TerrainRenderer::Impl::refuse_a_view_of_nothing(const Frame& f) const {
+    bool outside_all[6] = {true, true, true, true, true, true};
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec4 p = f.view_projection * glm::dvec4(c & 1 ? f.box_max.x : f.box_min.x,
+                                                            c & 2 ? f.box_max.y : f.box_min.y,
+                                                            c & 4 ? f.box_max.z : f.box_min.z, 1.0);
+        const double v[6] = {p.x + p.w, p.w - p.x, p.y + p.w, p.w - p.y, p.z + p.w, p.w - p.z};
+        for (int k = 0; k < 6; ++k) outside_all[k] = outside_all[k] && v[k] < 0;
+    }
+    for (bool o : outside_all)
+        if (o)
+            throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
+                           "(target, to, azimuth/elevation) or widen the field of view");
+}
+
+void TerrainRenderer::Impl::set_grid(GLuint p, const glm::mat4& view_projection, double exaggeration) const {
+    set(p, "grid", glm::ivec2(width, height));
+    set(p, "stride", stride);
+    set(p, "kept", kept);
+    set(p, "cell", float(terrain->cell()));
+    set(p, "exaggeration", float(exaggeration));
+    set(p, "view_projection", view_projection);
+}
+
+/// The shadow map: depth seen from the sun, orthographic around the terrain's box. Kept from the last frame
+/// when the light and the mesh are the same.
+void TerrainRenderer::Impl::prepare_shadow_map(const Frame& f, const Style& st) {
+    if (shadow_size != st.shadow_size) {
+        if (shadow_fbo) glDeleteFramebuffers(1, &shadow_fbo);
+        if (shadow_depth) glDeleteTextures(1, &shadow_depth);
+        shadow_size = st.shadow_size;
+        shadow_ready = false;
+        glGenTextures(1, &shadow_depth);
+        glBindTexture(GL_TEXTURE_2D, shadow_depth);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, shadow_size, shadow_size, 0, GL_DEPTH_COMPONENT,
+                     GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
+        const float white[4] = {1, 1, 1, 1};
+        glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, white);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        glGenFramebuffers(1, &shadow_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow_depth, 0);
+        glDrawBuffer(GL_NONE);
+        glReadBuffer(GL_NONE);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            throw Error("render:terrain: OSMesa could not set up the shadow map");
+    }
+    const bool draw_shadows = f.shaded && st.sun_elevation > 0;
+    if (shadow_ready && shadow_light == f.light_view_projection && shadow_stride == stride &&
+        shadow_drawn == draw_shadows)
+        return;
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_fbo);
+    glViewport(0, 0, shadow_size, shadow_size);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    if (draw_shadows) {
+        const GLuint program = programs().shadow;
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(1.5f, 2.0f);
+        glUseProgram(program);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, heights);
+        set(program, "heights", 0);
+        set_grid(program, glm::mat4(f.light_view_projection), f.exag);
+        set(program, "skirt_edge", -1);
+        glDrawElements(GL_TRIANGLE_STRIP, bind_order(rows_southward), GL_UNSIGNED_INT, nullptr);
+        glDisable(GL_POLYGON_OFFSET_FILL);
+    }
+    shadow_ready = true;
+    shadow_drawn = draw_shadows;
+    shadow_light = f.light_view_projection;
+    shadow_stride = stride;
+}
+
+/// The sky, which also clears the colour.
+void TerrainRenderer::Impl::draw_sky(const Frame& f) const {
+    const GLuint program = programs().sky;
+    glUseProgram(program);
+    f.light->set_on(program, 1.0f, f.eye);
+    set(program, "inverse_view_projection", glm::mat4(glm::inverse(f.view_projection)));
+    gl::draw_fullscreen();
+}
+
+/// The surface, nearest strips first and its back faces culled (a heightfield seen from above the ground only
+/// ever shows its front faces), then the skirt down to below the lowest point (and below the sea).
+/// `mirrored`: the matrix mirrors the world (the sea's reflection), which turns the winding over.
+/// `seen`: a query that learns whether any of the surface (not the skirt) reached the frame.
+void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored,
+                                         GLuint seen) {
+    const GLuint program = programs().terrain;
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glUseProgram(program);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, heights);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, shadow_depth);
+    glActiveTexture(GL_TEXTURE0);
+    set(program, "heights", 0);
+    set(program, "shadow_map", 1);
+    set_grid(program, matrix, f.exag);
+    f.light->set_on(program, 0.0f, f.eye);
+    set(program, "height_min", lo);
+    set(program, "height_max", hi);
+    const float starts[4] = {0.0f, st.splat.band_start[0], st.splat.band_start[1], st.splat.band_start[2]};
+    glUniform1fv(loc(program, "band_start"), 4, starts);
+    set(program, "blend_fraction", st.splat.blend_fraction);
+    set(program, "slope_start", st.splat.slope_start);
+    set(program, "slope_full", st.splat.slope_full);
+    float materials[12];
+    for (int i = 0; i < 4; ++i)
+        for (int c = 0; c < 3; ++c) materials[3 * i + c] = st.materials[std::size_t(i)][std::size_t(c)];
+    glUniform3fv(loc(program, "material"), 4, materials);
+    set(program, "jitter", float(st.jitter));
+    set(program, "texture_scale", float(st.texture_scale));
+    set(program, "output_mode", int(st.output));
+    set(program, "light_view_projection", glm::mat4(f.light_view_projection));
+    set(program, "shadow_texel", 1.0f / float(shadow_size));
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(mirrored ? GL_CW : GL_CCW);
+    set(program, "skirt_edge", -1);
+    if (seen) glBeginQuery(GL_ANY_SAMPLES_PASSED, seen);
+    glDrawElements(GL_TRIANGLE_STRIP, bind_order(front_to_back(f.eye)), GL_UNSIGNED_INT, nullptr);
+    if (seen) glEndQuery(GL_ANY_SAMPLES_PASSED);
+    glDisable(GL_CULL_FACE);
+    glFrontFace(GL_CCW);
+    set(program, "floor_height", float(f.floor_height * f.exag));
+    for (int edge = 0; edge < 4; ++edge) {
+        set(program, "skirt_edge", edge);
+        glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? kept.x : kept.y));
+    }
+}
+
+/// Particles: lit spheres (points).
+void TerrainRenderer::Impl::draw_particles(const Frame& f, const Style& st, const Camera& camera,
+                                           const ParticleFrame& particles) {
+    const auto it = particles.attributes.find("position");
+    if (it == particles.attributes.end() || it->second.components != 3)
+        throw BadInput("render:terrain: the particle frame has no 3-component 'position' attribute");
+    if (!particle_vao) {
+        glGenVertexArrays(1, &particle_vao);
+        glGenBuffers(1, &particle_vbo);
+    }
+    glBindVertexArray(particle_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, particle_vbo);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(it->second.data.size() * sizeof(float)), it->second.data.data(),
+                 GL_STREAM_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
+    glEnable(GL_PROGRAM_POINT_SIZE);
+    const GLuint program = programs().particles;
+    glUseProgram(program);
+    set(program, "view_projection", glm::mat4(f.view_projection));
+    set(program, "exaggeration", float(f.exag));
+    set(program, "radius", float(st.particle_radius));
+    const double ppm = camera.mode == Camera::Mode::top ? 0.0 : f.height / (2.0 * std::tan(camera.fov * 0.5 * kDegree));
+    set(program, "pixels_per_metre_at_unit_distance", float(ppm));
+    set(program, "particle_colour", glm::vec3(st.particle_colour[0], st.particle_colour[1], st.particle_colour[2]));
+    f.light->set_on(program, 0.0f, f.eye);
+    glDrawArrays(GL_POINTS, 0, GLsizei(particles.count()));
+    glDisable(GL_PROGRAM_POINT_SIZE);
+}
+
+/// The sea's reflection: the terrain above the water mirrored in its plane, drawn into a smaller texture
+/// (alpha 1 where terrain is, 0 where the water shader keeps its analytic sky), from the mirrored eye so fog
+/// and glints follow the reflected ray's length. Binds `scene_fbo` again when done.
+gl::Target TerrainRenderer::Impl::draw_reflection(const Frame& f, const Style& st, GLuint scene_fbo) {
+    gl::Target reflection(std::max(1, int(std::lround(f.width * st.reflection))),
+                          std::max(1, int(std::lround(f.height * st.reflection))), true);
+    reflection.bind();
+    glClearColor(0, 0, 0, 0);
+    glClearDepth(1.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    const double water_y = st.sea_level * f.exag;
+    // y → 2·water_y − y: the mirror in the plane y = water_y
+    const glm::dmat4 mirror = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2 * water_y, 0)) *
+                              glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
+    const Programs& prog = programs();
+    glEnable(GL_CLIP_DISTANCE0);
+    for (GLuint p : {prog.shadow, prog.terrain})
+        glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
+    // Lit from the mirrored eye; the strips' order is the same (the mirror keeps x and z).
+    Frame mirrored = f;
+    mirrored.eye = glm::dvec3(mirror * glm::dvec4(f.eye, 1.0));
+    draw_terrain(mirrored, st, glm::mat4(f.view_projection * mirror), true, 0);
+    glDisable(GL_CLIP_DISTANCE0);
+    for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
+    glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
+    glViewport(0, 0, f.width, f.height);
+    return reflection;
+}
+
+/// Water, blended over the terrain: what shows through is scaled by alpha.
+void TerrainRenderer::Impl::draw_water(const Frame& f, const Style& st, const gl::Target& reflection, bool reflect) {
+    const GLuint program = programs().water;
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);  // the frame stays opaque
+    glUseProgram(program);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, surface);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, heights);
+    set(program, "surface", 0);
+    set(program, "heights", 1);
+    set_grid(program, glm::mat4(f.view_projection), f.exag);
+    f.light->set_on(program, 0.0f, f.eye);
+    set(program, "time", float(st.time));
+    set(program, "wave_height", float(st.wave_height));
+    set(program, "water_colour", glm::vec3(0.02f, 0.09f, 0.12f));
+    set(program, "clarity", float(st.clarity));
+    set(program, "has_reflection", 0);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, reflection.colour.id);
+    set(program, "reflection", 2);
+    glActiveTexture(GL_TEXTURE0);  // the unit every other pass and gl::upload expect to be active
+    set(program, "viewport", glm::vec2(float(f.width), float(f.height)));
+    set(program, "sea_level", float(st.sea_level));
+    glBindVertexArray(vao);
+    if (has_water) {
+        // Farthest strips first: the water is blended, and where it overlaps itself the nearer must come last.
+        set(program, "sea_plane", 0);
+        const auto back_to_front = Order(int(front_to_back(f.eye)) ^ 1);
+        glDrawElements(GL_TRIANGLE_STRIP, bind_order(back_to_front), GL_UNSIGNED_INT, nullptr);
+    }
+    if (st.sea) {
+        const double reach = f.radius * 38.0;
+        set(program, "sea_plane", 1);
+        set(program, "has_reflection", reflect ? 1 : 0);
+        const glm::vec4 extent(float(f.centre.x - reach), float(f.centre.z - reach), float(f.centre.x + reach),
+                               float(f.centre.z + reach));
+        glUniform4fv(loc(program, "plane_extent"), 1, glm::value_ptr(extent));
+        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    }
+    glDisable(GL_BLEND);
+    glDepthMask(GL_TRUE);
+}
+
 Image TerrainRenderer::render(int width, int height, const Camera& camera, const ParticleFrame* particles,
                               Timings* timings) {
     Impl& m = *impl_;
@@ -257,152 +770,12 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     if (!(camera.fov > 0 && camera.fov < 180))
         throw BadInput("render:terrain: the field of view must be between 0 and 180 degrees (exclusive), got " +
                        std::to_string(camera.fov));
-    const double exag = st.exaggeration;
-    const double skirt = 0.08 * std::max(double(m.hi - m.lo), 1.0);  // m below the lowest point (and the sea)
-    const double floor_height = st.sea ? std::min(double(m.lo), st.sea_level) - skirt : m.lo - skirt;
-    const glm::dvec3 box_min(0, floor_height * exag, 0), box_max(m.extent_x(), m.hi * exag, m.extent_z());
-    const glm::dvec3 centre = (box_min + box_max) * 0.5;
-    const double radius = glm::length(box_max - box_min) * 0.5;
-    const double aspect = double(width) / double(std::max(height, 1));
-
-    // ---- camera
-    glm::dvec3 eye, target, up(0, 1, 0);
-    glm::dmat4 projection;
-    double near_plane = 1, far_plane = 1;
-    if (camera.mode == Camera::Mode::top) {
-        target = {centre.x, centre.y, centre.z};
-        eye = {centre.x, box_max.y + radius, centre.z};
-        up = {0, 0, -1};  // north up
-        double half_w = m.extent_x() * 0.5, half_h = m.extent_z() * 0.5;
-        if (half_w / half_h > aspect) half_h = half_w / aspect;
-        else half_w = half_h * aspect;
-        near_plane = radius * 0.5;
-        far_plane = eye.y - box_min.y + radius * 0.5;
-        projection = glm::ortho(-half_w, half_w, -half_h, half_h, near_plane, far_plane);
-    } else {
-        if (camera.mode == Camera::Mode::orbit) {
-            target = {camera.target.x * m.extent_x(), centre.y, camera.target.y * m.extent_z()};
-            double distance = camera.distance;
-            const glm::dvec3 back = direction(camera.azimuth, camera.elevation);
-            if (distance <= 0) {
-                // The nearest distance at which all of the land is in the frame (with a 4 % margin), by
-                // bisection. What must fit is the surface itself (a lattice of at most 65 × 65 of its samples at
-                // their heights) and its skirt's foot along the edges, not the box around them: the box's top
-                // corners stand at the highest summit's height over every corner. With a sea, what lies under
-                // it is sea to the horizon, so only the land above it counts (the skirt down to the water):
-                // fitting the drowned corners and the skirt's foot under the water left the land a small slab
-                // in a wide frame.
-                std::vector<glm::dvec3> outline;
-                const ConstGridView g = m.terrain->view();
-                const double cell = m.terrain->cell();
-                const int stride = std::max(1, (std::max(m.width, m.height) - 1) / 64);
-                std::vector<int> xs, ys;  // every stride-th sample, and the last
-                for (int x = 0; x < m.width - 1; x += stride) xs.push_back(x);
-                for (int y = 0; y < m.height - 1; y += stride) ys.push_back(y);
-                xs.push_back(m.width - 1);
-                ys.push_back(m.height - 1);
-                const double foot = st.sea ? st.sea_level * exag : box_min.y;
-                for (int y : ys)
-                    for (int x : xs) {
-                        const double h = g.at(x, y);
-                        if (st.sea && !(h > st.sea_level)) continue;
-                        outline.emplace_back(x * cell, h * exag, y * cell);
-                        if (x == 0 || y == 0 || x == m.width - 1 || y == m.height - 1)
-                            outline.emplace_back(x * cell, foot, y * cell);
-                    }
-                if (outline.empty())  // all under the sea: the terrain's box, as a frame for the sea floor
-                    for (int c = 0; c < 8; ++c)
-                        outline.emplace_back(c & 1 ? box_max.x : box_min.x, c & 2 ? box_max.y : box_min.y,
-                                             c & 4 ? box_max.z : box_min.z);
-                const glm::dmat4 proj = glm::perspective(camera.fov * kDegree, aspect, radius * 1e-3, radius * 100);
-                auto fits = [&](double d) {
-                    const glm::dvec3 e = target + back * d;
-                    const glm::dmat4 vp = proj * glm::lookAt(e, target, std::abs(back.y) > 0.9999 ? glm::dvec3(0, 0, -1) : up);
-                    for (const glm::dvec3& q : outline) {
-                        const glm::dvec4 p = vp * glm::dvec4(q, 1.0);
-                        if (p.w <= 0 || std::abs(p.x / p.w) > 0.96 || std::abs(p.y / p.w) > 0.96) return false;
-                    }
-                    return true;
-                };
-                auto fit = [&] {
-                    double lo = 0, hi = radius / std::sin(std::min(camera.fov, 179.0) * 0.5 * kDegree) * 4 + radius;
-                    for (int i = 0; i < 40; ++i) (fits(0.5 * (lo + hi)) ? hi : lo) = 0.5 * (lo + hi);
-                    return hi;
-                };
-                distance = fit();
-                // Looking at the terrain's middle (the default target), the land is centred in the frame and
-                // fitted again: a few rounds of moving the target by the land's offset from the frame's middle
-                // (its extent at the target's distance), so the land fills the frame instead of leaving a band
-                // of sky above it.
-                if (camera.centre_land && camera.target.x == 0.5 && camera.target.y == 0.5 && std::abs(back.y) < 0.9999) {
-                    const glm::dvec3 right = glm::normalize(glm::cross(up, back)), upward = glm::cross(back, right);
-                    for (int round = 0; round < 4; ++round) {
-                        const glm::dvec3 e = target + back * distance;
-                        const glm::dmat4 vp = proj * glm::lookAt(e, target, up);
-                        glm::dvec2 lo(1e300), hi(-1e300);
-                        for (const glm::dvec3& q : outline) {
-                            const glm::dvec4 p = vp * glm::dvec4(q, 1.0);
-                            lo = glm::min(lo, glm::dvec2(p) / p.w);
-                            hi = glm::max(hi, glm::dvec2(p) / p.w);
-                        }
-                        const glm::dvec2 off = 0.5 * (lo + hi);  // the land's middle, in the frame's -1..1
-                        const double half_height = distance * std::tan(camera.fov * 0.5 * kDegree);
-                        target += right * (off.x * half_height * aspect) + upward * (off.y * half_height);
-                        distance = fit();
-                    }
-                }
-            }
-            eye = target + back * distance;
-        } else {
-            eye = {camera.from.x * m.extent_x(), (m.lo + camera.from_height) * exag, camera.from.y * m.extent_z()};
-            target = {camera.to.x * m.extent_x(), (m.lo + camera.to_height) * exag, camera.to.y * m.extent_z()};
-            if (glm::length(target - eye) < 1e-6)
-                throw BadInput("render:terrain: the camera's from and to are the same point; move one of them");
-        }
-        const glm::dvec3 forward = glm::normalize(target - eye);
-        if (std::abs(forward.y) > 0.9999) up = {0, 0, -1};
-        const double g = m.ground(eye.x, eye.z);
-        if (!std::isnan(g) && eye.y <= g * exag)
-            throw BadInput("render:terrain: the camera is inside the terrain (at " + std::to_string(int(eye.y / exag)) +
-                           " m where the ground is " + std::to_string(int(g)) +
-                           " m); raise its elevation, distance or height");
-        // Beside the terrain and below its lowest point (or below the sea): only the underside and the skirt show.
-        const double lowest = st.sea ? std::max(double(m.lo), st.sea_level) : double(m.lo);
-        if (std::isnan(g) && eye.y < lowest * exag)
-            throw BadInput("render:terrain: the camera is below the terrain (at " + std::to_string(int(eye.y / exag)) +
-                           " m, under its lowest point" + (st.sea ? std::string(" or the sea") : std::string()) +
-                           " at " + std::to_string(int(lowest)) +
-                           " m), where it sees only its underside; raise its elevation (above 0° for an orbit) or height");
-        // Near and far: around the terrain's bounding sphere.
-        const double to_centre = glm::length(centre - eye);
-        far_plane = to_centre + radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
-        near_plane = std::max(std::max(to_centre - radius, 0.0) * 0.8, far_plane * 2e-5);
-        // The sea comes up to the camera: a ray at most 60° off the view axis meets it no nearer (along the
-        // axis) than half the camera's height above it, so keep the near plane inside that.
-        if (st.sea && eye.y > st.sea_level * exag)
-            near_plane = std::max(std::min(near_plane, 0.5 * (eye.y - st.sea_level * exag)), far_plane * 2e-6);
-        projection = glm::perspective(camera.fov * kDegree, aspect, near_plane, far_plane);
-    }
-    const glm::dmat4 view = glm::lookAt(eye, target, up);
-    const glm::dmat4 view_projection = projection * view;
-    // Looking at nothing: every corner of the terrain's box outside one clip plane.
-    {
-        bool outside_all[6] = {true, true, true, true, true, true};
-        for (int c = 0; c < 8; ++c) {
-            const glm::dvec4 p = view_projection * glm::dvec4(c & 1 ? box_max.x : box_min.x,
-                                                              c & 2 ? box_max.y : box_min.y,
-                                                              c & 4 ? box_max.z : box_min.z, 1.0);
-            const double v[6] = {p.x + p.w, p.w - p.x, p.y + p.w, p.w - p.y, p.z + p.w, p.w - p.z};
-            for (int k = 0; k < 6; ++k) outside_all[k] = outside_all[k] && v[k] < 0;
-        }
-        for (bool o : outside_all)
-            if (o)
-                throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
-                               "(target, to, azimuth/elevation) or widen the field of view");
-    }
+    Impl::Frame f = m.frame_box(width, height, st);
+    m.place_camera(f, camera, st);
+    m.refuse_a_view_of_nothing(f);
 
     gl::Lock lock("render:terrain");
-    const Programs& prog = programs();
+    programs();
     gl::check_frame_size("render:terrain", width, height, bytes_per_pixel(st.samples));
     // Auto detail: at most one kept sample per 2.5 pixels of the frame's longer side
     // (llvmpipe pays per triangle; normals and colours come from the full grid anyway).
@@ -416,192 +789,20 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         timings->*field += seconds_since(t0);
         t0 = std::chrono::steady_clock::now();
     };
-
-    // ---- light
-    const glm::dvec3 sun = direction(st.sun_azimuth, st.sun_elevation);
-    const glm::vec3 sun_colour = glm::vec3(1.0f, 0.93f, 0.82f) * float(st.sun_intensity);
-    // Sky: bluer at the zenith, warmer and paler at the horizon when the sun is low.
-    const float low = float(std::clamp(1.0 - st.sun_elevation / 45.0, 0.0, 1.0));
-    const glm::vec3 zenith = glm::mix(glm::vec3(0.05f, 0.14f, 0.42f), glm::vec3(0.08f, 0.16f, 0.38f), low);
-    const glm::vec3 horizon = glm::mix(glm::vec3(0.42f, 0.52f, 0.68f), glm::vec3(0.62f, 0.52f, 0.46f), low * 0.5f);
-    const glm::vec3 ambient = (zenith * 0.6f + horizon * 0.4f) * 0.9f;
-    const float fog_density = float(st.haze / std::max(2.0 * radius, 1e-6));
-    glm::dvec3 light_eye = eye;  // the mirrored eye while the reflection is drawn
-    auto set_light = [&](GLuint p, float disc) {
-        set(p, "sun_direction", glm::vec3(sun));
-        set(p, "sun_colour", sun_colour);
-        set(p, "sky_zenith", zenith);
-        set(p, "sky_horizon", horizon);
-        set(p, "sun_disc", disc);
-        set(p, "fog_density", fog_density);
-        set(p, "ambient_colour", ambient);
-        set(p, "eye", glm::vec3(light_eye));
-    };
-    auto set_grid = [&](GLuint p, const glm::mat4& vp) {
-        set(p, "grid", glm::ivec2(m.width, m.height));
-        set(p, "stride", m.stride);
-        set(p, "kept", m.kept);
-        set(p, "cell", float(m.terrain->cell()));
-        set(p, "exaggeration", float(exag));
-        set(p, "view_projection", vp);
-    };
     glEnable(GL_PRIMITIVE_RESTART);
     glPrimitiveRestartIndex(0xFFFFFFFFu);
     glDisable(GL_CULL_FACE);
 
-    // ---- shadow map: depth seen from the sun, orthographic around the terrain's box
-    if (m.shadow_size != st.shadow_size) {
-        if (m.shadow_fbo) glDeleteFramebuffers(1, &m.shadow_fbo);
-        if (m.shadow_depth) glDeleteTextures(1, &m.shadow_depth);
-        m.shadow_size = st.shadow_size;
-        m.shadow_ready = false;
-        glGenTextures(1, &m.shadow_depth);
-        glBindTexture(GL_TEXTURE_2D, m.shadow_depth);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, m.shadow_size, m.shadow_size, 0, GL_DEPTH_COMPONENT,
-                     GL_FLOAT, nullptr);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_BORDER);
-        const float white[4] = {1, 1, 1, 1};
-        glTexParameterfv(GL_TEXTURE_2D, GL_TEXTURE_BORDER_COLOR, white);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
-        glGenFramebuffers(1, &m.shadow_fbo);
-        glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, m.shadow_depth, 0);
-        glDrawBuffer(GL_NONE);
-        glReadBuffer(GL_NONE);
-        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-            throw Error("render:terrain: OSMesa could not set up the shadow map");
-    }
-    glm::dmat4 light_vp(1.0);
-    {
-        const glm::dvec3 light_up = std::abs(sun.y) > 0.999 ? glm::dvec3(0, 0, -1) : glm::dvec3(0, 1, 0);
-        const glm::dmat4 light_view = glm::lookAt(centre + sun * radius * 2.0, centre, light_up);
-        glm::dvec3 lo(1e300), hi(-1e300);
-        for (int c = 0; c < 8; ++c) {
-            const glm::dvec3 p = glm::dvec3(light_view * glm::dvec4(c & 1 ? box_max.x : box_min.x,
-                                                                    c & 2 ? box_max.y : box_min.y,
-                                                                    c & 4 ? box_max.z : box_min.z, 1.0));
-            lo = glm::min(lo, p);
-            hi = glm::max(hi, p);
-        }
-        light_vp = glm::ortho(lo.x, hi.x, lo.y, hi.y, -hi.z - 1.0, -lo.z + 1.0) * light_view;
-    }
-    const bool shaded = st.output == Style::Output::beauty;
-    const bool draw_shadows = shaded && st.sun_elevation > 0;
-    const bool shadow_kept = m.shadow_ready && m.shadow_light == light_vp && m.shadow_stride == m.stride &&
-                             m.shadow_drawn == draw_shadows;
-    if (!shadow_kept) {
-    glBindFramebuffer(GL_FRAMEBUFFER, m.shadow_fbo);
-    glViewport(0, 0, m.shadow_size, m.shadow_size);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    if (draw_shadows) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glDepthMask(GL_TRUE);
-        glEnable(GL_POLYGON_OFFSET_FILL);
-        glPolygonOffset(1.5f, 2.0f);
-        glUseProgram(prog.shadow);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, m.heights);
-        set(prog.shadow, "heights", 0);
-        set_grid(prog.shadow, glm::mat4(light_vp));
-        set(prog.shadow, "skirt_edge", -1);
-        glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(Impl::rows_southward), GL_UNSIGNED_INT, nullptr);
-        glDisable(GL_POLYGON_OFFSET_FILL);
-    }
-    m.shadow_ready = true;
-    m.shadow_drawn = draw_shadows;
-    m.shadow_light = light_vp;
-    m.shadow_stride = m.stride;
-    }
+    f.light_view_projection = light_matrix(f.light->sun, f.centre, f.radius, f.box_min, f.box_max);
+    m.prepare_shadow_map(f, st);
     mark(&Timings::shadow);
 
-    // ---- the frame: multisampled half-float colour and float depth
-    const int samples = std::max(1, st.samples);
-    GLuint fbo = 0, colour_rb = 0, depth_rb = 0;
-    glGenFramebuffers(1, &fbo);
-    glGenRenderbuffers(1, &colour_rb);
-    glGenRenderbuffers(1, &depth_rb);
-    struct Cleanup {
-        GLuint& f; GLuint& c; GLuint& d;
-        ~Cleanup() { glDeleteFramebuffers(1, &f); glDeleteRenderbuffers(1, &c); glDeleteRenderbuffers(1, &d); }
-    } cleanup{fbo, colour_rb, depth_rb};
-    glBindRenderbuffer(GL_RENDERBUFFER, colour_rb);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_RGBA16F, width, height);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth_rb);
-    glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples > 1 ? samples : 0, GL_DEPTH_COMPONENT32F, width, height);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_rb);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_rb);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        throw Error("render:terrain: OSMesa could not set up a " + std::to_string(width) + " × " +
-                    std::to_string(height) + " framebuffer with " + std::to_string(samples) + " samples");
+    SceneTarget scene(width, height, std::max(1, st.samples));
     glViewport(0, 0, width, height);
     glDepthMask(GL_TRUE);
     glClearDepth(1.0);
     glClear(GL_DEPTH_BUFFER_BIT);
-
-    const glm::mat4 vp(view_projection);
-    // Sky (also clears the colour).
-    glUseProgram(prog.sky);
-    set_light(prog.sky, 1.0f);
-    set(prog.sky, "inverse_view_projection", glm::mat4(glm::inverse(view_projection)));
-    gl::draw_fullscreen();
-
-    // Terrain.
-    // The surface, nearest strips first and its back faces culled (a heightfield seen from above the ground
-    // only ever shows its front faces), then the skirt down to below the lowest point (and below the sea).
-    // `mirrored`: the matrix mirrors the world (the sea's reflection), which turns the winding over.
-    // `seen`: a query that learns whether any of the surface (not the skirt) reached the frame.
-    auto draw_terrain = [&](const glm::mat4& matrix, int mode, bool mirrored, GLuint seen) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glDepthMask(GL_TRUE);
-        glDisable(GL_BLEND);
-        glUseProgram(prog.terrain);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, m.heights);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, m.shadow_depth);
-        glActiveTexture(GL_TEXTURE0);
-        set(prog.terrain, "heights", 0);
-        set(prog.terrain, "shadow_map", 1);
-        set_grid(prog.terrain, matrix);
-        set_light(prog.terrain, 0.0f);
-        set(prog.terrain, "height_min", m.lo);
-        set(prog.terrain, "height_max", m.hi);
-        const float starts[4] = {0.0f, st.splat.band_start[0], st.splat.band_start[1], st.splat.band_start[2]};
-        glUniform1fv(loc(prog.terrain, "band_start"), 4, starts);
-        set(prog.terrain, "blend_fraction", st.splat.blend_fraction);
-        set(prog.terrain, "slope_start", st.splat.slope_start);
-        set(prog.terrain, "slope_full", st.splat.slope_full);
-        float materials[12];
-        for (int i = 0; i < 4; ++i)
-            for (int c = 0; c < 3; ++c) materials[3 * i + c] = st.materials[std::size_t(i)][std::size_t(c)];
-        glUniform3fv(loc(prog.terrain, "material"), 4, materials);
-        set(prog.terrain, "jitter", float(st.jitter));
-        set(prog.terrain, "texture_scale", float(st.texture_scale));
-        set(prog.terrain, "output_mode", mode);
-        set(prog.terrain, "light_view_projection", glm::mat4(light_vp));
-        set(prog.terrain, "shadow_texel", 1.0f / float(m.shadow_size));
-        glEnable(GL_CULL_FACE);
-        glCullFace(GL_BACK);
-        glFrontFace(mirrored ? GL_CW : GL_CCW);
-        set(prog.terrain, "skirt_edge", -1);
-        if (seen) glBeginQuery(GL_ANY_SAMPLES_PASSED, seen);
-        glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(m.front_to_back(eye)), GL_UNSIGNED_INT, nullptr);
-        if (seen) glEndQuery(GL_ANY_SAMPLES_PASSED);
-        glDisable(GL_CULL_FACE);
-        glFrontFace(GL_CCW);
-        set(prog.terrain, "floor_height", float(floor_height * exag));
-        for (int edge = 0; edge < 4; ++edge) {
-            set(prog.terrain, "skirt_edge", edge);
-            glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? m.kept.x : m.kept.y));
-        }
-    };
+    m.draw_sky(f);
     // A camera that sees none of the surface (looking past it, from under it, or from inside its box at the
     // sky) renders a picture of nothing: refused, as the frustum test above refuses one that looks away.
     {
@@ -610,121 +811,22 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
             Query() { glGenQueries(1, &id); }
             ~Query() { glDeleteQueries(1, &id); }
         } seen;
-        draw_terrain(vp, int(st.output), false, seen.id);
+        m.draw_terrain(f, st, glm::mat4(f.view_projection), false, seen.id);
         GLuint any = 0;
         glGetQueryObjectuiv(seen.id, GL_QUERY_RESULT, &any);
         if (!any)
             throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
                            "(target, to, azimuth/elevation) or widen the field of view");
     }
-
-    // Particles: lit spheres (points).
-    if (shaded && particles && particles->count() > 0) {
-        const auto it = particles->attributes.find("position");
-        if (it == particles->attributes.end() || it->second.components != 3)
-            throw BadInput("render:terrain: the particle frame has no 3-component 'position' attribute");
-        if (!m.particle_vao) {
-            glGenVertexArrays(1, &m.particle_vao);
-            glGenBuffers(1, &m.particle_vbo);
-        }
-        glBindVertexArray(m.particle_vao);
-        glBindBuffer(GL_ARRAY_BUFFER, m.particle_vbo);
-        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(it->second.data.size() * sizeof(float)), it->second.data.data(),
-                     GL_STREAM_DRAW);
-        glEnableVertexAttribArray(0);
-        glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 0, nullptr);
-        glEnable(GL_PROGRAM_POINT_SIZE);
-        glUseProgram(prog.particles);
-        set(prog.particles, "view_projection", vp);
-        set(prog.particles, "exaggeration", float(exag));
-        set(prog.particles, "radius", float(st.particle_radius));
-        const double ppm = camera.mode == Camera::Mode::top ? 0.0
-                                                             : height / (2.0 * std::tan(camera.fov * 0.5 * kDegree));
-        set(prog.particles, "pixels_per_metre_at_unit_distance", float(ppm));
-        set(prog.particles, "particle_colour", glm::vec3(st.particle_colour[0], st.particle_colour[1], st.particle_colour[2]));
-        set_light(prog.particles, 0.0f);
-        glDrawArrays(GL_POINTS, 0, GLsizei(particles->count()));
-        glDisable(GL_PROGRAM_POINT_SIZE);
-    }
-
-    // The sea's reflection: the terrain above the water mirrored in its plane, drawn into a smaller texture
-    // (alpha 1 where terrain is, 0 where the water shader keeps its analytic sky), from the mirrored eye so
-    // fog and glints follow the reflected ray's length.
-    gl::Target reflection;
-    const bool reflect = shaded && st.sea && st.reflection > 0;
-    if (reflect) {
-        reflection = gl::Target(std::max(1, int(std::lround(width * st.reflection))),
-                                std::max(1, int(std::lround(height * st.reflection))), true);
-        reflection.bind();
-        glClearColor(0, 0, 0, 0);
-        glClearDepth(1.0);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        const double water_y = st.sea_level * exag;
-        // y → 2·water_y − y: the mirror in the plane y = water_y
-        const glm::dmat4 mirror = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2 * water_y, 0)) *
-                                  glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
-        light_eye = glm::dvec3(mirror * glm::dvec4(eye, 1.0));
-        glEnable(GL_CLIP_DISTANCE0);
-        for (GLuint p : {prog.shadow, prog.terrain})
-            glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
-        draw_terrain(glm::mat4(view_projection * mirror), int(st.output), true, 0);
-        glDisable(GL_CLIP_DISTANCE0);
-        for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
-        light_eye = eye;
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-        glViewport(0, 0, width, height);
-    }
-
-    // Water, blended over the terrain: what shows through is scaled by alpha.
-    if (shaded && (m.has_water || st.sea)) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthMask(GL_FALSE);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_SRC_ALPHA, GL_ZERO, GL_ONE);  // the frame stays opaque
-        glUseProgram(prog.water);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, m.surface);
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, m.heights);
-        set(prog.water, "surface", 0);
-        set(prog.water, "heights", 1);
-        set_grid(prog.water, vp);
-        set_light(prog.water, 0.0f);
-        set(prog.water, "time", float(st.time));
-        set(prog.water, "wave_height", float(st.wave_height));
-        set(prog.water, "water_colour", glm::vec3(0.02f, 0.09f, 0.12f));
-        set(prog.water, "clarity", float(st.clarity));
-        set(prog.water, "has_reflection", 0);
-        glActiveTexture(GL_TEXTURE2);
-        glBindTexture(GL_TEXTURE_2D, reflection.colour.id);
-        set(prog.water, "reflection", 2);
-        glActiveTexture(GL_TEXTURE0);  // the unit every other pass and gl::upload expect to be active
-        set(prog.water, "viewport", glm::vec2(float(width), float(height)));
-        set(prog.water, "sea_level", float(st.sea_level));
-        glBindVertexArray(m.vao);
-        if (m.has_water) {
-            // Farthest strips first: the water is blended, and where it overlaps itself the nearer must come last.
-            set(prog.water, "sea_plane", 0);
-            const auto back_to_front = Impl::Order(int(m.front_to_back(eye)) ^ 1);
-            glDrawElements(GL_TRIANGLE_STRIP, m.bind_order(back_to_front), GL_UNSIGNED_INT, nullptr);
-        }
-        if (st.sea) {
-            const double reach = radius * 38.0;
-            set(prog.water, "sea_plane", 1);
-            set(prog.water, "has_reflection", reflect ? 1 : 0);
-            const glm::vec4 extent(float(centre.x - reach), float(centre.z - reach), float(centre.x + reach),
-                                   float(centre.z + reach));
-            glUniform4fv(loc(prog.water, "plane_extent"), 1, glm::value_ptr(extent));
-            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-        }
-        glDisable(GL_BLEND);
-        glDepthMask(GL_TRUE);
-    }
+    if (f.shaded && particles && particles->count() > 0) m.draw_particles(f, st, camera, *particles);
+    const bool reflect = f.shaded && st.sea && st.reflection > 0;
+    const gl::Target reflection = reflect ? m.draw_reflection(f, st, scene.fbo) : gl::Target();
+    if (f.shaded && (m.has_water || st.sea)) m.draw_water(f, st, reflection, reflect);
     mark(&Timings::scene);
 
     // ---- resolve the samples into a float target and read it back
     gl::Target resolved(width, height);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, scene.fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolved.framebuffer);
     glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, resolved.framebuffer);
