@@ -15,6 +15,8 @@ function(orogen_add_plugin name)
   set_target_properties(${name} PROPERTIES
     PREFIX "" CXX_VISIBILITY_PRESET hidden VISIBILITY_INLINES_HIDDEN ON
     CXX_STANDARD 20 CXX_STANDARD_REQUIRED ON)
+  # In orogen's own tree, the layering check (cmake/OrogenLayering.cmake) walks this plugin's links.
+  set_property(GLOBAL APPEND PROPERTY OROGEN_PLUGIN_TARGETS ${name})
   if(DEFINED OROGEN_PLUGIN_OUTPUT_DIR)
     set_target_properties(${name} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${OROGEN_PLUGIN_OUTPUT_DIR})
     install(TARGETS ${name} LIBRARY DESTINATION ${OROGEN_PLUGIN_SUBDIR})

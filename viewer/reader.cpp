@@ -2,6 +2,7 @@
 #include "reader.hpp"
 
 #include <orogen/error.hpp>
+#include <orogen/formats/raw.hpp>
 #include <orogen/io.hpp>
 
 #include <gdal_priv.h>
@@ -270,53 +271,25 @@ Terrain read_png(const fs::path& file) {
     return t;
 }
 
-Terrain read_raw(const fs::path& file, bool r16) {
+/// RAW heightmaps through libs/formats, the same reader as import:raw: the sidecar checked field by field
+/// and the file's size against it before anything is allocated.
+Terrain read_raw(const fs::path& file) {
     const fs::path sidecar = file.string() + ".json";
     if (!fs::exists(sidecar))
         throw BadInput("cannot show " + quoted(file) + ": its sidecar " + quoted(sidecar.filename()) +
                        " is missing (a RAW file has no size or height range; export:raw writes both files: copy the "
                        ".json along)");
-    check_readable(sidecar);
-    nlohmann::json j;
-    try {
-        std::ifstream in(sidecar);
-        j = nlohmann::json::parse(in);
-    } catch (const std::exception&) {
-        throw BadInput("cannot read " + quoted(sidecar) + ": not valid JSON");
-    }
-    auto number = [&](const char* key) -> double {
-        if (!j.contains(key) || !j[key].is_number())
-            throw BadInput(quoted(sidecar) + " has no number '" + key + "' (export:raw writes width, height, " +
-                           "cell_size, height_min, height_max)");
-        return j[key].get<double>();
-    };
+    raw::Sidecar info;
+    const std::vector<float> heights = raw::read_raw(file, info);
     Terrain t;
     t.file = file;
-    t.width = int(number("width"));
-    t.height = int(number("height"));
-    t.cell = number("cell_size");
-    const double low = r16 ? number("height_min") : 0.0, high = r16 ? number("height_max") : 0.0;
-    const std::size_t count = std::size_t(t.width) * std::size_t(t.height), bytes = count * (r16 ? 2 : 4);
-    std::error_code ec;
-    if (t.width < 2 || t.height < 2 || fs::file_size(file, ec) != bytes)
-        throw BadInput("cannot show " + quoted(file) + ": it holds " + std::to_string(fs::file_size(file, ec)) +
-                       " bytes, but its sidecar says " + std::to_string(t.width) + " × " + std::to_string(t.height) +
-                       " samples of " + (r16 ? "2" : "4") + " bytes (" + std::to_string(bytes) + ")");
-    std::vector<char> data(bytes);
-    std::ifstream(file, std::ios::binary).read(data.data(), std::streamsize(bytes));
+    t.width = info.width;
+    t.height = info.height;
+    t.cell = info.cell;
     t.heights = vtkSmartPointer<vtkFloatArray>::New();
     t.heights->SetName("height");
-    t.heights->SetNumberOfTuples(vtkIdType(count));
-    for (std::size_t i = 0; i < count; ++i) {
-        if (r16) {
-            const auto* b = reinterpret_cast<const unsigned char*>(data.data() + 2 * i);
-            t.heights->SetValue(vtkIdType(i), float(low + (high - low) * (b[0] | (b[1] << 8)) / 65535.0));
-        } else {
-            float v;
-            std::memcpy(&v, data.data() + 4 * i, 4);  // little-endian, as the host
-            t.heights->SetValue(vtkIdType(i), v);
-        }
-    }
+    t.heights->SetNumberOfTuples(vtkIdType(heights.size()));
+    std::copy(heights.begin(), heights.end(), t.heights->GetPointer(0));
     return t;
 }
 
@@ -510,7 +483,7 @@ Content read_files(std::span<const fs::path> files) {
                                "for a RAW file's sidecar open the .r16 or .r32 beside it");
             c.terrains.push_back(read_tiles_index(file, index));
         } else {
-            c.terrains.push_back(read_raw(file, ext == ".r16"));
+            c.terrains.push_back(read_raw(file));
         }
     }
     return c;

@@ -1,7 +1,7 @@
 // scene.cpp — the VTK scene of orogen-view (see scene.hpp).
 #include "scene.hpp"
 
-#include "terrain_mesh.hpp"  // splat colours and mesh layout: one definition, shared with the exporters
+#include <orogen/mesh/terrain_mesh.hpp>  // splat colours and mesh layout: one definition, shared with the exporters
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -1,7 +1,7 @@
-// bench-links: TBB::tbb
+// bench-links: TBB::tbb orogen_solvers
 // One hillslope-diffusion step (orogen::diffusion::Solver::step) at 1025² and
 // 4097², per scheme, on 1 and 2 threads. Target (2 cores): 1025² ≤ 15 ms.
-#include "diffusion.hpp"
+#include <orogen/solvers/diffusion.hpp>
 
 #include <orogen/random.hpp>
 

@@ -1,8 +1,9 @@
+// bench-links: orogen_gltf
 // export:gltf on a 4097² terrain (20 m cells): .glb with the default automatic
 // chunks (16-bit indices) and 2048² texture, written to disk (fsync included).
 #include "export_common.hpp"
-#include "gltf_writer.hpp"
-#include "terrain_mesh.hpp"
+#include <orogen/gltf/gltf_writer.hpp>
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <benchmark/benchmark.h>
 

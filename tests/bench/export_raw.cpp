@@ -1,6 +1,7 @@
+// bench-links: orogen_formats
 // export:raw on a 4097² terrain: .r16 (quantised) and .r32, with the sidecar, to disk.
 #include "export_common.hpp"
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include <benchmark/benchmark.h>
 

@@ -1,8 +1,9 @@
+// bench-links: orogen_vtk
 // export:vtk on a 4097² terrain with two layers: .vti (raw appended; up=y
 // writes the samples without a copy, up=z, the default, copies each array
 // with its rows reversed) and the .vtp mesh, written to disk (fsync included).
 #include "export_common.hpp"
-#include "vtk_writer.hpp"
+#include <orogen/vtk/vtk_writer.hpp>
 
 #include <benchmark/benchmark.h>
 

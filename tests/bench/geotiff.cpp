@@ -1,6 +1,7 @@
+// bench-links: orogen_geotiff
 // export:geotiff on a 4097² terrain (the target: DEFLATE ≤ 2 s), per compression, to disk.
 #include "export_common.hpp"
-#include "geotiff.hpp"
+#include <orogen/geotiff/geotiff.hpp>
 
 #include <benchmark/benchmark.h>
 

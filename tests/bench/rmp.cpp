@@ -3,8 +3,8 @@
 //   build-rmp/bench/bench_rmp --benchmark_min_time=1 --benchmark_counters_tabular=true
 // Each benchmark runs one whole RMP (100 iterations) per benchmark iteration.
 #include "cones.hpp"
-#include "range.hpp"
-#include "voronoi.hpp"
+#include <orogen/relief/range.hpp>
+#include <orogen/relief/voronoi.hpp>
 #include "rmp.hpp"
 
 #include <benchmark/benchmark.h>

@@ -1,5 +1,5 @@
 // libFuzzer target: the RAW sidecar JSON parser (export:raw's <file>.json, read by import:raw).
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include <orogen/error.hpp>
 

@@ -1,8 +1,8 @@
 // orogen-view, run as users run it: a subprocess under Xvfb (tests/viewer/xvfb-run.sh),
 // on files written by the real exporters; its pictures are read back and sampled.
-#include "terrain_mesh.hpp"
-#include "raw.hpp"
-#include "vtk_writer.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
+#include <orogen/formats/raw.hpp>
+#include <orogen/vtk/vtk_writer.hpp>
 
 #include <orogen/io.hpp>
 #include <orogen/values.hpp>

@@ -1,5 +1,5 @@
 // erode:diffusion — registers implicit hillslope diffusion (diffusion.hpp) with the kernel.
-#include "diffusion.hpp"
+#include <orogen/solvers/diffusion.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>

@@ -31,7 +31,7 @@
 
 #include "flow.hpp"
 
-#include <diffusion.hpp>
+#include <orogen/solvers/diffusion.hpp>
 
 #include <algorithm>
 #include <cmath>

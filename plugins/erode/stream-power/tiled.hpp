@@ -41,7 +41,7 @@
 #include "flow.hpp"
 #include "stream_power.hpp"
 
-#include <diffusion.hpp>
+#include <orogen/solvers/diffusion.hpp>
 #include <orogen/tiles.hpp>
 
 #include <chrono>

@@ -1,5 +1,5 @@
 // export:geotiff — registers the GeoTIFF writer (geotiff.hpp) with the kernel.
-#include "geotiff.hpp"
+#include <orogen/geotiff/geotiff.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

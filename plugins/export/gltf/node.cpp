@@ -1,5 +1,5 @@
 // export:gltf — registers the glTF terrain writer (gltf_writer.hpp) with the kernel.
-#include "gltf_writer.hpp"
+#include <orogen/gltf/gltf_writer.hpp>
 
 #include <orogen/plugin.hpp>
 

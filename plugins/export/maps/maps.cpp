@@ -1,6 +1,6 @@
 #include "maps.hpp"
 
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/parallel.hpp>
 

@@ -5,7 +5,7 @@
 // names files that exist, in the frame it expects, with the layer it colours
 // by (checked when the spec is checked, before anything runs).
 #include "paraview_state.hpp"
-#include "vtk_writer.hpp"
+#include <orogen/vtk/vtk_writer.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -1,9 +1,9 @@
 // export:png — a heightmap (or one of its layers, or its hillshade) as an 8- or 16-bit grayscale PNG,
 // or a colour relief map (the thesis's splatting colours, hillshaded); or an image (a rendered
 // frame) as 8-bit sRGB.
-#include "heightmap_png.hpp"
-#include "image_srgb.hpp"
-#include "terrain_mesh.hpp"
+#include <orogen/formats/heightmap_png.hpp>
+#include <orogen/formats/image_srgb.hpp>
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/io.hpp>
 #include <orogen/plugin.hpp>

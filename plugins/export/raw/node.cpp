@@ -1,5 +1,5 @@
 // export:raw — registers the RAW heightmap writer (raw.hpp) with the kernel.
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>

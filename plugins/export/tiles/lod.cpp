@@ -1,6 +1,6 @@
 #include "lod.hpp"
 
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 #include "tiles.hpp"
 
 #include <orogen/error.hpp>

@@ -1,9 +1,9 @@
 // export:tiles — registers the tiled heightmap writer (tiles.hpp) with the kernel.
 #include "tiles.hpp"
 
-#include "gltf_writer.hpp"
+#include <orogen/gltf/gltf_writer.hpp>
 #include "lod.hpp"
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

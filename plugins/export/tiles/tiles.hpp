@@ -11,7 +11,7 @@
 // of a row or column is smaller when W − 1 is not a multiple of tile_size − 1.
 #pragma once
 
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include <orogen/grid.hpp>
 

@@ -8,7 +8,7 @@
 // Plain C++ over orogen::Image; FFmpeg's headers stay in video_encoder.cpp.
 #pragma once
 
-#include "image_srgb.hpp"
+#include <orogen/formats/image_srgb.hpp>
 
 #include <orogen/values.hpp>
 

@@ -1,7 +1,7 @@
 // export:vtk, export:vtk-particles, export:vtk-plates — VTK XML files for
 // ParaView (vtk_writer.hpp). Three nodes because each input has one value
 // type: a particle export asked of a heightmap is then a check-time type error.
-#include "vtk_writer.hpp"
+#include <orogen/vtk/vtk_writer.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -3,7 +3,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include "cones.hpp"
 
-#include "voronoi.hpp"
+#include <orogen/relief/voronoi.hpp>
 
 #include <GL/gl.h>
 #include <GL/glext.h>

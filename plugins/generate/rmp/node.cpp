@@ -1,6 +1,6 @@
 // generate:rmp and generate:range — register the RMP cores as nodes.
 #include "cones.hpp"
-#include "range.hpp"
+#include <orogen/relief/range.hpp>
 #include "rmp.hpp"
 
 #include <orogen/plugin.hpp>

@@ -1,7 +1,7 @@
 #include "rmp.hpp"
 
-#include "graph.hpp"
-#include "voronoi.hpp"
+#include <orogen/relief/graph.hpp>
+#include <orogen/relief/voronoi.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/random.hpp>

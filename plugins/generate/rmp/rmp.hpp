@@ -10,7 +10,7 @@
 // `voronoi` and `cones` draw the same sites for the same seed and iteration.
 #pragma once
 
-#include "convex_fill.hpp"
+#include <orogen/relief/convex_fill.hpp>
 
 #include <orogen/grid.hpp>
 

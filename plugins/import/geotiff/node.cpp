@@ -1,5 +1,5 @@
 // import:geotiff — any raster GDAL reads (GeoTIFF, SRTM .hgt, ESRI .asc, USGS .dem...) as a heightmap.
-#include "geotiff.hpp"
+#include <orogen/geotiff/geotiff.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>

@@ -1,5 +1,5 @@
 // import:raw — a .r16/.r32 heightmap with its JSON sidecar (what export:raw writes) as a heightmap.
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/plugin.hpp>

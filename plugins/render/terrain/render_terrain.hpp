@@ -6,7 +6,7 @@
 // Plain C++ over orogen::Heightmap; the GL calls stay in render_terrain.cpp.
 #pragma once
 
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/values.hpp>
 

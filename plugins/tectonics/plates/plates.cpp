@@ -7,7 +7,7 @@
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>
 #include <orogen/random.hpp>
-#include <range.hpp>  // orogen::rmp::raise_range (plugins/generate/rmp)
+#include <orogen/relief/range.hpp>  // orogen::rmp::raise_range (libs/relief)
 
 #include <box2d/box2d.h>
 

@@ -1,7 +1,7 @@
 // Tests of the implicit hillslope-diffusion core: volume with closed sides,
 // the error-function solution of a step, the maximum principle at huge time
 // steps, fixed sides, nonlinear diffusion, determinism across thread counts.
-#include "diffusion.hpp"
+#include <orogen/solvers/diffusion.hpp>
 
 #include <orogen/random.hpp>
 

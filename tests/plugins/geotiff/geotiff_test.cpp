@@ -1,7 +1,7 @@
 // GeoTIFF out and DEMs in, checked with GDAL's API (what QGIS reads) and the
 // real `orogen` binary: georeference, CRS, band values equal to the
 // heightmap's, compression, COG layout, nodata filling, and the bad inputs.
-#include "geotiff.hpp"
+#include <orogen/geotiff/geotiff.hpp>
 #include "orogen_test.hpp"
 
 #include <orogen/error.hpp>

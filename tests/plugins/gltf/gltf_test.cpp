@@ -1,5 +1,5 @@
 // export:gltf — files read back with tinygltf and checked by the Khronos validator.
-#include "gltf_writer.hpp"
+#include <orogen/gltf/gltf_writer.hpp>
 
 #include "../raw/export_test_support.hpp"
 #include "orogen_test.hpp"

@@ -1,5 +1,5 @@
 // The mesh layout and splat colours shared by export:gltf and export:vtk.
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include "../raw/export_test_support.hpp"
 

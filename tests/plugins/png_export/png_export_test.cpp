@@ -1,5 +1,5 @@
 // export:png's layer= and hillshade=: the core, and 16-bit round trips through the binary.
-#include "heightmap_png.hpp"
+#include <orogen/formats/heightmap_png.hpp>
 
 #include "../raw/export_test_support.hpp"
 #include "orogen_test.hpp"

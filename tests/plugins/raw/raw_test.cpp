@@ -1,5 +1,5 @@
 // export:raw — .r16 / .r32 round trips, the sidecar, and failing writes.
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include "export_test_support.hpp"
 #include "orogen_test.hpp"

@@ -4,7 +4,7 @@
 #include "render_terrain.hpp"
 
 #include "bloom.hpp"
-#include "image_srgb.hpp"
+#include <orogen/formats/image_srgb.hpp>
 #include "orogen_test.hpp"
 
 #include <orogen/error.hpp>

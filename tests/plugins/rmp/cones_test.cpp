@@ -1,7 +1,7 @@
 // The cone method through OSMesa against the exact Voronoi diagram.
 #include "cones.hpp"
 #include "rmp.hpp"
-#include "voronoi.hpp"
+#include <orogen/relief/voronoi.hpp>
 
 #include <orogen/error.hpp>
 

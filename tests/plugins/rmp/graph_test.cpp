@@ -1,6 +1,6 @@
 // Line arrangements: face counts against the arrangement formula, simple
 // convex faces, degenerate line sets (parallel, nearly parallel, concurrent).
-#include "graph.hpp"
+#include <orogen/relief/graph.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // raise_range: the band of cells between two points.
-#include "range.hpp"
-#include "voronoi.hpp"
+#include <orogen/relief/range.hpp>
+#include <orogen/relief/voronoi.hpp>
 
 #include <orogen/error.hpp>
 

@@ -1,6 +1,6 @@
 // The exact Voronoi index: nearest-site queries against brute force, cells
 // as row spans that tile the grid, the covering radius bound.
-#include "voronoi.hpp"
+#include <orogen/relief/voronoi.hpp>
 
 #include <gtest/gtest.h>
 

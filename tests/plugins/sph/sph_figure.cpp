@@ -4,7 +4,7 @@
 // height. Used for docs/erosion.md when ParaView is not at hand:
 //   build/tests/sph_figure out.png [n=257] [cell=2] [steps=200] [rain=150]
 #include "diamond_square.hpp"
-#include "heightmap_png.hpp"
+#include <orogen/formats/heightmap_png.hpp>
 #include "sph.hpp"
 
 #include <orogen/io.hpp>

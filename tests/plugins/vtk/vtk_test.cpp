@@ -1,5 +1,5 @@
 // export:vtk — every file read back with VTK's own XML readers.
-#include "vtk_writer.hpp"
+#include <orogen/vtk/vtk_writer.hpp>
 
 #include "../raw/export_test_support.hpp"
 #include "orogen_test.hpp"

@@ -7,7 +7,7 @@
 //
 // TIMINGS.csv lines: method,regions,seconds (method: graph | cones | voronoi),
 // made from Google Benchmark's JSON by bench_to_csv.py.
-#include "voronoi.hpp"
+#include <orogen/relief/voronoi.hpp>
 
 #include <orogen/io.hpp>
 #include <orogen/random.hpp>

@@ -1,4 +1,4 @@
-#include "heightmap_png.hpp"
+#include <orogen/formats/heightmap_png.hpp>
 
 #include <orogen/parallel.hpp>
 

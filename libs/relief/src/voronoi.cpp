@@ -1,4 +1,4 @@
-#include "voronoi.hpp"
+#include <orogen/relief/voronoi.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>

@@ -13,7 +13,7 @@
 // covers [0, width-1] × [0, height-1].
 #pragma once
 
-#include "convex_fill.hpp"
+#include <orogen/relief/convex_fill.hpp>
 
 #include <orogen/grid.hpp>
 

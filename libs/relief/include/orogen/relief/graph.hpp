@@ -11,7 +11,7 @@
 // Coordinates: sample coordinates, the rectangle [0, width] × [0, height].
 #pragma once
 
-#include "convex_fill.hpp"
+#include <orogen/relief/convex_fill.hpp>
 
 #include <orogen/grid.hpp>
 

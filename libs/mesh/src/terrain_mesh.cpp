@@ -1,4 +1,4 @@
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>

@@ -1,5 +1,5 @@
 // diffusion.cpp — alternating-direction implicit hillslope diffusion (see diffusion.hpp).
-#include "diffusion.hpp"
+#include <orogen/solvers/diffusion.hpp>
 
 #include <orogen/parallel.hpp>
 

@@ -1,4 +1,4 @@
-#include "image_srgb.hpp"
+#include <orogen/formats/image_srgb.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>

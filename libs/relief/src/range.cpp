@@ -1,6 +1,6 @@
-#include "range.hpp"
+#include <orogen/relief/range.hpp>
 
-#include "voronoi.hpp"
+#include <orogen/relief/voronoi.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/random.hpp>

@@ -9,9 +9,9 @@
 // the buffer's byteLength (and, for .gltf, its uri) is set in the JSON text
 // afterwards; then each chunk's vertices are generated and written one
 // attribute at a time. Peak memory: the heightmap, the texture, one chunk.
-#include "gltf_writer.hpp"
+#include <orogen/gltf/gltf_writer.hpp>
 
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

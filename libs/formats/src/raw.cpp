@@ -1,4 +1,4 @@
-#include "raw.hpp"
+#include <orogen/formats/raw.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -1,4 +1,4 @@
-#include "geotiff.hpp"
+#include <orogen/geotiff/geotiff.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>

@@ -1,4 +1,4 @@
-#include "convex_fill.hpp"
+#include <orogen/relief/convex_fill.hpp>
 
 #include <algorithm>
 #include <cmath>

@@ -1,7 +1,7 @@
 // The only translation unit of export:vtk that includes VTK.
-#include "vtk_writer.hpp"
+#include <orogen/vtk/vtk_writer.hpp>
 
-#include "terrain_mesh.hpp"
+#include <orogen/mesh/terrain_mesh.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

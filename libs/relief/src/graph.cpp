@@ -1,4 +1,4 @@
-#include "graph.hpp"
+#include <orogen/relief/graph.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/random.hpp>
