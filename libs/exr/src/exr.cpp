@@ -276,7 +276,8 @@ void require_channel(const Source& s, const FileInfo& info, const std::string& n
                            param);
 }
 
-void open_checked(Source& s, const ReadOptions& options, Opened& o) {
+/// The magic number, then OpenEXRCore's context over `s` with allocations capped by the file's size.
+void start_reading(Source& s, Opened& o) {
     // The magic number first, for a clear word on a file that is not an EXR at all.
     std::uint8_t head[4] = {};
     if (s.size < 8 || source_read(nullptr, &s, head, 4, 0, nullptr) != 4 || std::memcmp(head, kMagic, 4) != 0)
@@ -300,8 +301,12 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
         if (rv != EXR_ERR_SUCCESS)
             refuse(s, "its header is damaged or not one OpenEXR reads (OpenEXR: " + core_message(rv) + ")");
     }
-    exr_const_context_t ctx = o.context.ctx;
+}
 
+/// One flat part, its data window, channel list, compression and the attributes export:exr writes, into
+/// o.info. Returns the storage (scanline or tiled).
+exr_storage_t read_header(Source& s, Opened& o) {
+    exr_const_context_t ctx = o.context.ctx;
     int parts = 0;
     exr_get_count(ctx, &parts);
     if (parts != 1)
@@ -363,6 +368,11 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
         attr->type == EXR_ATTR_STRING && attr->string && attr->string->str)
         o.info.height_units.assign(attr->string->str, std::size_t(std::max(attr->string->length, 0)));
 
+    return storage;
+}
+
+/// The channels to read into o.wanted: the heights' channel first, then the layers asked for.
+void choose_channels(const Source& s, const ReadOptions& options, Opened& o) {
     // What to read.
     require_channel(s, o.info, options.channel, "channel");
     o.wanted.push_back(options.channel);
@@ -383,6 +393,11 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
         }
     }
 
+}
+
+/// The memory budget: one heightmap, and all the wanted channels together.
+void check_budget(Source& s, const Opened& o) {
+    const std::int64_t w = o.info.width, h = o.info.height;
     // The memory budget: one heightmap, and all of them together.
     if (const std::string problem = heightmap_memory_problem(double(w), double(h)); !problem.empty())
         refuse(s, "its data window is " + std::to_string(w) + "x" + std::to_string(h) + " samples, which " + problem);
@@ -395,8 +410,15 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
                           " allowed here; read fewer layers");
     }
 
-    // The chunks of the full-resolution level: each inside the file, none overlapping another, each
-    // stored big enough for what it decompresses to.
+}
+
+/// The chunks of the full-resolution level into o.chunks: each inside the file, none overlapping another,
+/// each stored big enough for what it decompresses to.
+void index_chunks(Source& s, exr_storage_t storage, Opened& o) {
+    exr_const_context_t ctx = o.context.ctx;
+    const std::int64_t w = o.info.width, h = o.info.height;
+    exr_attr_box2i_t window{};
+    exr_get_data_window(ctx, 0, &window);
     std::int32_t chunk_count = 0;
     if (exr_result_t rv = exr_get_chunk_count(ctx, 0, &chunk_count); rv != EXR_ERR_SUCCESS || chunk_count < 1)
         refuse(s, "it declares no image data (OpenEXR: " + core_message(rv) + ")");
@@ -451,6 +473,14 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
         if (spans[i - 1].first + spans[i - 1].second > spans[i].first)
             refuse(s, "it is damaged: two chunks of its image share the same bytes (at offset " +
                           std::to_string(spans[i].first) + ")");
+}
+
+void open_checked(Source& s, const ReadOptions& options, Opened& o) {
+    start_reading(s, o);
+    const exr_storage_t storage = read_header(s, o);
+    choose_channels(s, options, o);
+    check_budget(s, o);
+    index_chunks(s, storage, o);
 }
 
 /// Decodes chunk `c` into its rows of `planes` (the wanted channels, `w` samples a row) with `dec`, set up on
