@@ -10,6 +10,7 @@
 #include <charconv>
 #include <chrono>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <memory>
 #include <cmath>
@@ -73,14 +74,35 @@ double largest(Tiling* tiles, double v) {
     return v;
 }
 
-NodeOutputs run(NodeContext& ctx) {
-    auto hm = ctx.take_heightmap(0);
-    // In a tiled run (mpirun) the heightmap is this rank's tile and the model
-    // joins the tiles' rivers (tiled.hpp): the same bits as one process.
-    Tiling* tiles = ctx.tiling();
-    using clock = std::chrono::steady_clock;
-    const auto started = clock::now();
-    const std::size_t n = hm->size();
+/// The model of one process (Model) or of this rank's tile (TiledModel, joined with the other ranks'
+/// tiles: the same bits as one process), behind the few calls the node makes.
+struct Engine {
+    std::unique_ptr<stream_power::Model> whole;
+    std::unique_ptr<stream_power::TiledModel> tiled;
+
+    std::vector<double>& heights() { return tiled ? tiled->heights() : whole->heights(); }
+    bool is_outlet(std::size_t i) const {
+        return tiled ? tiled->is_outlet(i) : whole->flow().is_outlet(std::int64_t(i));
+    }
+    void run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {
+        if (tiled) tiled->run(years, dt, on_step);
+        else whole->run(years, dt, on_step);
+    }
+    void route_only() {
+        if (tiled) tiled->route_only();
+        else whole->route_only();
+    }
+    std::int64_t pits() const { return tiled ? tiled->pits() : whole->flow().pits(); }
+    std::int64_t first_non_finite() const { return tiled ? tiled->first_non_finite() : whole->first_non_finite(); }
+    const std::vector<double>& area() const { return tiled ? tiled->area() : whole->flow().area(); }
+    int direction(std::size_t i) const {
+        return tiled ? tiled->direction(i) : whole->flow().direction(std::int64_t(i));
+    }
+    const std::vector<double>& uplifted() const { return tiled ? tiled->uplifted() : whole->uplifted(); }
+    std::vector<double> chi() { return tiled ? tiled->chi(1.0) : whole->chi(1.0); }
+};
+
+stream_power::Settings settings_of(NodeContext& ctx) {
     stream_power::Settings s;
     s.erodibility = ctx.real("erodibility");
     s.area_exponent = ctx.real("m");
@@ -90,151 +112,219 @@ NodeOutputs run(NodeContext& ctx) {
     s.open = *parse_sides(ctx.text("open"));
     s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
-
     s.deposition = ctx.real("deposition");
+    return s;
+}
 
-    std::vector<double> h(hm->heights().begin(), hm->heights().end());
-    const double sigma = ctx.real("uplift_smoothing");
-    // Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp
-    // relief. Four implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides;
-    // backward Euler keeps the maximum principle, so the spread rate is never faster).
-    auto smooth = [&](std::vector<double>& rate) {
-        if (!(sigma > 0.0)) return;
-        diffusion::Settings ds;
-        ds.diffusivity = 1.0;
-        diffusion::Solver blur = tiles ? diffusion::Solver(*tiles, hm->cell(), ds)
-                                       : diffusion::Solver(hm->width(), hm->height(), hm->cell(), ds);
-        for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
-    };
-    auto fastest_of = [tiles](const std::vector<double>& rate, double base) {
-        double fastest = 0.0;
-        for (double r : rate) fastest = std::max(fastest, std::abs(r + base));
-        return largest(tiles, fastest);
-    };
-    // A sample's index in the whole grid, for the messages.
-    auto sample = [&](std::size_t k) {
+/// What the uplift helpers share: the node's context, the terrain (this rank's tile when tiled) and the tiling.
+struct UpliftInputs {
+    NodeContext& ctx;
+    const Heightmap& hm;
+    Tiling* tiles;
+    std::size_t n;
+
+    /// A sample's index in the whole grid, for the messages.
+    std::int64_t sample(std::size_t k) const {
         if (!tiles) return std::int64_t(k);
         const TileRect own = tiles->owned();
         const auto x = std::int64_t(k % std::size_t(own.width)), y = std::int64_t(k / std::size_t(own.width));
         return (own.y0 + y) * tiles->grid_width() + own.x0 + x;
-    };
-    // Uplift: the uniform rate plus the layer read as metres accumulated over uplift_layer_years.
+    }
+    /// Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp relief. Four
+    /// implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides; backward Euler keeps the
+    /// maximum principle, so the spread rate is never faster).
+    void smooth(std::vector<double>& rate) const {
+        const double sigma = ctx.real("uplift_smoothing");
+        if (!(sigma > 0.0)) return;
+        diffusion::Settings ds;
+        ds.diffusivity = 1.0;
+        diffusion::Solver blur = tiles ? diffusion::Solver(*tiles, hm.cell(), ds)
+                                       : diffusion::Solver(hm.width(), hm.height(), hm.cell(), ds);
+        for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
+    }
+    /// The fastest |rate + base| over every rank (m/yr).
+    double fastest(const std::vector<double>& rate, double base) const {
+        double fastest = 0.0;
+        for (double r : rate) fastest = std::max(fastest, std::abs(r + base));
+        return largest(tiles, fastest);
+    }
+};
+
+/// Uplift (m/yr per sample): the uniform rate plus the layer read as metres accumulated over
+/// uplift_layer_years, smoothed; refuses a rate faster than any measured range.
+std::vector<double> steady_uplift(const UpliftInputs& in) {
+    NodeContext& ctx = in.ctx;
     const double uniform = ctx.real("uplift") * 1e-3;  // mm/yr → m/yr
-    std::vector<double> uplift(n, uniform);
+    std::vector<double> uplift(in.n, uniform);
     const std::string& layer = ctx.text("uplift_layer");
-    if (!layer.empty()) {
-        if (!hm->has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
-        const ConstGridView u = std::as_const(*hm).layer(layer);
-        const double years = ctx.real("uplift_layer_years");
-        std::vector<double> rate(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            if (!std::isfinite(u.data[i]))
-                throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " +
-                               std::to_string(sample(i)));
-            rate[i] = double(u.data[i]) / years;
+    if (layer.empty()) return uplift;
+    if (!in.hm.has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
+    const ConstGridView u = in.hm.layer(layer);
+    const double years = ctx.real("uplift_layer_years");
+    std::vector<double> rate(in.n);
+    for (std::size_t i = 0; i < in.n; ++i) {
+        if (!std::isfinite(u.data[i]))
+            throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " +
+                           std::to_string(in.sample(i)));
+        rate[i] = double(u.data[i]) / years;
+    }
+    in.smooth(rate);
+    for (std::size_t i = 0; i < in.n; ++i) uplift[i] += rate[i];
+    const double fastest = in.fastest(uplift, 0.0);
+    if (fastest * 1e3 > kMaxUpliftMmYr) {
+        std::ostringstream msg;
+        msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives "
+            << fastest * 1e3 << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
+            << " mm/yr); give a longer uplift_layer_years";
+        throw BadInput(msg.str());
+    }
+    return uplift;
+}
+
+/// The history's frame times (years from the run's start), checked on rank 0 and shared with every rank.
+std::vector<double> history_times(NodeContext& ctx, const std::shared_ptr<const Series>& series, Tiling* tiles) {
+    std::vector<double> times;
+    std::string shared;
+    if (series) {
+        const std::size_t frames = series->size();
+        if (frames < 2)
+            throw BadInput("uplift_history: the series has " + std::to_string(frames) +
+                           " frame(s); a rate needs at least two (the start and the end)");
+        const double span =
+            ctx.real("uplift_history_years") > 0.0 ? ctx.real("uplift_history_years") : ctx.real("years");
+        const double t0 = series->times.front(), t1 = series->times.back();
+        if (!(t1 > t0)) throw BadInput("uplift_history: the series' frames do not advance in time");
+        for (std::size_t k = 0; k < frames; ++k) {
+            times.push_back((series->times[k] - t0) / (t1 - t0) * span);
+            if (k > 0 && !(times[k] > times[k - 1]))
+                throw BadInput("uplift_history: frame " + std::to_string(k) + " is not later than frame " +
+                               std::to_string(k - 1));
         }
-        smooth(rate);
-        for (std::size_t i = 0; i < n; ++i) uplift[i] += rate[i];
-        const double fastest = fastest_of(uplift, 0.0);
+        shared.assign(reinterpret_cast<const char*>(times.data()), times.size() * sizeof(double));
+    }
+    if (tiles) {
+        tiles->share_from_rank0(shared);
+        times.resize(shared.size() / sizeof(double));
+        std::memcpy(times.data(), shared.data(), shared.size());
+    }
+    return times;
+}
+
+/// Uplift from a history (e.g. plates.timelapse): frame k's time, normalised so that the first frame is
+/// year 0 of the run and the last is uplift_history_years (default: the run's years); between frames k and
+/// k+1 the rate is their height change over the years between them. In a tiled run the series is rank
+/// 0's (whole frames): rank 0 checks it and shares its times, and each interval's two frames are cut into
+/// tiles for every rank to make its rate. Refuses an impossible rate before the run.
+stream_power::UpliftHistory uplift_history(const UpliftInputs& in) {
+    NodeContext& ctx = in.ctx;
+    Tiling* tiles = in.tiles;
+    stream_power::UpliftHistory history;
+    std::shared_ptr<const Series> series;
+    if (!tiles || tiles->rank() == 0) series = ctx.input(1).series();
+    history.times = history_times(ctx, series, tiles);
+    const int W = tiles ? tiles->grid_width() : in.hm.width(), H = tiles ? tiles->grid_height() : in.hm.height();
+    auto frame = [series, tiles, W, H](std::size_t k) -> std::shared_ptr<const Heightmap> {  // collective when tiled
+        std::shared_ptr<const Heightmap> f;
+        if (series) {
+            f = series->at(k).heightmap();
+            if (!f || f->width() != W || f->height() != H)
+                throw BadInput("uplift_history: frame " + std::to_string(k) + " is " +
+                               (f ? std::to_string(f->width()) + " x " + std::to_string(f->height()) : "not a heightmap") +
+                               ", the terrain " + std::to_string(W) + " x " + std::to_string(H));
+        }
+        return tiles ? tiles->scatter_from_rank0(f.get()) : f;
+    };
+    auto rate_of = [frame, times = history.times, in](std::size_t k) {
+        const auto a = frame(k), b = frame(k + 1);
+        const double years = times[k + 1] - times[k];
+        std::vector<double> rate(in.n);
+        for (std::size_t i = 0; i < in.n; ++i) {
+            rate[i] = (double(b->heights()[i]) - double(a->heights()[i])) / years;
+            if (!std::isfinite(rate[i]))
+                throw BadInput("uplift_history: frame " + std::to_string(k + 1) +
+                               " holds a non-finite height at sample " + std::to_string(in.sample(i)));
+        }
+        in.smooth(rate);
+        return rate;
+    };
+    const double uniform = ctx.real("uplift") * 1e-3;
+    for (std::size_t k = 0; k + 1 < history.times.size(); ++k) {
+        const double fastest = in.fastest(rate_of(k), uniform);
         if (fastest * 1e3 > kMaxUpliftMmYr) {
             std::ostringstream msg;
-            msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives "
-                << fastest * 1e3 << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
-                << " mm/yr); give a longer uplift_layer_years";
+            msg << "uplift_history_years: frames " << k << " to " << k + 1 << " spread over "
+                << history.times[k + 1] - history.times[k] << " years give " << fastest * 1e3
+                << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
+                << " mm/yr); give a longer uplift_history_years";
             throw BadInput(msg.str());
         }
     }
-    // Uplift from a history (e.g. plates.timelapse): frame k's time, normalised so that the first
-    // frame is year 0 of the run and the last is uplift_history_years (default: the run's years);
-    // between frames k and k+1 the rate is their height change over the years between them.
-    stream_power::UpliftHistory history;
-    if (ctx.has_input(1)) {
-        // In a tiled run the series is rank 0's (whole frames): rank 0 checks it and shares its
-        // times, and each interval's two frames are cut into tiles for every rank to make its rate.
-        std::shared_ptr<const Series> series;
-        if (!tiles || tiles->rank() == 0) series = ctx.input(1).series();
-        std::string shared;
-        if (series) {
-            const std::size_t frames = series->size();
-            if (frames < 2)
-                throw BadInput("uplift_history: the series has " + std::to_string(frames) +
-                               " frame(s); a rate needs at least two (the start and the end)");
-            const double span =
-                ctx.real("uplift_history_years") > 0.0 ? ctx.real("uplift_history_years") : ctx.real("years");
-            const double t0 = series->times.front(), t1 = series->times.back();
-            if (!(t1 > t0)) throw BadInput("uplift_history: the series' frames do not advance in time");
-            for (std::size_t k = 0; k < frames; ++k) {
-                history.times.push_back((series->times[k] - t0) / (t1 - t0) * span);
-                if (k > 0 && !(history.times[k] > history.times[k - 1]))
-                    throw BadInput("uplift_history: frame " + std::to_string(k) + " is not later than frame " +
-                                   std::to_string(k - 1));
-            }
-            shared.assign(reinterpret_cast<const char*>(history.times.data()), history.times.size() * sizeof(double));
-        }
-        if (tiles) {
-            tiles->share_from_rank0(shared);
-            history.times.resize(shared.size() / sizeof(double));
-            std::memcpy(history.times.data(), shared.data(), shared.size());
-        }
-        const int W = tiles ? tiles->grid_width() : hm->width(), H = tiles ? tiles->grid_height() : hm->height();
-        auto frame = [series, tiles, W, H](std::size_t k) -> std::shared_ptr<const Heightmap> {  // collective when tiled
-            std::shared_ptr<const Heightmap> f;
-            if (series) {
-                f = series->at(k).heightmap();
-                if (!f || f->width() != W || f->height() != H)
-                    throw BadInput("uplift_history: frame " + std::to_string(k) + " is " +
-                                   (f ? std::to_string(f->width()) + " x " + std::to_string(f->height()) : "not a heightmap") +
-                                   ", the terrain " + std::to_string(W) + " x " + std::to_string(H));
-            }
-            return tiles ? tiles->scatter_from_rank0(f.get()) : f;
-        };
-        auto rate_of = [frame, times = history.times, n, smooth, sample](std::size_t k) {
-            const auto a = frame(k), b = frame(k + 1);
-            const double years = times[k + 1] - times[k];
-            std::vector<double> rate(n);
-            for (std::size_t i = 0; i < n; ++i) {
-                rate[i] = (double(b->heights()[i]) - double(a->heights()[i])) / years;
-                if (!std::isfinite(rate[i]))
-                    throw BadInput("uplift_history: frame " + std::to_string(k + 1) +
-                                   " holds a non-finite height at sample " + std::to_string(sample(i)));
-            }
-            smooth(rate);
-            return rate;
-        };
-        // Refuse an impossible rate before the run (each interval's rate is made again when the run reaches it).
-        for (std::size_t k = 0; k + 1 < history.times.size(); ++k) {
-            const double fastest = fastest_of(rate_of(k), uniform);
-            if (fastest * 1e3 > kMaxUpliftMmYr) {
-                std::ostringstream msg;
-                msg << "uplift_history_years: frames " << k << " to " << k + 1 << " spread over "
-                    << history.times[k + 1] - history.times[k] << " years give " << fastest * 1e3
-                    << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
-                    << " mm/yr); give a longer uplift_history_years";
-                throw BadInput(msg.str());
-            }
-        }
-        history.rate = rate_of;
+    history.rate = rate_of;
+    return history;
+}
+
+/// The heights after the run and the final surface's flow graph as layers: drainage, flow_direction,
+/// eroded (what the surface processes did: negative where rock was removed, positive where sediment
+/// settled, as the other eroders' layer), uplifted (the rock uplift, kept apart so that on a rising range
+/// `eroded` does not read +400 m where the rivers removed 100 m of 500 m of uplift) and chi if asked.
+void write_layers(NodeContext& ctx, Heightmap& hm, Engine& engine, std::int64_t last) {
+    const std::size_t n = hm.size();
+    const std::vector<double>& heights = engine.heights();
+    const std::vector<float> before = hm.heights();
+    std::vector<float>& out = hm.heights();
+    for (std::size_t i = 0; i < n; ++i) out[i] = float(heights[i]);
+    ctx.check_finite(out, "height", last);
+    engine.route_only();
+    GridView drainage = hm.layer("drainage", 0.0f);
+    GridView direction = hm.layer("flow_direction", -1.0f);
+    const auto& area = engine.area();
+    for (std::size_t i = 0; i < n; ++i) {
+        drainage.data[i] = float(area[i]);
+        direction.data[i] = float(engine.direction(i));
     }
+    const std::vector<double>& rock_uplift = engine.uplifted();
+    GridView eroded = hm.layer("eroded", 0.0f);
+    GridView uplifted = hm.layer("uplifted", 0.0f);
+    for (std::size_t i = 0; i < n; ++i) {
+        eroded.data[i] += float(double(out[i]) - double(before[i]) - rock_uplift[i]);
+        uplifted.data[i] += float(rock_uplift[i]);
+    }
+    if (ctx.flag("chi")) {
+        const std::vector<double> chi = engine.chi();
+        GridView c = hm.layer("chi", 0.0f);
+        for (std::size_t i = 0; i < n; ++i) c.data[i] = float(chi[i]);
+    }
+}
+
+NodeOutputs run(NodeContext& ctx) {
+    auto hm = ctx.take_heightmap(0);
+    Tiling* tiles = ctx.tiling();
+    using clock = std::chrono::steady_clock;
+    const auto started = clock::now();
+    const std::size_t n = hm->size();
+    const stream_power::Settings s = settings_of(ctx);
+
+    const UpliftInputs uplift_in{ctx, *hm, tiles, n};
+    std::vector<double> uplift = steady_uplift(uplift_in);
+    stream_power::UpliftHistory history;
+    if (ctx.has_input(1)) history = uplift_history(uplift_in);
     const auto base = *parse_base_level(ctx.text("base_level"));
 
-    std::unique_ptr<stream_power::Model> whole;
-    std::unique_ptr<stream_power::TiledModel> tiled;
+    Engine engine;
+    std::vector<double> h(hm->heights().begin(), hm->heights().end());
     if (tiles)
-        tiled = std::make_unique<stream_power::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
+        engine.tiled = std::make_unique<stream_power::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
     else
-        whole = std::make_unique<stream_power::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
-                                                      std::move(uplift), s);
+        engine.whole = std::make_unique<stream_power::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
+                                                             std::move(uplift), s);
     if (history.rate) {
-        if (tiles)
-            tiled->set_uplift_history(std::move(history));
-        else
-            whole->set_uplift_history(std::move(history));
+        if (tiles) engine.tiled->set_uplift_history(std::move(history));
+        else engine.whole->set_uplift_history(std::move(history));
     }
-    std::vector<double>& heights = tiles ? tiled->heights() : whole->heights();
-    auto is_outlet = [&](std::size_t i) { return tiles ? tiled->is_outlet(i) : whole->flow().is_outlet(std::int64_t(i)); };
+    std::vector<double>& heights = engine.heights();
     if (base) {
         for (std::size_t i = 0; i < n; ++i)
-            if (is_outlet(i)) heights[i] = *base;
+            if (engine.is_outlet(i)) heights[i] = *base;
     }
     const double years = ctx.real("years"), dt = ctx.real("dt");
     constexpr double kSecondsPerYear = 31'557'600.0;  // the series' clock is in seconds (Julian years)
@@ -246,62 +336,28 @@ NodeOutputs run(NodeContext& ctx) {
     std::int64_t pits = 0, last = 0;
     int rounds = 0;
     double sediment_out = 0.0;  // m³ that left by the outlets (deposition > 0)
-    auto on_step = [&](std::int64_t step, std::int64_t steps) {
+    engine.run(years, dt, [&](std::int64_t step, std::int64_t steps) {
         ctx.check_cancelled();
         if (every > 0 && (step % every == 0 || step == steps)) {
             frame.assign(heights.begin(), heights.end());
             lapse.record(step, ConstGridView(frame.data(), hm->width(), hm->height(), hm->cell()));
         }
-        pits += tiles ? tiled->pits() : whole->flow().pits();
-        if (tiles) rounds = std::max(rounds, tiled->rounds());
-        if (whole) sediment_out += whole->sediment_out();
+        pits += engine.pits();
+        if (tiles) rounds = std::max(rounds, engine.tiled->rounds());
+        if (engine.whole) sediment_out += engine.whole->sediment_out();
         last = steps;
-        const std::int64_t bad = tiles ? tiled->first_non_finite() : whole->first_non_finite();
-        if (bad >= 0) {
+        if (const std::int64_t bad = engine.first_non_finite(); bad >= 0) {
             std::ostringstream msg;
-            msg << "non-finite height (" << heights[std::size_t(bad)] << ") at sample " << sample(std::size_t(bad))
-                << " after step " << step << " of " << steps << "; the simulation became unstable";
+            msg << "non-finite height (" << heights[std::size_t(bad)] << ") at sample "
+                << uplift_in.sample(std::size_t(bad)) << " after step " << step << " of " << steps
+                << "; the simulation became unstable";
             throw Error(msg.str());
         }
         ctx.progress(double(step) / double(steps));
-    };
-    if (tiles)
-        tiled->run(years, dt, on_step);
-    else
-        whole->run(years, dt, on_step);
+    });
+    write_layers(ctx, *hm, engine, last);
 
-    // Outputs: heights, the last step's flow graph as layers.
-    const std::vector<float> before = hm->heights();
-    std::vector<float>& out = hm->heights();
-    for (std::size_t i = 0; i < n; ++i) out[i] = float(heights[i]);
-    ctx.check_finite(out, "height", last);
-    // Drainage and directions of the final surface.
-    if (tiles)
-        tiled->route_only();
-    else
-        whole->route_only();
-    GridView drainage = hm->layer("drainage", 0.0f);
-    GridView direction = hm->layer("flow_direction", -1.0f);
-    const auto& area = tiles ? tiled->area() : whole->flow().area();
-    for (std::size_t i = 0; i < n; ++i) {
-        drainage.data[i] = float(area[i]);
-        direction.data[i] = float(tiles ? tiled->direction(i) : whole->flow().direction(std::int64_t(i)));
-    }
-    // eroded: what the surface processes did (m; negative where rock was removed, positive where sediment
-    // settled), as the other eroders' layer; the rock uplift is kept apart in uplifted, so that on a rising
-    // range `eroded` does not read +400 m where the rivers removed 100 m of 500 m of uplift.
-    const std::vector<double>& rock_uplift = tiles ? tiled->uplifted() : whole->uplifted();
-    GridView eroded = hm->layer("eroded", 0.0f);
-    GridView uplifted = hm->layer("uplifted", 0.0f);
-    for (std::size_t i = 0; i < n; ++i) {
-        eroded.data[i] += float(double(out[i]) - double(before[i]) - rock_uplift[i]);
-        uplifted.data[i] += float(rock_uplift[i]);
-    }
-    if (ctx.flag("chi")) {
-        const std::vector<double> chi = tiles ? tiled->chi(1.0) : whole->chi(1.0);
-        GridView c = hm->layer("chi", 0.0f);
-        for (std::size_t i = 0; i < n; ++i) c.data[i] = float(chi[i]);
-    }
+    const std::vector<float>& out = hm->heights();
     auto [lo, hi] = std::minmax_element(out.begin(), out.end());
     float low = *lo, high = *hi;
     if (tiles) tiles->min_max(low, high);
@@ -312,7 +368,8 @@ NodeOutputs run(NodeContext& ctx) {
     if (tiles)
         msg << "; rank " << tiles->rank() << " of " << tiles->ranks() << ", up to " << rounds
             << " round(s) a step down rivers crossing tiles; " << seconds << " s in the node, of which joining the tiles "
-            << tiled->seconds_joining() << " s (" << 100.0 * tiled->seconds_joining() / std::max(1e-9, seconds) << " %)";
+            << engine.tiled->seconds_joining() << " s ("
+            << 100.0 * engine.tiled->seconds_joining() / std::max(1e-9, seconds) << " %)";
     ctx.info(msg.str());
     lapse.finish(last, *hm);
     NodeOutputs result(hm);
