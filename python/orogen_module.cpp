@@ -8,11 +8,11 @@
 // Bad input (a spec error, a parameter out of range, a file refused at check time) raises ValueError with
 // the CLI's message; a failed run RuntimeError naming the node; Ctrl-C stops the node as on the command
 // line and raises KeyboardInterrupt. The run itself happens on a thread of its own with the GIL released.
-#include "loader.hpp"
-#include "plan.hpp"
-#include "progress.hpp"
-#include "runner.hpp"
-#include "spec.hpp"
+#include "run/loader.hpp"
+#include "spec/plan.hpp"
+#include "run/progress.hpp"
+#include "run/runner.hpp"
+#include "spec/spec.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -1,13 +1,13 @@
 // The `orogen` command: run | check | list | help | version | cache | analyze.
 // Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
 // usage), 130 interrupted (SIGINT), 143 terminated (SIGTERM).
-#include "../src/loader.hpp"
-#include "../src/mpi_comm.hpp"
-#include "../src/plan.hpp"
-#include "../src/progress.hpp"
-#include "../src/runner.hpp"
-#include "../src/spec.hpp"
-#include "../src/tiles.hpp"
+#include "run/loader.hpp"
+#include "tiles/mpi_comm.hpp"
+#include "spec/plan.hpp"
+#include "run/progress.hpp"
+#include "run/runner.hpp"
+#include "spec/spec.hpp"
+#include "tiles/tiles.hpp"
 #include "analyze.hpp"
 
 #include <orogen/error.hpp>

@@ -1,11 +1,11 @@
-// The node cache's entries (kernel/src/cache.cpp): reading one back (mmap, the arrays copied into fresh
+// The node cache's entries (kernel/src/cache/cache.cpp): reading one back (mmap, the arrays copied into fresh
 // vectors that a Heightmap adopts, beside the payload's XXH3-128 checksum, all on both cores) and writing one
 // (encode, checksum, temporary + rename),
 // for a 2049² heightmap with four layers (80 MiB) — the size of a 4097² run's smaller values. Bytes per
 // second are the entry's size over the real time. The folder is in /tmp, and read from the page cache,
 // as a re-run finds it. On a shared machine the real time says little: the counter `all_threads_cpu_ms` is
 // the CPU time of the whole process (every thread, user + system, page faults included) per iteration.
-#include "cache.hpp"
+#include "cache/cache.hpp"
 
 #include <benchmark/benchmark.h>
 

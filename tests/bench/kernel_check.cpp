@@ -1,9 +1,9 @@
 // bench-links: orogen_kernel
 // Loading every plugin and checking the spec: target ≤ 50 ms. This is
 // what `orogen check` does before anything runs (process start-up aside).
-#include "loader.hpp"
-#include "plan.hpp"
-#include "spec.hpp"
+#include "run/loader.hpp"
+#include "spec/plan.hpp"
+#include "spec/spec.hpp"
 
 #include <benchmark/benchmark.h>
 

@@ -1,8 +1,8 @@
 // The node cache end to end (docs/cache.md): the real CLI on real specs, each
 // test with its own cache folder, looking at the files it leaves and at the
 // timing table ("cached" / "cached, read" rows).
-#include "cache.hpp"
-#include "loader.hpp"
+#include "cache/cache.hpp"
+#include "run/loader.hpp"
 
 #include <orogen/io.hpp>
 

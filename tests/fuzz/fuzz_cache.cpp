@@ -1,4 +1,4 @@
-// libFuzzer target: the node cache's entry decoder (kernel/src/cache.cpp, docs/cache.md).
+// libFuzzer target: the node cache's entry decoder (kernel/src/cache/cache.cpp, docs/cache.md).
 //
 // Each input is decoded twice: as it is (so the header, size and checksum checks are exercised) and resealed
 // (cache::reseal sets the magic, version and key and recomputes the sizes and checksums, so mutations of the
@@ -6,7 +6,7 @@
 // hostile entry must be refused with CorruptEntry or OtherVersion: never a crash, a read outside the input, or
 // an allocation much larger than the input (run with -malloc_limit_mb). Whatever is accepted must hold values
 // whose sizes agree, and encode to an entry that decodes to the same contents.
-#include "cache.hpp"
+#include "cache/cache.hpp"
 
 #include <orogen/values.hpp>
 

@@ -2,9 +2,9 @@
 // against the real plugins (loaded once, from the build tree).
 #pragma once
 
-#include "loader.hpp"
-#include "plan.hpp"
-#include "spec.hpp"
+#include "run/loader.hpp"
+#include "spec/plan.hpp"
+#include "spec/spec.hpp"
 
 #include <cstdint>
 #include <memory>

@@ -1,6 +1,6 @@
 // The spec front end alone: lexer and parser (the checker is tested through the CLI).
-#include "diagnostics.hpp"
-#include "spec.hpp"
+#include "spec/diagnostics.hpp"
+#include "spec/spec.hpp"
 
 #include <gtest/gtest.h>
 

@@ -6,7 +6,7 @@
 #include <orogen/random.hpp>
 #include <orogen/values.hpp>
 
-#include "digest.hpp"
+#include "io/digest.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 #include "plan.hpp"
 
-#include "outputs.hpp"
-#include "tiles.hpp"
+#include "io/outputs.hpp"
+#include "tiles/tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

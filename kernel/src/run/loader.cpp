@@ -1,6 +1,6 @@
 #include "loader.hpp"
 
-#include "cache.hpp"
+#include "cache/cache.hpp"
 
 #include <boost/dll/shared_library.hpp>
 

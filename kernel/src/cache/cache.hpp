@@ -17,7 +17,7 @@
 // modification time; when the folder outgrows its limit the oldest entries go.
 #pragma once
 
-#include "plan.hpp"
+#include "spec/plan.hpp"
 
 #include <orogen/values.hpp>
 

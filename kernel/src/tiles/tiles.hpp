@@ -4,8 +4,8 @@
 // failure). The MPI calls themselves are in mpi_comm.cpp.
 #pragma once
 
-#include "diagnostics.hpp"
-#include "plan.hpp"
+#include "spec/diagnostics.hpp"
+#include "spec/plan.hpp"
 
 #include <orogen/tiles.hpp>
 #include <orogen/values.hpp>

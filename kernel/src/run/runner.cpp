@@ -1,9 +1,9 @@
 #include "runner.hpp"
 
-#include "digest.hpp"
-#include "json.hpp"
-#include "outputs.hpp"
-#include "tiles.hpp"
+#include "io/digest.hpp"
+#include "io/json.hpp"
+#include "io/outputs.hpp"
+#include "tiles/tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

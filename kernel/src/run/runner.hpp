@@ -2,8 +2,8 @@
 // next, each node timed, every error stopped at the node boundary.
 #pragma once
 
-#include "cache.hpp"
-#include "plan.hpp"
+#include "cache/cache.hpp"
+#include "spec/plan.hpp"
 #include "progress.hpp"
 
 #include <atomic>
