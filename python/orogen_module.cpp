@@ -49,8 +49,8 @@ PluginSet& plugins() {
         auto* s = new PluginSet;
         Dl_info info{};
         fs::path here = ::dladdr(reinterpret_cast<void*>(&plugins), &info) && info.dli_fname
-                            ? fs::absolute(info.dli_fname)
-                            : fs::current_path() / "orogen";
+            ? fs::absolute(info.dli_fname)
+            : fs::current_path() / "orogen";
         // The loader searches <bin>/../lib/orogen/plugins for the binary's path it is given: from the build
         // tree's <build>/python/orogen/_orogen.so that is <build>/bin/orogen, from an installed
         // <prefix>/lib/python3.X/dist-packages/orogen/_orogen.so <prefix>/bin/orogen (and the kernel's own
@@ -58,7 +58,8 @@ PluginSet& plugins() {
         const fs::path build = here.parent_path().parent_path().parent_path();
         const fs::path installed = build.parent_path().parent_path();
         std::error_code ec;
-        s->load_all((fs::is_directory(build / "lib" / "orogen" / "plugins", ec) ? build : installed) / "bin" / "orogen");
+        s->load_all((fs::is_directory(build / "lib" / "orogen" / "plugins", ec) ? build : installed) / "bin" /
+                    "orogen");
         for (const auto& p : s->problems()) {
             const std::string text = "orogen: plugin " + p;
             PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1);
@@ -141,7 +142,9 @@ py::object plates_to_python(const PlateHistory& p) {
         d["plates"] = py::make_tuple(c.plate_a, c.plate_b);
         d["a"] = py::make_tuple(c.a.x, c.a.y);
         d["b"] = py::make_tuple(c.b.x, c.b.y);
-        d["kind"] = c.kind == BoundaryKind::convergent ? "convergent" : c.kind == BoundaryKind::divergent ? "divergent" : "transform";
+        d["kind"] = c.kind == BoundaryKind::convergent ? "convergent"
+            : c.kind == BoundaryKind::divergent        ? "divergent"
+                                                       : "transform";
         d["impulse"] = c.impulse;
         collisions.append(d);
     }
@@ -190,7 +193,8 @@ std::string override_text(const py::handle& v) {
 }
 
 std::string error_count(const spec::Diagnostics& diags, const std::string& name) {
-    return std::to_string(diags.error_count()) + (diags.error_count() == 1 ? " error" : " errors") + " in " + name + "\n";
+    return std::to_string(diags.error_count()) + (diags.error_count() == 1 ? " error" : " errors") + " in " + name +
+        "\n";
 }
 
 std::atomic<bool> g_cancel{false};
@@ -202,7 +206,7 @@ struct ScratchFolder {
     ScratchFolder() {
         static std::atomic<int> counter{0};
         path = fs::temp_directory_path() /
-               ("orogen-python-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+            ("orogen-python-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
         fs::remove_all(path);
         fs::create_directories(path);
     }
@@ -236,9 +240,7 @@ py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed,
         try {
             const auto bytes = read_file(spec);
             text.assign(bytes.begin(), bytes.end());
-        } catch (const std::exception& e) {
-            throw py::value_error(std::string("orogen: error: ") + e.what());
-        }
+        } catch (const std::exception& e) { throw py::value_error(std::string("orogen: error: ") + e.what()); }
         name = spec;
         spec_path = spec;
     } else if (!is_text && !spec.empty() && spec.rfind("orogen", 0) != 0) {
@@ -254,7 +256,8 @@ py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed,
         throw py::value_error("threads must be a number from 1 to 1024, got " + std::to_string(*threads));
 
     CheckOptions check_options;
-    for (const auto& [k, v] : overrides) check_options.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
+    for (const auto& [k, v] : overrides)
+        check_options.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
     check_options.seed = seed;
     std::optional<ScratchFolder> scratch;
     if (!out) scratch.emplace();
@@ -301,9 +304,7 @@ py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed,
     std::thread worker([&] {
         try {
             result = run(plan, options);
-        } catch (...) {
-            failure = std::current_exception();
-        }
+        } catch (...) { failure = std::current_exception(); }
         done.set_value();
     });
     bool interrupted = false;
@@ -445,9 +446,13 @@ void write_input(const std::string& path, const std::string& channel,
 PYBIND11_MODULE(_orogen, m) {
     m.doc() = "orogen: mountain terrain from text pipeline specs (docs/python.md)";
 
-    py::class_<PyHeightmap>(m, "Heightmap", "A heightmap: heights and layers as read-only float32 views, rows north to south")
+    py::class_<PyHeightmap>(m, "Heightmap",
+                            "A heightmap: heights and layers as read-only float32 views, rows north to south")
         .def_property_readonly(
-            "height", [](const PyHeightmap& h) { return float_grid(h.hm->heights().data(), h.hm->width(), h.hm->height(), h.hm); },
+            "height",
+            [](const PyHeightmap& h) {
+                return float_grid(h.hm->heights().data(), h.hm->width(), h.hm->height(), h.hm);
+            },
             "heights in metres, a (rows, columns) float32 array, row 0 the north edge")
         .def_property_readonly(
             "layers",
@@ -458,8 +463,10 @@ PYBIND11_MODULE(_orogen, m) {
                 return d;
             },
             "the layers by name, each like height")
-        .def_property_readonly("cell", [](const PyHeightmap& h) { return h.hm->cell(); }, "metres between vertices")
-        .def_property_readonly("shape", [](const PyHeightmap& h) { return py::make_tuple(h.hm->height(), h.hm->width()); })
+        .def_property_readonly(
+            "cell", [](const PyHeightmap& h) { return h.hm->cell(); }, "metres between vertices")
+        .def_property_readonly("shape",
+                               [](const PyHeightmap& h) { return py::make_tuple(h.hm->height(), h.hm->width()); })
         .def("__repr__", [](const PyHeightmap& h) {
             std::ostringstream s;
             s << "<orogen.Heightmap " << h.hm->width() << "x" << h.hm->height() << ", cell " << h.hm->cell() << " m";
@@ -468,22 +475,25 @@ PYBIND11_MODULE(_orogen, m) {
             return s.str() + ">";
         });
 
-    py::class_<PySeries>(m, "Series", "A series of values (a time-lapse, a turntable's frames), each made when asked for")
+    py::class_<PySeries>(m, "Series",
+                         "A series of values (a time-lapse, a turntable's frames), each made when asked for")
         .def_property_readonly("times", [](const PySeries& s) { return s.series->times; })
         .def("__len__", [](const PySeries& s) { return s.series->size(); })
-        .def("__getitem__", [](const PySeries& s, std::int64_t i) {
-            const auto n = std::int64_t(s.series->size());
-            if (i < 0) i += n;
-            if (i < 0 || i >= n) throw py::index_error("series index out of range");
-            Value v;
-            {
-                py::gil_scoped_release release;
-                v = s.series->at(std::size_t(i));
-            }
-            return to_python(v);
-        })
+        .def("__getitem__",
+             [](const PySeries& s, std::int64_t i) {
+                 const auto n = std::int64_t(s.series->size());
+                 if (i < 0) i += n;
+                 if (i < 0 || i >= n) throw py::index_error("series index out of range");
+                 Value v;
+                 {
+                     py::gil_scoped_release release;
+                     v = s.series->at(std::size_t(i));
+                 }
+                 return to_python(v);
+             })
         .def("__repr__", [](const PySeries& s) {
-            return "<orogen.Series of " + std::to_string(s.series->size()) + " " + std::string(to_string(s.series->element)) + "s>";
+            return "<orogen.Series of " + std::to_string(s.series->size()) + " " +
+                std::string(to_string(s.series->element)) + "s>";
         });
 
     m.def("run", &run_spec, py::arg("spec"), py::kw_only(), py::arg("seed") = py::none(), py::arg("set") = py::dict(),

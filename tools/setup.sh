@@ -13,7 +13,7 @@ packages=(
   libssl-dev libxxhash-dev libstb-dev libpng-dev libdeflate-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev
-  clang-14 libclang-rt-14-dev
+  clang-14 libclang-rt-14-dev clang-format-14   # clang-format-14: the Format test checks .clang-format
   openmpi-bin libopenmpi-dev
   gnuplot-nox                 # analyze:terrain's charts (pngcairo)
 )

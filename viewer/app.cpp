@@ -109,8 +109,7 @@ double number(const std::string& option, const std::string& text) {
         std::size_t used = 0;
         const double v = std::stod(text, &used);
         if (used == text.size() && std::isfinite(v)) return v;
-    } catch (const std::exception&) {
-    }
+    } catch (const std::exception&) {}
     throw BadInput(option + " expects a number, got '" + text + "'");
 }
 
@@ -130,7 +129,8 @@ Options parse(int argc, char** argv) {
         } else if (a == "--size") {
             const std::string v = value();
             const auto x = v.find('x');
-            if (x == std::string::npos) throw BadInput("--size expects WIDTHxHEIGHT in pixels, e.g. 1280x800; got '" + v + "'");
+            if (x == std::string::npos)
+                throw BadInput("--size expects WIDTHxHEIGHT in pixels, e.g. 1280x800; got '" + v + "'");
             const double w = number("--size", v.substr(0, x)), h = number("--size", v.substr(x + 1));
             if (w < 16 || h < 16 || w > 8192 || h > 8192 || w != std::floor(w) || h != std::floor(h))
                 throw BadInput("--size: width and height must be whole numbers from 16 to 8192, got '" + v + "'");
@@ -337,9 +337,11 @@ public:
         // A coarser mesh while the camera moves, the full one for the still frame.
         vtkNew<vtkCallbackCommand> start, end;
         start->SetClientData(this);
-        start->SetCallback([](vtkObject*, unsigned long, void* app, void*) { static_cast<App*>(app)->scene_->set_moving(true); });
+        start->SetCallback(
+            [](vtkObject*, unsigned long, void* app, void*) { static_cast<App*>(app)->scene_->set_moving(true); });
         end->SetClientData(this);
-        end->SetCallback([](vtkObject*, unsigned long, void* app, void*) { static_cast<App*>(app)->scene_->set_moving(false); });
+        end->SetCallback(
+            [](vtkObject*, unsigned long, void* app, void*) { static_cast<App*>(app)->scene_->set_moving(false); });
         style_->AddObserver(vtkCommand::StartInteractionEvent, start);
         style_->AddObserver(vtkCommand::EndInteractionEvent, end);
         interactor_->Initialize();
@@ -417,7 +419,9 @@ private:
     /// machine the CPU time is the figure that does not depend on the load.
     void timing_report() {
         std::cout << "first frame: " << ms_since_process_start() << " ms wall, " << cpu_ms() << " ms CPU\n";
-        auto ms = [](Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); };
+        auto ms = [](Clock::time_point a, Clock::time_point b) {
+            return std::chrono::duration<double, std::milli>(b - a).count();
+        };
         // Twice round: the first switch to a layer maps its colours, a switch back uploads the kept texture.
         for (const char* round : {"", " (again)"}) {
             std::vector<double> walls, cpus;
@@ -441,8 +445,9 @@ private:
                 return v[v.size() / 2];
             };
             std::cout << "layer switch" << (*round ? round : " (first time)") << ": median " << median(walls)
-                      << " ms wall, " << median(cpus) << " ms CPU; min " << *std::min_element(walls.begin(), walls.end())
-                      << " ms wall, " << *std::min_element(cpus.begin(), cpus.end()) << " ms CPU\n";
+                      << " ms wall, " << median(cpus) << " ms CPU; min "
+                      << *std::min_element(walls.begin(), walls.end()) << " ms wall, "
+                      << *std::min_element(cpus.begin(), cpus.end()) << " ms CPU\n";
         }
         scene_->set_layer(o_.layer.empty() ? "splat" : o_.layer);
         scene_->render();
@@ -488,7 +493,8 @@ private:
             last_step_ = Clock::now();
             step_time(1, true);
         }
-        const bool still = style_->GetState() == VTKIS_NONE && Clock::now() - last_interaction_ > std::chrono::milliseconds(200);
+        const bool still =
+            style_->GetState() == VTKIS_NONE && Clock::now() - last_interaction_ > std::chrono::milliseconds(200);
         if (still && refine_pending_) {
             refine_pending_ = false;
             if (scene_->refine()) scene_->render();
@@ -522,24 +528,24 @@ private:
                 show(outputs(), loaded_);
                 if (!options_applied_) apply_options();
                 options_applied_ = true;
-            } catch (const std::exception& e) {
-                error = e.what();
-            }
+            } catch (const std::exception& e) { error = e.what(); }
         } else {
             error = log.empty() ? "orogen exited with code " + std::to_string(code) : log;
         }
         // Errors stay on screen over the last good terrain until a run succeeds.
-        scene_->set_message(error.empty() ? "" : trim_lines(error, 14) + (loaded_ ? "\n(showing the last good run)" : ""),
-                            true);
+        scene_->set_message(
+            error.empty() ? "" : trim_lines(error, 14) + (loaded_ ? "\n(showing the last good run)" : ""), true);
         scene_->render();
         std::cout << "reload " << reloads_ << ": " << (error.empty() ? "ok" : "error") << "\n";
         if (!error.empty()) std::cout << error << (error.back() == '\n' ? "" : "\n");
         std::cout.flush();
         if (!o_.screenshot.empty()) {
             const fs::path s = o_.screenshot;
-            scene_->screenshot((s.parent_path() / (s.stem().string() + "-" + std::to_string(reloads_) + ".png")).string());
+            scene_->screenshot(
+                (s.parent_path() / (s.stem().string() + "-" + std::to_string(reloads_) + ".png")).string());
         }
-        if (o_.exit_after_reloads > 0 && reloads_ >= o_.exit_after_reloads) interactor_->SetDone(true);  // not TerminateApp(): in VTK 9.1 it crashes the X event loop from a callback
+        if (o_.exit_after_reloads > 0 && reloads_ >= o_.exit_after_reloads)
+            interactor_->SetDone(true);  // not TerminateApp(): in VTK 9.1 it crashes the X event loop from a callback
     }
 
     static std::string trim_lines(const std::string& text, int max) {

@@ -53,7 +53,8 @@ struct ErrorFlag {
     vtkNew<vtkCallbackCommand> command;
     explicit ErrorFlag(vtkObject* watched) {
         command->SetClientData(this);
-        command->SetCallback([](vtkObject*, unsigned long, void* self, void*) { static_cast<ErrorFlag*>(self)->raised = true; });
+        command->SetCallback(
+            [](vtkObject*, unsigned long, void* self, void*) { static_cast<ErrorFlag*>(self)->raised = true; });
         watched->AddObserver(vtkCommand::ErrorEvent, command);
     }
 };
@@ -62,8 +63,7 @@ struct ErrorFlag {
 void check_readable(const fs::path& file) {
     std::error_code ec;
     const auto status = fs::status(file, ec);
-    if (!fs::exists(status))
-        throw BadInput("cannot open " + quoted(file) + ": no such file");
+    if (!fs::exists(status)) throw BadInput("cannot open " + quoted(file) + ": no such file");
     if (fs::is_directory(status))
         throw BadInput("cannot open " + quoted(file) + ": it is a folder; give a file inside it");
     std::ifstream probe(file, std::ios::binary);
@@ -111,7 +111,8 @@ void turn_to_y_up(vtkPolyData* poly) {
             back(p);
             points->SetPoint(i, p);
         }
-    for (vtkFieldData* fd : {static_cast<vtkFieldData*>(poly->GetPointData()), static_cast<vtkFieldData*>(poly->GetCellData())})
+    for (vtkFieldData* fd :
+         {static_cast<vtkFieldData*>(poly->GetPointData()), static_cast<vtkFieldData*>(poly->GetCellData())})
         for (int a = 0; a < fd->GetNumberOfArrays(); ++a) {
             vtkDataArray* arr = fd->GetArray(a);
             if (!arr || arr->GetNumberOfComponents() != 3) continue;
@@ -158,7 +159,8 @@ void check_appended_data(const fs::path& file) {
     const auto appended = head.find("<AppendedData encoding=\"raw\"");
     if (appended == std::string::npos || head.find("compressor=") != std::string::npos) return;
     const auto start = head.find('_', appended);
-    if (start == std::string::npos) throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
+    if (start == std::string::npos)
+        throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
     const bool wide = head.find("header_type=\"UInt64\"") != std::string::npos;
     std::error_code ec;
     const std::uintmax_t size = fs::file_size(file, ec);
@@ -189,7 +191,8 @@ Terrain read_vti(const fs::path& file) {
     if (error.raised || reader->GetErrorCode() != 0)
         throw BadInput("cannot read " + quoted(file) + ": the file is damaged (truncated?)");
     if (!h)
-        throw BadInput("cannot read " + quoted(file) + ": it has no 'height' point array; is it an export:vtk heightmap?");
+        throw BadInput("cannot read " + quoted(file) +
+                       ": it has no 'height' point array; is it an export:vtk heightmap?");
     // export:vtk's layouts: up=z width × height × 1 (XY plane), up=y width × 1 × height (XZ plane).
     const bool z = dims[2] == 1 && dims[1] > 1;
     if (dims[0] < 2 || (z ? dims[1] < 2 : (dims[1] != 1 || dims[2] < 2)))
@@ -240,7 +243,8 @@ Terrain terrain_from_mesh(const fs::path& file, vtkPolyData* poly) {
     const double r0 = poly->GetPoint(0)[row_axis];
     while (width < n && poly->GetPoint(width)[row_axis] == r0) ++width;
     if (width < 2 || n % width != 0 || n / width < 2)
-        throw BadInput("cannot show " + quoted(file) + ": its points are not a grid of rows (export:vtk's .vtp mesh is)");
+        throw BadInput("cannot show " + quoted(file) +
+                       ": its points are not a grid of rows (export:vtk's .vtp mesh is)");
     Terrain t;
     t.file = file;
     t.width = int(width);
@@ -314,7 +318,8 @@ Terrain read_gdal(const fs::path& file) {
     double gt[6] = {0, 1, 0, 0, 0, -1};
     const bool georeferenced = ds->GetGeoTransform(gt) == CE_None;
     const OGRSpatialReference* srs = ds->GetSpatialRef();
-    const bool metres = !srs || ((srs->IsProjected() || srs->IsLocal()) && std::fabs(srs->GetLinearUnits() - 1.0) < 1e-9);
+    const bool metres =
+        !srs || ((srs->IsProjected() || srs->IsLocal()) && std::fabs(srs->GetLinearUnits() - 1.0) < 1e-9);
     Terrain t;
     t.file = file;
     t.width = w;
@@ -346,7 +351,8 @@ Terrain read_gdal(const fs::path& file) {
         for (std::size_t i = 0; i < std::size_t(w) * h; ++i)  // holes (nodata) shown at the lowest height
             if (std::isnan(v[i])) v[i] = lowest == std::numeric_limits<float>::max() ? 0.f : lowest;
         if (south_up)
-            for (int y = 0; y < h / 2; ++y) std::swap_ranges(v + std::size_t(y) * w, v + std::size_t(y + 1) * w, v + std::size_t(h - 1 - y) * w);
+            for (int y = 0; y < h / 2; ++y)
+                std::swap_ranges(v + std::size_t(y) * w, v + std::size_t(y + 1) * w, v + std::size_t(h - 1 - y) * w);
         return values;
     };
     t.heights = read_band(1, "height");
@@ -362,13 +368,15 @@ Terrain read_gdal(const fs::path& file) {
 Terrain read_tiles_index(const fs::path& file, const nlohmann::json& index) {
     const std::string format = index.value("format", "");
     if (format == "glb")
-        throw BadInput("cannot show " + quoted(file) + ": it indexes glTF chunks (a 3D Tiles tileset, for CesiumJS and "
+        throw BadInput("cannot show " + quoted(file) +
+                       ": it indexes glTF chunks (a 3D Tiles tileset, for CesiumJS and "
                        "other streamers); open one chunk (.glb) or write raster tiles (format=png16, r16, r32)");
     fs::path vrt = file;
     vrt.replace_extension(".vrt");
     if (!fs::exists(vrt))
-        throw BadInput("cannot show " + quoted(file) + ": the tiles are shown through " + quoted(vrt.filename()) +
-                       ", the GDAL mosaic export:tiles writes beside the index (vrt=true, the default), which is missing");
+        throw BadInput(
+            "cannot show " + quoted(file) + ": the tiles are shown through " + quoted(vrt.filename()) +
+            ", the GDAL mosaic export:tiles writes beside the index (vrt=true, the default), which is missing");
     Terrain t = read_gdal(vrt);
     t.file = file;
     return t;
@@ -377,12 +385,9 @@ Terrain read_tiles_index(const fs::path& file, const nlohmann::json& index) {
 /// Which part of a frame a .vtp fills, by what it holds (turned into the viewer's frame).
 void place(Frame& frame, vtkSmartPointer<vtkPolyData> poly) {
     if (z_up(poly)) turn_to_y_up(poly);
-    if (poly->GetNumberOfPolys() > 0 || poly->GetCellData()->GetArray("plate"))
-        frame.plates = poly;
-    else if (poly->GetNumberOfLines() > 0 || poly->GetCellData()->GetArray("plate_a"))
-        frame.collisions = poly;
-    else
-        frame.particles = poly;
+    if (poly->GetNumberOfPolys() > 0 || poly->GetCellData()->GetArray("plate")) frame.plates = poly;
+    else if (poly->GetNumberOfLines() > 0 || poly->GetCellData()->GetArray("plate_a")) frame.collisions = poly;
+    else frame.particles = poly;
 }
 
 Series read_pvd(const fs::path& file) {
@@ -443,8 +448,8 @@ Content read_files(std::span<const fs::path> files) {
         }
         const std::string ext = extension(file);
         const bool known = ext == ".vti" || ext == ".vtp" || ext == ".pvd" || ext == ".glb" || ext == ".gltf" ||
-                           ext == ".png" || ext == ".r16" || ext == ".r32" || ext == ".tif" || ext == ".tiff" ||
-                           ext == ".vrt" || ext == ".json";
+            ext == ".png" || ext == ".r16" || ext == ".r32" || ext == ".tif" || ext == ".tiff" || ext == ".vrt" ||
+            ext == ".json";
         if (!known)
             throw BadInput("cannot open " + quoted(file) + ": unknown file type '" + ext + "'; orogen-view opens " +
                            known_extensions);
@@ -475,11 +480,10 @@ Content read_files(std::span<const fs::path> files) {
             try {
                 std::ifstream in(file);
                 index = nlohmann::json::parse(in);
-            } catch (const std::exception&) {
-                throw BadInput("cannot read " + quoted(file) + ": not valid JSON");
-            }
+            } catch (const std::exception&) { throw BadInput("cannot read " + quoted(file) + ": not valid JSON"); }
             if (!index.is_object() || !index.contains("tile_size"))
-                throw BadInput("cannot show " + quoted(file) + ": orogen-view opens the .json index of export:tiles; "
+                throw BadInput("cannot show " + quoted(file) +
+                               ": orogen-view opens the .json index of export:tiles; "
                                "for a RAW file's sidecar open the .r16 or .r32 beside it");
             c.terrains.push_back(read_tiles_index(file, index));
         } else {
@@ -519,9 +523,7 @@ std::vector<fs::path> pick_outputs(const fs::path& folder) {
         try {
             auto poly = read_polydata(p);
             return poly->GetNumberOfPolys() > 0 && poly->GetPointData()->GetArray("height") != nullptr;
-        } catch (const std::exception&) {
-            return false;
-        }
+        } catch (const std::exception&) { return false; }
     };
     first(ext_is(".vti")) || first(terrain_vtp) || first(ext_is(".r16")) || first(ext_is(".r32")) || first(gray16) ||
         first(ext_is(".tif")) || first(ext_is(".tiff")) || first(ext_is(".vrt")) || first(ext_is(".glb")) ||

@@ -34,18 +34,18 @@ struct Layer {
 struct Terrain {
     std::filesystem::path file;
     int width = 0, height = 0;
-    double cell = 1.0;                       ///< metres between samples
+    double cell = 1.0;  ///< metres between samples
     vtkSmartPointer<vtkFloatArray> heights;  ///< metres
-    std::vector<Layer> layers;               ///< in file order
+    std::vector<Layer> layers;  ///< in file order
     const float* layer(const std::string& name) const;
 };
 
 /// One instant of a .pvd series; empty pointers where the series has no such part.
 struct Frame {
     double time = 0.0;
-    vtkSmartPointer<vtkPolyData> plates;      ///< polygons, cell arrays plate, velocity, density
+    vtkSmartPointer<vtkPolyData> plates;  ///< polygons, cell arrays plate, velocity, density
     vtkSmartPointer<vtkPolyData> collisions;  ///< lines, cell arrays plate_a, plate_b, kind, impulse, step
-    vtkSmartPointer<vtkPolyData> particles;   ///< vertices, point arrays per attribute
+    vtkSmartPointer<vtkPolyData> particles;  ///< vertices, point arrays per attribute
 };
 
 struct Series {
@@ -55,9 +55,9 @@ struct Series {
 
 /// Everything given on the command line (or written by a spec run).
 struct Content {
-    std::vector<Terrain> terrains;               ///< usually one
+    std::vector<Terrain> terrains;  ///< usually one
     std::vector<Series> series;
-    std::vector<std::filesystem::path> gltf;     ///< imported by the scene
+    std::vector<std::filesystem::path> gltf;  ///< imported by the scene
 };
 
 /// File extensions the viewer opens, for messages: ".vti, .vtp, ...".

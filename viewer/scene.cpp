@@ -76,19 +76,19 @@ LayerStyle style_of(const std::string& name, float lo, float hi) {
     if (name == "boundary") return {"1 convergent, 2 divergent, 3 transform", LayerStyle::categorical};
     if (name == "eroded") return {"m", LayerStyle::diverging};
     // The units the nodes write (orogen help NODE): drainage is an area; flow_direction a D8 code.
-    const char* unit = name == "flow"             ? "m/s"
-                       : name == "hardness"       ? "0..1"
-                       : name == "drainage"       ? "m²"
-                       : name == "flow_direction" ? "D8 code"
-                                                  : "m";
+    const char* unit = name == "flow" ? "m/s"
+        : name == "hardness"          ? "0..1"
+        : name == "drainage"          ? "m²"
+        : name == "flow_direction"    ? "D8 code"
+                                      : "m";
     return {unit, lo < 0 && hi > 0 ? LayerStyle::diverging : LayerStyle::sequential};
 }
 
 /// Qualitative colours (ColorBrewer Set1/Set3 family) for ids.
-const unsigned char categorical_colours[][3] = {
-    {228, 26, 28},  {55, 126, 184}, {77, 175, 74},   {152, 78, 163}, {255, 127, 0},  {255, 255, 51},
-    {166, 86, 40},  {247, 129, 191}, {141, 211, 199}, {190, 186, 218}, {128, 177, 211}, {179, 222, 105},
-    {252, 205, 229}, {188, 128, 189}, {204, 235, 197}, {255, 237, 111}};
+const unsigned char categorical_colours[][3] = {{228, 26, 28},   {55, 126, 184},  {77, 175, 74},   {152, 78, 163},
+                                                {255, 127, 0},   {255, 255, 51},  {166, 86, 40},   {247, 129, 191},
+                                                {141, 211, 199}, {190, 186, 218}, {128, 177, 211}, {179, 222, 105},
+                                                {252, 205, 229}, {188, 128, 189}, {204, 235, 197}, {255, 237, 111}};
 
 /// A colour map with a control point at each of `colours` (RGB 0..255) spread over lo..hi, evenly in the
 /// value or, with `log`, in its logarithm (lo > 0).
@@ -98,7 +98,8 @@ vtkSmartPointer<vtkLookupTable> ramp(std::initializer_list<std::array<int, 3>> c
     ctf->SetColorSpaceToLab();
     const int n = int(colours.size());
     int i = 0;
-    for (const auto& c : colours) ctf->AddRGBPoint(lo + (hi - lo) * i++ / (n - 1), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
+    for (const auto& c : colours)
+        ctf->AddRGBPoint(lo + (hi - lo) * i++ / (n - 1), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0);
     auto lut = vtkSmartPointer<vtkLookupTable>::New();
     lut->SetNumberOfTableValues(256);
     lut->SetScale(log ? VTK_SCALE_LOG10 : VTK_SCALE_LINEAR);
@@ -138,7 +139,8 @@ std::pair<float, float> value_range(const float* v, std::size_t n) {
     parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
         for (std::int64_t b = b0; b < b1; ++b) {
             auto& [lo, hi] = part[std::size_t(b)];
-            for (std::size_t i = n * std::size_t(b) / std::size_t(blocks); i < n * std::size_t(b + 1) / std::size_t(blocks); ++i)
+            for (std::size_t i = n * std::size_t(b) / std::size_t(blocks);
+                 i < n * std::size_t(b + 1) / std::size_t(blocks); ++i)
                 lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
         }
     });
@@ -165,7 +167,8 @@ float kth_magnitude(const float* v, std::size_t n, std::size_t k) {
     parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
         for (std::int64_t b = b0; b < b1; ++b) {
             std::uint32_t* c = &count[std::size_t(b) * buckets];
-            for (std::size_t i = n * std::size_t(b) / std::size_t(blocks); i < n * std::size_t(b + 1) / std::size_t(blocks); ++i)
+            for (std::size_t i = n * std::size_t(b) / std::size_t(blocks);
+                 i < n * std::size_t(b + 1) / std::size_t(blocks); ++i)
                 ++c[bits(v[i]) >> 16];
         }
     });
@@ -256,8 +259,8 @@ struct Scene::Impl {
     bool full = false;
     std::size_t layer = 0;
     double top = 0.0;  // highest terrain point, m
-    std::vector<float> shade;     // per texel: ambient + diffuse · (normal · light), for `shade_for`
-    double shade_for = -1.0;      // the exaggeration `shade` was computed with
+    std::vector<float> shade;  // per texel: ambient + diffuse · (normal · light), for `shade_for`
+    double shade_for = -1.0;  // the exaggeration `shade` was computed with
     std::vector<std::uint8_t> splat;  // the baked splat texture (RGBA), kept for switching back
 
     /// How a layer's values become texel colours, worked out once per layer
@@ -267,8 +270,8 @@ struct Scene::Impl {
         std::string title;
         bool categorical = false;
         double lo = 0.0, scale = 0.0;  // sequential/diverging: table index = (v − lo) · scale, clamped
-        bool log = false;              // ... of log10(v) instead of v (lo is then log10 of the range's start)
-        long lowest = 0;               // categorical: the colour of id k is table[k − lowest]
+        bool log = false;  // ... of log10(v) instead of v (lo is then log10 of the range's start)
+        long lowest = 0;  // categorical: the colour of id k is table[k − lowest]
         std::vector<std::array<std::uint8_t, 3>> table;
     };
     std::map<std::size_t, Colouring> colourings;  // by layer index; cleared with the content
@@ -459,9 +462,21 @@ struct Scene::Impl {
         const double* p = cam->GetPosition();
         const double* f = cam->GetFocalPoint();
         const double* u = cam->GetViewUp();
-        const std::array<double, 15> view{p[0], p[1], p[2], f[0], f[1], f[2], u[0], u[1], u[2], cam->GetViewAngle(),
-                                          cam->GetParallelScale(), double(cam->GetParallelProjection()),
-                                          double(size[0]), double(size[1]), exaggeration};
+        const std::array<double, 15> view{p[0],
+                                          p[1],
+                                          p[2],
+                                          f[0],
+                                          f[1],
+                                          f[2],
+                                          u[0],
+                                          u[1],
+                                          u[2],
+                                          cam->GetViewAngle(),
+                                          cam->GetParallelScale(),
+                                          double(cam->GetParallelProjection()),
+                                          double(size[0]),
+                                          double(size[1]),
+                                          exaggeration};
         if (seen_valid && view == seen_view) return false;
         seen_view = view;
         seen_valid = true;
@@ -477,23 +492,27 @@ struct Scene::Impl {
 
     Detail detail_in_view(int width_px, int height_px) const {
         const Terrain& t = *ground();
-        const std::vector<int> cols = terrain::kept_indices(t.width, step), rows = terrain::kept_indices(t.height, step);
+        const std::vector<int> cols = terrain::kept_indices(t.width, step),
+                               rows = terrain::kept_indices(t.height, step);
         const std::size_t nc = cols.size(), nr = rows.size();
         // world (X east, Y up × exaggeration, Z south) → clip coordinates
         vtkMatrix4x4* m = renderer->GetActiveCamera()->GetCompositeProjectionTransformMatrix(
             double(width_px) / std::max(height_px, 1), -1, 1);
-        struct Clip { double x, y, w; };
+        struct Clip {
+            double x, y, w;
+        };
         std::vector<Clip> clip(nc * nr);
         const float* h = t.heights->GetPointer(0);
         parallel_for(0, std::int64_t(nr), 16, [&](std::int64_t j0, std::int64_t j1) {
             for (std::int64_t j = j0; j < j1; ++j)
                 for (std::size_t i = 0; i < nc; ++i) {
-                    const double p[3] = {cols[i] * t.cell, h[std::size_t(rows[std::size_t(j)]) * t.width + cols[i]] * exaggeration,
+                    const double p[3] = {cols[i] * t.cell,
+                                         h[std::size_t(rows[std::size_t(j)]) * t.width + cols[i]] * exaggeration,
                                          rows[std::size_t(j)] * t.cell};
                     double q[3];
                     for (int r = 0; r < 3; ++r)
                         q[r] = m->GetElement(r == 2 ? 3 : r, 0) * p[0] + m->GetElement(r == 2 ? 3 : r, 1) * p[1] +
-                               m->GetElement(r == 2 ? 3 : r, 2) * p[2] + m->GetElement(r == 2 ? 3 : r, 3);
+                            m->GetElement(r == 2 ? 3 : r, 2) * p[2] + m->GetElement(r == 2 ? 3 : r, 3);
                     clip[std::size_t(j) * nc + i] = {q[0], q[1], q[2]};
                 }
         });
@@ -506,7 +525,8 @@ struct Scene::Impl {
         double widest = 0.0;  // pixels, the largest cell side on screen among cells in view
         for (std::size_t j = 0; j + 1 < nr; ++j)
             for (std::size_t i = 0; i + 1 < nc; ++i) {
-                const Clip* c[4] = {&clip[j * nc + i], &clip[j * nc + i + 1], &clip[(j + 1) * nc + i], &clip[(j + 1) * nc + i + 1]};
+                const Clip* c[4] = {&clip[j * nc + i], &clip[j * nc + i + 1], &clip[(j + 1) * nc + i],
+                                    &clip[(j + 1) * nc + i + 1]};
                 int out[5] = {0, 0, 0, 0, 0};  // corners beyond: right, left, top, bottom, behind
                 for (const Clip* k : c) {
                     out[0] += k->x > margin * k->w;
@@ -516,7 +536,8 @@ struct Scene::Impl {
                     out[4] += k->w <= 1e-9;
                 }
                 if (std::any_of(out, out + 5, [](int n) { return n == 4; })) continue;
-                ci0 = std::min(ci0, int(i)), ci1 = std::max(ci1, int(i)), rj0 = std::min(rj0, int(j)), rj1 = std::max(rj1, int(j));
+                ci0 = std::min(ci0, int(i)), ci1 = std::max(ci1, int(i)), rj0 = std::min(rj0, int(j)),
+                rj1 = std::max(rj1, int(j));
                 if (out[4] > 0) {
                     widest = 1e300;
                     continue;
@@ -528,10 +549,11 @@ struct Scene::Impl {
                 widest = std::max({widest, side(0, 1), side(0, 2), side(1, 3), side(2, 3)});
             }
         if (ci1 < 0 || widest <= refine_pixels) return {};
-        Detail d{cols[std::size_t(ci0)], rows[std::size_t(rj0)], cols[std::size_t(ci1) + 1], rows[std::size_t(rj1) + 1], 0};
+        Detail d{cols[std::size_t(ci0)], rows[std::size_t(rj0)], cols[std::size_t(ci1) + 1], rows[std::size_t(rj1) + 1],
+                 0};
         const int span = std::max(d.x1 - d.x0, d.y1 - d.y0);
-        const int budget = (span + display_samples - 2) / (display_samples - 1);            // fits 257 a side
-        const int sharp = widest > 1e299 ? 1 : int(std::ceil(2.0 * step / widest));        // ≥ 2 px a sample
+        const int budget = (span + display_samples - 2) / (display_samples - 1);  // fits 257 a side
+        const int sharp = widest > 1e299 ? 1 : int(std::ceil(2.0 * step / widest));  // ≥ 2 px a sample
         d.step = std::max({1, budget, sharp});
         if (2 * d.step > step) return {};  // not worth it: less than twice as fine
         return d;
@@ -596,7 +618,8 @@ struct Scene::Impl {
     /// this layer was shown before with the same exaggeration.
     void apply_layer() {
         if (shade_for != exaggeration) textures.clear();  // the hillshade they carry is stale
-        auto hit = std::find_if(textures.begin(), textures.end(), [&](const CachedTexture& c) { return c.layer == layer; });
+        auto hit =
+            std::find_if(textures.begin(), textures.end(), [&](const CachedTexture& c) { return c.layer == layer; });
         if (hit != textures.end()) {
             textures.splice(textures.begin(), textures, hit);
         } else {
@@ -634,7 +657,8 @@ struct Scene::Impl {
         const std::size_t count = names().size();
         for (std::size_t k = 1; k <= count; ++k) {
             const std::size_t index = (layer + k) % count;  // the next layers first: where `l` goes
-            if (std::none_of(textures.begin(), textures.end(), [&](const CachedTexture& c) { return c.layer == index; })) {
+            if (std::none_of(textures.begin(), textures.end(),
+                             [&](const CachedTexture& c) { return c.layer == index; })) {
                 textures.push_back({index, colour_texture(index)});
                 return true;
             }
@@ -662,7 +686,8 @@ struct Scene::Impl {
             for (int i = 0; i < count; ++i) {
                 const double* rgb = c.lut->GetTableValue(i);
                 c.table[std::size_t(c.lut->GetAnnotatedValue(i).ToInt() - c.lowest)] = {
-                    std::uint8_t(rgb[0] * 255 + 0.5), std::uint8_t(rgb[1] * 255 + 0.5), std::uint8_t(rgb[2] * 255 + 0.5)};
+                    std::uint8_t(rgb[0] * 255 + 0.5), std::uint8_t(rgb[1] * 255 + 0.5),
+                    std::uint8_t(rgb[2] * 255 + 0.5)};
             }
         } else {
             // The lookup table's own colours and index rule (vtkLookupTable: index
@@ -892,16 +917,15 @@ struct Scene::Impl {
         const double dir[3] = {std::cos(el) * std::sin(az), std::sin(el), -std::cos(el) * std::cos(az)};
         cam->SetFocalPoint(centre);
         cam->SetPosition(centre[0] + dir[0], centre[1] + dir[1], centre[2] + dir[2]);
-        if (top_view)
-            cam->SetViewUp(0, 0, -1);  // a map: north up
+        if (top_view) cam->SetViewUp(0, 0, -1);  // a map: north up
         else if (el > 89.9 * pi / 180)
             cam->SetViewUp(-std::sin(az), 0, std::cos(az));  // looking down from a bearing: that side at the bottom
-        else
-            cam->SetViewUp(0, 1, 0);
+        else cam->SetViewUp(0, 1, 0);
         cam->SetParallelProjection(top_view);
         renderer->ResetCamera(b);
         if (top_view) {
-            cam->SetParallelScale(cam->GetParallelScale() / 1.35);  // ResetCamera fits the bounding sphere: fit the square
+            cam->SetParallelScale(cam->GetParallelScale() /
+                                  1.35);  // ResetCamera fits the bounding sphere: fit the square
             // A map keeps clear of the colour scale and the status line at the window's bottom: it is fitted
             // into the window above them (smaller by that band, and moved up by half of it).
             const double window_height = renderer->GetSize()[1];
@@ -920,10 +944,9 @@ struct Scene::Impl {
             // vtkCamera::SetDistance would move the focal point; the camera moves instead.
             const double* f = cam->GetFocalPoint();
             const double* d = cam->GetDirectionOfProjection();
-            cam->SetPosition(f[0] - d[0] * angles.distance, f[1] - d[1] * angles.distance, f[2] - d[2] * angles.distance);
-        }
-        else
-            cam->Dolly(1.3);
+            cam->SetPosition(f[0] - d[0] * angles.distance, f[1] - d[1] * angles.distance,
+                             f[2] - d[2] * angles.distance);
+        } else cam->Dolly(1.3);
         renderer->ResetCameraClippingRange();
     }
 };
@@ -976,7 +999,8 @@ Scene::Scene(vtkRenderWindow* window) : impl_(std::make_unique<Impl>()) {
     m.particles_mapper->SetSplatShaderCode(
         "//VTK::Color::Impl\n"
         "float dist = dot(offsetVCVSOutput.xy, offsetVCVSOutput.xy);\n"
-        "if (dist > 1.0) { discard; } else { float scale = 1.0 - dist; ambientColor *= scale; diffuseColor *= scale; }\n");
+        "if (dist > 1.0) { discard; } else { float scale = 1.0 - dist; ambientColor *= scale; diffuseColor *= scale; "
+        "}\n");
     m.bar->SetNumberOfLabels(5);
     m.bar->SetOrientationToHorizontal();  // bottom right, clear of long titles
     // 48 pixels above the window's bottom whatever its size: the status line
@@ -1073,7 +1097,7 @@ void Scene::show(Content content, bool keep_camera) {
     m.plate_series = m.particle_series = nullptr;
     std::set<double> times;
     int plate_score = 0;  // the series with plates and collisions, else plates, else collisions (a folder
-                          // holding export:paraview-state's split series besides export:vtk-plates' own)
+        // holding export:paraview-state's split series besides export:vtk-plates' own)
     for (const auto& s : m.content.series) {
         bool plates = false, collisions = false;
         for (const auto& f : s.frames) {
@@ -1108,9 +1132,7 @@ void Scene::show(Content content, bool keep_camera) {
     m.renderer->ResetCameraClippingRange();
 }
 
-bool Scene::empty() const {
-    return !impl_->ground() && impl_->content.series.empty() && impl_->gltf_actors.empty();
-}
+bool Scene::empty() const { return !impl_->ground() && impl_->content.series.empty() && impl_->gltf_actors.empty(); }
 
 std::vector<std::string> Scene::layer_names() const { return impl_->names(); }
 std::string Scene::layer() const { return impl_->names()[impl_->layer]; }
@@ -1215,10 +1237,8 @@ bool Scene::playing() const { return impl_->playing; }
 
 void Scene::set_message(const std::string& text, bool error) {
     impl_->message->SetInput(text.c_str());
-    if (error)
-        impl_->message->GetTextProperty()->SetColor(1.0, 0.45, 0.4);
-    else
-        impl_->message->GetTextProperty()->SetColor(0.9, 0.95, 1.0);
+    if (error) impl_->message->GetTextProperty()->SetColor(1.0, 0.45, 0.4);
+    else impl_->message->GetTextProperty()->SetColor(0.9, 0.95, 1.0);
     impl_->message->SetVisibility(!text.empty());
 }
 
@@ -1240,8 +1260,7 @@ std::string Scene::state() const {
       << "detail=";
     if (m.detail.step > 0)
         s << m.detail.x0 << "," << m.detail.y0 << "," << m.detail.x1 << "," << m.detail.y1 << " step " << m.detail.step;
-    else
-        s << "none";
+    else s << "none";
     s << "\n"
       << "time_index=" << m.time_index << "\n"
       << "playing=" << (m.playing ? "on" : "off") << "\n"

@@ -14,9 +14,9 @@ namespace orogen::analysis::detail {
 struct Terrain {
     int width = 0, height = 0;
     double cell = 0.0;
-    std::vector<double> z;            ///< heights, m; nodata samples hold the minimum (never read as heights)
+    std::vector<double> z;  ///< heights, m; nodata samples hold the minimum (never read as heights)
     std::vector<std::uint8_t> valid;  ///< 1 measured, 0 nodata
-    std::size_t samples = 0;          ///< valid samples
+    std::size_t samples = 0;  ///< valid samples
     double minimum = 0.0, maximum = 0.0;
     std::size_t size() const { return z.size(); }
     std::size_t at(int x, int y) const { return std::size_t(y) * std::size_t(width) + std::size_t(x); }

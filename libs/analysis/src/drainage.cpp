@@ -19,11 +19,11 @@ namespace {
 constexpr std::size_t minimum_channel_cells = 51;
 
 struct Routing {
-    std::vector<double> filled;          ///< m
+    std::vector<double> filled;  ///< m
     std::vector<std::int64_t> receiver;  ///< −1: none (outlet, hole, or no lower neighbour)
-    std::vector<double> slope;           ///< to the receiver, m/m (0 without one)
-    std::vector<double> distance;        ///< to the receiver, m
-    std::vector<std::size_t> order;      ///< valid cells from the highest filled height down
+    std::vector<double> slope;  ///< to the receiver, m/m (0 without one)
+    std::vector<double> distance;  ///< to the receiver, m
+    std::vector<std::size_t> order;  ///< valid cells from the highest filled height down
 };
 
 Routing route(const Terrain& t) {
@@ -121,10 +121,10 @@ std::string area_text(double m2) {
 void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
     if (t.width < 3 || t.height < 3) {
         const std::string why = "the terrain (" + std::to_string(t.width) + "x" + std::to_string(t.height) +
-                                ") is too small to route water over (needs at least 3x3)";
-        for (FigureId id : {FigureId::concavity, FigureId::steepness, FigureId::hack_exponent,
-                            FigureId::drainage_density, FigureId::network_share, FigureId::hillslope_length,
-                            FigureId::channel_sinuosity})
+            ") is too small to route water over (needs at least 3x3)";
+        for (FigureId id :
+             {FigureId::concavity, FigureId::steepness, FigureId::hack_exponent, FigureId::drainage_density,
+              FigureId::network_share, FigureId::hillslope_length, FigureId::channel_sinuosity})
             f[id].why_not = why;
         return;
     }
@@ -153,9 +153,8 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
         }
     if (ca.size() < minimum_channel_cells) {
         const std::string why = "only " + std::to_string(ca.size()) + " channel cells (draining more than " +
-                                area_text(o.channel_area) + ", slope above " + number(o.channel_min_slope) +
-                                "); the fit needs " + std::to_string(minimum_channel_cells) +
-                                ": the terrain's rivers are too short";
+            area_text(o.channel_area) + ", slope above " + number(o.channel_min_slope) + "); the fit needs " +
+            std::to_string(minimum_channel_cells) + ": the terrain's rivers are too short";
         f[FigureId::concavity].why_not = why;
         f[FigureId::steepness].why_not = why;
         f[FigureId::hack_exponent].why_not = why;
@@ -197,10 +196,8 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
         }
         if (reaches == 0)
             f[FigureId::channel_sinuosity].why_not = "no channel (draining more than " + area_text(o.channel_area) +
-                                                     ") runs " + number(o.sinuosity_reach) +
-                                                     " m before it leaves the terrain";
-        else
-            f[FigureId::channel_sinuosity].value = sum / double(reaches);
+                ") runs " + number(o.sinuosity_reach) + " m before it leaves the terrain";
+        else f[FigureId::channel_sinuosity].value = sum / double(reaches);
     }
 
     // The network: cells draining more than 0.1 km².
@@ -214,8 +211,8 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
     f[FigureId::network_share].value = 100.0 * double(network) / double(t.samples);
     const double measured_area = double(t.samples) * t.cell * t.cell;  // m²
     if (network == 0) {
-        const std::string why = "no cell drains more than " + area_text(o.network_area) +
-                                " (the terrain covers " + area_text(measured_area) + ")";
+        const std::string why = "no cell drains more than " + area_text(o.network_area) + " (the terrain covers " +
+            area_text(measured_area) + ")";
         f[FigureId::drainage_density].why_not = why;
         f[FigureId::hillslope_length].why_not = why;
         return;

@@ -43,7 +43,8 @@ constexpr FigureInfo table[] = {
      "−slope of the least-squares line of ln S against ln A over channel cells (A > 1 km², S > 1e-4) on the "
      "priority-flood-filled DEM (ε = 1e-4·cell), D8 area A and slope S to the steepest receiver",
      "Flint 1974, Water Resour. Res. 10:969; Barnes, Lehman & Mulla 2014, Comput. Geosci. 62:117; "
-     "O'Callaghan & Mark 1984", 2},
+     "O'Callaghan & Mark 1984",
+     2},
     {steepness, "steepness", "k_sn", "m^0.9",
      "normalised channel steepness: geometric mean of S·A^0.45 over the channel cells of the concavity "
      "(reference concavity 0.45)",
@@ -66,11 +67,13 @@ constexpr FigureInfo table[] = {
     {hillslope_length, "hillslope_length", "hillslope L", "m",
      "mean D8 flow distance from each sample off the network (A ≤ 0.1 km²) down to the first network cell",
      "Roering, Perron & Kirchner 2007, Earth Planet. Sci. Lett. 264:245; Grieve et al. 2016, Earth Surf. "
-     "Dynam. 4:627", 0},
+     "Dynam. 4:627",
+     0},
     {curvature_spread, "curvature_spread", "curvature sd", "1/km",
      "standard deviation of the Laplacian curvature d²z/dx² + d²z/dy² (5-point stencil) over interior samples",
      "Zevenbergen & Thorne 1987, Earth Surf. Proc. Landf. 12:47; Hurst et al. 2012, J. Geophys. Res. "
-     "117:F02017", 2},
+     "117:F02017",
+     2},
     {channel_sinuosity, "channel_sinuosity", "sinuosity", "",
      "mean over the channel cells (A > 1 km²) of the D8 flow length along the next 1 km of flow path over the "
      "straight distance between its ends (D8 reads a straight channel as 1.00–1.08, by its direction)",

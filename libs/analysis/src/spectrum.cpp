@@ -43,8 +43,7 @@ std::vector<double> half_power_spectrum(const std::vector<double>& data, int n) 
         std::vector<std::complex<double>> z(side);
         for (auto pair = std::size_t(begin); pair < std::size_t(end); ++pair) {
             const std::size_t y0 = 2 * pair, y1 = y0 + 1;
-            for (std::size_t x = 0; x < side; ++x)
-                z[x] = {data[y0 * side + x], y1 < side ? data[y1 * side + x] : 0.0};
+            for (std::size_t x = 0; x < side; ++x) z[x] = {data[y0 * side + x], y1 < side ? data[y1 * side + x] : 0.0};
             fft.transform(z);
             for (std::size_t u = 0; u < columns; ++u) {
                 const std::complex<double> zk = z[u], zm = std::conj(z[(side - u) % side]);
@@ -72,9 +71,8 @@ void measure_spectrum(const Terrain& t, Figures& f) {
     f.spectrum_side = n;
     if (n < minimum_side) {
         f[FigureId::spectral_exponent].why_not = "the terrain (" + std::to_string(t.width) + "x" +
-                                                 std::to_string(t.height) + ") is narrower than " +
-                                                 std::to_string(minimum_side) +
-                                                 " samples: too few wavenumbers in 4 … n/4 to fit";
+            std::to_string(t.height) + ") is narrower than " + std::to_string(minimum_side) +
+            " samples: too few wavenumbers in 4 … n/4 to fit";
         return;
     }
     // Mean of the crop's measured samples; holes take it, so they add no power (after the mean is removed).
@@ -94,7 +92,8 @@ void measure_spectrum(const Terrain& t, Figures& f) {
         for (int x = 0; x < n; ++x) {
             const std::size_t i = t.at(x, y);
             const double v = t.valid[i] ? t.z[i] - mean : 0.0;
-            data[std::size_t(y) * std::size_t(n) + std::size_t(x)] = v * window[std::size_t(y)] * window[std::size_t(x)];
+            data[std::size_t(y) * std::size_t(n) + std::size_t(x)] =
+                v * window[std::size_t(y)] * window[std::size_t(x)];
         }
     const std::vector<double> half = half_power_spectrum(data, n);
 

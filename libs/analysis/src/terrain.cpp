@@ -70,7 +70,8 @@ void measure_slopes(const Terrain& t, Figures& f) {
 void measure_hypsometry(const Terrain& t, Figures& f) {
     const double relief = t.maximum - t.minimum;
     if (!(relief > 0.0)) {
-        f[FigureId::hypsometric_integral].why_not = "the terrain is flat (no relief between its lowest and highest sample)";
+        f[FigureId::hypsometric_integral].why_not =
+            "the terrain is flat (no relief between its lowest and highest sample)";
         return;
     }
     double sum = 0.0;
@@ -156,7 +157,8 @@ void measure_relief(const Terrain& t, const Options& o, Figures& f) {
     for (std::size_t i = 0; i < t.size(); ++i) hi[i] = t.valid[i] ? t.z[i] : -inf, lo[i] = t.valid[i] ? t.z[i] : inf;
     std::deque<std::size_t> q;
     for (auto [field, sign] : {std::pair{&hi, 1.0}, std::pair{&lo, -1.0}}) {
-        for (std::size_t y = 0; y < h; ++y) sliding_extreme(field->data() + y * w, tmp.data() + y * w, w, 1, r, sign, q);
+        for (std::size_t y = 0; y < h; ++y)
+            sliding_extreme(field->data() + y * w, tmp.data() + y * w, w, 1, r, sign, q);
         for (std::size_t x = 0; x < w; ++x) sliding_extreme(tmp.data() + x, field->data() + x, h, w, r, sign, q);
     }
     double sum = 0.0;
@@ -180,7 +182,8 @@ void measure_curvature(const Terrain& t, Figures& f) {
             ++n;
         }
     if (n < 2) {
-        f[FigureId::curvature_spread].why_not = too_small(t, "has fewer than 2 interior samples with 4 measured neighbours");
+        f[FigureId::curvature_spread].why_not =
+            too_small(t, "has fewer than 2 interior samples with 4 measured neighbours");
         return;
     }
     const double mean = sum / double(n);

@@ -41,8 +41,9 @@ Compression parse_compression(const std::string& name) {
 
 std::string channel_name_problem(const std::string& name) {
     if (name.empty()) return "a channel name cannot be empty";
-    if (name.size() > 255) return "a channel name has at most 255 bytes, '" + name.substr(0, 40) + "...' has " +
-                                  std::to_string(name.size());
+    if (name.size() > 255)
+        return "a channel name has at most 255 bytes, '" + name.substr(0, 40) + "...' has " +
+            std::to_string(name.size());
     if (name.find('\0') != std::string::npos) return "a channel name cannot hold a NUL byte";
     return "";
 }
@@ -72,8 +73,8 @@ void write(const fs::path& path, int width, int height, std::span<const Plane> p
             throw BadInput("two channels are named '" + p.channel + "'; an OpenEXR file's channel names are distinct");
         header.channels().insert(p.channel, Imf::Channel(Imf::FLOAT));
         // The heightmap's own rows: nothing is copied.
-        frame.insert(p.channel, Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(p.data)),
-                                           sizeof(float), row));
+        frame.insert(p.channel,
+                     Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(const_cast<float*>(p.data)), sizeof(float), row));
     }
     try {
         // Blocks are compressed on OpenEXR's process-wide pool, grown (never shrunk) to what is asked for; they
@@ -87,9 +88,7 @@ void write(const fs::path& path, int width, int height, std::span<const Plane> p
         Imf::OutputFile file(path.c_str(), header, threads > 1 ? threads : 0);
         file.setFrameBuffer(frame);
         file.writePixels(height);
-    } catch (const std::exception& e) {
-        throw Error("OpenEXR could not write " + path.string() + ": " + e.what());
-    }
+    } catch (const std::exception& e) { throw Error("OpenEXR could not write " + path.string() + ": " + e.what()); }
 }
 
 // ------------------------------------------------------------------- read
@@ -171,7 +170,9 @@ std::int64_t source_read(exr_const_context_t, void* user, void* buffer, std::uin
     return done == 0 && n > 0 ? -1 : std::int64_t(done);
 }
 
-std::int64_t source_size(exr_const_context_t, void* user) { return std::int64_t(static_cast<const Source*>(user)->size); }
+std::int64_t source_size(exr_const_context_t, void* user) {
+    return std::int64_t(static_cast<const Source*>(user)->size);
+}
 
 void open_file(Source& s, const fs::path& path) {
     s.name = path.string();
@@ -179,8 +180,7 @@ void open_file(Source& s, const fs::path& path) {
         throw BadInput("cannot read " + s.name + ": it " + problem);
     s.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     struct stat st {};
-    if (s.fd < 0 || ::fstat(s.fd, &st) != 0)
-        throw BadInput("cannot read " + s.name + ": " + std::strerror(errno));
+    if (s.fd < 0 || ::fstat(s.fd, &st) != 0) throw BadInput("cannot read " + s.name + ": " + std::strerror(errno));
     s.size = std::uint64_t(st.st_size);
 }
 
@@ -250,7 +250,9 @@ struct Opened {
     std::uint64_t largest_chunk = 0;  ///< bytes, packed or unpacked
 };
 
-[[noreturn]] void refuse(const Source& s, const std::string& what) { throw BadInput("cannot read " + s.name + ": " + what); }
+[[noreturn]] void refuse(const Source& s, const std::string& what) {
+    throw BadInput("cannot read " + s.name + ": " + what);
+}
 
 std::string core_message(exr_result_t rv) {
     std::string m = last_message.empty() ? exr_get_default_error_message(rv) : last_message;
@@ -261,8 +263,8 @@ std::string core_message(exr_result_t rv) {
 void require_channel(const Source& s, const FileInfo& info, const std::string& name, const char* param) {
     const ChannelInfo* c = info.find(name);
     if (!c) {
-        throw ChannelError("cannot read " + s.name + ": it has no channel '" + name + "' (its channels are: " +
-                               info.channel_list() + "); give " + param + "=NAME",
+        throw ChannelError("cannot read " + s.name + ": it has no channel '" + name +
+                               "' (its channels are: " + info.channel_list() + "); give " + param + "=NAME",
                            param);
     }
     if (c->type == SampleType::uint32)
@@ -310,8 +312,10 @@ exr_storage_t read_header(Source& s, Opened& o) {
     int parts = 0;
     exr_get_count(ctx, &parts);
     if (parts != 1)
-        refuse(s, "it has " + std::to_string(parts) + " parts; import:exr reads single-part files (split it with "
-                  "exrmultipart -separate)");
+        refuse(s,
+               "it has " + std::to_string(parts) +
+                   " parts; import:exr reads single-part files (split it with "
+                   "exrmultipart -separate)");
     exr_storage_t storage = EXR_STORAGE_LAST_TYPE;
     exr_get_storage(ctx, 0, &storage);
     if (storage != EXR_STORAGE_SCANLINE && storage != EXR_STORAGE_TILED)
@@ -324,8 +328,9 @@ exr_storage_t read_header(Source& s, Opened& o) {
     const std::int64_t w = std::int64_t(window.max.x) - window.min.x + 1;
     const std::int64_t h = std::int64_t(window.max.y) - window.min.y + 1;
     if (w < 1 || h < 1 || w > 1000000 || h > 1000000)
-        refuse(s, "its data window is " + std::to_string(w) + "x" + std::to_string(h) +
-                      " samples; a heightmap has 1 to 1000000 on each side");
+        refuse(s,
+               "its data window is " + std::to_string(w) + "x" + std::to_string(h) +
+                   " samples; a heightmap has 1 to 1000000 on each side");
     o.info.width = int(w);
     o.info.height = int(h);
 
@@ -337,8 +342,8 @@ exr_storage_t read_header(Source& s, Opened& o) {
         ChannelInfo c;
         c.name.assign(e.name.str ? e.name.str : "", e.name.str ? std::size_t(std::max(e.name.length, 0)) : 0);
         c.type = e.pixel_type == EXR_PIXEL_UINT ? SampleType::uint32
-                 : e.pixel_type == EXR_PIXEL_HALF ? SampleType::half
-                                                  : SampleType::float32;
+            : e.pixel_type == EXR_PIXEL_HALF    ? SampleType::half
+                                                : SampleType::float32;
         c.x_sampling = e.x_sampling;
         c.y_sampling = e.y_sampling;
         o.info.channels.push_back(std::move(c));
@@ -348,10 +353,11 @@ exr_storage_t read_header(Source& s, Opened& o) {
     exr_get_compression(ctx, 0, &compression);
     o.info.compression = compression_name(compression);
     if (max_ratio(compression) == 0)
-        refuse(s, "it is compressed with " + o.info.compression +
-                      ", which import:exr does not read (it reads the lossless none, rle, zips, zip and piz, so "
-                      "heights come back bit for bit); save it again with one of those, e.g. exrmaketiled -z zip "
-                      "IN.exr OUT.exr");
+        refuse(s,
+               "it is compressed with " + o.info.compression +
+                   ", which import:exr does not read (it reads the lossless none, rle, zips, zip and piz, so "
+                   "heights come back bit for bit); save it again with one of those, e.g. exrmaketiled -z zip "
+                   "IN.exr OUT.exr");
 
     // The custom attributes export:exr writes.
     const exr_attribute_t* attr = nullptr;
@@ -360,8 +366,9 @@ exr_storage_t read_header(Source& s, Opened& o) {
         if (attr->type == EXR_ATTR_DOUBLE) cell = attr->d;
         else if (attr->type == EXR_ATTR_FLOAT) cell = attr->f;
         if (!(std::isfinite(cell) && cell > 0.0 && cell <= 1e6))
-            refuse(s, "its cellSize attribute must be a number of metres above 0 and at most 1e6 (a double); give "
-                      "cell=METRES to override it");
+            refuse(s,
+                   "its cellSize attribute must be a number of metres above 0 and at most 1e6 (a double); give "
+                   "cell=METRES to override it");
         o.info.cell = cell;
     }
     if (exr_get_attribute_by_name(ctx, 0, "heightUnits", &attr) == EXR_ERR_SUCCESS && attr &&
@@ -392,7 +399,6 @@ void choose_channels(const Source& s, const ReadOptions& options, Opened& o) {
             o.wanted.push_back(name);
         }
     }
-
 }
 
 /// The memory budget: one heightmap, and all the wanted channels together.
@@ -404,12 +410,12 @@ void check_budget(Source& s, const Opened& o) {
     if (o.wanted.size() > 1) {
         const double total = double(w) * double(h) * 4.0 * double(o.wanted.size());
         if (total > double(heightmap_memory_limit()))
-            refuse(s, "its " + std::to_string(o.wanted.size()) + " channels to read (the heights and " +
-                          std::to_string(o.wanted.size() - 1) + " layers) need " + human_bytes(total) +
-                          ", more than the " + human_bytes(double(heightmap_memory_limit())) +
-                          " allowed here; read fewer layers");
+            refuse(s,
+                   "its " + std::to_string(o.wanted.size()) + " channels to read (the heights and " +
+                       std::to_string(o.wanted.size() - 1) + " layers) need " + human_bytes(total) +
+                       ", more than the " + human_bytes(double(heightmap_memory_limit())) +
+                       " allowed here; read fewer layers");
     }
-
 }
 
 /// The chunks of the full-resolution level into o.chunks: each inside the file, none overlapping another,
@@ -423,20 +429,23 @@ void index_chunks(Source& s, exr_storage_t storage, Opened& o) {
     if (exr_result_t rv = exr_get_chunk_count(ctx, 0, &chunk_count); rv != EXR_ERR_SUCCESS || chunk_count < 1)
         refuse(s, "it declares no image data (OpenEXR: " + core_message(rv) + ")");
     if (std::uint64_t(chunk_count) * 8 > s.size)
-        refuse(s, "it is truncated: its " + std::to_string(chunk_count) + " chunks' offset table alone needs " +
-                      human_bytes(double(chunk_count) * 8) + ", and the file has " + human_bytes(double(s.size)));
+        refuse(s,
+               "it is truncated: its " + std::to_string(chunk_count) + " chunks' offset table alone needs " +
+                   human_bytes(double(chunk_count) * 8) + ", and the file has " + human_bytes(double(s.size)));
     AllocCap cap(std::size_t(s.size) + (1u << 16));
     auto add_chunk = [&](exr_result_t rv, const exr_chunk_info_t& ci, std::int64_t x, std::int64_t y) {
         if (rv != EXR_ERR_SUCCESS)
-            refuse(s, "it is truncated or damaged: chunk " + std::to_string(o.chunks.size() + 1) + " of its image " +
-                          "cannot be read (OpenEXR: " + core_message(rv) + ")");
+            refuse(s,
+                   "it is truncated or damaged: chunk " + std::to_string(o.chunks.size() + 1) + " of its image " +
+                       "cannot be read (OpenEXR: " + core_message(rv) + ")");
         if (ci.data_offset > s.size || ci.packed_size > s.size - ci.data_offset)
             refuse(s, "it is truncated: chunk " + std::to_string(o.chunks.size() + 1) + " runs past its end");
         const std::uint64_t ratio = max_ratio(exr_compression_t(ci.compression));
         if (ratio == 0 || ci.unpacked_size > ci.packed_size * ratio + 64)
-            refuse(s, "it is damaged: chunk " + std::to_string(o.chunks.size() + 1) + " claims to hold " +
-                          human_bytes(double(ci.unpacked_size)) + " in " + human_bytes(double(ci.packed_size)) +
-                          ", more than " + o.info.compression + " compression can");
+            refuse(s,
+                   "it is damaged: chunk " + std::to_string(o.chunks.size() + 1) + " claims to hold " +
+                       human_bytes(double(ci.unpacked_size)) + " in " + human_bytes(double(ci.packed_size)) +
+                       ", more than " + o.info.compression + " compression can");
         o.largest_chunk = std::max({o.largest_chunk, ci.unpacked_size, ci.packed_size});
         o.chunks.push_back({ci, int(x), int(y)});
     };
@@ -461,8 +470,9 @@ void index_chunks(Source& s, exr_storage_t storage, Opened& o) {
                 exr_chunk_info_t ci{};
                 add_chunk(exr_read_tile_chunk_info(ctx, 0, int(tx), int(ty), 0, 0, &ci), ci, x, y);
                 if (ci.width != std::min<std::int64_t>(tw, w - x) || ci.height != std::min<std::int64_t>(th, h - y))
-                    refuse(s, "it is damaged: tile (" + std::to_string(tx) + ", " + std::to_string(ty) +
-                                  ") is not the size its tiling says");
+                    refuse(s,
+                           "it is damaged: tile (" + std::to_string(tx) + ", " + std::to_string(ty) +
+                               ") is not the size its tiling says");
             }
     }
     std::vector<std::pair<std::uint64_t, std::uint64_t>> spans;
@@ -471,8 +481,9 @@ void index_chunks(Source& s, exr_storage_t storage, Opened& o) {
     std::sort(spans.begin(), spans.end());
     for (std::size_t i = 1; i < spans.size(); ++i)
         if (spans[i - 1].first + spans[i - 1].second > spans[i].first)
-            refuse(s, "it is damaged: two chunks of its image share the same bytes (at offset " +
-                          std::to_string(spans[i].first) + ")");
+            refuse(s,
+                   "it is damaged: two chunks of its image share the same bytes (at offset " +
+                       std::to_string(spans[i].first) + ")");
 }
 
 void open_checked(Source& s, const ReadOptions& options, Opened& o) {
@@ -485,8 +496,8 @@ void open_checked(Source& s, const ReadOptions& options, Opened& o) {
 
 /// Decodes chunk `c` into its rows of `planes` (the wanted channels, `w` samples a row) with `dec`, set up on
 /// its first chunk and updated after. Throws orogen::BadInput naming the chunk.
-void decode_chunk(const Source& s, const Opened& o, const Chunk& c, Decoder& dec, std::vector<std::vector<float>>& planes,
-                  int w) {
+void decode_chunk(const Source& s, const Opened& o, const Chunk& c, Decoder& dec,
+                  std::vector<std::vector<float>>& planes, int w) {
     exr_const_context_t ctx = dec.ctx;
     exr_result_t rv = dec.pipe.channels ? exr_decoding_update(ctx, 0, &c.info, &dec.pipe)
                                         : exr_decoding_initialize(ctx, 0, &c.info, &dec.pipe);
@@ -513,8 +524,9 @@ void decode_chunk(const Source& s, const Opened& o, const Chunk& c, Decoder& dec
     }
     rv = exr_decoding_run(ctx, 0, &dec.pipe);
     if (rv != EXR_ERR_SUCCESS)
-        refuse(s, "it is damaged: the chunk at row " + std::to_string(c.y) + ", column " + std::to_string(c.x) +
-                      " does not decode (OpenEXR: " + core_message(rv) + ")");
+        refuse(s,
+               "it is damaged: the chunk at row " + std::to_string(c.y) + ", column " + std::to_string(c.x) +
+                   " does not decode (OpenEXR: " + core_message(rv) + ")");
 }
 
 std::shared_ptr<Heightmap> read_source(Source& s, const ReadOptions& options) {
@@ -522,8 +534,7 @@ std::shared_ptr<Heightmap> read_source(Source& s, const ReadOptions& options) {
     open_checked(s, options, o);
     double cell = options.cell;
     if (cell <= 0.0) {
-        if (!o.info.cell)
-            refuse(s, "it has no cellSize attribute to take a cell size from; give cell=METRES");
+        if (!o.info.cell) refuse(s, "it has no cellSize attribute to take a cell size from; give cell=METRES");
         cell = *o.info.cell;
     }
     const int w = o.info.width, h = o.info.height;
@@ -562,17 +573,17 @@ std::shared_ptr<Heightmap> read_source(Source& s, const ReadOptions& options) {
     // Small images (and the fuzz target's) on this thread: waking workers would cost more than it saves.
     if (o.chunks.size() >= 8 && n * planes.size() >= (std::size_t(1) << 20))
         parallel_for(0, std::int64_t(o.chunks.size()), 1, decode);
-    else
-        decode(0, std::int64_t(o.chunks.size()));
+    else decode(0, std::int64_t(o.chunks.size()));
     if (failed_at < o.chunks.size()) throw BadInput(failure);
 
     for (std::size_t p = 0; p < planes.size(); ++p) {
         const auto bad = std::find_if(planes[p].begin(), planes[p].end(), [](float v) { return !std::isfinite(v); });
         if (bad != planes[p].end()) {
             const std::size_t i = std::size_t(bad - planes[p].begin());
-            refuse(s, "sample (" + std::to_string(i % std::size_t(w)) + ", " + std::to_string(i / std::size_t(w)) +
-                          ") of channel '" + o.wanted[p] + "' is " + (std::isnan(*bad) ? "NaN" : "infinite") +
-                          "; heights and layers must be finite numbers");
+            refuse(s,
+                   "sample (" + std::to_string(i % std::size_t(w)) + ", " + std::to_string(i / std::size_t(w)) +
+                       ") of channel '" + o.wanted[p] + "' is " + (std::isnan(*bad) ? "NaN" : "infinite") +
+                       "; heights and layers must be finite numbers");
         }
     }
     auto hm = std::make_shared<Heightmap>(w, h, cell, std::move(planes[0]));

@@ -46,8 +46,10 @@ std::vector<std::uint16_t> hillshade(ConstGridView h, int bits, double azimuth_d
             const int ya = std::max(y - 1, 0), yb = std::min(y + 1, h.height - 1);
             for (int x = 0; x < h.width; ++x) {
                 const int xa = std::max(x - 1, 0), xb = std::min(x + 1, h.width - 1);
-                const double gx = xb > xa ? (double(h.at(xb, y)) - h.at(xa, y)) * vertical_scale / ((xb - xa) * h.cell) : 0.0;
-                const double gy = yb > ya ? (double(h.at(x, yb)) - h.at(x, ya)) * vertical_scale / ((yb - ya) * h.cell) : 0.0;
+                const double gx =
+                    xb > xa ? (double(h.at(xb, y)) - h.at(xa, y)) * vertical_scale / ((xb - xa) * h.cell) : 0.0;
+                const double gy =
+                    yb > ya ? (double(h.at(x, yb)) - h.at(x, ya)) * vertical_scale / ((yb - ya) * h.cell) : 0.0;
                 // Normal (−∂h/∂x, −∂h/∂y, 1), normalised.
                 const double shade = (-gx * lx - gy * ly + lz) / std::sqrt(gx * gx + gy * gy + 1.0);
                 const double v = std::round(std::clamp(std::isnan(shade) ? 0.0 : shade, 0.0, 1.0) * top);

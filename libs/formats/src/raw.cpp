@@ -73,7 +73,8 @@ std::string sidecar_json(Format format, int width, int height, double cell, Rang
       << "  \"height_max\": " << number(range.high) << ",\n"
       << "  \"units\": \"m\",\n"
       << "  \"layout\": \"rows north to south, samples west to east, no header\"";
-    if (format == Format::r16) s << ",\n  \"height_of_sample\": \"height_min + (height_max - height_min) * value / 65535\"";
+    if (format == Format::r16)
+        s << ",\n  \"height_of_sample\": \"height_min + (height_max - height_min) * value / 65535\"";
     s << "\n}\n";
     return s.str();
 }
@@ -130,25 +131,30 @@ Sidecar parse_sidecar(std::string_view text, const std::string& name) {
     auto real = [&](const char* key) {
         const auto& v = field(key);
         if (!v.is_number() || !std::isfinite(v.get<double>()))
-            throw BadInput("cannot read " + name + ": \"" + key + "\" must be a finite number, got " + v.dump().substr(0, 40));
+            throw BadInput("cannot read " + name + ": \"" + key + "\" must be a finite number, got " +
+                           v.dump().substr(0, 40));
         return v.get<double>();
     };
     Sidecar s;
     const auto& format = field("format");
     if (format == "r16") s.format = Format::r16;
     else if (format == "r32") s.format = Format::r32;
-    else throw BadInput("cannot read " + name + ": \"format\" must be \"r16\" or \"r32\", got " + format.dump().substr(0, 40));
+    else
+        throw BadInput("cannot read " + name + ": \"format\" must be \"r16\" or \"r32\", got " +
+                       format.dump().substr(0, 40));
     if (auto it = j.find("byte_order"); it != j.end() && *it != "little-endian")
-        throw BadInput("cannot read " + name + ": \"byte_order\" must be \"little-endian\", got " + it->dump().substr(0, 40));
+        throw BadInput("cannot read " + name + ": \"byte_order\" must be \"little-endian\", got " +
+                       it->dump().substr(0, 40));
     s.width = size("width");
     s.height = size("height");
     s.cell = real("cell_size");
-    if (!(s.cell > 0)) throw BadInput("cannot read " + name + ": \"cell_size\" must be above 0 m, got " + number(s.cell));
+    if (!(s.cell > 0))
+        throw BadInput("cannot read " + name + ": \"cell_size\" must be above 0 m, got " + number(s.cell));
     s.range.low = real("height_min");
     s.range.high = real("height_max");
     if (s.range.high < s.range.low)
-        throw BadInput("cannot read " + name + ": \"height_max\" (" + number(s.range.high) + ") is below \"height_min\" (" +
-                       number(s.range.low) + ")");
+        throw BadInput("cannot read " + name + ": \"height_max\" (" + number(s.range.high) +
+                       ") is below \"height_min\" (" + number(s.range.low) + ")");
     return s;
 }
 
@@ -162,11 +168,12 @@ Sidecar read_raw_header(const fs::path& file) {
     if (bytes.size() > (1u << 20))
         throw BadInput("cannot read " + sidecar.string() + ": " + human_bytes(double(bytes.size())) +
                        " is far too big for a sidecar (at most 1 MiB)");
-    Sidecar s = parse_sidecar(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
-                              sidecar.string());
+    Sidecar s =
+        parse_sidecar(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), sidecar.string());
     if (s.format != format)
-        throw BadInput("cannot read " + file.string() + ": the sidecar says " + (s.format == Format::r16 ? "r16" : "r32") +
-                       ", but the file's extension says " + file.extension().string());
+        throw BadInput("cannot read " + file.string() + ": the sidecar says " +
+                       (s.format == Format::r16 ? "r16" : "r32") + ", but the file's extension says " +
+                       file.extension().string());
     if (const std::string problem = heightmap_memory_problem(s.width, s.height); !problem.empty())
         throw BadInput("cannot read " + file.string() + ": its sidecar declares " + std::to_string(s.width) + "x" +
                        std::to_string(s.height) + " samples, which " + problem);
@@ -176,8 +183,8 @@ Sidecar read_raw_header(const fs::path& file) {
     std::error_code ec;
     const std::uint64_t have = fs::file_size(file, ec);
     if (ec || have != want)
-        throw BadInput("cannot read " + file.string() + ": it holds " + std::to_string(have) + " bytes, but its sidecar's " +
-                       std::to_string(s.width) + "x" + std::to_string(s.height) + " " +
+        throw BadInput("cannot read " + file.string() + ": it holds " + std::to_string(have) +
+                       " bytes, but its sidecar's " + std::to_string(s.width) + "x" + std::to_string(s.height) + " " +
                        (format == Format::r16 ? "16-bit" : "32-bit") + " samples need exactly " + std::to_string(want) +
                        (have < want ? "; it is truncated" : "; the sidecar belongs to another file"));
     return s;
@@ -202,7 +209,7 @@ std::vector<float> read_raw(const fs::path& file, Sidecar& info) {
                 dst[x] = float(dequantize16(std::uint16_t(b[0] | (b[1] << 8)), info.range));
             } else {
                 const std::uint32_t bits = std::uint32_t(b[0]) | (std::uint32_t(b[1]) << 8) |
-                                           (std::uint32_t(b[2]) << 16) | (std::uint32_t(b[3]) << 24);
+                    (std::uint32_t(b[2]) << 16) | (std::uint32_t(b[3]) << 24);
                 dst[x] = std::bit_cast<float>(bits);
                 if (!std::isfinite(dst[x]))
                     throw BadInput("cannot read " + file.string() + ": sample (" + std::to_string(x) + ", " +

@@ -65,7 +65,7 @@ bool make_crs(const std::string& crs, OGRSpatialReference& srs, std::string& mes
     QuietErrors quiet;
     if (srs.SetFromUserInput(crs.c_str(), kCrsInputOptions) != OGRERR_NONE) {
         message = "unknown CRS '" + crs + "' (GDAL: " + last_error() +
-                  "); give an EPSG code such as EPSG:32632, a WKT string or a PROJ string";
+            "); give an EPSG code such as EPSG:32632, a WKT string or a PROJ string";
         return false;
     }
     return true;
@@ -125,8 +125,9 @@ void write(const Heightmap& terrain, const fs::path& path, const WriteOptions& o
     GDALDriver* mem_driver = GetGDALDriverManager()->GetDriverByName("MEM");
     if (!mem_driver) throw Error("GDAL has no MEM driver");
     Dataset mem(mem_driver->Create("", w, h, 0, GDT_Float32, nullptr));
-    if (!mem) throw Error("GDAL could not make an in-memory raster of " + std::to_string(w) + "×" +
-                          std::to_string(h) + ": " + last_error());
+    if (!mem)
+        throw Error("GDAL could not make an in-memory raster of " + std::to_string(w) + "×" + std::to_string(h) + ": " +
+                    last_error());
     auto add_band = [&](const float* data, const std::string& description) {
         char pointer[64];
         std::snprintf(pointer, sizeof pointer, "DATAPOINTER=%p", static_cast<const void*>(data));
@@ -155,8 +156,8 @@ void write(const Heightmap& terrain, const fs::path& path, const WriteOptions& o
     creation.SetNameValue("NUM_THREADS", std::to_string(threads).c_str());
     creation.SetNameValue("BIGTIFF", "IF_SAFER");
     const char* compress = options.compression == Compression::deflate ? "DEFLATE"
-                           : options.compression == Compression::zstd  ? "ZSTD"
-                           : options.compression == Compression::lzw   ? "LZW"
+        : options.compression == Compression::zstd                     ? "ZSTD"
+        : options.compression == Compression::lzw                      ? "LZW"
                                                                        : "NONE";
     creation.SetNameValue("COMPRESS", compress);
     const bool predictor = options.compression != Compression::none;
@@ -168,7 +169,8 @@ void write(const Heightmap& terrain, const fs::path& path, const WriteOptions& o
         if (options.compression == Compression::zstd) creation.SetNameValue("LEVEL", "3");
     } else {
         if (predictor) creation.SetNameValue("PREDICTOR", "3");  // floating-point predictor
-        if (options.compression == Compression::zstd) creation.SetNameValue("ZSTD_LEVEL", "3");  // GDAL defaults to 9: 10× slower for 2 % less
+        if (options.compression == Compression::zstd)
+            creation.SetNameValue("ZSTD_LEVEL", "3");  // GDAL defaults to 9: 10× slower for 2 % less
         if (options.tiled) {
             creation.SetNameValue("TILED", "YES");
             creation.SetNameValue("BLOCKXSIZE", "256");
@@ -325,8 +327,10 @@ ReadResult read(const fs::path& path, const ReadOptions& options) {
     const RasterInfo info = describe(*ds, path, options.band);
     const int W = info.width, H = info.height;
     if (info.has_geotransform && (info.geotransform[2] != 0.0 || info.geotransform[4] != 0.0))
-        throw BadInput(path.string() + " is rotated (its geotransform has shear terms); warp it north-up first, e.g. "
-                                       "gdalwarp " + path.filename().string() + " north-up.tif");
+        throw BadInput(path.string() +
+                       " is rotated (its geotransform has shear terms); warp it north-up first, e.g. "
+                       "gdalwarp " +
+                       path.filename().string() + " north-up.tif");
     double cell = options.cell;
     if (cell <= 0.0) {
         if (info.cell_metres <= 0.0)
@@ -340,7 +344,8 @@ ReadResult read(const fs::path& path, const ReadOptions& options) {
         QuietErrors quiet;
         GDALRasterBand* band = ds->GetRasterBand(options.band);
         if (band->RasterIO(GF_Read, 0, 0, W, H, src.data(), W, H, GDT_Float32, 0, 0, nullptr) != CE_None)
-            throw BadInput("GDAL could not read " + path.string() + " (" + last_error() + "); the file may be truncated");
+            throw BadInput("GDAL could not read " + path.string() + " (" + last_error() +
+                           "); the file may be truncated");
     }
     std::vector<std::uint8_t> valid(src.size(), 1);
     std::size_t holes = 0;
@@ -398,9 +403,7 @@ ReadResult read(const fs::path& path, const ReadOptions& options) {
                     const double tx = fx - ix;
                     double v;
                     switch (options.resample) {
-                        case Resample::nearest:
-                            v = at(int(std::lround(fx)), int(std::lround(fy)));
-                            break;
+                        case Resample::nearest: v = at(int(std::lround(fx)), int(std::lround(fy))); break;
                         case Resample::bilinear:
                             v = (at(ix, iy) * (1 - tx) + at(ix + 1, iy) * tx) * (1 - ty) +
                                 (at(ix, iy + 1) * (1 - tx) + at(ix + 1, iy + 1) * tx) * ty;

@@ -177,7 +177,8 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
                        "' has another extension");
     if (options.texture_size < 1) throw BadInput("texture must be at least 1 pixel");
 
-    const terrain::TerrainMesh mesh = terrain::plan_mesh(heights, options.decimate, options.chunks, options.vertical_scale);
+    const terrain::TerrainMesh mesh =
+        terrain::plan_mesh(heights, options.decimate, options.chunks, options.vertical_scale);
 
     // Texture: no larger than the terrain's tile count (more pixels than tiles add nothing).
     const int tw = std::max(1, std::min(options.texture_size, heights.width - 1));
@@ -221,16 +222,20 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
         const auto& v = views[i];
         const auto bounds = terrain::chunk_bounds(mesh, mesh.chunks[i]);
-        const int pos = add_accessor(model, add_view(model, v.positions, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
+        const int pos =
+            add_accessor(model, add_view(model, v.positions, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
         model.accessors[std::size_t(pos)].minValues.assign(bounds.min.begin(), bounds.min.end());
         model.accessors[std::size_t(pos)].maxValues.assign(bounds.max.begin(), bounds.max.end());
-        const int nrm = add_accessor(model, add_view(model, v.normals, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
-        const int uv = add_accessor(model, add_view(model, v.texcoords, v.vertex_count * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
-                                    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, v.vertex_count, true);
+        const int nrm =
+            add_accessor(model, add_view(model, v.normals, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                         TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
+        const int uv =
+            add_accessor(model, add_view(model, v.texcoords, v.vertex_count * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, v.vertex_count, true);
         const int idx = add_accessor(
-            model, add_view(model, v.indices, v.index_count * (v.index16 ? 2 : 4), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+            model,
+            add_view(model, v.indices, v.index_count * (v.index16 ? 2 : 4), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
             v.index16 ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT,
             TINYGLTF_TYPE_SCALAR, v.index_count, false);
         tinygltf::Primitive prim;
@@ -242,8 +247,8 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
         prim.mode = TINYGLTF_MODE_TRIANGLES;
         tinygltf::Mesh m;
         m.name = mesh.chunks.size() == 1
-                     ? std::string("terrain")
-                     : "terrain_" + std::to_string(int(i) % per_row) + "_" + std::to_string(int(i) / per_row);
+            ? std::string("terrain")
+            : "terrain_" + std::to_string(int(i) % per_row) + "_" + std::to_string(int(i) / per_row);
         m.primitives.push_back(prim);
         model.meshes.push_back(m);
         tinygltf::Node node;
@@ -274,10 +279,8 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
         terrain::chunk_positions(mesh, c, as(0, (float*)nullptr, v.vertex_count * 3));
         terrain::chunk_normals(mesh, c, as(v.vertex_count * 12, (float*)nullptr, v.vertex_count * 3));
         terrain::chunk_texcoords(mesh, c, as(v.vertex_count * 24, (std::uint16_t*)nullptr, v.vertex_count * 2));
-        if (v.index16)
-            terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint16_t*)nullptr, v.index_count));
-        else
-            terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
+        if (v.index16) terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint16_t*)nullptr, v.index_count));
+        else terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
         return bytes;
     };
     write_document(model, buffer_length, target, [&](std::ostream& payload) {
@@ -314,14 +317,12 @@ std::size_t write_mesh(const MeshData& mesh, std::span<const std::uint8_t> png, 
     model.buffers.emplace_back();  // empty here; its length is set by write_document
     add_splat_material(model, png_offset, png.size());
     tinygltf::Primitive prim;
-    prim.attributes["POSITION"] =
-        add_accessor(model, add_view(model, pos, vertices * 12, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                     TINYGLTF_TYPE_VEC3, vertices, false);
+    prim.attributes["POSITION"] = add_accessor(model, add_view(model, pos, vertices * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                               TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, vertices, false);
     model.accessors.back().minValues.assign(mesh.min.begin(), mesh.min.end());
     model.accessors.back().maxValues.assign(mesh.max.begin(), mesh.max.end());
-    prim.attributes["NORMAL"] =
-        add_accessor(model, add_view(model, nrm, vertices * 12, TINYGLTF_TARGET_ARRAY_BUFFER), TINYGLTF_COMPONENT_TYPE_FLOAT,
-                     TINYGLTF_TYPE_VEC3, vertices, false);
+    prim.attributes["NORMAL"] = add_accessor(model, add_view(model, nrm, vertices * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                                             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, vertices, false);
     prim.attributes["TEXCOORD_0"] =
         add_accessor(model, add_view(model, uv, vertices * 4, TINYGLTF_TARGET_ARRAY_BUFFER),
                      TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_VEC2, vertices, true);

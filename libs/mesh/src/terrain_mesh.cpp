@@ -54,7 +54,8 @@ TerrainMesh plan_mesh(ConstGridView heights, int decimate, int chunks, double ve
     if (heights.width < 2 || heights.height < 2)
         throw BadInput("a mesh needs at least 2 x 2 samples, the heightmap has " + std::to_string(heights.width) +
                        " x " + std::to_string(heights.height));
-    if (decimate < 1) throw BadInput("decimate must be at least 1 (1 keeps every vertex), got " + std::to_string(decimate));
+    if (decimate < 1)
+        throw BadInput("decimate must be at least 1 (1 keeps every vertex), got " + std::to_string(decimate));
     if (chunks < 0) throw BadInput("chunks must be 0 (automatic) or at least 1, got " + std::to_string(chunks));
     TerrainMesh mesh;
     mesh.heights = heights;
@@ -71,8 +72,7 @@ TerrainMesh plan_mesh(ConstGridView heights, int decimate, int chunks, double ve
     const auto bx = split(column_tiles, std::min(per_side, column_tiles));
     const auto by = split(row_tiles, std::min(per_side, row_tiles));
     for (std::size_t j = 0; j + 1 < by.size(); ++j)
-        for (std::size_t i = 0; i + 1 < bx.size(); ++i)
-            mesh.chunks.push_back({bx[i], bx[i + 1], by[j], by[j + 1]});
+        for (std::size_t i = 0; i + 1 < bx.size(); ++i) mesh.chunks.push_back({bx[i], bx[i + 1], by[j], by[j + 1]});
     return mesh;
 }
 
@@ -116,15 +116,16 @@ void for_each_vertex(const TerrainMesh& mesh, const MeshChunk& chunk, F&& f) {
         for (std::int64_t r = r0; r < r1; ++r) {
             const int y = mesh.rows[std::size_t(chunk.row_begin + r)];
             for (int c = 0; c < w; ++c)
-                f(std::size_t(r) * std::size_t(w) + std::size_t(c), mesh.columns[std::size_t(chunk.column_begin + c)], y);
+                f(std::size_t(r) * std::size_t(w) + std::size_t(c), mesh.columns[std::size_t(chunk.column_begin + c)],
+                  y);
         }
     });
 }
 
 void check_size(std::size_t have, std::size_t want, const char* what) {
     if (have != want)
-        throw Error(std::string("internal error: ") + what + " buffer holds " + std::to_string(have) + " values, needs " +
-                    std::to_string(want));
+        throw Error(std::string("internal error: ") + what + " buffer holds " + std::to_string(have) +
+                    " values, needs " + std::to_string(want));
 }
 
 template <typename Index>
@@ -231,21 +232,23 @@ SplatWeights splat_weights(float height, float min_height, float max_height, flo
 void validate(const SplatRules& r) {
     const auto& b = r.band_start;
     if (!(0 < b[0] && b[0] < b[1] && b[1] < b[2] && b[2] < 1))
-        throw BadInput("splatting: the bands must start in increasing order between 0 and 1 (grass < rock < snow), got " +
-                       std::to_string(b[0]) + ", " + std::to_string(b[1]) + ", " + std::to_string(b[2]));
+        throw BadInput(
+            "splatting: the bands must start in increasing order between 0 and 1 (grass < rock < snow), got " +
+            std::to_string(b[0]) + ", " + std::to_string(b[1]) + ", " + std::to_string(b[2]));
     if (!(r.blend_fraction >= 0 && r.blend_fraction <= 1))
         throw BadInput("splatting: the blend fraction must be in [0, 1], got " + std::to_string(r.blend_fraction));
     if (!(0 <= r.slope_full && r.slope_full < r.slope_start && r.slope_start <= 1))
-        throw BadInput("splatting: rock must start covering at a flatter slope than it covers fully (0 ≤ slope_full < "
-                       "slope_start ≤ 1, normal y), got " + std::to_string(r.slope_start) + " and " +
-                       std::to_string(r.slope_full));
+        throw BadInput(
+            "splatting: rock must start covering at a flatter slope than it covers fully (0 ≤ slope_full < "
+            "slope_start ≤ 1, normal y), got " +
+            std::to_string(r.slope_start) + " and " + std::to_string(r.slope_full));
 }
 
 std::array<std::uint8_t, 3> splat_colour(const SplatWeights& w) {
     std::array<std::uint8_t, 3> rgb{};
     for (int c = 0; c < 3; ++c) {
         const float v = w.sand * float(sand_colour[std::size_t(c)]) + w.grass * float(grass_colour[std::size_t(c)]) +
-                        w.rock * float(rock_colour[std::size_t(c)]) + w.snow * float(snow_colour[std::size_t(c)]);
+            w.rock * float(rock_colour[std::size_t(c)]) + w.snow * float(snow_colour[std::size_t(c)]);
         rgb[std::size_t(c)] = std::uint8_t(std::clamp(std::lround(v), 0L, 255L));
     }
     return rgb;

@@ -39,7 +39,7 @@ bool clip_line(const Line& line, double w, double h, double eps, Segment& out) {
     if (std::hypot(out.b.x - out.a.x, out.b.y - out.a.y) < 16 * eps) return false;  // touches a corner only
     // A cut along the border adds nothing but overlapping edges.
     const bool on_border = (std::abs(out.a.x - out.b.x) < eps && (out.a.x < eps || out.a.x > w - eps)) ||
-                           (std::abs(out.a.y - out.b.y) < eps && (out.a.y < eps || out.a.y > h - eps));
+        (std::abs(out.a.y - out.b.y) < eps && (out.a.y < eps || out.a.y > h - eps));
     return !on_border;
 }
 
@@ -77,9 +77,9 @@ std::vector<Line> random_cuts(int count, double width, double height, std::uint6
     std::vector<Line> lines(static_cast<std::size_t>(count));
     for (int i = 0; i < count; ++i) {
         const double angle = random::uniform(seed, std::uint64_t(i), 2u) * std::numbers::pi;
-        lines[std::size_t(i)] = {{random::uniform(seed, std::uint64_t(i), 0u) * width,
-                                  random::uniform(seed, std::uint64_t(i), 1u) * height},
-                                 {std::cos(angle), std::sin(angle)}};
+        lines[std::size_t(i)] = {
+            {random::uniform(seed, std::uint64_t(i), 0u) * width, random::uniform(seed, std::uint64_t(i), 1u) * height},
+            {std::cos(angle), std::sin(angle)}};
     }
     return lines;
 }

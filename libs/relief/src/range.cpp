@@ -112,8 +112,7 @@ std::vector<int> crossed_cells(const SiteIndex& index, Point2 a, Point2 b, std::
     return order;
 }
 
-int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
-                GridView* uplift) {
+int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed, GridView* uplift) {
     return raise_range(terrain, terrain.width, terrain.height, 0, 0, a, b, params, seed, uplift);
 }
 

@@ -54,15 +54,12 @@ SiteIndex::SiteIndex(std::span<const Point2> sites, int width, int height)
     for (std::size_t b = 0; b < nb; ++b) bucket_start_[b + 1] += bucket_start_[b];
     bucket_items_.resize(sites.size());
     std::vector<int> fill(bucket_start_.begin(), bucket_start_.end() - 1);
-    for (std::size_t i = 0; i < sites.size(); ++i) bucket_items_[std::size_t(fill[std::size_t(bucket_of[i])]++)] = int(i);
+    for (std::size_t i = 0; i < sites.size(); ++i)
+        bucket_items_[std::size_t(fill[std::size_t(bucket_of[i])]++)] = int(i);
 }
 
-int SiteIndex::bucket_x(double x) const {
-    return std::clamp(int(std::floor(x / bucket_size_)), 0, buckets_x_ - 1);
-}
-int SiteIndex::bucket_y(double y) const {
-    return std::clamp(int(std::floor(y / bucket_size_)), 0, buckets_y_ - 1);
-}
+int SiteIndex::bucket_x(double x) const { return std::clamp(int(std::floor(x / bucket_size_)), 0, buckets_x_ - 1); }
+int SiteIndex::bucket_y(double y) const { return std::clamp(int(std::floor(y / bucket_size_)), 0, buckets_y_ - 1); }
 
 namespace {
 

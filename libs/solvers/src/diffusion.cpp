@@ -17,7 +17,8 @@ namespace {
 struct Line {
     std::vector<double> sub, cp, m;  // a_i, c'_i, 1/(b_i − a_i c'_{i−1})
 
-    Line(int n, double a, bool first_fixed, bool last_fixed) : sub(std::size_t(n)), cp(std::size_t(n)), m(std::size_t(n)) {
+    Line(int n, double a, bool first_fixed, bool last_fixed)
+        : sub(std::size_t(n)), cp(std::size_t(n)), m(std::size_t(n)) {
         for (int i = 0; i < n; ++i) {
             double lo = i > 0 ? -a : 0.0, hi = i + 1 < n ? -a : 0.0;
             double diag = 1.0 - lo - hi;  // 1 + a per existing neighbour: the closed-end finite-volume form
@@ -48,7 +49,8 @@ void strips(int first, int count, const Pass& pass) {
 
 Solver::Solver(int width, int height, double cell, const Settings& settings)
     : W_(width), H_(height), x0_(0), y0_(0), tw_(width), th_(height), cell_(cell), settings_(settings) {
-    if (width < 1 || height < 1 || !(cell > 0.0)) throw std::invalid_argument("diffusion::Solver: empty grid or cell <= 0");
+    if (width < 1 || height < 1 || !(cell > 0.0))
+        throw std::invalid_argument("diffusion::Solver: empty grid or cell <= 0");
     scratch_.resize(std::size_t(width) * std::size_t(height));
     if (settings.critical_slope > 0.0) {
         scratch2_.resize(scratch_.size());
@@ -66,18 +68,14 @@ Solver::Solver(Tiling& tiles, double cell, const Settings& settings)
 
 void Solver::step(double* h, double dt) {
     if (!(settings_.diffusivity > 0.0) || !(dt > 0.0)) return;
-    if (settings_.critical_slope > 0.0)
-        nonlinear_step(h, dt);
-    else
-        linear_step(h, dt);
+    if (settings_.critical_slope > 0.0) nonlinear_step(h, dt);
+    else linear_step(h, dt);
 }
 
 void Solver::carry(Tiling::Toward toward, std::vector<double>& values, int per_line,
                    const std::function<void(int first, int count)>& advance) {
-    if (tiles_)
-        tiles_->carry(toward, values, per_line, advance);
-    else
-        advance(0, int(values.size() / std::size_t(per_line)));
+    if (tiles_) tiles_->carry(toward, values, per_line, advance);
+    else advance(0, int(values.size() / std::size_t(per_line)));
 }
 
 void Solver::edge_rows(const double* g) {
@@ -88,7 +86,8 @@ void Solver::edge_rows(const double* g) {
     carry_.assign(w, 0.0);
     carry(Tiling::Toward::south, carry_, 1, [&](int first, int count) {
         for (int x = first; x < first + count; ++x)
-            north_[std::size_t(x)] = carry_[std::size_t(x)], carry_[std::size_t(x)] = g[std::size_t(th_ - 1) * w + std::size_t(x)];
+            north_[std::size_t(x)] = carry_[std::size_t(x)],
+            carry_[std::size_t(x)] = g[std::size_t(th_ - 1) * w + std::size_t(x)];
     });
     carry_.assign(w, 0.0);
     carry(Tiling::Toward::north, carry_, 1, [&](int first, int count) {
@@ -192,7 +191,8 @@ void Solver::linear_step(double* h, double dt) {
             int held = 0;
             for (std::int64_t y = y0; y < y1; ++y) {
                 if (!solved(y)) {
-                    if (copy_unsolved) std::copy(h + std::size_t(y) * w, h + std::size_t(y) * w + w, hs + std::size_t(y) * w);
+                    if (copy_unsolved)
+                        std::copy(h + std::size_t(y) * w, h + std::size_t(y) * w + w, hs + std::size_t(y) * w);
                     continue;
                 }
                 ys[held++] = y;

@@ -67,10 +67,8 @@ void write_with(vtkDataObject* data, AtomicFile& file, const Options& o) {
     w->SetDataModeToAppended();
     w->EncodeAppendedDataOff();  // raw binary, not base64
     w->SetHeaderTypeToUInt64();  // arrays over 4 GiB
-    if (o.compress)
-        w->SetCompressorTypeToZLib();
-    else
-        w->SetCompressorTypeToNone();
+    if (o.compress) w->SetCompressorTypeToZLib();
+    else w->SetCompressorTypeToNone();
     file.stream().close();  // VTK writes the temporary file by name
     QuietVtk quiet;
     const int ok = w->Write();
@@ -78,8 +76,8 @@ void write_with(vtkDataObject* data, AtomicFile& file, const Options& o) {
     if (ok != 1 || code != 0)
         throw Error("cannot write " + file.target().string() + ": VTK's writer failed (" +
                     (code == vtkErrorCode::OutOfDiskSpaceError       ? std::string("out of disk space")
-                     : code == vtkErrorCode::CannotOpenFileError     ? std::string("cannot open the file")
-                     : code != 0                                     ? "VTK error code " + std::to_string(code)
+                         : code == vtkErrorCode::CannotOpenFileError ? std::string("cannot open the file")
+                         : code != 0                                 ? "VTK error code " + std::to_string(code)
                                                                      : std::string("unknown error")) +
                     "; disk full or folder not writable?); the existing file, if any, is unchanged");
 }
@@ -205,10 +203,10 @@ std::string pvti_text(int width, int height, double cell, std::span<const std::s
     const bool z = up == Up::z;
     s << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"PImageData\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
-      << "  <PImageData WholeExtent=\"0 " << width - 1 << (z ? " 0 " + std::to_string(height - 1) + " 0 0"
-                                                              : " 0 0 0 " + std::to_string(height - 1))
-      << "\" GhostLevel=\"0\" Origin=\"0 " << (z ? number(-(height - 1) * cell + 0.0) : std::string("0")) << " 0\" Spacing=\""
-      << number(cell) << (z ? " " + number(cell) + " 1" : " 1 " + number(cell)) << "\">\n"
+      << "  <PImageData WholeExtent=\"0 " << width - 1
+      << (z ? " 0 " + std::to_string(height - 1) + " 0 0" : " 0 0 0 " + std::to_string(height - 1))
+      << "\" GhostLevel=\"0\" Origin=\"0 " << (z ? number(-(height - 1) * cell + 0.0) : std::string("0"))
+      << " 0\" Spacing=\"" << number(cell) << (z ? " " + number(cell) + " 1" : " 1 " + number(cell)) << "\">\n"
       << "    <PPointData Scalars=\"height\">\n"
       << "      <PDataArray type=\"Float32\" Name=\"height\"/>\n";
     for (const auto& n : layer_names) s << "      <PDataArray type=\"Float32\" Name=\"" << n << "\"/>\n";
@@ -243,7 +241,8 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     const terrain::MeshChunk& chunk = mesh.chunks.at(0);
     const std::size_t n = chunk.vertex_count(), triangles = chunk.triangle_count();
     if (triangles * 3 > std::size_t(std::numeric_limits<std::int32_t>::max()))
-        throw BadInput("the mesh has " + std::to_string(triangles) + " triangles, too many for one .vtp; use decimate=2");
+        throw BadInput("the mesh has " + std::to_string(triangles) +
+                       " triangles, too many for one .vtp; use decimate=2");
     vtkNew<vtkFloatArray> xyz;
     xyz->SetNumberOfComponents(3);
     xyz->SetNumberOfTuples(vtkIdType(n));
@@ -440,18 +439,16 @@ std::size_t write_plates(const PlateHistory& history, const fs::path& target, co
             vtkNew<vtkPolyData> poly;
             poly->SetPoints(points);
             poly->SetLines(lines);
-            for (vtkDataArray* arr : {static_cast<vtkDataArray*>(a), static_cast<vtkDataArray*>(b),
-                                      static_cast<vtkDataArray*>(kind), static_cast<vtkDataArray*>(impulse),
-                                      static_cast<vtkDataArray*>(step)})
+            for (vtkDataArray* arr :
+                 {static_cast<vtkDataArray*>(a), static_cast<vtkDataArray*>(b), static_cast<vtkDataArray*>(kind),
+                  static_cast<vtkDataArray*>(impulse), static_cast<vtkDataArray*>(step)})
                 poly->GetCellData()->AddArray(arr);
             mark_frame(poly, o.up);
             const std::string name = frame_name(target, "_collisions", s);
             files.push_back(std::make_unique<AtomicFile>(target.parent_path() / name));
             write_with<vtkXMLPolyDataWriter>(poly, *files.back(), o);
-            if (split)
-                collision_entries.push_back({snap.time, 0, name});
-            else
-                entries.push_back({snap.time, 1, name});
+            if (split) collision_entries.push_back({snap.time, 0, name});
+            else entries.push_back({snap.time, 1, name});
         }
         previous_step = snap.step;
     }

@@ -41,13 +41,14 @@ std::string number(double v) {
 
 /// Colour per terrain (Okabe–Ito, legible for colour-blind readers); references dashed.
 std::string style(std::size_t i, const Terrain& t) {
-    static const char* colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#F0E442"};
+    static const char* colours[] = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                    "#E69F00", "#56B4E9", "#000000", "#F0E442"};
     return std::string("lc rgb '") + colours[i % 8] + "' lw 2" + (t.reference ? " dt 2" : "");
 }
 
 std::string header(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
-    return "reset\nset termoption noenhanced\nset title " + gp_string(title) + "\nset xlabel " + gp_string(xlabel) + "\nset ylabel " + gp_string(ylabel) +
-           "\nset grid\nset key outside right top\nunset logscale\n";
+    return "reset\nset termoption noenhanced\nset title " + gp_string(title) + "\nset xlabel " + gp_string(xlabel) +
+        "\nset ylabel " + gp_string(ylabel) + "\nset grid\nset key outside right top\nunset logscale\n";
 }
 
 struct Series {
@@ -113,10 +114,10 @@ std::string run_gnuplot(const std::string& script, const std::filesystem::path& 
     pid_t pid = 0;
     const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv, environ);
     posix_spawn_file_actions_destroy(&actions);
-    if (spawned != 0) return "gnuplot is not installed (apt-get install gnuplot-nox): " + std::string(std::strerror(spawned));
+    if (spawned != 0)
+        return "gnuplot is not installed (apt-get install gnuplot-nox): " + std::string(std::strerror(spawned));
     int status = 0;
-    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-    }
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         std::ifstream err(errors);
         std::stringstream text;
@@ -140,101 +141,108 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
     pending.push_back({{stem + "-slopes.png", "Slope distribution"},
                        header("Slope distribution", "slope (°)", "share of the samples (% per degree)") +
                            "set xrange [0:90]\n" +
-                           plot(terrains, "slopes",
-                                [](const Terrain& t) {
-                                    Series s{{}, t.name};
-                                    for (std::size_t b = 0; b < t.figures.slope_histogram.size(); ++b)
-                                        s.points.emplace_back(double(b) + 0.5, 100.0 * t.figures.slope_histogram[b]);
-                                    return s;
-                                },
-                                "lines")});
+                           plot(
+                               terrains, "slopes",
+                               [](const Terrain& t) {
+                                   Series s{{}, t.name};
+                                   for (std::size_t b = 0; b < t.figures.slope_histogram.size(); ++b)
+                                       s.points.emplace_back(double(b) + 0.5, 100.0 * t.figures.slope_histogram[b]);
+                                   return s;
+                               },
+                               "lines")});
     pending.push_back({{stem + "-hypsometry.png", "Hypsometric curve"},
                        header("Hypsometric curve (Strahler 1952)", "relative area above a / A",
                               "relative height (h − min) / (max − min)") +
                            "set xrange [0:1]\nset yrange [0:1]\n" +
-                           plot(terrains, "hyps",
-                                [](const Terrain& t) {
-                                    Series s{{}, t.name};
-                                    const auto& hi = t.figures[FigureId::hypsometric_integral];
-                                    if (hi.ok()) s.title += ": HI " + number(std::round(hi.value * 1000) / 1000);
-                                    for (std::size_t k = 0; k < t.figures.hypsometric_area.size(); ++k)
-                                        s.points.emplace_back(t.figures.hypsometric_area[k], double(k) / 100.0);
-                                    return s;
-                                },
-                                "lines")});
-    pending.push_back(
-        {{stem + "-spectrum.png", "Radially averaged power spectrum"},
-         header("Power spectrum (Perron et al. 2008), normalised at k = 4", "wavelength (m)", "power / power at k = 4") +
-             "set logscale xy\n" +
-             plot(
-                 terrains, "spec",
-                 [](const Terrain& t) {
-                     Series s{{}, t.name};
-                     const auto& f = t.figures;
-                     const auto& beta = f[FigureId::spectral_exponent];
-                     if (!beta.ok() || f.spectrum_power.size() < 4 || !(f.spectrum_power[3] > 0.0)) return s;
-                     s.title += ": β " + number(std::round(beta.value * 100) / 100);
-                     for (std::size_t k = 0; k < f.spectrum_k.size(); ++k)
-                         if (f.spectrum_power[k] > 0.0)
-                             s.points.emplace_back(double(f.spectrum_side) * f.cell / f.spectrum_k[k],
-                                                   f.spectrum_power[k] / f.spectrum_power[3]);
-                     return s;
-                 },
-                 "lines")});
-    pending.push_back(
-        {{stem + "-slope-area.png", "Slope–area (channel cells)"},
-         header("Slope–area of the channels (A > 1 km²), log-binned; lines: the fits", "drainage area A (m²)",
-                "slope S (m/m)") +
-             "set logscale xy\n" +
-             plot(
-                 terrains, "sa",
-                 [](const Terrain& t) {
-                     Series s{{}, t.name};
-                     const auto& f = t.figures;
-                     if (!f[FigureId::concavity].ok()) return s;
-                     s.title += ": θ " + number(std::round(f[FigureId::concavity].value * 100) / 100) + ", k_sn " +
-                                number(std::round(f[FigureId::steepness].value));
-                     for (std::size_t b = 0; b < f.slope_area.x.size(); ++b) s.points.emplace_back(f.slope_area.x[b], f.slope_area.y[b]);
-                     return s;
-                 },
-                 "points pt 7 ps 0.8",
-                 [](const Terrain& t) {
-                     std::vector<std::pair<double, double>> line;
-                     const auto& f = t.figures;
-                     if (!f[FigureId::concavity].ok() || f.slope_area.x.empty()) return line;
-                     for (double a : {f.slope_area.x.front(), f.slope_area.x.back()})
-                         line.emplace_back(a, std::exp(f.slope_area_fit.intercept + f.slope_area_fit.slope * std::log(a)));
-                     return line;
-                 })});
-    pending.push_back(
-        {{stem + "-hack.png", "Hack's law"},
-         header("Hack's law L = c A^h (channel cells, log-binned; lines: the fits)", "drainage area A (m²)",
-                "longest flow path upstream L (m)") +
-             "set logscale xy\n" +
-             plot(
-                 terrains, "hack",
-                 [](const Terrain& t) {
-                     Series s{{}, t.name};
-                     const auto& f = t.figures;
-                     if (!f[FigureId::hack_exponent].ok()) return s;
-                     s.title += ": h " + number(std::round(f[FigureId::hack_exponent].value * 100) / 100);
-                     for (std::size_t b = 0; b < f.hack.x.size(); ++b) s.points.emplace_back(f.hack.x[b], f.hack.y[b]);
-                     return s;
-                 },
-                 "points pt 7 ps 0.8",
-                 [](const Terrain& t) {
-                     std::vector<std::pair<double, double>> line;
-                     const auto& f = t.figures;
-                     if (!f[FigureId::hack_exponent].ok() || f.hack.x.empty()) return line;
-                     for (double a : {f.hack.x.front(), f.hack.x.back()})
-                         line.emplace_back(a, std::exp(f.hack_fit.intercept + f.hack_fit.slope * std::log(a)));
-                     return line;
-                 })});
+                           plot(
+                               terrains, "hyps",
+                               [](const Terrain& t) {
+                                   Series s{{}, t.name};
+                                   const auto& hi = t.figures[FigureId::hypsometric_integral];
+                                   if (hi.ok()) s.title += ": HI " + number(std::round(hi.value * 1000) / 1000);
+                                   for (std::size_t k = 0; k < t.figures.hypsometric_area.size(); ++k)
+                                       s.points.emplace_back(t.figures.hypsometric_area[k], double(k) / 100.0);
+                                   return s;
+                               },
+                               "lines")});
+    pending.push_back({{stem + "-spectrum.png", "Radially averaged power spectrum"},
+                       header("Power spectrum (Perron et al. 2008), normalised at k = 4", "wavelength (m)",
+                              "power / power at k = 4") +
+                           "set logscale xy\n" +
+                           plot(
+                               terrains, "spec",
+                               [](const Terrain& t) {
+                                   Series s{{}, t.name};
+                                   const auto& f = t.figures;
+                                   const auto& beta = f[FigureId::spectral_exponent];
+                                   if (!beta.ok() || f.spectrum_power.size() < 4 || !(f.spectrum_power[3] > 0.0))
+                                       return s;
+                                   s.title += ": β " + number(std::round(beta.value * 100) / 100);
+                                   for (std::size_t k = 0; k < f.spectrum_k.size(); ++k)
+                                       if (f.spectrum_power[k] > 0.0)
+                                           s.points.emplace_back(double(f.spectrum_side) * f.cell / f.spectrum_k[k],
+                                                                 f.spectrum_power[k] / f.spectrum_power[3]);
+                                   return s;
+                               },
+                               "lines")});
+    pending.push_back({{stem + "-slope-area.png", "Slope–area (channel cells)"},
+                       header("Slope–area of the channels (A > 1 km²), log-binned; lines: the fits",
+                              "drainage area A (m²)", "slope S (m/m)") +
+                           "set logscale xy\n" +
+                           plot(
+                               terrains, "sa",
+                               [](const Terrain& t) {
+                                   Series s{{}, t.name};
+                                   const auto& f = t.figures;
+                                   if (!f[FigureId::concavity].ok()) return s;
+                                   s.title += ": θ " + number(std::round(f[FigureId::concavity].value * 100) / 100) +
+                                       ", k_sn " + number(std::round(f[FigureId::steepness].value));
+                                   for (std::size_t b = 0; b < f.slope_area.x.size(); ++b)
+                                       s.points.emplace_back(f.slope_area.x[b], f.slope_area.y[b]);
+                                   return s;
+                               },
+                               "points pt 7 ps 0.8",
+                               [](const Terrain& t) {
+                                   std::vector<std::pair<double, double>> line;
+                                   const auto& f = t.figures;
+                                   if (!f[FigureId::concavity].ok() || f.slope_area.x.empty()) return line;
+                                   for (double a : {f.slope_area.x.front(), f.slope_area.x.back()})
+                                       line.emplace_back(
+                                           a,
+                                           std::exp(f.slope_area_fit.intercept + f.slope_area_fit.slope * std::log(a)));
+                                   return line;
+                               })});
+    pending.push_back({{stem + "-hack.png", "Hack's law"},
+                       header("Hack's law L = c A^h (channel cells, log-binned; lines: the fits)",
+                              "drainage area A (m²)", "longest flow path upstream L (m)") +
+                           "set logscale xy\n" +
+                           plot(
+                               terrains, "hack",
+                               [](const Terrain& t) {
+                                   Series s{{}, t.name};
+                                   const auto& f = t.figures;
+                                   if (!f[FigureId::hack_exponent].ok()) return s;
+                                   s.title += ": h " + number(std::round(f[FigureId::hack_exponent].value * 100) / 100);
+                                   for (std::size_t b = 0; b < f.hack.x.size(); ++b)
+                                       s.points.emplace_back(f.hack.x[b], f.hack.y[b]);
+                                   return s;
+                               },
+                               "points pt 7 ps 0.8",
+                               [](const Terrain& t) {
+                                   std::vector<std::pair<double, double>> line;
+                                   const auto& f = t.figures;
+                                   if (!f[FigureId::hack_exponent].ok() || f.hack.x.empty()) return line;
+                                   for (double a : {f.hack.x.front(), f.hack.x.back()})
+                                       line.emplace_back(
+                                           a, std::exp(f.hack_fit.intercept + f.hack_fit.slope * std::log(a)));
+                                   return line;
+                               })});
 
     ChartsWritten written;
     std::vector<std::unique_ptr<AtomicFile>> files;
-    std::string script = "set terminal pngcairo size 960,600 font 'Sans,11'\nset termoption noenhanced\n"
-                         "set encoding utf8\n";
+    std::string script =
+        "set terminal pngcairo size 960,600 font 'Sans,11'\nset termoption noenhanced\n"
+        "set encoding utf8\n";
     for (auto& p : pending) {
         if (p.body.find("plot ") == std::string::npos) continue;  // no terrain has data for it
         files.push_back(std::make_unique<AtomicFile>(folder / p.chart.file));

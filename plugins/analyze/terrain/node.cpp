@@ -38,9 +38,9 @@ void check(CheckContext& ctx) {
     const std::size_t n = inputs_given(ctx);
     const auto names = split_list(ctx.text("names"));
     if (ctx.given("names") && names.size() != n) {
-        ctx.error("names", "names= gives " + std::to_string(names.size()) + " name" + (names.size() == 1 ? "" : "s") +
-                               " for " + std::to_string(n) + " terrain" + (n == 1 ? "" : "s") +
-                               "; give one per input, comma-separated");
+        ctx.error("names",
+                  "names= gives " + std::to_string(names.size()) + " name" + (names.size() == 1 ? "" : "s") + " for " +
+                      std::to_string(n) + " terrain" + (n == 1 ? "" : "s") + "; give one per input, comma-separated");
         return;
     }
     for (const auto& name : names)
@@ -49,17 +49,20 @@ void check(CheckContext& ctx) {
             return;
         }
     if (std::size_t(ctx.integer("references")) >= n && ctx.integer("references") > 0)
-        ctx.error("references", "references=" + std::to_string(ctx.integer("references")) + " marks every one of the " +
-                                    std::to_string(n) + " inputs as a reference; leave at least one terrain to measure");
+        ctx.error("references",
+                  "references=" + std::to_string(ctx.integer("references")) + " marks every one of the " +
+                      std::to_string(n) + " inputs as a reference; leave at least one terrain to measure");
     const auto images = split_list(ctx.text("images"));
     if (!images.empty() && images.size() != n)
-        ctx.error("images", "images= gives " + std::to_string(images.size()) + " pictures for " + std::to_string(n) +
-                                " terrains; give one per input (or none)");
+        ctx.error("images",
+                  "images= gives " + std::to_string(images.size()) + " pictures for " + std::to_string(n) +
+                      " terrains; give one per input (or none)");
     for (std::size_t i = 0; i < n; ++i) {
         const ValueInfo* in = ctx.input(i);
         if (in->width > 0 && in->height > 0 && (in->width < 3 || in->height < 3))
-            ctx.error("", "input " + std::to_string(i + 1) + " is " + std::to_string(in->width) + "x" +
-                              std::to_string(in->height) + ": too small to measure (at least 3x3)");
+            ctx.error("",
+                      "input " + std::to_string(i + 1) + " is " + std::to_string(in->width) + "x" +
+                          std::to_string(in->height) + ": too small to measure (at least 3x3)");
     }
 }
 
@@ -93,13 +96,14 @@ NodeOutputs run(NodeContext& ctx) {
         t.name = names[i];
         t.reference = i >= n - references;
         if (!images.empty()) t.image = images[i];
-        t.figures = analysis::measure({hm.heights().data(), hm.width(), hm.height(), hm.cell(),
-                                       valid.empty() ? nullptr : valid.data()});
+        t.figures = analysis::measure(
+            {hm.heights().data(), hm.width(), hm.height(), hm.cell(), valid.empty() ? nullptr : valid.data()});
         for (const auto& m : t.figures.values) anything = anything || m.ok();
         ctx.progress(double(i + 1) / double(n + 1));
     }
     if (!anything)
-        throw BadInput("no figure could be measured on any terrain: " + terrains.front().figures.values.front().why_not);
+        throw BadInput("no figure could be measured on any terrain: " +
+                       terrains.front().figures.values.front().why_not);
 
     const auto comparison = analyze::compare(terrains);
     const std::string json_rel = ctx.text("path");
@@ -150,7 +154,7 @@ std::string description() {
         "Definitions as shared/realism/README.md and terrain_stats.py (docs/analysis.md). Figures:\n";
     for (const auto& f : analysis::figure_table()) {
         text += "  " + std::string(f.key) + (f.unit.empty() ? "" : " (" + std::string(f.unit) + ")") + ": " +
-                std::string(f.definition) + ". [" + std::string(f.source) + "]\n";
+            std::string(f.definition) + ". [" + std::string(f.source) + "]\n";
     }
     return text;
 }
@@ -176,10 +180,13 @@ OROGEN_PLUGIN("analyze-terrain", "0.1.0", registry) {
                 Param::path("page", PathRole::output, {".md"}, "analysis.md")
                     .help("the Markdown page showing the table, charts and pictures, relative to --out"),
                 Param::string("names", "").help("a name per input, comma-separated (default: terrain1, terrain2...)"),
-                Param::integer("references", 0).min(0).max(max_terrains - 1).help(
-                    "how many of the last inputs are references (real DEMs) the others are compared with"),
-                Param::string("images", "").help(
-                    "a picture per input, comma-separated paths relative to --out, shown side by side on the page"),
+                Param::integer("references", 0)
+                    .min(0)
+                    .max(max_terrains - 1)
+                    .help("how many of the last inputs are references (real DEMs) the others are compared with"),
+                Param::string("images", "")
+                    .help(
+                        "a picture per input, comma-separated paths relative to --out, shown side by side on the page"),
                 Param::boolean("charts", true).help("draw the charts (needs gnuplot-nox)"),
             },
         .check = check,

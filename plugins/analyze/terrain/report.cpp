@@ -90,7 +90,8 @@ Comparison compare(const std::vector<Terrain>& terrains) {
 }
 
 std::string table_text(const std::vector<Terrain>& terrains, const Comparison& comparison) {
-    const bool have_references = std::any_of(terrains.begin(), terrains.end(), [](const Terrain& t) { return t.reference; });
+    const bool have_references =
+        std::any_of(terrains.begin(), terrains.end(), [](const Terrain& t) { return t.reference; });
     std::vector<std::string> head = {"figure", "unit"};
     for (const auto& t : terrains) head.push_back(t.reference ? t.name + "*" : t.name);
     if (have_references) {
@@ -145,8 +146,8 @@ std::string table_text(const std::vector<Terrain>& terrains, const Comparison& c
         any_nodata = true;
         const double all = double(t.figures.samples + t.figures.nodata);
         char line[160];
-        std::snprintf(line, sizeof line, "  %s: %zu of %.0f samples (%.2f %%)\n", t.name.c_str(), t.figures.nodata,
-                      all, 100.0 * double(t.figures.nodata) / all);
+        std::snprintf(line, sizeof line, "  %s: %zu of %.0f samples (%.2f %%)\n", t.name.c_str(), t.figures.nodata, all,
+                      100.0 * double(t.figures.nodata) / all);
         out << line;
     }
     double smallest = 0.0, largest = 0.0;
@@ -158,7 +159,8 @@ std::string table_text(const std::vector<Terrain>& terrains, const Comparison& c
         out << "\nnote: the cell sizes differ (" << format(smallest, 1) << " m to " << format(largest, 1)
             << " m); slopes, pits, curvature and the network's figures depend on the cell size: compare "
                "terrains at the same cell size\n";
-    const auto references = std::count_if(terrains.begin(), terrains.end(), [](const Terrain& t) { return t.reference; });
+    const auto references =
+        std::count_if(terrains.begin(), terrains.end(), [](const Terrain& t) { return t.reference; });
     if (references == 1 && std::size_t(references) < terrains.size())
         out << "\n(one reference: no spread to measure the distance to it by; give two or more to see which a "
                "terrain resembles most)\n";
@@ -189,11 +191,12 @@ std::string json_text(const std::vector<Terrain>& terrains, const Comparison& co
     for (std::size_t i = 0; i < terrains.size(); ++i) {
         const auto& t = terrains[i];
         const auto& g = t.figures;
-        out << "    {\n      \"name\": " << json_string(t.name) << ",\n      \"reference\": "
-            << (t.reference ? "true" : "false") << ",\n      \"width\": " << g.width << ", \"height\": " << g.height
-            << ", \"cell_m\": " << json_number(g.cell) << ",\n      \"samples\": " << g.samples
-            << ", \"nodata\": " << g.nodata << ", \"min_m\": " << json_number(g.minimum)
-            << ", \"max_m\": " << json_number(g.maximum) << ",\n      \"figures\": {\n";
+        out << "    {\n      \"name\": " << json_string(t.name)
+            << ",\n      \"reference\": " << (t.reference ? "true" : "false") << ",\n      \"width\": " << g.width
+            << ", \"height\": " << g.height << ", \"cell_m\": " << json_number(g.cell)
+            << ",\n      \"samples\": " << g.samples << ", \"nodata\": " << g.nodata
+            << ", \"min_m\": " << json_number(g.minimum) << ", \"max_m\": " << json_number(g.maximum)
+            << ",\n      \"figures\": {\n";
         for (std::size_t f = 0; f < table.size(); ++f) {
             const auto& m = g.values[f];
             out << "        " << json_string(table[f].key) << ": {\"value\": " << json_number(m.value)

@@ -19,7 +19,7 @@ struct Terrain {
     std::string name;  ///< as the table and the charts label it
     analysis::Figures figures;
     bool reference = false;  ///< one of the --against DEMs
-    std::string image;       ///< its rendering, relative to the Markdown page ("" = none)
+    std::string image;  ///< its rendering, relative to the Markdown page ("" = none)
 };
 
 /// What the references say of the terrains: each figure's band, and each terrain's nearest reference.
@@ -54,7 +54,7 @@ struct Chart {
 
 struct ChartsWritten {
     std::vector<Chart> charts;  ///< those drawn (a chart no terrain has data for is left out)
-    std::string problem;        ///< "" or why none was drawn (gnuplot missing: install gnuplot-nox)
+    std::string problem;  ///< "" or why none was drawn (gnuplot missing: install gnuplot-nox)
 };
 
 /// Draws the charts with gnuplot (pngcairo) into `folder` as `stem`-slopes.png, -hypsometry.png,

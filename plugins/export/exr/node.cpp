@@ -13,7 +13,6 @@ namespace {
 
 using namespace orogen;
 
-
 bool is_all(const std::vector<std::string>& names) { return names.size() == 1 && names[0] == "all"; }
 
 /// "" if layer `name` can be part of a file name (split=true), else why not.
@@ -21,7 +20,7 @@ std::string file_name_problem(const std::string& name) {
     if (name.empty() || name.front() == '.' || name.find_first_of("/\\") != std::string::npos ||
         name.find('\0') != std::string::npos)
         return "layer '" + name + "' cannot be part of a file name (split=true writes <stem>.<layer>.exr); " +
-               "leave it out of layers or write one file (split=false)";
+            "leave it out of layers or write one file (split=false)";
     return "";
 }
 
@@ -99,8 +98,9 @@ void check(CheckContext& ctx) {
     for (const auto& name : names) {
         if (!ctx.require_layer(0, "layers", name, "name layers the terrain has, or all")) continue;
         if (!split && name == channel)
-            ctx.error("layers", "layer '" + name + "' would share channel '" + channel +
-                                    "' with the heights; give the heights another channel name (channel=height)");
+            ctx.error("layers",
+                      "layer '" + name + "' would share channel '" + channel +
+                          "' with the heights; give the heights another channel name (channel=height)");
         if (split)
             if (const std::string problem = file_name_problem(name); !problem.empty()) ctx.error("layers", problem);
     }
@@ -128,11 +128,13 @@ OROGEN_PLUGIN("export-exr", "0.1.0", registry) {
         .params =
             {
                 Param::path("path", PathRole::output, {".exr"}).help("output file: .exr"),
-                Param::string("channel", "Y").help("the heights' channel name (Y: grayscale in viewers; R, height, "
-                                                   "... for tools that want another)"),
+                Param::string("channel", "Y")
+                    .help("the heights' channel name (Y: grayscale in viewers; R, height, "
+                          "... for tools that want another)"),
                 Param::string("layers", "").help("layers written too, comma-separated (\"water, eroded\"), or all"),
-                Param::boolean("split", false).help("one file per layer (<stem>.<layer>.exr, each in channel "
-                                                    "`channel`) instead of one file of many channels"),
+                Param::boolean("split", false)
+                    .help("one file per layer (<stem>.<layer>.exr, each in channel "
+                          "`channel`) instead of one file of many channels"),
                 Param::choice("compression", {"zip", "zips", "piz", "rle", "none"}, "zip")
                     .help("lossless compression: zip (16 rows a block), zips (1 row), piz (wavelet), rle, none"),
             },

@@ -13,7 +13,6 @@ namespace {
 
 using namespace orogen;
 
-
 /// "none" → nothing, a number → that number; anything else throws BadInput.
 std::optional<double> parse_nodata(const std::string& text) {
     if (text == "none") return std::nullopt;
@@ -50,9 +49,7 @@ void check(CheckContext& ctx) {
     if (!crs.ok) ctx.error("crs", crs.message);
     try {
         parse_nodata(ctx.text("nodata"));
-    } catch (const BadInput& e) {
-        ctx.error("nodata", e.what());
-    }
+    } catch (const BadInput& e) { ctx.error("nodata", e.what()); }
     if (ctx.flag("cog") && ctx.given("tiled") && !ctx.flag("tiled"))
         ctx.error("tiled", "a Cloud-Optimized GeoTIFF is always tiled; drop tiled=false");
     const auto names = split_names(ctx.text("layers"));
@@ -72,7 +69,8 @@ OROGEN_PLUGIN("export-geotiff", "0.1.0", registry) {
             "layer names). Samples are vertices: the file says AREA_OR_POINT=Point and sample (x, y) lies at "
             "(origin.x + x·cell, origin.y + (height − 1 − y)·cell) in the CRS, origin being the south-west vertex. "
             "Default CRS: a local metric engineering CRS; give crs=\"EPSG:32632\" (or WKT, or a PROJ string) and "
-            "origin=(easting, northing) to place the terrain on Earth. Compressed with a floating-point predictor; tiled or Cloud-Optimized "
+            "origin=(easting, northing) to place the terrain on Earth. Compressed with a floating-point predictor; "
+            "tiled or Cloud-Optimized "
             "(COG, with overviews) on request. QGIS, GDAL, Blender GIS and game-engine importers read it.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to write"}},
         .output = ValueType::none,
@@ -90,8 +88,9 @@ OROGEN_PLUGIN("export-geotiff", "0.1.0", registry) {
                     .help("compression, with the floating-point predictor"),
                 Param::boolean("tiled", false).help("256 × 256 tiles instead of strips"),
                 Param::boolean("cog", false).help("a Cloud-Optimized GeoTIFF: tiled, with overviews"),
-                Param::string("layers", "").help("layers written as extra bands, comma-separated (\"water, eroded\"), "
-                                                 "or all"),
+                Param::string("layers", "")
+                    .help("layers written as extra bands, comma-separated (\"water, eroded\"), "
+                          "or all"),
             },
         .check = check,
         .run = run,

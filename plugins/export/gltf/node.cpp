@@ -27,9 +27,10 @@ void check(CheckContext& ctx) {
     if (!in || in->width == 0) return;
     const std::int64_t k = ctx.integer("decimate");
     if (k > 1 && (in->width - 1) / k < 1 && (in->height - 1) / k < 1)
-        ctx.error("decimate", "decimate=" + std::to_string(k) + " keeps only the corners of a " +
-                                  std::to_string(in->width) + " x " + std::to_string(in->height) +
-                                  " heightmap; use at most " + std::to_string(std::max(in->width, in->height) - 1));
+        ctx.error("decimate",
+                  "decimate=" + std::to_string(k) + " keeps only the corners of a " + std::to_string(in->width) +
+                      " x " + std::to_string(in->height) + " heightmap; use at most " +
+                      std::to_string(std::max(in->width, in->height) - 1));
 }
 
 }  // namespace
@@ -51,14 +52,25 @@ OROGEN_PLUGIN("export-gltf", "0.1.0", registry) {
             {
                 Param::path("path", PathRole::output, {".glb", ".gltf"})
                     .help("output file: .glb (one binary file) or .gltf (JSON, with <stem>.bin beside it)"),
-                Param::real("scale", 1.0).min(0, true).max(1000).help("vertical exaggeration: heights are multiplied by it"),
-                Param::integer("decimate", 1).min(1).max(4096).help(
-                    "keep every k-th vertex along each axis (the last row and column are always kept); 1 keeps all"),
-                Param::integer("chunks", 0).min(0).max(1024).help(
-                    "split the terrain into chunks x chunks meshes; 0 picks the fewest that keep each mesh under "
-                    "65535 vertices (16-bit indices); meshes over that use 32-bit indices"),
-                Param::integer("texture", 2048).min(1).max(16384).unit("px").help(
-                    "largest side of the baked colour texture (never more than the terrain's tiles)"),
+                Param::real("scale", 1.0)
+                    .min(0, true)
+                    .max(1000)
+                    .help("vertical exaggeration: heights are multiplied by it"),
+                Param::integer("decimate", 1)
+                    .min(1)
+                    .max(4096)
+                    .help("keep every k-th vertex along each axis (the last row and column are always kept); 1 keeps "
+                          "all"),
+                Param::integer("chunks", 0)
+                    .min(0)
+                    .max(1024)
+                    .help("split the terrain into chunks x chunks meshes; 0 picks the fewest that keep each mesh under "
+                          "65535 vertices (16-bit indices); meshes over that use 32-bit indices"),
+                Param::integer("texture", 2048)
+                    .min(1)
+                    .max(16384)
+                    .unit("px")
+                    .help("largest side of the baked colour texture (never more than the terrain's tiles)"),
             },
         .check = check,
         .run = run,

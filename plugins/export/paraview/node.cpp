@@ -24,14 +24,17 @@ void check(CheckContext& ctx) {
         if (!in) continue;
         bool& seen = in->type == ValueType::plates ? plates : particles;
         if (in->type != ValueType::plates && in->type != ValueType::particles)
-            ctx.error("", "export:paraview-state input " + std::to_string(i + 1) +
-                              " must be a plate history (e.g. plates.plates) or particle frames (e.g. wet.particles), "
-                              "not a " + describe_type(in->type == ValueType::series ? in->element : in->type,
-                                                       in->type == ValueType::series));
+            ctx.error("",
+                      "export:paraview-state input " + std::to_string(i + 1) +
+                          " must be a plate history (e.g. plates.plates) or particle frames (e.g. wet.particles), "
+                          "not a " +
+                          describe_type(in->type == ValueType::series ? in->element : in->type,
+                                        in->type == ValueType::series));
         else if (seen)
-            ctx.error("", std::string("export:paraview-state takes one ") +
-                              (in->type == ValueType::plates ? "plate history" : "particle series") +
-                              "; inputs 2 and 3 are both one");
+            ctx.error("",
+                      std::string("export:paraview-state takes one ") +
+                          (in->type == ValueType::plates ? "plate history" : "particle series") +
+                          "; inputs 2 and 3 are both one");
         seen = true;
     }
     const std::string& layer = ctx.text("layer");
@@ -77,7 +80,8 @@ NodeOutputs run(NodeContext& ctx) {
     const ConstGridView coloured = s.layer == "height" ? heights : hm.layer(s.layer);
     s.colours = paraview::colours_for(s.layer, {coloured.data, coloured.size()});
     const double given = ctx.real("exaggeration");
-    s.exaggeration = given > 0 ? given : paraview::auto_exaggeration(s.height_max - s.height_min, std::max(s.size_x, s.size_y));
+    s.exaggeration =
+        given > 0 ? given : paraview::auto_exaggeration(s.height_max - s.height_min, std::max(s.size_x, s.size_y));
     s.azimuth = ctx.real("azimuth");
     s.elevation = ctx.real("elevation");
 
@@ -119,8 +123,9 @@ NodeOutputs run(NodeContext& ctx) {
     const std::string text = paraview::state_script(s);
     file.write({reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
     file.commit();
-    ctx.info("wrote " + ctx.text("path") + " and " + std::to_string(files - 1) + " data file(s) beside it; exaggeration " +
-             std::to_string(s.exaggeration).substr(0, 6) + ", coloured by " + s.layer);
+    ctx.info("wrote " + ctx.text("path") + " and " + std::to_string(files - 1) +
+             " data file(s) beside it; exaggeration " + std::to_string(s.exaggeration).substr(0, 6) + ", coloured by " +
+             s.layer);
     return {};
 }
 
@@ -136,7 +141,8 @@ OROGEN_PLUGIN("export-paraview", "0.1.0", registry) {
             "Writes PATH (a Python state for ParaView: File > Load State, paraview --script, or pvbatch PATH "
             "--screenshot view.png) and beside it, with the same stem, its data in ParaView's frame (X east, Y north, "
             "Z up): STEM.vti (height and every layer), STEM-plates.pvd and STEM-collisions.pvd (given a plate "
-            "history), STEM-particles.pvd (given particle frames; the two optional inputs in either order). The script opens them by relative path, so the "
+            "history), STEM-particles.pvd (given particle frames; the two optional inputs in either order). The script "
+            "opens them by relative path, so the "
             "folder can be moved. The terrain is raised by Warp By Scalar (exaggeration, auto: relief a fifth of the "
             "larger side), coloured by LAYER with a scalar bar and a colour map that suits it (categorical for plate "
             "and boundary, diverging for eroded, hypsometric for height), viewed from an oblique camera; plates and "
@@ -155,10 +161,16 @@ OROGEN_PLUGIN("export-paraview", "0.1.0", registry) {
                     .help("the state script; its data files go beside it with the same stem"),
                 Param::string("layer", std::string("height"))
                     .help("what colours the terrain: height or a layer of the input (eroded, plate, water, ...)"),
-                Param::real("exaggeration", 0.0).min(0).max(1000).help(
-                    "vertical exaggeration of Warp By Scalar; 0: automatic (relief a fifth of the larger side, 1..20)"),
-                Param::real("azimuth", 200.0).min(0).max(360).unit("°").help(
-                    "camera bearing from the terrain's centre, clockwise from north"),
+                Param::real("exaggeration", 0.0)
+                    .min(0)
+                    .max(1000)
+                    .help("vertical exaggeration of Warp By Scalar; 0: automatic (relief a fifth of the larger side, "
+                          "1..20)"),
+                Param::real("azimuth", 200.0)
+                    .min(0)
+                    .max(360)
+                    .unit("°")
+                    .help("camera bearing from the terrain's centre, clockwise from north"),
                 Param::real("elevation", 30.0).min(1).max(89).unit("°").help("camera height angle above the horizon"),
                 Param::boolean("compress", false).help("zlib-compress the data files' arrays: smaller, slower"),
             },

@@ -17,10 +17,10 @@ using RGB = std::array<double, 3>;
 RGB rgb(int r, int g, int b) { return {r / 255.0, g / 255.0, b / 255.0}; }
 
 /// Qualitative colours (ColorBrewer Set1/Set3 family), as orogen-view's.
-const RGB categorical_palette[] = {
-    rgb(228, 26, 28),   rgb(55, 126, 184),  rgb(77, 175, 74),   rgb(152, 78, 163),  rgb(255, 127, 0),  rgb(255, 255, 51),
-    rgb(166, 86, 40),   rgb(247, 129, 191), rgb(141, 211, 199), rgb(190, 186, 218), rgb(128, 177, 211), rgb(179, 222, 105),
-    rgb(252, 205, 229), rgb(188, 128, 189), rgb(204, 235, 197), rgb(255, 237, 111)};
+const RGB categorical_palette[] = {rgb(228, 26, 28),   rgb(55, 126, 184),  rgb(77, 175, 74),   rgb(152, 78, 163),
+                                   rgb(255, 127, 0),   rgb(255, 255, 51),  rgb(166, 86, 40),   rgb(247, 129, 191),
+                                   rgb(141, 211, 199), rgb(190, 186, 218), rgb(128, 177, 211), rgb(179, 222, 105),
+                                   rgb(252, 205, 229), rgb(188, 128, 189), rgb(204, 235, 197), rgb(255, 237, 111)};
 
 /// Shortest text that reads back as the same double (deterministic, no locale).
 std::string number(double v) {
@@ -53,8 +53,9 @@ Colours categories(const std::string& title, const std::vector<int>& ids, const 
     for (int id : ids) {
         const auto f = fixed.find(id);
         const auto n = names.find(id);
-        c.categories.push_back({id, n != names.end() ? n->second : std::to_string(id),
-                                f != fixed.end() ? f->second : categorical_palette[next++ % std::size(categorical_palette)]});
+        c.categories.push_back(
+            {id, n != names.end() ? n->second : std::to_string(id),
+             f != fixed.end() ? f->second : categorical_palette[next++ % std::size(categorical_palette)]});
     }
     if (!ids.empty()) c.low = ids.front(), c.high = ids.back();
     return c;
@@ -102,10 +103,10 @@ Colours colours_for(const std::string& name, std::span<const float> values) {
                 c.title = "plate (id)";
                 return c;
             }
-            return categories("boundary", {ids.begin(), ids.end()},
-                              {{0, "none"}, {1, "convergent"}, {2, "divergent"}, {3, "transform"}},
-                              {{0, rgb(200, 200, 200)}, {1, rgb(215, 48, 39)}, {2, rgb(69, 117, 180)},
-                               {3, rgb(26, 152, 80)}});
+            return categories(
+                "boundary", {ids.begin(), ids.end()},
+                {{0, "none"}, {1, "convergent"}, {2, "divergent"}, {3, "transform"}},
+                {{0, rgb(200, 200, 200)}, {1, rgb(215, 48, 39)}, {2, rgb(69, 117, 180)}, {3, rgb(26, 152, 80)}});
         }
     }
     const std::string unit = name == "flow" ? "m/s" : name == "hardness" ? "0..1" : name == "plate" ? "id" : "m";
@@ -136,10 +137,8 @@ Colours colours_for(const std::string& name, std::span<const float> values) {
     }
     c.low = lo;
     c.high = lo >= 0 ? std::max(top, double(lo) + 1e-9) : std::max(double(hi), double(lo) + 1e-9);
-    if (name == "water" || name == "flow")
-        c.ramp = {rgb(247, 251, 255), rgb(107, 174, 214), rgb(8, 48, 107)};
-    else if (name == "sediment")
-        c.ramp = {rgb(255, 247, 188), rgb(254, 153, 41), rgb(102, 37, 6)};
+    if (name == "water" || name == "flow") c.ramp = {rgb(247, 251, 255), rgb(107, 174, 214), rgb(8, 48, 107)};
+    else if (name == "sediment") c.ramp = {rgb(255, 247, 188), rgb(254, 153, 41), rgb(102, 37, 6)};
     else  // viridis, sampled
         c.ramp = {rgb(68, 1, 84), rgb(59, 82, 139), rgb(33, 145, 140), rgb(94, 201, 98), rgb(253, 231, 37)};
     return c;
@@ -175,7 +174,9 @@ namespace {
 
 std::string colours_python(const Colours& c) {
     std::ostringstream s;
-    const char* kind = c.kind == Colours::categorical ? "categorical" : c.kind == Colours::diverging ? "diverging" : "sequential";
+    const char* kind = c.kind == Colours::categorical ? "categorical"
+        : c.kind == Colours::diverging                ? "diverging"
+                                                      : "sequential";
     s << "{\n        \"kind\": \"" << kind << "\",\n        \"title\": " << python_string(c.title)
       << ",\n        \"range\": [" << number(c.low) << ", " << number(c.high) << "],\n        \"ramp\": [";
     for (std::size_t i = 0; i < c.ramp.size(); ++i) s << (i ? ", " : "") << rgb_list(c.ramp[i]);
@@ -416,8 +417,8 @@ std::string state_script(const StateScript& s) {
       << "    \"layer\": " << python_string(s.layer) << ",\n"
       << "    \"colours\": " << colours_python(s.colours) << ",\n"
       << "    \"plate_colours\": " << colours_python(s.plates_colours) << ",\n"
-      << "    \"collision_colours\": "
-      << colours_python(colours_for("boundary", std::vector<float>{1.0f, 2.0f, 3.0f})) << ",\n"
+      << "    \"collision_colours\": " << colours_python(colours_for("boundary", std::vector<float>{1.0f, 2.0f, 3.0f}))
+      << ",\n"
       << "    \"particle_colour\": " << optional_file(s.particle_colour) << ",\n"
       << "    \"particle_colours\": " << colours_python(s.particle_colours) << ",\n"
       << "    \"exaggeration\": " << number(s.exaggeration) << ",  # vertical, applied by Warp By Scalar\n"

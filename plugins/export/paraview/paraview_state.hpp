@@ -55,19 +55,19 @@ double auto_exaggeration(double relief, double side);
 
 struct StateScript {
     std::string script_name;  ///< the script's own file name, for its header
-    std::string terrain;      ///< .vti beside the script (relative)
-    std::string plates;       ///< .pvd of plate polygons beside the script, or empty
-    std::string collisions;   ///< .pvd of plate collisions beside the script, or empty
-    std::string particles;    ///< .pvd of particle frames beside the script, or empty
-    std::string layer;        ///< point array that colours the terrain ("height" or a layer)
-    Colours colours;          ///< of `layer`
-    Colours plates_colours;   ///< of the plate polygons (categorical by id)
+    std::string terrain;  ///< .vti beside the script (relative)
+    std::string plates;  ///< .pvd of plate polygons beside the script, or empty
+    std::string collisions;  ///< .pvd of plate collisions beside the script, or empty
+    std::string particles;  ///< .pvd of particle frames beside the script, or empty
+    std::string layer;  ///< point array that colours the terrain ("height" or a layer)
+    Colours colours;  ///< of `layer`
+    Colours plates_colours;  ///< of the plate polygons (categorical by id)
     std::string particle_colour;  ///< particle attribute that colours them (empty: solid)
-    Colours particle_colours;     ///< of `particle_colour`, by magnitude
+    Colours particle_colours;  ///< of `particle_colour`, by magnitude
     double exaggeration = 1.0;
     double height_min = 0.0, height_max = 0.0;  ///< m
-    double size_x = 0.0, size_y = 0.0;          ///< extent east and north, m
-    double azimuth = 200.0, elevation = 30.0;   ///< degrees
+    double size_x = 0.0, size_y = 0.0;  ///< extent east and north, m
+    double azimuth = 200.0, elevation = 30.0;  ///< degrees
 };
 
 /// The Python text (UTF-8, deterministic).

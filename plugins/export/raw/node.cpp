@@ -24,12 +24,12 @@ NodeOutputs run(NodeContext& ctx) {
 void check(CheckContext& ctx) {
     const bool low = ctx.given("low"), high = ctx.given("high");
     if (low != high) {
-        ctx.error(low ? "low" : "high", "give both low and high (the heights mapped to 0 and 65535), or neither "
-                                        "to use the terrain's own lowest and highest point");
+        ctx.error(low ? "low" : "high",
+                  "give both low and high (the heights mapped to 0 and 65535), or neither "
+                  "to use the terrain's own lowest and highest point");
         return;
     }
-    if (low && !(ctx.real("high") > ctx.real("low")))
-        ctx.error("high", "high must be above low");
+    if (low && !(ctx.real("high") > ctx.real("low"))) ctx.error("high", "high must be above low");
 }
 
 }  // namespace
@@ -48,10 +48,12 @@ OROGEN_PLUGIN("export-raw", "0.1.0", registry) {
         .params =
             {
                 Param::path("path", PathRole::output, {".r16", ".r32"}).help("output file: .r16 or .r32"),
-                Param::real("low", 0.0).unit("m").help(
-                    "height written as 0 in .r16 (with high; both 0 = the terrain's lowest point)"),
-                Param::real("high", 0.0).unit("m").help(
-                    "height written as 65535 in .r16 (with low; both 0 = the terrain's highest point)"),
+                Param::real("low", 0.0)
+                    .unit("m")
+                    .help("height written as 0 in .r16 (with high; both 0 = the terrain's lowest point)"),
+                Param::real("high", 0.0)
+                    .unit("m")
+                    .help("height written as 65535 in .r16 (with low; both 0 = the terrain's highest point)"),
             },
         .check = check,
         .run = run,

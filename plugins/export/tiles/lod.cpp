@@ -86,7 +86,8 @@ std::vector<Chunk> pyramid(int width, int height, int tile_size, const std::stri
                 ch.y0 = int(r * s);
                 ch.x1 = int(std::min<std::int64_t>(ch.x0 + s, width - 1));
                 ch.y1 = int(std::min<std::int64_t>(ch.y0 + s, height - 1));
-                ch.file = stem + "_l" + std::to_string(k) + "_x" + std::to_string(c) + "_y" + std::to_string(r) + ".glb";
+                ch.file =
+                    stem + "_l" + std::to_string(k) + "_x" + std::to_string(c) + "_y" + std::to_string(r) + ".glb";
                 out.push_back(std::move(ch));
             }
     }
@@ -176,10 +177,12 @@ Mesh chunk_mesh(const Chunk& c, const Samples& s, int width, int height, double 
             m.positions[3 * v + 1] = float(hgt * vertical_scale);
             m.positions[3 * v + 2] = float(double(y - c.y0) * cell);
             // Slopes of the scaled surface along +X and +Z over the level's neighbours, as surface_normal.
-            const double gx = slope(lx, ki, s.xs, cell, [&](int a) { return s.at(std::size_t(a), std::size_t(ly[kj])); }) *
-                              vertical_scale;
-            const double gz = slope(ly, kj, s.ys, cell, [&](int b) { return s.at(std::size_t(lx[ki]), std::size_t(b)); }) *
-                              vertical_scale;
+            const double gx =
+                slope(lx, ki, s.xs, cell, [&](int a) { return s.at(std::size_t(a), std::size_t(ly[kj])); }) *
+                vertical_scale;
+            const double gz =
+                slope(ly, kj, s.ys, cell, [&](int b) { return s.at(std::size_t(lx[ki]), std::size_t(b)); }) *
+                vertical_scale;
             const double inv = 1.0 / std::sqrt(gx * gx + 1.0 + gz * gz);
             m.normals[3 * v] = float(-gx * inv);
             m.normals[3 * v + 1] = float(inv);
@@ -239,12 +242,13 @@ double deviation(const Chunk& c, const Samples& s, int width, int height, double
         const double fy = by[j].fraction;
         for (std::size_t i = 0; i < s.xs.size(); ++i) {
             if (bx[i].vertex < 0) continue;
-            const auto xa = std::size_t(lx[std::size_t(bx[i].vertex)]), xb = std::size_t(lx[std::size_t(bx[i].vertex) + 1]);
+            const auto xa = std::size_t(lx[std::size_t(bx[i].vertex)]),
+                       xb = std::size_t(lx[std::size_t(bx[i].vertex) + 1]);
             const double fx = bx[i].fraction;
             const double a = s.at(xa, ya), b = s.at(xb, ya), cc = s.at(xa, yb), d = s.at(xb, yb);
             // The cell's triangles (a, c, b) and (b, c, d) meet along the diagonal from b to c.
-            const double surface = fx + fy <= 1.0 ? a + fx * (b - a) + fy * (cc - a)
-                                                  : d + (1.0 - fx) * (cc - d) + (1.0 - fy) * (b - d);
+            const double surface =
+                fx + fy <= 1.0 ? a + fx * (b - a) + fy * (cc - a) : d + (1.0 - fx) * (cc - d) + (1.0 - fy) * (b - d);
             worst = std::max(worst, std::abs(double(s.at(i, j)) - surface));
         }
     }
@@ -284,7 +288,7 @@ std::vector<std::uint8_t> chunk_texture(const Chunk& c, const Samples& s, double
         for (int i = 0; i < tw; ++i) {
             const Place& p = px[std::size_t(i)];
             const double height = (s.at(p.a, q.a) * (1 - p.f) + s.at(p.b, q.a) * p.f) * (1 - q.f) +
-                                  (s.at(p.a, q.b) * (1 - p.f) + s.at(p.b, q.b) * p.f) * q.f;
+                (s.at(p.a, q.b) * (1 - p.f) + s.at(p.b, q.b) * p.f) * q.f;
             const double gx = slope(all_x, p.near, s.xs, cell, [&](int a) { return s.at(std::size_t(a), q.near); });
             const double gz = slope(all_y, q.near, s.ys, cell, [&](int b) { return s.at(p.near, std::size_t(b)); });
             const double ny = 1.0 / std::sqrt(gx * gx + 1.0 + gz * gz);  // the true terrain's slope
@@ -353,8 +357,8 @@ std::string tileset_json(const std::vector<Chunk>& chunks, const std::vector<Wri
         o << pad << "{\"boundingVolume\": {\"box\": [" << number(0.5 * (b[0] + b[3])) << ", "
           << number(0.5 * (b[1] + b[4])) << ", " << number(0.5 * (b[2] + b[5])) << ", " << number(0.5 * (b[3] - b[0]))
           << ", 0, 0, 0, " << number(0.5 * (b[4] - b[1])) << ", 0, 0, 0, " << number(0.5 * (b[5] - b[2])) << "]},\n"
-          << pad << " \"geometricError\": " << number(error[i]) << ", \"refine\": \"REPLACE\", \"content\": {\"uri\": "
-          << json_string(chunks[i].file) << "}";
+          << pad << " \"geometricError\": " << number(error[i])
+          << ", \"refine\": \"REPLACE\", \"content\": {\"uri\": " << json_string(chunks[i].file) << "}";
         const auto kids = children(i);
         if (!kids.empty()) {
             o << ",\n" << pad << " \"children\": [\n";

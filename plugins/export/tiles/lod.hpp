@@ -67,17 +67,17 @@ std::array<std::array<AxisSamples, 2>, 2> edge_lattices(const Chunk& chunk, int 
 /// The skirt depth (m, after vertical_scale) that closes any crack along the chunk's edges: twice the
 /// largest deviation of a level's edge (levels 1 .. levels − 1) from the full-resolution edge, at least
 /// 1 % of a cell. `rows`: the samples of edge_lattices()[0], `columns`: of [1].
-double skirt_depth(const Chunk& chunk, const Samples& rows, const Samples& columns, int width, int height,
-                   int levels, double cell, double vertical_scale);
+double skirt_depth(const Chunk& chunk, const Samples& rows, const Samples& columns, int width, int height, int levels,
+                   double cell, double vertical_scale);
 
 /// A chunk's triangle mesh: its level's samples within the chunk as a grid of two counter-clockwise
 /// triangles per cell (terrain_mesh.hpp's layout), then the skirt: the edge ring copied `skirt` m lower,
 /// with outward-facing walls. Positions local to the chunk's first sample (X east, Y up, Z south, m).
 struct Mesh {
-    std::vector<float> positions, normals;    // 3 per vertex
-    std::vector<std::uint16_t> texcoords;     // 2 per vertex, u east and v south over the chunk, normalised
-    std::vector<std::uint32_t> indices;       // 3 per triangle
-    std::array<float, 3> min{}, max{};        // of the positions, exactly the written floats
+    std::vector<float> positions, normals;  // 3 per vertex
+    std::vector<std::uint16_t> texcoords;  // 2 per vertex, u east and v south over the chunk, normalised
+    std::vector<std::uint32_t> indices;  // 3 per triangle
+    std::array<float, 3> min{}, max{};  // of the positions, exactly the written floats
     std::size_t vertex_count() const { return positions.size() / 3; }
 };
 Mesh chunk_mesh(const Chunk& chunk, const Samples& samples, int width, int height, double cell, double vertical_scale,
@@ -94,7 +94,7 @@ std::vector<std::uint8_t> chunk_texture(const Chunk& chunk, const Samples& sampl
 
 /// What the tileset needs to know of a written chunk.
 struct Written {
-    double deviation = 0.0;             ///< deviation(), m
+    double deviation = 0.0;  ///< deviation(), m
     std::array<float, 3> min{}, max{};  ///< Mesh::min and max (glTF frame, local to the chunk)
 };
 

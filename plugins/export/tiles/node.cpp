@@ -24,8 +24,10 @@ void check(CheckContext& ctx) {
     if (ctx.text("format") == "glb") {
         for (const char* raster : {"low", "high", "compression", "vrt"})
             if (ctx.given(raster))
-                ctx.error(raster, std::string(raster) + " applies to the raster formats (png16, r16, r32); format=glb "
-                                                        "writes meshes in metres (see scale)");
+                ctx.error(raster,
+                          std::string(raster) +
+                              " applies to the raster formats (png16, r16, r32); format=glb "
+                              "writes meshes in metres (see scale)");
         return;
     }
     for (const char* mesh : {"scale", "texture", "skirts"})
@@ -33,10 +35,10 @@ void check(CheckContext& ctx) {
             ctx.error(mesh, std::string(mesh) + " applies to format=glb (the meshes); the raster formats ignore it");
     const bool low = ctx.given("low"), high = ctx.given("high");
     if (low != high)
-        ctx.error(low ? "low" : "high", "give both low and high (the heights written as 0 and 65535), or neither "
-                                        "to use the terrain's own lowest and highest point");
-    else if (low && !(ctx.real("high") > ctx.real("low")))
-        ctx.error("high", "high must be above low");
+        ctx.error(low ? "low" : "high",
+                  "give both low and high (the heights written as 0 and 65535), or neither "
+                  "to use the terrain's own lowest and highest point");
+    else if (low && !(ctx.real("high") > ctx.real("low"))) ctx.error("high", "high must be above low");
     if ((low || high) && ctx.text("format") == "r32")  // reported with the above: every mistake at once
         ctx.error(low ? "low" : "high", "low and high set the 16-bit scale; format=r32 writes metres as they are");
 }
@@ -129,7 +131,8 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
                 gltf::write_mesh(data, png, lod::translation(c, cell), name, targets[first + k]);
                 float* out = &info[w.chunk * kInfo];
                 out[0] = float(lod::deviation(c, w.area, width, height, scale));
-                for (int a = 0; a < 3; ++a) out[1 + a] = mesh.min[std::size_t(a)], out[4 + a] = mesh.max[std::size_t(a)];
+                for (int a = 0; a < 3; ++a)
+                    out[1 + a] = mesh.min[std::size_t(a)], out[4 + a] = mesh.max[std::size_t(a)];
             }
         });
         ctx.progress(double(std::min(end, mine.size())) / double(std::max<std::size_t>(mine.size(), 1)));
@@ -140,7 +143,8 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
     for (std::size_t i = 0; i < chunks.size(); ++i) {
         const float* in = &info[i * kInfo];
         written[i].deviation = double(in[0]);
-        for (int a = 0; a < 3; ++a) written[i].min[std::size_t(a)] = in[1 + a], written[i].max[std::size_t(a)] = in[4 + a];
+        for (int a = 0; a < 3; ++a)
+            written[i].min[std::size_t(a)] = in[1 + a], written[i].max[std::size_t(a)] = in[4 + a];
     }
     const std::string json = lod::tileset_json(chunks, written, width, height, tile_size, cell, scale);
     write_file_atomically(ctx.output_path(index_path.string()),
@@ -260,8 +264,7 @@ NodeOutputs run(NodeContext& ctx) {
     std::size_t outside = 0;
     for (std::size_t c : clamped) outside += c;
     if (tiling) outside = std::size_t(tiling->sum_all(double(outside)));
-    if (outside > 0)
-        ctx.warn(std::to_string(outside) + " samples lie outside low..high and were clamped to its ends");
+    if (outside > 0) ctx.warn(std::to_string(outside) + " samples lie outside low..high and were clamped to its ends");
 
     for (std::size_t i = 0; i < raw_vrts.size(); ++i) {
         const std::string text = raw_tile_vrt(index, index.tiles[i]);
@@ -279,10 +282,10 @@ NodeOutputs run(NodeContext& ctx) {
     // What was written, in the same words as the warning above: one tile of the grid's size, or the count.
     const std::string size = std::to_string(last.width) + " × " + std::to_string(last.height);
     ctx.info((one_small ? "wrote 1 tile of " + size + " samples"
-                        : "wrote " + std::to_string(index.tiles.size()) + (index.tiles.size() == 1 ? " tile" : " tiles") +
-                              " of " + std::to_string(tile_size) + " samples (" + std::to_string(last.column + 1) + " × " +
-                              std::to_string(last.row + 1) + ")" +
-                              (last.width != tile_size || last.height != tile_size ? ", the last ones " + size : "")) +
+                        : "wrote " + std::to_string(index.tiles.size()) +
+                      (index.tiles.size() == 1 ? " tile" : " tiles") + " of " + std::to_string(tile_size) +
+                      " samples (" + std::to_string(last.column + 1) + " × " + std::to_string(last.row + 1) + ")" +
+                      (last.width != tile_size || last.height != tile_size ? ", the last ones " + size : "")) +
              ", " + index_path.string() + (vrt ? " and " + (folder / (stem + ".vrt")).string() : std::string()));
     return {};
 }
@@ -314,19 +317,28 @@ OROGEN_PLUGIN("export-tiles", "0.1.0", registry) {
                 Param::choice("format", {"png16", "r16", "r32", "glb"}, "png16")
                     .help("png16: 16-bit grayscale PNG; r16: RAW unsigned 16-bit little-endian; r32: RAW float metres; "
                           "glb: textured glTF meshes in levels of detail, the index a 3D Tiles tileset"),
-                Param::integer("tile_size", 505).min(2).max(65537).unit("samples").help(
-                    "samples per tile side, the shared edge included (Unreal: 127, 253, 505, 1009, 2017, 4033)"),
-                Param::real("low", 0.0).unit("m").help("height written as 0 (with high; both 0 = the terrain's lowest)"),
-                Param::real("high", 0.0).unit("m").help(
-                    "height written as 65535 (with low; both 0 = the terrain's highest)"),
+                Param::integer("tile_size", 505)
+                    .min(2)
+                    .max(65537)
+                    .unit("samples")
+                    .help("samples per tile side, the shared edge included (Unreal: 127, 253, 505, 1009, 2017, 4033)"),
+                Param::real("low", 0.0)
+                    .unit("m")
+                    .help("height written as 0 (with high; both 0 = the terrain's lowest)"),
+                Param::real("high", 0.0)
+                    .unit("m")
+                    .help("height written as 65535 (with low; both 0 = the terrain's highest)"),
                 Param::boolean("vrt", true).help("also write <stem>.vrt, the tiles as one GDAL raster"),
                 Param::integer("compression", 6).min(0).max(12).help("png16: deflate level (libdeflate), 0 to 12"),
                 Param::real("scale", 1.0).min(0.0, true).help("glb: vertical exaggeration (heights × scale)"),
-                Param::integer("texture", 512).min(1).max(8192).unit("pixels").help(
-                    "glb: largest side of each chunk's colour texture"),
-                Param::boolean("skirts", true).help(
-                    "glb: hang a strip below each chunk's edges, deep enough to close the cracks where chunks of "
-                    "different levels meet"),
+                Param::integer("texture", 512)
+                    .min(1)
+                    .max(8192)
+                    .unit("pixels")
+                    .help("glb: largest side of each chunk's colour texture"),
+                Param::boolean("skirts", true)
+                    .help("glb: hang a strip below each chunk's edges, deep enough to close the cracks where chunks of "
+                          "different levels meet"),
             },
         .tile_halo = 0,  // tiled: each rank writes the engine tiles whose middle is in its tile
         .check = check,

@@ -109,7 +109,8 @@ std::string index_json(const Index& ix) {
     if (quantised) {
         o << "  \"height_low_m\": " << number(ix.range.low) << ",\n"
           << "  \"height_high_m\": " << number(ix.range.high) << ",\n"
-          << "  \"metres_per_unit\": " << number(span / 65535.0) << ",\n"
+          << "  \"metres_per_unit\": " << number(span / 65535.0)
+          << ",\n"
           // Unreal maps 0..65535 to ±256 cm times Z scale / 100, and X/Y scale is the cell in cm; Unity's terrain
           // height is the whole range in metres.
           << "  \"unreal\": {\"x_scale\": " << number(ix.cell * 100.0) << ", \"y_scale\": " << number(ix.cell * 100.0)
@@ -149,7 +150,8 @@ std::string raw_tile_vrt(const Index& ix, const Tile& t) {
 std::string mosaic_vrt(const Index& ix) {
     const bool quantised = ix.format != Format::r32;
     std::ostringstream o;
-    o << "<VRTDataset rasterXSize=\"" << ix.width << "\" rasterYSize=\"" << ix.height << "\">\n"
+    o << "<VRTDataset rasterXSize=\"" << ix.width << "\" rasterYSize=\"" << ix.height
+      << "\">\n"
       // x east, y north (GDAL's convention): the north-west corner at (0, 0), rows running south
       << "  <GeoTransform>0, " << number(ix.cell) << ", 0, 0, 0, " << number(-ix.cell) << "</GeoTransform>\n"
       << "  <VRTRasterBand dataType=\"" << (quantised ? "UInt16" : "Float32") << "\" band=\"1\">\n";

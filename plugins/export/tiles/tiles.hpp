@@ -23,7 +23,7 @@ namespace orogen::tiles_export {
 /// glb: the chunked level-of-detail pyramid of lod.hpp, with a 3D Tiles tileset as the index.
 enum class Format { png16, r16, r32, glb };
 Format format_named(const std::string& name);  ///< "png16", "r16", "r32", "glb"; throws orogen::BadInput
-const char* extension(Format format);           ///< ".png", ".r16", ".r32", ".glb"
+const char* extension(Format format);  ///< ".png", ".r16", ".r32", ".glb"
 
 /// A double as JSON, exactly (%.17g), and a string as a JSON string.
 std::string number(double v);
@@ -45,8 +45,8 @@ std::vector<float> cut(ConstGridView grid, const Tile& tile);
 struct Index {
     Format format = Format::png16;
     int width = 0, height = 0, tile_size = 0;
-    double cell = 1.0;      ///< m
-    raw::Range range;       ///< png16 / r16: the heights of 0 and 65535, m (the same for every tile)
+    double cell = 1.0;  ///< m
+    raw::Range range;  ///< png16 / r16: the heights of 0 and 65535, m (the same for every tile)
     std::vector<Tile> tiles;
 };
 

@@ -47,7 +47,8 @@ openvdb::points::PointDataGrid::Ptr frame_grid(const ParticleFrame& frame, std::
             for (std::size_t i = 0; i < n; ++i)
                 values[i] = Vec3f(attr.data[3 * i], attr.data[3 * i + 1], attr.data[3 * i + 2]);
             points::appendAttribute<Vec3f>(grid->tree(), name);
-            points::populateAttribute(grid->tree(), index_grid->tree(), name, points::PointAttributeVector<Vec3f>(values));
+            points::populateAttribute(grid->tree(), index_grid->tree(), name,
+                                      points::PointAttributeVector<Vec3f>(values));
         } else {
             // Scalars, and other widths as a float array of `components` per point.
             points::appendAttribute<float>(grid->tree(), name, 0.0f, Index(attr.components));

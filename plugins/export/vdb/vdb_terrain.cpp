@@ -43,7 +43,9 @@ struct Columns {
     ConstGridView grid;  ///< one sample per column, `cell` = voxel size
     std::vector<float> storage;
 
-    float at(int i, int k) const { return grid.at(std::clamp(i, 0, grid.width - 1), std::clamp(k, 0, grid.height - 1)); }
+    float at(int i, int k) const {
+        return grid.at(std::clamp(i, 0, grid.width - 1), std::clamp(k, 0, grid.height - 1));
+    }
     /// Slopes (m/m) along X and Z, central differences (one-sided at the edges).
     std::pair<double, double> gradient(int i, int k) const {
         const int i0 = std::max(i - 1, 0), i1 = std::min(i + 1, grid.width - 1);
@@ -73,7 +75,8 @@ Columns make_columns(ConstGridView h, double voxel) {
             for (int i = 0; i < nx; ++i) {
                 const double sx = std::min(i * voxel / h.cell, double(h.width - 1));
                 const double sz = std::min(double(k) * voxel / h.cell, double(h.height - 1));
-                const int x0 = std::min(int(sx), std::max(h.width - 2, 0)), z0 = std::min(int(sz), std::max(h.height - 2, 0));
+                const int x0 = std::min(int(sx), std::max(h.width - 2, 0)),
+                          z0 = std::min(int(sz), std::max(h.height - 2, 0));
                 const int x1 = std::min(x0 + 1, h.width - 1), z1 = std::min(z0 + 1, h.height - 1);
                 const double fx = sx - x0, fz = sz - z0;
                 c.storage[std::size_t(k) * std::size_t(nx) + std::size_t(i)] =
@@ -158,11 +161,13 @@ FloatGrid::Ptr build(int nx, int nz, float background, const Range& range, const
             for (int bx = 0; bx < blocks_x; ++bx) {
                 const int top = lowest_leaf[std::size_t(bz) * std::size_t(blocks_x) + std::size_t(bx)];
                 if (top != INT_MAX && top > floor_j)
-                    tree.fill(openvdb::CoordBBox(Coord(bx * 8, floor_j, bz * 8), Coord(bx * 8 + 7, top - 1, bz * 8 + 7)),
-                              -background, false);
+                    tree.fill(
+                        openvdb::CoordBBox(Coord(bx * 8, floor_j, bz * 8), Coord(bx * 8 + 7, top - 1, bz * 8 + 7)),
+                        -background, false);
             }
-        tree.fill(openvdb::CoordBBox(Coord(0, floor_j - 4096, 0), Coord(blocks_x * 8 - 1, floor_j - 1, blocks_z * 8 - 1)),
-                  -background, false);
+        tree.fill(
+            openvdb::CoordBBox(Coord(0, floor_j - 4096, 0), Coord(blocks_x * 8 - 1, floor_j - 1, blocks_z * 8 - 1)),
+            -background, false);
     }
     active = 0;
     for (auto n : counts) active += n;
@@ -201,7 +206,8 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
         for (std::int64_t k = k0; k < k1; ++k)
             for (int i = 0; i < nx; ++i) {
                 const auto [gx, gz] = col.gradient(i, int(k));
-                cos_slope[std::size_t(k) * std::size_t(nx) + std::size_t(i)] = float(1.0 / std::sqrt(1.0 + gx * gx + gz * gz));
+                cos_slope[std::size_t(k) * std::size_t(nx) + std::size_t(i)] =
+                    float(1.0 / std::sqrt(1.0 + gx * gx + gz * gz));
             }
     });
     auto cos_at = [&](int i, int k) { return double(cos_slope[std::size_t(k) * std::size_t(nx) + std::size_t(i)]); };
@@ -228,7 +234,10 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
 
     std::size_t height_voxels = 0;
     auto height = build(
-        nx, nz, 0.0f, [](int, int) { return std::pair<int, int>{0, 0}; },
+        nx, nz, 0.0f,
+        [](int, int) {
+            return std::pair<int, int>{0, 0};
+        },
         [&](int i, int k, int) { return col.at(i, k); }, [](int, int, int) { return false; }, false, height_voxels);
     height->setName("height");
     height->setGridClass(openvdb::GRID_UNKNOWN);
@@ -250,9 +259,9 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
         auto top = [&](int i, int k) { return double(col.at(i, k)) + double(wcol.at(i, k)); };
         auto top_cos = [&](int i, int k) {
             const double gx = (top(std::min(i + 1, nx - 1), k) - top(std::max(i - 1, 0), k)) /
-                              (std::max(1, std::min(i + 1, nx - 1) - std::max(i - 1, 0)) * v);
+                (std::max(1, std::min(i + 1, nx - 1) - std::max(i - 1, 0)) * v);
             const double gz = (top(i, std::min(k + 1, nz - 1)) - top(i, std::max(k - 1, 0))) /
-                              (std::max(1, std::min(k + 1, nz - 1) - std::max(k - 1, 0)) * v);
+                (std::max(1, std::min(k + 1, nz - 1) - std::max(k - 1, 0)) * v);
             return 1.0 / std::sqrt(1.0 + gx * gx + gz * gz);
         };
         // The water body lies between the ground B and the water surface T:
@@ -291,9 +300,7 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
         openvdb::io::Stream stream(file.stream());
         stream.setCompression(openvdb::io::COMPRESS_ACTIVE_MASK);
         stream.write(grids, meta);
-    } catch (const openvdb::Exception& e) {
-        throw Error("cannot write " + target.string() + ": OpenVDB: " + e.what());
-    }
+    } catch (const openvdb::Exception& e) { throw Error("cannot write " + target.string() + ": OpenVDB: " + e.what()); }
     stamp_content_uuid(file);
     file.commit();  // checks the stream: a full disk is an error, the old file stays
     return summary;

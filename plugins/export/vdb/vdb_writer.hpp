@@ -56,8 +56,7 @@ TerrainSummary write_terrain(ConstGridView heights, const ConstGridView* water, 
 /// kept (3-component ones as Vec3f): one frame to `target`, several to
 /// <stem>_NNNNNN.vdb beside it (committed together). voxel_size 0 = about
 /// 8 points per voxel. Returns the number of files written.
-std::size_t write_particles(const ParticleSeries& series, const std::filesystem::path& target,
-                            double voxel_size = 0.0);
+std::size_t write_particles(const ParticleSeries& series, const std::filesystem::path& target, double voxel_size = 0.0);
 
 /// openvdb::initialize(), once per process (thread-safe).
 void initialize_once();

@@ -21,8 +21,9 @@ void check(CheckContext& ctx) {
     }
     const std::string& named = ctx.text("codec");
     if (named != "auto" && video::parse_codec(named) != codec)
-        ctx.error("codec", "codec=" + named + " is written to " + std::string(video::extension_for(video::parse_codec(named))) +
-                               " files, but path is " + path.filename().string() + "; change one of them");
+        ctx.error("codec",
+                  "codec=" + named + " is written to " + std::string(video::extension_for(video::parse_codec(named))) +
+                      " files, but path is " + path.filename().string() + "; change one of them");
     const ValueInfo* in = ctx.input(0);
     const int w = in && in->width > 0 ? in->width : 2, h = in && in->height > 0 ? in->height : 2;
     for (const video::Problem& p : video::problems(codec, ctx.real("fps"), w, h)) ctx.error(p.param, p.message);
@@ -63,11 +64,16 @@ OROGEN_PLUGIN("export-video", "0.1.0", registry) {
         .output = ValueType::none,
         .params =
             {
-                Param::path("path", PathRole::output, {".mp4", ".mpg", ".mpeg"}).help("output file (.mp4: H.264, .mpg: MPEG-2)"),
-                Param::choice("codec", {"auto", "h264", "mpeg2"}, "auto").help("must match the extension; auto: from it"),
+                Param::path("path", PathRole::output, {".mp4", ".mpg", ".mpeg"})
+                    .help("output file (.mp4: H.264, .mpg: MPEG-2)"),
+                Param::choice("codec", {"auto", "h264", "mpeg2"}, "auto")
+                    .help("must match the extension; auto: from it"),
                 Param::real("fps", 30.0).min(0, true).max(240).unit("1/s").help("frames per second"),
-                Param::integer("quality", 18).min(0).max(51).help(
-                    "H.264 constant rate factor (lower is better; 18 looks lossless); MPEG-2 quantiser = quality/6 + 1"),
+                Param::integer("quality", 18)
+                    .min(0)
+                    .max(51)
+                    .help("H.264 constant rate factor (lower is better; 18 looks lossless); MPEG-2 quantiser = "
+                          "quality/6 + 1"),
                 Param::choice("tonemap", {"clamp", "reinhard", "aces"}, "aces").help("as export:png"),
                 Param::real("exposure", 0.0).min(-20).max(20).help("as export:png: colours × 2^exposure first"),
             },

@@ -37,7 +37,8 @@ Codec codec_for(const std::filesystem::path& path) {
 namespace {
 
 /// The standard MPEG-2 frame rates, as num/den.
-const AVRational kMpeg2Rates[] = {{24000, 1001}, {24, 1}, {25, 1}, {30000, 1001}, {30, 1}, {50, 1}, {60000, 1001}, {60, 1}};
+const AVRational kMpeg2Rates[] = {{24000, 1001}, {24, 1}, {25, 1},       {30000, 1001},
+                                  {30, 1},       {50, 1}, {60000, 1001}, {60, 1}};
 
 bool rational_matches(double fps, AVRational r) { return std::abs(fps - av_q2d(r)) < 1e-3; }
 
@@ -71,11 +72,13 @@ std::vector<Problem> problems(Codec codec, double fps, int width, int height) {
     } else if (codec == Codec::mpeg2) {
         bool standard = false;
         for (AVRational r : kMpeg2Rates) standard = standard || rational_matches(fps, r);
-        if (!standard) found.push_back({"fps", "MPEG-2 takes only the frame rates 23.976, 24, 25, 29.97, 30, 50, 59.94 and 60"});
+        if (!standard)
+            found.push_back({"fps", "MPEG-2 takes only the frame rates 23.976, 24, 25, 29.97, 30, 50, 59.94 and 60"});
     }
     if (width % 2 || height % 2)
-        found.push_back({"", "the frames are " + std::to_string(width) + " × " + std::to_string(height) +
-                                 " pixels; video with 4:2:0 colour needs even sizes (use an even width and height)"});
+        found.push_back({"",
+                         "the frames are " + std::to_string(width) + " × " + std::to_string(height) +
+                             " pixels; video with 4:2:0 colour needs even sizes (use an even width and height)"});
     if (codec == Codec::mpeg2 && (width > 4095 || height > 4095))
         found.push_back({"", "MPEG-2 frames are at most 4095 pixels a side"});
     return found;
@@ -87,8 +90,9 @@ std::string why_not(Codec codec, double fps, int width, int height) {
     return all;
 }
 
-void encode_video(const std::filesystem::path& target, std::size_t count, const std::function<Image(std::size_t)>& frame,
-                  const VideoSettings& s, const std::function<void(std::size_t)>& progress) {
+void encode_video(const std::filesystem::path& target, std::size_t count,
+                  const std::function<Image(std::size_t)>& frame, const VideoSettings& s,
+                  const std::function<void(std::size_t)>& progress) {
     if (count == 0) throw BadInput("export:video: the sequence has no frames");
     av_log_set_level(AV_LOG_ERROR);  // libx264 reports its statistics on stderr otherwise
     const AVCodec* encoder = find_encoder(s.codec);
@@ -127,8 +131,9 @@ void encode_video(const std::filesystem::path& target, std::size_t count, const 
         if (code < 0) throw Error(std::string("export:video: FFmpeg failed ") + what + ": " + av_error(code));
     };
 
-    check(avformat_alloc_output_context2(&st.format, nullptr, s.codec == Codec::h264 ? "mp4" : "mpeg", temporary.c_str()),
-          "to set up the container");
+    check(
+        avformat_alloc_output_context2(&st.format, nullptr, s.codec == Codec::h264 ? "mp4" : "mpeg", temporary.c_str()),
+        "to set up the container");
     st.format->flags |= AVFMT_FLAG_BITEXACT;  // no library versions or times that change between runs
     AVStream* stream = avformat_new_stream(st.format, nullptr);
     if (!stream) throw Error("export:video: FFmpeg could not add a video stream");

@@ -85,14 +85,16 @@ NodeOutputs run_tiles(NodeContext& ctx) {
     auto piece_grid = [&](const float* tile) {
         std::vector<float> held(std::size_t(grown.width) * std::size_t(grown.height));
         for (int y = 0; y < own.height; ++y)
-            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
-                      held.begin() + std::ptrdiff_t(std::size_t(y + own.y0 - grown.y0) * std::size_t(grown.width) +
-                                                    std::size_t(own.x0 - grown.x0)));
+            std::copy(tile + std::size_t(y) * std::size_t(own.width),
+                      tile + std::size_t(y + 1) * std::size_t(own.width),
+                      held.begin() +
+                          std::ptrdiff_t(std::size_t(y + own.y0 - grown.y0) * std::size_t(grown.width) +
+                                         std::size_t(own.x0 - grown.x0)));
         if (tiles) tiles->exchange_halo({held.data(), grown.width, grown.height, hm.cell()}, 1);
         std::vector<float> out(std::size_t(piece.width) * std::size_t(piece.height));
         for (int y = 0; y < piece.height; ++y) {
             const float* src = held.data() + std::size_t(piece.y0 - grown.y0 + y) * std::size_t(grown.width) +
-                               std::size_t(piece.x0 - grown.x0);
+                std::size_t(piece.x0 - grown.x0);
             std::copy(src, src + piece.width, out.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(piece.width)));
         }
         return out;
@@ -128,8 +130,9 @@ NodeOutputs run_tiles(NodeContext& ctx) {
 
 Param up_param() {
     return Param::choice("up", {"z", "y"}, "z")
-        .help("which axis points up: z (X east, Y north, Z up: ParaView's and GIS's convention, the terrain in the "
-              "XY plane) or y (X east, Y up, Z south: glTF's)");
+        .help(
+            "which axis points up: z (X east, Y north, Z up: ParaView's and GIS's convention, the terrain in the "
+            "XY plane) or y (X east, Y up, Z south: glTF's)");
 }
 
 Param compress_param() {
@@ -177,7 +180,8 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
         .output = ValueType::none,
         .params =
             {
-                Param::path("path", PathRole::output, {".pvti"}).help("output .pvti; the pieces NAME_RANK.vti go beside it"),
+                Param::path("path", PathRole::output, {".pvti"})
+                    .help("output .pvti; the pieces NAME_RANK.vti go beside it"),
                 up_param(),
                 compress_param(),
             },
@@ -188,10 +192,12 @@ OROGEN_PLUGIN("export-vtk", "0.1.0", registry) {
         .kind = "export",
         .name = "vtk-particles",
         .summary = "write particle frames for ParaView: one .vtp per frame with every attribute, and a .pvd",
-        .description = "Positions in metres (up=z: X east, Y north, Z up; up=y: X east, Y up, Z south), vectors "
-                       "(velocity) turned the same way; every other attribute (velocity, density, "
-                       "sediment...) as a point array. A .pvd lists the frames with their times so ParaView plays them.",
-        .inputs = {{"particles", ValueType::particles, Need::required, "particle frames (e.g. an SPH eroder's .particles)"}},
+        .description =
+            "Positions in metres (up=z: X east, Y north, Z up; up=y: X east, Y up, Z south), vectors "
+            "(velocity) turned the same way; every other attribute (velocity, density, "
+            "sediment...) as a point array. A .pvd lists the frames with their times so ParaView plays them.",
+        .inputs = {{"particles", ValueType::particles, Need::required,
+                    "particle frames (e.g. an SPH eroder's .particles)"}},
         .output = ValueType::none,
         .params =
             {

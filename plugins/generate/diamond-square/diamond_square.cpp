@@ -90,8 +90,14 @@ void generate(GridView out, const Params& params, std::uint64_t seed) {
                     if (cx < 0) continue;
                     float sum = row[xs[std::size_t(i)]] + row[xs[std::size_t(i) + 1]];
                     float n = 2.0f;
-                    if (up) { sum += up[cx]; n += 1.0f; }
-                    if (down) { sum += down[cx]; n += 1.0f; }
+                    if (up) {
+                        sum += up[cx];
+                        n += 1.0f;
+                    }
+                    if (down) {
+                        sum += down[cx];
+                        n += 1.0f;
+                    }
                     row[cx] = sum / n + offset(k, cx, scale);
                 }
             }
@@ -110,8 +116,14 @@ void generate(GridView out, const Params& params, std::uint64_t seed) {
                     const int x = xs[std::size_t(i)];
                     float sum = top[x] + bottom[x];
                     float n = 2.0f;
-                    if (i > 0 && mx[std::size_t(i) - 1] >= 0) { sum += row[mx[std::size_t(i) - 1]]; n += 1.0f; }
-                    if (i < nx - 1 && mx[std::size_t(i)] >= 0) { sum += row[mx[std::size_t(i)]]; n += 1.0f; }
+                    if (i > 0 && mx[std::size_t(i) - 1] >= 0) {
+                        sum += row[mx[std::size_t(i) - 1]];
+                        n += 1.0f;
+                    }
+                    if (i < nx - 1 && mx[std::size_t(i)] >= 0) {
+                        sum += row[mx[std::size_t(i)]];
+                        n += 1.0f;
+                    }
                     row[x] = sum / n + offset(k, x, scale);
                 }
             }
@@ -200,7 +212,7 @@ void generate_tile(GridView out, int x0, int y0, int W, int H, const Params& par
     std::vector<float> span;
     for (int L = 0; L < levels; ++L) {
         const std::vector<int>&xs = X[std::size_t(L)], &ys = Y[std::size_t(L)], &mx = MX[std::size_t(L)],
-                                &my = MY[std::size_t(L)];
+              &my = MY[std::size_t(L)];
         const int nx = int(xs.size()), ny = int(ys.size());
         const Window w = win[std::size_t(L)], next = win[std::size_t(L) + 1];
         positions(mx, xs.size(), ox, mxa);
@@ -212,9 +224,13 @@ void generate_tile(GridView out, int x0, int y0, int W, int H, const Params& par
         auto S = [&](int fy, int fx) -> float& {
             return span[std::size_t(fy - sy0) * std::size_t(sw) + std::size_t(fx - sx0)];
         };
-        auto V = [&](int j, int i) { return v[std::size_t(j - w.y_lo) * std::size_t(w.width()) + std::size_t(i - w.x_lo)]; };
+        auto V = [&](int j, int i) {
+            return v[std::size_t(j - w.y_lo) * std::size_t(w.width()) + std::size_t(i - w.x_lo)];
+        };
         // Whether a vertex of the finer lattice lies in the window the next level needs.
-        auto wanted = [&](int fy, int fx) { return fx >= next.x_lo && fx <= next.x_hi && fy >= next.y_lo && fy <= next.y_hi; };
+        auto wanted = [&](int fy, int fx) {
+            return fx >= next.x_lo && fx <= next.x_hi && fy >= next.y_lo && fy <= next.y_hi;
+        };
         for (int j = w.y_lo; j <= w.y_hi; ++j)
             for (int i = w.x_lo; i <= w.x_hi; ++i) S(oy[std::size_t(j)], ox[std::size_t(i)]) = V(j, i);
         // Diamond step: every centre of the window (the square steps below read them), as generate() computes it.

@@ -11,16 +11,23 @@ OROGEN_PLUGIN("generate-diamond-square", "0.1.0", registry) {
         .kind = "generate",
         .name = "diamond-square",
         .summary = "Diamond-Square fractal terrain (Fournier et al.; thesis 3.1), any grid size",
-        .description =
-            "Corners get random heights, then diamond and square steps alternate, the random offset\n"
-            "multiplied by `roughness` each level (0.5 halves it, as the thesis does). With an input,\n"
-            "the fractal is added to it.",
-        .inputs = {{"base", ValueType::heightmap, Need::optional, "terrain to add the fractal to (default: the spec's grid, flat at 0 m)"}},
+        .description = "Corners get random heights, then diamond and square steps alternate, the random offset\n"
+                       "multiplied by `roughness` each level (0.5 halves it, as the thesis does). With an input,\n"
+                       "the fractal is added to it.",
+        .inputs = {{"base", ValueType::heightmap, Need::optional,
+                    "terrain to add the fractal to (default: the spec's grid, flat at 0 m)"}},
         .output = ValueType::heightmap,
         .params =
             {
-                Param::real("roughness", 0.5).min(0, true).max(1).help("offset scale kept per level: higher is rougher"),
-                Param::real("amplitude", 100.0).min(0).max(1e6).unit("m").help("random range of the corners and the first level: ±amplitude"),
+                Param::real("roughness", 0.5)
+                    .min(0, true)
+                    .max(1)
+                    .help("offset scale kept per level: higher is rougher"),
+                Param::real("amplitude", 100.0)
+                    .min(0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("random range of the corners and the first level: ±amplitude"),
             },
         // Tiled: each rank makes its own tile (diamond_square::generate_tile),
         // computing each coarser level only near it; no halo.

@@ -27,9 +27,7 @@ struct Line {
 std::vector<Line> random_lines(int width, int height, int count, std::uint64_t seed);
 
 /// The thesis's side test: true if (p − a) × (b − a) ≥ 0 (the vertex is raised).
-inline bool raised(const Line& l, double px, double py) {
-    return (px - l.ax) * l.dy - (py - l.ay) * l.dx >= 0.0;
-}
+inline bool raised(const Line& l, double px, double py) { return (px - l.ax) * l.dy - (py - l.ay) * l.dx >= 0.0; }
 
 /// Per vertex, the number of lines that raise it minus the number that lower it.
 /// Exactly what applying raised() to every vertex for every line gives.

@@ -10,11 +10,11 @@ OROGEN_PLUGIN("generate-fault", "0.1.0", registry) {
         .kind = "generate",
         .name = "fault",
         .summary = "Fault algorithm (Krten; thesis 3.2): random lines raise one side, lower the other",
-        .description =
-            "Each iteration draws a random line; vertices on one side rise by `displacement`, the\n"
-            "others sink by it. Many lines give cliffs and plateaus; smooth the result with\n"
-            "erode:thermal. With no input, starts from the spec's grid, flat at 0 m.",
-        .inputs = {{"base", ValueType::heightmap, Need::optional, "terrain to cut (default: the spec's grid, flat at 0 m)"}},
+        .description = "Each iteration draws a random line; vertices on one side rise by `displacement`, the\n"
+                       "others sink by it. Many lines give cliffs and plateaus; smooth the result with\n"
+                       "erode:thermal. With no input, starts from the spec's grid, flat at 0 m.",
+        .inputs = {{"base", ValueType::heightmap, Need::optional,
+                    "terrain to cut (default: the spec's grid, flat at 0 m)"}},
         .output = ValueType::heightmap,
         .params =
             {
@@ -29,7 +29,8 @@ OROGEN_PLUGIN("generate-fault", "0.1.0", registry) {
             auto hm = ctx.has_input(0) ? ctx.take_heightmap(0)
                                        : std::make_shared<Heightmap>(area.width, area.height, ctx.grid().cell);
             // With an input, its size is the grid (apply() cuts it as the whole grid's lines).
-            const int grid_w = tiles ? tiles->grid_width() : hm->width(), grid_h = tiles ? tiles->grid_height() : hm->height();
+            const int grid_w = tiles ? tiles->grid_width() : hm->width(),
+                      grid_h = tiles ? tiles->grid_height() : hm->height();
             fault::apply_tile(hm->view(), grid_w, grid_h, area.x0, area.y0, int(ctx.integer("iterations")),
                               ctx.real("displacement"), ctx.seed());
             ctx.progress(1.0);

@@ -101,8 +101,8 @@ ConeRenderer::ConeRenderer(int width, int height) : impl_(std::make_unique<Impl>
     const int limit = gl::max_framebuffer_size();
     if (width < 1 || height < 1 || width > limit || height > limit)
         throw BadInput("cones: the grid is " + std::to_string(width) + " × " + std::to_string(height) +
-                       " vertices but OSMesa draws at most " + std::to_string(limit) + " × " +
-                       std::to_string(limit) + " pixels (one per vertex); use method=voronoi for larger grids");
+                       " vertices but OSMesa draws at most " + std::to_string(limit) + " × " + std::to_string(limit) +
+                       " pixels (one per vertex); use method=voronoi for larger grids");
 
     m.program = gl::link_program("cones", kVertexShader, kFragmentShader);
     m.u_grid = glGetUniformLocation(m.program, "grid");
@@ -183,8 +183,7 @@ const std::vector<std::uint32_t>& ConeRenderer::render(std::span<const Point2> s
     glUniform1f(m.u_depth_scale, float(std::hypot(m.width, m.height) + max_radius + 1.0));
     glBindVertexArray(m.vao);
     glBindBuffer(GL_ARRAY_BUFFER, m.instances);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.site_data.size() * sizeof(float)), m.site_data.data(),
-                 GL_STREAM_DRAW);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(m.site_data.size() * sizeof(float)), m.site_data.data(), GL_STREAM_DRAW);
     glDrawArraysInstanced(GL_TRIANGLE_FAN, 0, kSegments + 2, GLsizei(sites.size()));
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glReadPixels(0, 0, m.width, m.height, GL_RGBA, GL_UNSIGNED_BYTE, m.pixels.data());
@@ -226,7 +225,8 @@ void rmp_cones(GridView terrain, const RmpParams& p, std::uint64_t seed, const I
                 picked.push_back(ids[v]);
         if (picked.empty()) throw Error("cones: no cone covered the peak; the cone radius is too small");
         std::vector<float> amount;
-        for (std::uint32_t id : picked) amount.push_back(float(cell_amount(iteration_height(p, k), p.jitter, s, int(id) - 1)));
+        for (std::uint32_t id : picked)
+            amount.push_back(float(cell_amount(iteration_height(p, k), p.jitter, s, int(id) - 1)));
         parallel_for(0, terrain.height, 16, [&](std::int64_t y0, std::int64_t y1) {
             for (std::int64_t y = y0; y < y1; ++y) {
                 float* row = terrain.row(int(y));

@@ -18,7 +18,8 @@ namespace {
 std::shared_ptr<Heightmap> base_or_grid(NodeContext& ctx) {
     const Tiling* tiles = ctx.tiling();
     const TileRect area = tiles ? tiles->owned() : TileRect{0, 0, ctx.grid().width, ctx.grid().height};
-    return ctx.has_input(0) ? ctx.take_heightmap(0) : std::make_shared<Heightmap>(area.width, area.height, ctx.grid().cell);
+    return ctx.has_input(0) ? ctx.take_heightmap(0)
+                            : std::make_shared<Heightmap>(area.width, area.height, ctx.grid().cell);
 }
 
 /// Where `hm` lies in the whole grid (all of it in one process), and the whole grid's size.
@@ -53,16 +54,15 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
         .kind = "generate",
         .name = "rmp",
         .summary = "Repeated Magnification and Probing (thesis 3.3): mountains at given peaks",
-        .description =
-            "Each iteration cuts the map into random regions and raises the region under each peak\n"
-            "by `height` (times decay^iteration). More cones (or cuts) per iteration make a steeper,\n"
-            "narrower mountain; more iterations a higher one. Methods find the regions differently:\n"
-            "  voronoi  exact Voronoi cells on the CPU, only the raised ones (default, fastest)\n"
-            "  cones    the thesis's GPU trick: flat cones drawn from above through OSMesa\n"
-            "  graph    faces of `cuts` random lines; the first `regions` faces of a depth-first\n"
-            "           search from each peak's face rise\n"
-            "voronoi and cones use the same sites for a seed, so they give the same mountain.\n"
-            "With no input, starts from the spec's grid, flat at 0 m.",
+        .description = "Each iteration cuts the map into random regions and raises the region under each peak\n"
+                       "by `height` (times decay^iteration). More cones (or cuts) per iteration make a steeper,\n"
+                       "narrower mountain; more iterations a higher one. Methods find the regions differently:\n"
+                       "  voronoi  exact Voronoi cells on the CPU, only the raised ones (default, fastest)\n"
+                       "  cones    the thesis's GPU trick: flat cones drawn from above through OSMesa\n"
+                       "  graph    faces of `cuts` random lines; the first `regions` faces of a depth-first\n"
+                       "           search from each peak's face rise\n"
+                       "voronoi and cones use the same sites for a seed, so they give the same mountain.\n"
+                       "With no input, starts from the spec's grid, flat at 0 m.",
         .inputs = {{"base", ValueType::heightmap, Need::optional,
                     "terrain to raise mountains on (default: the spec's grid, flat at 0 m)"}},
         .output = ValueType::heightmap,
@@ -108,10 +108,11 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
                 if (method == "graph") {
                     const std::int64_t cuts = ctx.integer("cuts"), regions = ctx.integer("regions");
                     if (regions > max_polygons(cuts))
-                        ctx.error("regions", "regions=" + std::to_string(regions) + " is more than the " +
-                                                 std::to_string(max_polygons(cuts)) + " polygons " +
-                                                 std::to_string(cuts) + " cuts can make at most (n(n+1)/2 + 1); "
-                                                 "lower regions or raise cuts");
+                        ctx.error("regions",
+                                  "regions=" + std::to_string(regions) + " is more than the " +
+                                      std::to_string(max_polygons(cuts)) + " polygons " + std::to_string(cuts) +
+                                      " cuts can make at most (n(n+1)/2 + 1); "
+                                      "lower regions or raise cuts");
                 }
                 if (method != "graph" && (ctx.given("cuts") || ctx.given("regions")))
                     ctx.error(ctx.given("cuts") ? "cuts" : "regions",
@@ -124,13 +125,16 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
                     const int w = base && base->width > 0 ? base->width : ctx.grid().width;
                     const int h = base && base->height > 0 ? base->height : ctx.grid().height;
                     if (w > 16384 || h > 16384)
-                        ctx.error("method", "method=cones draws one pixel per vertex and OSMesa draws at most "
-                                            "16384 × 16384; this grid is " + std::to_string(w) + " × " +
-                                            std::to_string(h) + ": use method=voronoi (the same diagram)");
+                        ctx.error("method",
+                                  "method=cones draws one pixel per vertex and OSMesa draws at most "
+                                  "16384 × 16384; this grid is " +
+                                      std::to_string(w) + " × " + std::to_string(h) +
+                                      ": use method=voronoi (the same diagram)");
                 }
                 if (method == "cones" && ctx.integer("cones") > 16'777'214)
-                    ctx.error("cones", "method=cones encodes a cone's index in a 24-bit colour: at most 16777214 "
-                                       "cones; use method=voronoi for more");
+                    ctx.error("cones",
+                              "method=cones encodes a cone's index in a 24-bit colour: at most 16777214 "
+                              "cones; use method=voronoi for more");
             },
         .run = [](NodeContext& ctx) -> NodeOutputs {
             auto hm = base_or_grid(ctx);
@@ -160,9 +164,10 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
         .untiled_because =
             [](const std::map<std::string, ParamValue, std::less<>>& params, const std::vector<bool>&) {
                 return std::get<std::string>(params.at("method")) == "cones"
-                           ? std::string("method=cones draws the whole grid through OSMesa (method=voronoi draws "
-                                         "the same mountain and tiles)")
-                           : std::string();
+                    ? std::string(
+                          "method=cones draws the whole grid through OSMesa (method=voronoi draws "
+                          "the same mountain and tiles)")
+                    : std::string();
             },
     });
 
@@ -170,11 +175,10 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
         .kind = "generate",
         .name = "range",
         .summary = "A mountain range between two points: RMP along a line (thesis 3.6.2)",
-        .description =
-            "Each iteration draws a fresh Voronoi diagram of `cones` sites and raises every cell the\n"
-            "segment from `from` to `to` passes through (and every cell of its Bresenham line's\n"
-            "vertices), as the plate simulation does at each collision. With no input, starts from\n"
-            "the spec's grid, flat at 0 m.",
+        .description = "Each iteration draws a fresh Voronoi diagram of `cones` sites and raises every cell the\n"
+                       "segment from `from` to `to` passes through (and every cell of its Bresenham line's\n"
+                       "vertices), as the plate simulation does at each collision. With no input, starts from\n"
+                       "the spec's grid, flat at 0 m.",
         .inputs = {{"base", ValueType::heightmap, Need::optional,
                     "terrain to raise the range on (default: the spec's grid, flat at 0 m)"}},
         .output = ValueType::heightmap,
@@ -204,8 +208,9 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
             [](CheckContext& ctx) {
                 const Point2 a = std::get<Point2>(ctx.param("from")), b = std::get<Point2>(ctx.param("to"));
                 if (a == b)
-                    ctx.error("to", "the range's two end points are the same point " + point_text(a) +
-                                        "; give `from` and `to` different points");
+                    ctx.error("to",
+                              "the range's two end points are the same point " + point_text(a) +
+                                  "; give `from` and `to` different points");
                 if (ctx.flag("uplift")) ctx.output().layers.insert("uplift");
             },
         .run = [](NodeContext& ctx) -> NodeOutputs {

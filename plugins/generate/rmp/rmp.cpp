@@ -91,10 +91,10 @@ void rmp_graph(Window window, int width, int height, const RmpParams& p, std::ui
         const Arrangement g = build_arrangement(cuts, w, h);
         if (int(g.faces.size()) < p.regions)
             throw BadInput("rmp: iteration " + std::to_string(k + 1) + "'s " + std::to_string(p.cuts) +
-                           " cuts made only " + std::to_string(g.faces.size()) + " polygons, fewer than regions=" +
-                           std::to_string(p.regions) + "; set regions to at most cuts+1 = " +
-                           std::to_string(p.cuts + 1) + " (the fewest polygons " + std::to_string(p.cuts) +
-                           " cuts can make) or use more cuts");
+                           " cuts made only " + std::to_string(g.faces.size()) +
+                           " polygons, fewer than regions=" + std::to_string(p.regions) +
+                           "; set regions to at most cuts+1 = " + std::to_string(p.cuts + 1) +
+                           " (the fewest polygons " + std::to_string(p.cuts) + " cuts can make) or use more cuts");
         std::vector<int> faces;
         for (const Point2& q : peaks) {
             const std::vector<int> order = depth_first_order(g, face_containing(g, q));
@@ -109,7 +109,8 @@ void rmp_graph(Window window, int width, int height, const RmpParams& p, std::ui
                 if (sp.y < window.y0 || sp.y >= wy1) continue;
                 float* row = t.row(sp.y - window.y0);
                 int* st = stamp.data() + std::size_t(sp.y - window.y0) * std::size_t(t.width);
-                for (int x = std::max(sp.x0, window.x0) - window.x0, x1 = std::min(sp.x1, wx1 - 1) - window.x0; x <= x1; ++x)
+                for (int x = std::max(sp.x0, window.x0) - window.x0, x1 = std::min(sp.x1, wx1 - 1) - window.x0; x <= x1;
+                     ++x)
                     if (st[x] != k) {
                         st[x] = k;
                         row[x] += amount;

@@ -23,12 +23,12 @@ namespace orogen::rmp {
 struct RmpParams {
     std::vector<Point2> peaks{{0.5, 0.5}};  ///< grid-relative, 0..1 across the grid
     int iterations = 100;
-    int cones = 100;       ///< Voronoi sites per iteration (voronoi, cones)
-    double height = 5.0;   ///< metres raised in the first iteration
-    double decay = 1.0;    ///< the raise is multiplied by this each iteration (thesis: 1 − 1/iterations)
-    double jitter = 0.0;   ///< 0: every region by the same amount; >0: each by height·(1 + jitter·u), u in [-1, 1)
-    int cuts = 5;          ///< random lines per iteration (graph)
-    int regions = 2;       ///< faces raised per peak per iteration, first in DFS order (graph)
+    int cones = 100;  ///< Voronoi sites per iteration (voronoi, cones)
+    double height = 5.0;  ///< metres raised in the first iteration
+    double decay = 1.0;  ///< the raise is multiplied by this each iteration (thesis: 1 − 1/iterations)
+    double jitter = 0.0;  ///< 0: every region by the same amount; >0: each by height·(1 + jitter·u), u in [-1, 1)
+    int cuts = 5;  ///< random lines per iteration (graph)
+    int regions = 2;  ///< faces raised per peak per iteration, first in DFS order (graph)
 };
 
 /// Called after each iteration with its index (for progress and cancelling).

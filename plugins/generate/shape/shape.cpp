@@ -42,8 +42,8 @@ void make_shape(GridView t, const ShapeParams& p) {
                 switch (p.kind) {
                     case Kind::crooked:
                         // 60 % a tilt falling south, 40 % ridges that twist as they run south.
-                        z = 0.6 * (1.0 - v) + 0.4 * (0.5 + 0.5 * std::sin(3.0 * std::numbers::pi * u +
-                                                                           2.0 * std::numbers::pi * v * v));
+                        z = 0.6 * (1.0 - v) +
+                            0.4 * (0.5 + 0.5 * std::sin(3.0 * std::numbers::pi * u + 2.0 * std::numbers::pi * v * v));
                         z *= p.height;
                         break;
                     case Kind::pyramid:

@@ -15,9 +15,9 @@ Kind kind_from_name(std::string_view name);
 
 struct ShapeParams {
     Kind kind = Kind::pyramid;
-    double height = 100.0;     ///< metres: the top (flat: the level; plane: the lowest corner)
-    double slope = 10.0;       ///< degrees, plane only
-    double direction = 0.0;    ///< degrees, plane only: the way it rises; 0 east, 90 south
+    double height = 100.0;  ///< metres: the top (flat: the level; plane: the lowest corner)
+    double slope = 10.0;  ///< degrees, plane only
+    double direction = 0.0;  ///< degrees, plane only: the way it rises; 0 east, 90 south
 };
 
 /// Fill `terrain` with the surface, sized by the grid: pyramid, hemisphere and

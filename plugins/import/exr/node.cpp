@@ -56,8 +56,9 @@ void check(CheckContext& ctx) {
         return;
     }
     if (!info.height_units.empty() && info.height_units != "m")
-        ctx.error("path", "the file says its heights are in '" + info.height_units +
-                              "' (its heightUnits attribute); import:exr reads metres: convert the file first");
+        ctx.error("path",
+                  "the file says its heights are in '" + info.height_units +
+                      "' (its heightUnits attribute); import:exr reads metres: convert the file first");
     ValueInfo& out = ctx.output();
     out.width = info.width;
     out.height = info.height;
@@ -94,8 +95,9 @@ OROGEN_PLUGIN("import-exr", "0.1.0", registry) {
             {
                 Param::path("path", PathRole::input).help("the .exr file, relative to the spec's folder"),
                 Param::string("channel", "Y").help("the channel read as heights"),
-                Param::string("layers", "").help("channels read as layers, comma-separated (\"water, eroded\"), or "
-                                                 "all"),
+                Param::string("layers", "")
+                    .help("channels read as layers, comma-separated (\"water, eroded\"), or "
+                          "all"),
                 Param::real("cell", 0.0).min(0.0).max(1e6).unit("m").help("vertex spacing; 0 = the file's cellSize"),
             },
         .check = check,

@@ -30,8 +30,7 @@ std::optional<double> number(std::string_view json, std::string_view key, const 
     const std::string rest(json.substr(i, std::min<std::size_t>(64, json.size() - i)));
     char* end = nullptr;
     const double v = std::strtod(rest.c_str(), &end);
-    if (end == rest.c_str() || !std::isfinite(v))
-        throw BadInput(name + ": '" + std::string(key) + "' is not a number");
+    if (end == rest.c_str() || !std::isfinite(v)) throw BadInput(name + ": '" + std::string(key) + "' is not a number");
     return v;
 }
 
@@ -50,7 +49,8 @@ Description parse_description(std::string_view json, const std::string& name) {
     d.width = side(json, "nx", name);
     d.height = side(json, "ny", name);
     if (const auto dx = number(json, "dx_m", name)) {
-        if (!(*dx > 0.0) || *dx > 1e6) throw BadInput(name + ": 'dx_m' must be a number of metres above 0, at most 1e6");
+        if (!(*dx > 0.0) || *dx > 1e6)
+            throw BadInput(name + ": 'dx_m' must be a number of metres above 0, at most 1e6");
         d.cell = *dx;
     } else if (const auto lat0 = number(json, "lat0", name), dlat = number(json, "dlat", name),
                dlon = number(json, "dlon", name);
@@ -68,16 +68,18 @@ Description read_description(const std::filesystem::path& file) {
     json.replace_extension(".json");
     std::error_code ec;
     if (!std::filesystem::exists(json, ec))
-        throw BadInput(file.string() + " needs its description " + json.string() + " (nx, ny, dx_m), which does not exist");
+        throw BadInput(file.string() + " needs its description " + json.string() +
+                       " (nx, ny, dx_m), which does not exist");
     if (std::filesystem::file_size(json, ec) > (1u << 20))
         throw BadInput(json.string() + " is larger than 1 MiB: not the description of a grid");
     const auto bytes = read_file(json);
-    const Description d = parse_description(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
-                                            json.string());
+    const Description d =
+        parse_description(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()), json.string());
     if (const std::string problem = heightmap_memory_problem(d.width, d.height); !problem.empty())
         throw BadInput(json.string() + " declares " + std::to_string(d.width) + "x" + std::to_string(d.height) +
                        " samples, which " + problem);
-    if (const std::string problem = regular_file_problem(file); !problem.empty()) throw BadInput(file.string() + " " + problem);
+    if (const std::string problem = regular_file_problem(file); !problem.empty())
+        throw BadInput(file.string() + " " + problem);
     const auto size = std::filesystem::file_size(file, ec);
     const std::uintmax_t expected = std::uintmax_t(d.width) * std::uintmax_t(d.height) * 4u;
     if (ec || size != expected)

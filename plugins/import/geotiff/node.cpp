@@ -22,22 +22,24 @@ std::string gib(double bytes) {
     return s.str();
 }
 
-geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band, const std::string& holes,
-                                  double cell, const GridSpec& grid) {
+geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band, const std::string& holes, double cell,
+                                  const GridSpec& grid) {
     geotiff::ReadOptions o;
     o.band = int(band);
     if (resample != "none") {
         o.resample = geotiff::parse_resample(resample);
         o.size = std::make_pair(grid.width, grid.height);
     }
-    o.holes = holes == "refuse" ? geotiff::Holes::refuse : holes == "mask" ? geotiff::Holes::mask : geotiff::Holes::fill;
+    o.holes = holes == "refuse" ? geotiff::Holes::refuse
+        : holes == "mask"       ? geotiff::Holes::mask
+                                : geotiff::Holes::fill;
     o.cell = cell;
     return o;
 }
 
 NodeOutputs run(NodeContext& ctx) {
-    const auto o = options_from(ctx.text("resample"), ctx.integer("band"), ctx.text("holes"), ctx.real("cell"),
-                                ctx.grid());
+    const auto o =
+        options_from(ctx.text("resample"), ctx.integer("band"), ctx.text("holes"), ctx.real("cell"), ctx.grid());
     auto result = geotiff::read(ctx.input_path("path"), o);
     const double scale = ctx.real("z_scale"), offset = ctx.real("z_offset");
     if (scale != 1.0 || offset != 0.0)
@@ -65,10 +67,11 @@ void check(CheckContext& ctx) {
     // The band is read whole before resampling: it and its hole mask must fit.
     const double bytes = double(info.width) * double(info.height) * 5.0;
     if (bytes > physical_memory() / 4) {
-        ctx.error("path", "this raster is " + std::to_string(info.width) + "×" + std::to_string(info.height) +
-                              " samples and needs " + gib(bytes) + " to read, more than the " +
-                              gib(physical_memory() / 4) + " allowed here (a quarter of this machine's memory); "
-                              "cut it down first, e.g. gdal_translate -outsize 25% 25%");
+        ctx.error("path",
+                  "this raster is " + std::to_string(info.width) + "×" + std::to_string(info.height) +
+                      " samples and needs " + gib(bytes) + " to read, more than the " + gib(physical_memory() / 4) +
+                      " allowed here (a quarter of this machine's memory); "
+                      "cut it down first, e.g. gdal_translate -outsize 25% 25%");
         return;
     }
     if (ctx.text("holes") == "mask" && ctx.text("resample") != "none")

@@ -11,10 +11,9 @@ OROGEN_PLUGIN("import-raw", "0.1.0", registry) {
         .kind = "import",
         .name = "raw",
         .summary = "read a headerless RAW heightmap (.r16 or .r32) and its JSON sidecar, as export:raw writes them",
-        .description =
-            "The sidecar (<file>.json) gives the size, the cell size and, for .r16, the heights of 0 and\n"
-            "65535. The size is checked against the memory budget and the file's length before anything\n"
-            "is read, so a damaged or hostile pair fails at check time with one message.",
+        .description = "The sidecar (<file>.json) gives the size, the cell size and, for .r16, the heights of 0 and\n"
+                       "65535. The size is checked against the memory budget and the file's length before anything\n"
+                       "is read, so a damaged or hostile pair fails at check time with one message.",
         .inputs = {},
         .output = ValueType::heightmap,
         .params =
@@ -22,17 +21,16 @@ OROGEN_PLUGIN("import-raw", "0.1.0", registry) {
                 Param::path("path", PathRole::input).help("the .r16 or .r32 file, relative to the spec's folder"),
                 Param::real("cell", 0.0).min(0).max(1e6).unit("m").help("vertex spacing; 0 = the sidecar's"),
             },
-        .check = [](CheckContext& ctx) {
-            try {
-                const raw::Sidecar s = raw::read_raw_header(ctx.resolved_path("path"));
-                ctx.output().width = s.width;
-                ctx.output().height = s.height;
-                ctx.output().cell = ctx.real("cell") > 0 ? ctx.real("cell") : s.cell;
-                ctx.output().layers_known = true;
-            } catch (const BadInput& e) {
-                ctx.error("path", e.what());
-            }
-        },
+        .check =
+            [](CheckContext& ctx) {
+                try {
+                    const raw::Sidecar s = raw::read_raw_header(ctx.resolved_path("path"));
+                    ctx.output().width = s.width;
+                    ctx.output().height = s.height;
+                    ctx.output().cell = ctx.real("cell") > 0 ? ctx.real("cell") : s.cell;
+                    ctx.output().layers_known = true;
+                } catch (const BadInput& e) { ctx.error("path", e.what()); }
+            },
         .run = [](NodeContext& ctx) -> NodeOutputs {
             raw::Sidecar s;
             std::vector<float> heights = raw::read_raw(ctx.input_path("path"), s);

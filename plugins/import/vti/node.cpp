@@ -21,20 +21,20 @@ OROGEN_PLUGIN("import-vti", "0.1.0", registry) {
                 Param::path("path", PathRole::input).help("the .vti file, relative to the spec's folder"),
                 Param::real("cell", 0.0).min(0).max(1e6).unit("m").help("vertex spacing; 0 = the image's spacing"),
             },
-        .check = [](CheckContext& ctx) {
-            try {
-                const vti::Header h = vti::read_header(ctx.resolved_path("path"));
-                ctx.output().width = h.width;
-                ctx.output().height = h.height;
-                ctx.output().cell = ctx.real("cell") > 0 ? ctx.real("cell") : h.cell;
-                if (!(ctx.output().cell > 0.0))
-                    ctx.error("cell", ctx.resolved_path("path").string() +
-                                          " has no positive spacing to take the cell size from; give cell=METRES");
-                ctx.output().layers_known = true;
-            } catch (const BadInput& e) {
-                ctx.error("path", e.what());
-            }
-        },
+        .check =
+            [](CheckContext& ctx) {
+                try {
+                    const vti::Header h = vti::read_header(ctx.resolved_path("path"));
+                    ctx.output().width = h.width;
+                    ctx.output().height = h.height;
+                    ctx.output().cell = ctx.real("cell") > 0 ? ctx.real("cell") : h.cell;
+                    if (!(ctx.output().cell > 0.0))
+                        ctx.error("cell",
+                                  ctx.resolved_path("path").string() +
+                                      " has no positive spacing to take the cell size from; give cell=METRES");
+                    ctx.output().layers_known = true;
+                } catch (const BadInput& e) { ctx.error("path", e.what()); }
+            },
         .run = [](NodeContext& ctx) -> NodeOutputs {
             auto hm = vti::read(ctx.input_path("path"), ctx.real("cell"));
             ctx.check_finite(hm->heights(), "height", 0);

@@ -45,7 +45,8 @@ Layout layout_of(const int extent[6], const double spacing[3], const std::filesy
 }
 
 Layout read_layout(vtkXMLImageDataReader* reader, const std::filesystem::path& path) {
-    if (const std::string problem = regular_file_problem(path); !problem.empty()) throw BadInput(path.string() + " " + problem);
+    if (const std::string problem = regular_file_problem(path); !problem.empty())
+        throw BadInput(path.string() + " " + problem);
     if (!reader->CanReadFile(path.c_str()))
         throw BadInput(path.string() + " is not a VTK XML image (.vti) VTK can read");
     reader->SetFileName(path.c_str());
@@ -89,7 +90,8 @@ std::shared_ptr<Heightmap> read(const std::filesystem::path& path, double cell) 
         throw BadInput(path.string() + ": its 'height' array is not one number per sample; the file is damaged");
     if (!(cell > 0.0)) cell = l.header.cell;
     if (!(cell > 0.0))
-        throw BadInput(path.string() + " has no positive spacing along X to take the cell size from; give "
+        throw BadInput(path.string() +
+                       " has no positive spacing along X to take the cell size from; give "
                        "cell=METRES (orogen analyze: --cell)");
     auto hm = std::make_shared<Heightmap>(l.header.width, l.header.height, cell);
     auto& out = hm->heights();

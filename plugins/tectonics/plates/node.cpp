@@ -100,9 +100,11 @@ void check(CheckContext& ctx) {
     const int most = plates::max_plates(w, h);
     const std::int64_t n = ctx.integer("plates");
     if (n > most)
-        ctx.error("plates", "a " + std::to_string(w) + " × " + std::to_string(h) + " heightmap holds at most " +
-                                std::to_string(most) + " plates (each needs 16 × 16 samples); ask for fewer plates "
-                                "or a larger grid");
+        ctx.error("plates",
+                  "a " + std::to_string(w) + " × " + std::to_string(h) + " heightmap holds at most " +
+                      std::to_string(most) +
+                      " plates (each needs 16 × 16 samples); ask for fewer plates "
+                      "or a larger grid");
     for (const char* layer : {"uplift", "boundary", "plate"}) ctx.output().layers.insert(layer);
     check_timelapse(ctx, ctx.integer("steps"));
 }
@@ -124,7 +126,8 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
             "ranges=cells: the thesis's Voronoi cells), or, if one plate is clearly denser (oceanic under "
             "continental), a narrow trench on its side and a chain of volcanoes inland on the other; separating → "
             "a rift valley stepping down in fault blocks, with a rough ridge on its axis; sliding past → no "
-            "change. Repeated contacts at one place saturate at `saturation` contacts' worth of relief. A plate whose collision impulse passes `rift_threshold` splits in two and the parts move "
+            "change. Repeated contacts at one place saturate at `saturation` contacts' worth of relief. A plate whose "
+            "collision impulse passes `rift_threshold` splits in two and the parts move "
             "apart. The simulation area (36 units on the longer side) covers the heightmap. Adds the layers "
             "uplift (m), boundary (1 convergent, 2 divergent, 3 transform) and plate (id of the plate over each "
             "sample at the end, -1 none), and the side value `plates` (polygons every `record_every` steps and "
@@ -170,7 +173,10 @@ OROGEN_PLUGIN("tectonics-plates", "0.1.0", registry) {
                     .unit("m")
                     .help("depth of a rift valley per divergent contact; its flanks step down in fault blocks "
                           "half this high"),
-                Param::real("ridge_height", 10.0).min(0.0).unit("m").help("height of the rough ridge along a rift's axis"),
+                Param::real("ridge_height", 10.0)
+                    .min(0.0)
+                    .unit("m")
+                    .help("height of the rough ridge along a rift's axis"),
                 Param::real("trench_depth", 25.0).min(0.0).unit("m").help("depth of a subduction trench per contact"),
                 Param::real("arc_height", 35.0)
                     .min(0.0)

@@ -83,25 +83,25 @@ struct PlateBody {
     b2Body* body = nullptr;
     int id = 0;
     double density = 1.0;
-    double impulse = 0.0;           // accumulated plate–plate normal impulse since the last rift attempt
+    double impulse = 0.0;  // accumulated plate–plate normal impulse since the last rift attempt
     double stress_x = 0.0, stress_y = 0.0;  // impulse-weighted sum of contact points, plate frame (u·N·s)
 };
 
 struct Beam {
     b2Body* body = nullptr;
-    Point2 rest;           // centre at rest, u
-    Point2 inward;         // unit normal into the area
-    double push = 0.0;     // inward offset amplitude as a multiple of the stroke (negative: outward)
-    double phase = 0.0;    // of the triangle wave, in periods
-    Point2 convey;         // surface velocity (conveyor belt) of the beam's face, u/s
+    Point2 rest;  // centre at rest, u
+    Point2 inward;  // unit normal into the area
+    double push = 0.0;  // inward offset amplitude as a multiple of the stroke (negative: outward)
+    double phase = 0.0;  // of the triangle wave, in periods
+    Point2 convey;  // surface velocity (conveyor belt) of the beam's face, u/s
 };
 
 struct PendingEvent {
     b2Contact* contact = nullptr;
     PlateBody* a = nullptr;
     PlateBody* b = nullptr;
-    Point2 p0, p1;   // u
-    Point2 normal;   // from a to b
+    Point2 p0, p1;  // u
+    Point2 normal;  // from a to b
     BoundaryKind kind = BoundaryKind::convergent;
     double impulse = 0.0;
 };
@@ -134,15 +134,15 @@ ReliefShape relief_shape(const Params& params, int w, int h) {
 void draw_stamp(const ReliefStamp& stamp, const Params& params, BoundaryRelief& relief, GridView terrain,
                 GridView* uplift, TileRect at) {
     switch (stamp.kind) {
-    case ReliefStamp::Kind::range: relief.add_range(stamp.a, stamp.b); break;
-    case ReliefStamp::Kind::subduction: relief.add_subduction(stamp.a, stamp.b, stamp.toward_light); break;
-    case ReliefStamp::Kind::rift: relief.add_rift(stamp.a, stamp.b); break;
-    case ReliefStamp::Kind::cells: {
-        const rmp::RangeParams range{params.cones, params.height, params.jitter};
-        rmp::raise_range(terrain, relief.width(), relief.height(), at.x0, at.y0, stamp.a, stamp.b, range, stamp.seed,
-                         uplift);
-        break;
-    }
+        case ReliefStamp::Kind::range: relief.add_range(stamp.a, stamp.b); break;
+        case ReliefStamp::Kind::subduction: relief.add_subduction(stamp.a, stamp.b, stamp.toward_light); break;
+        case ReliefStamp::Kind::rift: relief.add_rift(stamp.a, stamp.b); break;
+        case ReliefStamp::Kind::cells: {
+            const rmp::RangeParams range{params.cones, params.height, params.jitter};
+            rmp::raise_range(terrain, relief.width(), relief.height(), at.x0, at.y0, stamp.a, stamp.b, range,
+                             stamp.seed, uplift);
+            break;
+        }
     }
 }
 
@@ -157,8 +157,8 @@ void draw_layers(const Replay& replay, const Layers& layers, TileRect at) {
     if (layers.boundary.data) {
         const int radius = std::max(0, std::min(replay.width, replay.height) / 512);
         for (const CollisionEvent& e : replay.boundaries)
-            draw_segment(layers.boundary, at, (1.0 / replay.cell) * e.a, (1.0 / replay.cell) * e.b,
-                         float(int(e.kind)), radius);
+            draw_segment(layers.boundary, at, (1.0 / replay.cell) * e.a, (1.0 / replay.cell) * e.b, float(int(e.kind)),
+                         radius);
     }
 }
 
@@ -193,11 +193,14 @@ public:
         const double m = margin_units;
         const double reach = m + thick + params_.stroke + 1.0;  // beams overlap past the corners
         const double sx = size_.x, sy = size_.y;
-        struct Def { Point2 centre, inward; double hx, hy; };
+        struct Def {
+            Point2 centre, inward;
+            double hx, hy;
+        };
         const Def defs[4] = {
-            {{-m - 0.5 * thick, 0.5 * sy}, {1, 0}, 0.5 * thick, 0.5 * sy + reach},       // west
+            {{-m - 0.5 * thick, 0.5 * sy}, {1, 0}, 0.5 * thick, 0.5 * sy + reach},  // west
             {{sx + m + 0.5 * thick, 0.5 * sy}, {-1, 0}, 0.5 * thick, 0.5 * sy + reach},  // east
-            {{0.5 * sx, -m - 0.5 * thick}, {0, 1}, 0.5 * sx + reach, 0.5 * thick},       // north (y south)
+            {{0.5 * sx, -m - 0.5 * thick}, {0, 1}, 0.5 * sx + reach, 0.5 * thick},  // north (y south)
             {{0.5 * sx, sy + m + 0.5 * thick}, {0, -1}, 0.5 * sx + reach, 0.5 * thick},  // south
         };
         const double s = params_.speed;
@@ -206,27 +209,27 @@ public:
             beam.rest = defs[i].centre;
             beam.inward = defs[i].inward;
             switch (params_.drive) {
-            case Drive::still: break;
-            case Drive::converge:  // west+east squeeze together, north+south half a period later
-                beam.push = 1.0;
-                beam.phase = i < 2 ? 0.0 : 0.5;
-                break;
-            case Drive::thesis:  // every beam moves the same way at once: the box translates and shakes
-                beam.push = (i % 2 == 0) ? 1.0 : -1.0;
-                beam.phase = 0.0;
-                break;
-            case Drive::rotate: {  // faces convey clockwise on the map (x east, y south) and squeeze gently
-                const Point2 conveys[4] = {{0, -s}, {0, s}, {s, 0}, {-s, 0}};
-                beam.convey = conveys[i];
-                beam.push = 0.5;
-                beam.phase = i < 2 ? 0.0 : 0.5;
-                break;
-            }
-            case Drive::shear:  // north face conveys east, south face west; both squeeze a little
-                if (i == 2) beam.convey = {s, 0};
-                if (i == 3) beam.convey = {-s, 0};
-                beam.push = i >= 2 ? 0.5 : 0.0;
-                break;
+                case Drive::still: break;
+                case Drive::converge:  // west+east squeeze together, north+south half a period later
+                    beam.push = 1.0;
+                    beam.phase = i < 2 ? 0.0 : 0.5;
+                    break;
+                case Drive::thesis:  // every beam moves the same way at once: the box translates and shakes
+                    beam.push = (i % 2 == 0) ? 1.0 : -1.0;
+                    beam.phase = 0.0;
+                    break;
+                case Drive::rotate: {  // faces convey clockwise on the map (x east, y south) and squeeze gently
+                    const Point2 conveys[4] = {{0, -s}, {0, s}, {s, 0}, {-s, 0}};
+                    beam.convey = conveys[i];
+                    beam.push = 0.5;
+                    beam.phase = i < 2 ? 0.0 : 0.5;
+                    break;
+                }
+                case Drive::shear:  // north face conveys east, south face west; both squeeze a little
+                    if (i == 2) beam.convey = {s, 0};
+                    if (i == 3) beam.convey = {-s, 0};
+                    beam.push = i >= 2 ? 0.5 : 0.0;
+                    break;
             }
             b2BodyDef def;
             def.type = b2_kinematicBody;
@@ -289,8 +292,8 @@ public:
         if (contact->GetManifold()->pointCount != 2) return;
         auto* pa = reinterpret_cast<PlateBody*>(body_a->GetUserData().pointer);
         auto* pb = reinterpret_cast<PlateBody*>(body_b->GetUserData().pointer);
-        const std::uint64_t key = (std::uint64_t(std::uint32_t(std::min(pa->id, pb->id))) << 32) |
-                                  std::uint32_t(std::max(pa->id, pb->id));
+        const std::uint64_t key =
+            (std::uint64_t(std::uint32_t(std::min(pa->id, pb->id))) << 32) | std::uint32_t(std::max(pa->id, pb->id));
         const auto [it, first_touch] = last_touch_.try_emplace(key, step_);
         const bool begins = first_touch || (it->second != step_ - 1 && it->second != step_);
         it->second = step_;
@@ -301,7 +304,7 @@ public:
         const Point2 normal = to_point(wm.normal);
         const b2Vec2 mid(0.5f * (wm.points[0].x + wm.points[1].x), 0.5f * (wm.points[0].y + wm.points[1].y));
         const Point2 rel = to_point(body_b->GetLinearVelocityFromWorldPoint(mid)) -
-                           to_point(body_a->GetLinearVelocityFromWorldPoint(mid));
+            to_point(body_a->GetLinearVelocityFromWorldPoint(mid));
         const double speed = std::hypot(rel.x, rel.y);
         if (!(speed >= params_.min_speed)) {
             ++result_.stats.events[0];
@@ -469,8 +472,8 @@ private:
         for (std::size_t i = 0; i < plates_.size(); ++i) {
             PlateBody& p = *plates_[i];
             if (p.impulse < params_.rift_threshold) continue;
-            const Point2 stress = to_point(p.body->GetWorldPoint(
-                b2Vec2(float(p.stress_x / p.impulse), float(p.stress_y / p.impulse))));
+            const Point2 stress =
+                to_point(p.body->GetWorldPoint(b2Vec2(float(p.stress_x / p.impulse), float(p.stress_y / p.impulse))));
             p.impulse = p.stress_x = p.stress_y = 0.0;
             const Polygon poly = world_polygon(p.body);
             const double area = signed_area(poly);
@@ -479,7 +482,8 @@ private:
             if (std::hypot(d.x, d.y) < 1e-3) d = {1.0, 0.0};
             for (int k : {0, 1, -1, 2, -2, 3, -3}) {
                 const double turn = k * std::numbers::pi / 15.0;
-                const Point2 dk{d.x * std::cos(turn) - d.y * std::sin(turn), d.x * std::sin(turn) + d.y * std::cos(turn)};
+                const Point2 dk{d.x * std::cos(turn) - d.y * std::sin(turn),
+                                d.x * std::sin(turn) + d.y * std::cos(turn)};
                 auto parts = split_convex(poly, stress, dk, min_gap_units);
                 if (!parts) continue;
                 auto& [left, right] = *parts;
@@ -502,8 +506,8 @@ private:
             PlateSpec s;
             s.polygon = poly;
             const Point2 c = centroid(poly);
-            s.velocity = to_point(old.body->GetLinearVelocityFromWorldPoint(to_b2(c))) +
-                         (sign * params_.rift_speed) * n;
+            s.velocity =
+                to_point(old.body->GetLinearVelocityFromWorldPoint(to_b2(c))) + (sign * params_.rift_speed) * n;
             s.angular_velocity = old.body->GetAngularVelocity();
             s.density = old.density;
             return s;
@@ -639,7 +643,7 @@ std::vector<PlateSpec> random_plates(Point2 size, int count, double oceanic_frac
         const bool oceanic = random::uniform(seed, purpose_oceanic, i) < oceanic_fraction;
         // ±0.02 around the crust's density, so two plates of a kind still differ a little.
         s.density = (oceanic ? oceanic_density : continental_density) +
-                    random::uniform_in(-0.02, 0.02, seed, purpose_density, i);
+            random::uniform_in(-0.02, 0.02, seed, purpose_density, i);
         const double angle = random::uniform_in(0.0, 2.0 * std::numbers::pi, seed, purpose_velocity_angle, i);
         const double v = speed * random::uniform(seed, purpose_velocity_size, i);
         s.velocity = {v * std::cos(angle), v * std::sin(angle)};
@@ -884,7 +888,8 @@ void fill_polygon(GridView layer, TileRect at, std::span<const Point2> polygon, 
             for (std::size_t i = 0; i < n; ++i) {
                 const Point2 p = polygon[i], q = polygon[(i + 1) % n];
                 if ((p.y <= double(y) && q.y >= double(y)) || (q.y <= double(y) && p.y >= double(y))) {
-                    const double x = p.y == q.y ? std::min(p.x, q.x) : p.x + (double(y) - p.y) * (q.x - p.x) / (q.y - p.y);
+                    const double x =
+                        p.y == q.y ? std::min(p.x, q.x) : p.x + (double(y) - p.y) * (q.x - p.x) / (q.y - p.y);
                     const double x2 = p.y == q.y ? std::max(p.x, q.x) : x;
                     lo = std::min(lo, x), hi = std::max(hi, x2);
                 }

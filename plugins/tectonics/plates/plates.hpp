@@ -43,11 +43,11 @@ namespace orogen::plates {
 
 /// How the four beams move.
 enum class Drive {
-    still,     ///< beams stay put: the plates keep their initial velocities (scripted scenarios)
+    still,  ///< beams stay put: the plates keep their initial velocities (scripted scenarios)
     converge,  ///< opposite beams push inward together, the two axes half a period apart: squeezes the plates
-    rotate,    ///< beams convey their surfaces round the box (friction) and squeeze gently: plates circulate
-    shear,     ///< north beam conveys east, south beam west: plates slide past each other
-    thesis,    ///< the thesis's beams: all moving in phase, so the box shakes the plates back and forth
+    rotate,  ///< beams convey their surfaces round the box (friction) and squeeze gently: plates circulate
+    shear,  ///< north beam conveys east, south beam west: plates slide past each other
+    thesis,  ///< the thesis's beams: all moving in phase, so the box shakes the plates back and forth
 };
 inline constexpr std::array<std::string_view, 5> drive_names = {"still", "converge", "rotate", "shear", "thesis"};
 std::optional<Drive> parse_drive(std::string_view name);
@@ -60,7 +60,7 @@ enum class RangeStyle {
 inline constexpr std::array<std::string_view, 2> range_style_names = {"peaks", "cells"};
 std::optional<RangeStyle> parse_range_style(std::string_view name);
 
-inline constexpr double area_units = 36.0;   ///< u, the plate area's longer side
+inline constexpr double area_units = 36.0;  ///< u, the plate area's longer side
 inline constexpr double margin_units = 2.0;  ///< u, free space between the area and the beams at rest
 inline constexpr int max_plate_vertices = 8;  ///< b2_maxPolygonVertices
 
@@ -74,10 +74,10 @@ int max_plates(int width, int height);
 
 /// A plate to start from, in simulation units.
 struct PlateSpec {
-    Polygon polygon;                ///< convex, counter-clockwise in (x east, y south), ≤ 8 vertices
-    Point2 velocity;                ///< u/s
+    Polygon polygon;  ///< convex, counter-clockwise in (x east, y south), ≤ 8 vertices
+    Point2 velocity;  ///< u/s
     double angular_velocity = 0.0;  ///< rad/s
-    double density = 1.0;           ///< relative; the denser plate of a convergent pair subducts
+    double density = 1.0;  ///< relative; the denser plate of a convergent pair subducts
 };
 
 /// Plate densities: oceanic crust is denser than continental.
@@ -91,8 +91,7 @@ inline constexpr double continental_density = 2.7;
 /// fraction `oceanic_fraction` of the plates is oceanic. Every plate starts
 /// with a random velocity up to `speed` u/s. Throws orogen::Error if a plate
 /// cannot be cut after many tries (count far above max_plates).
-std::vector<PlateSpec> random_plates(Point2 size, int count, double oceanic_fraction, double speed,
-                                     std::uint64_t seed);
+std::vector<PlateSpec> random_plates(Point2 size, int count, double oceanic_fraction, double speed, std::uint64_t seed);
 
 struct Params {
     int steps = 1000;
@@ -102,21 +101,21 @@ struct Params {
     double restitution = 0.5;
     double friction = 0.6;
     Drive drive = Drive::converge;
-    double speed = 1.0;   ///< u/s, beam speed (the thesis's 1)
+    double speed = 1.0;  ///< u/s, beam speed (the thesis's 1)
     double stroke = 1.0;  ///< u, how far a beam moves inward from rest (≤ margin_units)
     /// u/s: below this relative speed at a contact the plates are resting on
     /// each other and the contact makes no boundary event.
     double min_speed = 0.05;
 
     // Relief, per event (profiles.hpp). Widths scale with the RMP's Voronoi cell size sqrt(area / cones).
-    int cones = 100;              ///< Voronoi sites over the grid (cells style: per range); sets every width
+    int cones = 100;  ///< Voronoi sites over the grid (cells style: per range); sets every width
     RangeStyle ranges = RangeStyle::peaks;
-    double height = 80.0;         ///< m raised per convergent collision
-    double jitter = 0.5;          ///< per-peak / per-cell height variation (thesis 4.2)
-    double rift_depth = 20.0;     ///< m
-    double ridge_height = 10.0;   ///< m
-    double trench_depth = 25.0;   ///< m
-    double arc_height = 35.0;     ///< m
+    double height = 80.0;  ///< m raised per convergent collision
+    double jitter = 0.5;  ///< per-peak / per-cell height variation (thesis 4.2)
+    double rift_depth = 20.0;  ///< m
+    double ridge_height = 10.0;  ///< m
+    double trench_depth = 25.0;  ///< m
+    double arc_height = 35.0;  ///< m
     /// Contacts' worth of relief a place can take at most: repeated contacts
     /// saturate toward saturation × the per-contact amount (not for ranges=cells).
     double saturation = 5.0;
@@ -125,8 +124,8 @@ struct Params {
     /// Accumulated plate–plate impulse (N·s, sim units) that splits a plate; 0 = never. Neither part of a
     /// rift may be smaller than half the mean start plate (or a fifth of the plate).
     double rift_threshold = 20000.0;
-    double rift_speed = 0.5;      ///< u/s, how fast the two parts of a rifted plate move apart
-    int max_plates = 256;         ///< rifting stops at this many plates
+    double rift_speed = 0.5;  ///< u/s, how fast the two parts of a rifted plate move apart
+    int max_plates = 256;  ///< rifting stops at this many plates
 
     int record_every = 10;  ///< record plate polygons every this many steps (and the first and last)
 };
@@ -144,10 +143,10 @@ struct Layers {
 
 struct Stats {
     std::int64_t events[4] = {0, 0, 0, 0};  ///< by BoundaryKind (index 0: resting contacts skipped)
-    std::int64_t subductions = 0;           ///< convergent events shaped as trench and arc
-    std::int64_t rifts = 0;                 ///< plates split during the run
-    double box2d_seconds = 0.0;             ///< wall time inside b2World::Step
-    double relief_seconds = 0.0;            ///< wall time raising ranges, rifts, trenches
+    std::int64_t subductions = 0;  ///< convergent events shaped as trench and arc
+    std::int64_t rifts = 0;  ///< plates split during the run
+    double box2d_seconds = 0.0;  ///< wall time inside b2World::Step
+    double relief_seconds = 0.0;  ///< wall time raising ranges, rifts, trenches
 };
 
 /// One boundary's relief, in the order the simulation made them (what
@@ -155,10 +154,10 @@ struct Stats {
 struct ReliefStamp {
     enum class Kind : std::uint8_t { range, subduction, rift, cells };
     Kind kind = Kind::range;
-    Point2 a, b;                ///< samples, clipped to the grid
-    Point2 toward_light;        ///< subduction: from the dense plate toward the light one
-    std::uint64_t seed = 0;     ///< cells: the RMP range's seed
-    std::int64_t step = 0;      ///< the simulation step whose contact made it (time-lapses replay up to a step)
+    Point2 a, b;  ///< samples, clipped to the grid
+    Point2 toward_light;  ///< subduction: from the dense plate toward the light one
+    std::uint64_t seed = 0;  ///< cells: the RMP range's seed
+    std::int64_t step = 0;  ///< the simulation step whose contact made it (time-lapses replay up to a step)
 };
 
 /// What draws a finished simulation into any rectangle of the grid without
@@ -166,10 +165,10 @@ struct ReliefStamp {
 /// this (encode/decode) and draw their tiles from it.
 struct Replay {
     int width = 0, height = 0;  ///< the whole grid, samples
-    double cell = 1.0;          ///< m
+    double cell = 1.0;  ///< m
     std::vector<ReliefStamp> stamps;
     std::vector<CollisionEvent> boundaries;  ///< every event (the boundary layer), metres
-    std::vector<Polygon> final_polygons;     ///< samples
+    std::vector<Polygon> final_polygons;  ///< samples
     std::vector<int> final_ids;
 };
 std::string encode(const Replay& replay);

@@ -57,8 +57,8 @@ double gradient_noise(double x, double y, std::uint64_t seed) {
     const double ix = std::floor(x), iy = std::floor(y);
     const double fx = x - ix, fy = y - iy;
     // One of 16 unit gradients per lattice point (no trigonometry per sample).
-    static constexpr double gx[16] = {1, 0.92388, 0.70711, 0.38268, 0, -0.38268, -0.70711, -0.92388,
-                                      -1, -0.92388, -0.70711, -0.38268, 0, 0.38268, 0.70711, 0.92388};
+    static constexpr double gx[16] = {1,  0.92388,  0.70711,  0.38268,  0, -0.38268, -0.70711, -0.92388,
+                                      -1, -0.92388, -0.70711, -0.38268, 0, 0.38268,  0.70711,  0.92388};
     auto grad = [&](double i, double j, double dx, double dy) {
         const auto k = random::hash(seed, std::uint64_t(std::int64_t(i)), std::uint64_t(std::int64_t(j))) & 15u;
         return gx[k] * dx + gx[(k + 12) & 15u] * dy;  // (cos, sin) = (gx[k], gx[k − 4])
@@ -163,8 +163,7 @@ void stamp(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point
 // contacts at one place keep one shape instead of summing into a smear.
 void stamp_max(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
                const Table& profile, const Table& taper) {
-    stamp_with(field, window, a, b, normal, end_reach, profile, taper,
-               [](float& v, float d) { v = std::max(v, d); });
+    stamp_with(field, window, a, b, normal, end_reach, profile, taper, [](float& v, float d) { v = std::max(v, d); });
 }
 
 // The tables of one relief: per-contact profiles across each kind of
@@ -204,9 +203,9 @@ double terrace(double d, double step) {
     const double q = d / step;
     const double k = std::floor(q), f = q - k;
     constexpr double scarp = 0.25;  // the last quarter of each step is the fault scarp
-    constexpr double tilt = 0.2;    // the tread descends 20 % of a step over its width
-    const double within = f < 1.0 - scarp ? tilt * f / (1.0 - scarp)
-                                          : tilt + (1.0 - tilt) * smoothstep((f - (1.0 - scarp)) / scarp);
+    constexpr double tilt = 0.2;  // the tread descends 20 % of a step over its width
+    const double within =
+        f < 1.0 - scarp ? tilt * f / (1.0 - scarp) : tilt + (1.0 - tilt) * smoothstep((f - (1.0 - scarp)) / scarp);
     return step * (k + within);
 }
 
@@ -233,7 +232,7 @@ double ridged_field(double x, double y, double spacing, std::uint64_t seed) {
     for (int octave = 0; octave < 4; ++octave) {
         const double n = gradient_noise(x * f, y * f, random::hash(seed, std::uint64_t(octave)));
         double r = std::clamp(1.0 - 1.5 * std::abs(n), 0.0, 1.0);
-        r = r * r * weight;          // sharp crests where the noise crosses zero
+        r = r * r * weight;  // sharp crests where the noise crosses zero
         weight = std::clamp(2.0 * r, 0.0, 1.0);  // finer ridges ride on the crests of coarser ones
         sum += amp * r;
         norm += amp;
@@ -312,9 +311,8 @@ void BoundaryRelief::add_rift(Point2 a, Point2 b) {
     // How deep (summed, saturated at compose time): the same across the
     // whole rift, fading just outside it.
     const double edge = 0.1 * shape_.cell;
-    const Table rift(-w.rift_half - edge, w.rift_half + edge, [&](double s) {
-        return depth * (1.0 - smoothstep((std::abs(s) - w.rift_half) / edge));
-    });
+    const Table rift(-w.rift_half - edge, w.rift_half + edge,
+                     [&](double s) { return depth * (1.0 - smoothstep((std::abs(s) - w.rift_half) / edge)); });
     stamp(field(rift_), window_, a, b, n, w.end_reach, rift, taper_table(w));
     // Where on the flank (the largest over contacts): 1 on the floor, 0 at
     // the rim; terraced at compose time into three fault blocks.
@@ -351,9 +349,11 @@ BoundaryRelief::Vents BoundaryRelief::vents() const {
             const int px = int(std::lround(vent.x)), py = int(std::lround(vent.y));
             // A vent outside the window stays dormant here: no sample apply() composes reaches it.
             if (px < window_.x0 || py < window_.y0 || px >= window_.x1() || py >= window_.y1()) continue;
-            const float act = arc_[std::size_t(py - window_.y0) * std::size_t(window_.width) + std::size_t(px - window_.x0)];
+            const float act =
+                arc_[std::size_t(py - window_.y0) * std::size_t(window_.width) + std::size_t(px - window_.x0)];
             if (!(act > 0.0f)) continue;
-            const double u_height = random::uniform(seed, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj)), 1u);
+            const double u_height =
+                random::uniform(seed, std::uint64_t(std::int64_t(ci)), std::uint64_t(std::int64_t(cj)), 1u);
             vent.height = saturate(act, cap) * (1.0 + shape_.jitter * (2.0 * u_height - 1.0));
         }
     return v;
@@ -398,16 +398,15 @@ float BoundaryRelief::relief_at(int x, int y, const Vents& vents) const {
     }
     if (!rift_.empty() && rift_[i] > 0.0f && flank_[i] > 0.0f) {
         // Wobble the fault scarps along strike: real faults are segmented, not offset copies of the axis.
-        const double t = std::clamp(double(flank_[i]) + 0.08 * value_noise(x, y, 0.4 * shape_.cell,
-                                                                          random::hash(seed_, purpose_wobble)),
-                                    0.0, 1.0);
-        const double valley =
-            saturate(rift_[i], sat * shape_.rift_depth) * terrace(t * rift_blocks, 1.0) / rift_blocks;
+        const double t = std::clamp(
+            double(flank_[i]) + 0.08 * value_noise(x, y, 0.4 * shape_.cell, random::hash(seed_, purpose_wobble)), 0.0,
+            1.0);
+        const double valley = saturate(rift_[i], sat * shape_.rift_depth) * terrace(t * rift_blocks, 1.0) / rift_blocks;
         double ridge = 0.0;
         if (!ridge_.empty() && ridge_[i] > 0.0f) {
-            const double rough = 0.6 + 0.5 * peak_field(x, y, std::max(2.0, 0.15 * shape_.cell), jitter,
-                                                        random::hash(seed_, purpose_ridge)) /
-                                           (1.0 + jitter);
+            const double rough = 0.6 +
+                0.5 * peak_field(x, y, std::max(2.0, 0.15 * shape_.cell), jitter, random::hash(seed_, purpose_ridge)) /
+                    (1.0 + jitter);
             ridge = std::min(saturate(ridge_[i], sat * shape_.ridge_height) * rough, valley);  // never above the land
         }
         dh += ridge - valley;
@@ -422,13 +421,14 @@ void BoundaryRelief::apply(GridView terrain, GridView* uplift) const {
 }
 
 void BoundaryRelief::apply(GridView terrain, TileRect at, GridView* uplift) const {
-    if (terrain.width != at.width || terrain.height != at.height || (uplift && (uplift->width != at.width ||
-                                                                                uplift->height != at.height)))
+    if (terrain.width != at.width || terrain.height != at.height ||
+        (uplift && (uplift->width != at.width || uplift->height != at.height)))
         throw BadInput("boundary relief: the terrain grid must be the size of the rectangle it covers");
     const int m = vent_margin();
-    const bool inside = at.x0 >= (window_.x0 > 0 ? window_.x0 + m : 0) && at.y0 >= (window_.y0 > 0 ? window_.y0 + m : 0) &&
-                        at.x1() <= (window_.x1() < width_ ? window_.x1() - m : width_) &&
-                        at.y1() <= (window_.y1() < height_ ? window_.y1() - m : height_);
+    const bool inside = at.x0 >= (window_.x0 > 0 ? window_.x0 + m : 0) &&
+        at.y0 >= (window_.y0 > 0 ? window_.y0 + m : 0) &&
+        at.x1() <= (window_.x1() < width_ ? window_.x1() - m : width_) &&
+        at.y1() <= (window_.y1() < height_ ? window_.y1() - m : height_);
     if (!inside) throw BadInput("boundary relief: the rectangle to compose reaches too near the window's edge");
     if (range_.empty() && trench_.empty() && arc_.empty() && rift_.empty()) return;
     const Vents vent_lattice = vents();

@@ -33,31 +33,31 @@
 namespace orogen::plates {
 
 struct ReliefShape {
-    double cell = 16.0;          ///< samples: the Voronoi cell size c; every width below scales with it
+    double cell = 16.0;  ///< samples: the Voronoi cell size c; every width below scales with it
     double range_height = 60.0;  ///< m per convergent contact (before the peak texture)
-    double jitter = 0.5;         ///< per-peak / per-volcano height variation: × (1 + jitter·u), u ∈ [−1, 1)
+    double jitter = 0.5;  ///< per-peak / per-volcano height variation: × (1 + jitter·u), u ∈ [−1, 1)
     double trench_depth = 40.0;  ///< m per subduction contact
-    double arc_height = 30.0;    ///< m per subduction contact (volcano height before jitter)
-    double rift_depth = 20.0;    ///< m per divergent contact
+    double arc_height = 30.0;  ///< m per subduction contact (volcano height before jitter)
+    double rift_depth = 20.0;  ///< m per divergent contact
     double ridge_height = 10.0;  ///< m per divergent contact, the axial ridge
-    double saturation = 5.0;     ///< contacts' worth: no place gets more than saturation × a contact's amount
+    double saturation = 5.0;  ///< contacts' worth: no place gets more than saturation × a contact's amount
 };
 
 /// Widths and offsets across a boundary, in samples, for a cell size c.
 struct ReliefWidths {
-    double range_half;       ///< 0.8 c: a range's envelope reaches this far either side of the contact
-    double peak_spacing;     ///< 0.4 c: spacing of the range's peaks (a second octave at a third of it)
-    double trench_offset;    ///< 0.12 c on the dense side: the trench's deepest line
-    double trench_outer;     ///< 0.3 c: the trench's gentle outer (oceanic) wall
-    double trench_inner;     ///< 0.12 c: its steep inner wall, toward the arc
-    double arc_offset;       ///< 0.6 c inland on the light plate: the volcanic line
-    double arc_band;         ///< 0.2 c: half-width of the band whose vents erupt
-    double vent_spacing;     ///< 0.4 c: lattice of possible vents
-    double vent_radius;      ///< 0.3 c: a volcano's base radius (± 20 %)
-    double rift_floor;       ///< 0.15 c: half-width of the flat rift floor
-    double rift_half;        ///< 0.6 c: the flanks reach the original ground here
-    double ridge_half;       ///< max(0.08 c, 1.5): the axial ridge's half-width
-    double end_reach;        ///< 0.3 c: relief fades past a segment's ends over this distance
+    double range_half;  ///< 0.8 c: a range's envelope reaches this far either side of the contact
+    double peak_spacing;  ///< 0.4 c: spacing of the range's peaks (a second octave at a third of it)
+    double trench_offset;  ///< 0.12 c on the dense side: the trench's deepest line
+    double trench_outer;  ///< 0.3 c: the trench's gentle outer (oceanic) wall
+    double trench_inner;  ///< 0.12 c: its steep inner wall, toward the arc
+    double arc_offset;  ///< 0.6 c inland on the light plate: the volcanic line
+    double arc_band;  ///< 0.2 c: half-width of the band whose vents erupt
+    double vent_spacing;  ///< 0.4 c: lattice of possible vents
+    double vent_radius;  ///< 0.3 c: a volcano's base radius (± 20 %)
+    double rift_floor;  ///< 0.15 c: half-width of the flat rift floor
+    double rift_half;  ///< 0.6 c: the flanks reach the original ground here
+    double ridge_half;  ///< max(0.08 c, 1.5): the axial ridge's half-width
+    double end_reach;  ///< 0.3 c: relief fades past a segment's ends over this distance
 };
 ReliefWidths relief_widths(double cell);
 
@@ -116,7 +116,7 @@ public:
     std::vector<float> relief() const;
 
     const ReliefWidths& widths() const { return widths_; }
-    int width() const { return width_; }   ///< the whole grid
+    int width() const { return width_; }  ///< the whole grid
     int height() const { return height_; }
 
 private:
@@ -135,7 +135,7 @@ private:
     std::vector<float>& field(std::vector<float>& f);
 
     int width_, height_;  // the whole grid
-    TileRect window_;     // the samples held (the activity fields' extent)
+    TileRect window_;  // the samples held (the activity fields' extent)
     ReliefShape shape_;
     ReliefWidths widths_;
     std::uint64_t seed_;

@@ -127,7 +127,9 @@ int plot(const std::string& csv, const std::string& out) {
     const Rgb grid{225, 225, 225}, ink{40, 40, 40};
     for (int k = int(xmin); k <= int(xmax); ++k) {
         c.line(X(std::pow(10, k)), T, X(std::pow(10, k)), B, grid, 1);
-        const std::string label = k == 0 ? "1" : k <= 3 ? std::to_string(int(std::pow(10, k))) : "1e" + std::to_string(k);
+        const std::string label = k == 0 ? "1"
+            : k <= 3                     ? std::to_string(int(std::pow(10, k)))
+                                         : "1e" + std::to_string(k);
         c.text(X(std::pow(10, k)) - Canvas::text_width(label) / 2, B + 10, label, ink);
     }
     const char* ylabels[] = {"1 ms", "10 ms", "0.1 s", "1 s", "10 s", "100 s", "1000 s", "1e4 s"};
@@ -190,7 +192,7 @@ int voronoi(int count, int size, const std::string& out) {
         for (int x = 0; x < size; ++x) {
             const int id = labels[std::size_t(y) * size + x];
             const bool border = (x + 1 < size && labels[std::size_t(y) * size + x + 1] != id) ||
-                                (y + 1 < size && labels[std::size_t(y + 1) * size + x] != id);
+                (y + 1 < size && labels[std::size_t(y + 1) * size + x] != id);
             c.set(x, y, border ? Rgb{30, 30, 30} : id == lit ? Rgb{255, 255, 255} : cell_colour(id));
         }
     for (const Point2& s : sites) c.disc(s.x, s.y, size > 400 && count > 500 ? 1.0 : 2.0, {20, 20, 20});
@@ -201,7 +203,8 @@ int voronoi(int count, int size, const std::string& out) {
 int shade(const std::string& in, int w, int h, const std::string& out) {
     const auto bytes = read_file(in);
     if (bytes.size() != std::size_t(w) * h * 4) {
-        std::cerr << "rmp_figures: " << in << " holds " << bytes.size() << " bytes, not " << w << " x " << h << " floats\n";
+        std::cerr << "rmp_figures: " << in << " holds " << bytes.size() << " bytes, not " << w << " x " << h
+                  << " floats\n";
         return 2;
     }
     std::vector<float> z(std::size_t(w) * h);

@@ -57,7 +57,9 @@ void colour(double t, double& r, double& g, double& b) {
 // Light from the north-west, 45° up, true vertical scale.
 void shade_into(Image& img, int ox, int oy, const std::vector<float>& z, int w, int h, double cell, int x0, int y0,
                 int cw, int ch, int zoom, double lo = 0.0, double hi = -1.0) {
-    auto at = [&](int x, int y) { return double(z[std::size_t(std::clamp(y, 0, h - 1)) * w + std::clamp(x, 0, w - 1)]); };
+    auto at = [&](int x, int y) {
+        return double(z[std::size_t(std::clamp(y, 0, h - 1)) * w + std::clamp(x, 0, w - 1)]);
+    };
     const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
     if (hi < lo) {  // the picture's own range
         const auto [lo_it, hi_it] = std::minmax_element(z.begin(), z.end());
@@ -89,7 +91,8 @@ int shade(const std::vector<std::string>& a) {
         return 2;
     }
     int x0 = 0, y0 = 0, cw = w, ch = h, zoom = 1;
-    if (a.size() == 11) x0 = std::stoi(a[6]), y0 = std::stoi(a[7]), cw = std::stoi(a[8]), ch = std::stoi(a[9]), zoom = std::stoi(a[10]);
+    if (a.size() == 11)
+        x0 = std::stoi(a[6]), y0 = std::stoi(a[7]), cw = std::stoi(a[8]), ch = std::stoi(a[9]), zoom = std::stoi(a[10]);
     Image img(cw * zoom, ch * zoom);
     shade_into(img, 0, 0, z, w, h, cell, x0, y0, cw, ch, zoom);
     img.save(a[5]);

@@ -18,8 +18,8 @@ namespace orogen::analysis {
 /// What the references measured of one figure.
 struct Band {
     double low = 0.0, high = 0.0;  ///< min and max over the references that measured it
-    double spread = 0.0;           ///< their (population) standard deviation; 0 with fewer than two
-    bool known = false;            ///< at least one reference measured it
+    double spread = 0.0;  ///< their (population) standard deviation; 0 with fewer than two
+    bool known = false;  ///< at least one reference measured it
     /// Whether `value` is finite and within [low, high] (false if no reference measured the figure).
     bool contains(double value) const;
 };
@@ -29,7 +29,7 @@ using Bands = std::array<Band, figure_count>;
 Bands reference_bands(std::span<const Figures* const> references);
 
 struct Distance {
-    double value = 0.0;    ///< root mean square of (a − b)/spread over the figures used
+    double value = 0.0;  ///< root mean square of (a − b)/spread over the figures used
     std::size_t used = 0;  ///< figures both measured and the references spread over (spread > 0); 0: no distance
 };
 

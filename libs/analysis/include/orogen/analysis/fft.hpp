@@ -29,8 +29,8 @@ private:
     std::size_t n_;
     std::size_t m_;  ///< the power-of-two length the radix-2 kernel runs at (n itself, or ≥ 2n − 1 for Bluestein)
     std::vector<std::complex<double>> twiddles_;  ///< e^{−2πi k/m}, k < m/2
-    std::vector<std::complex<double>> chirp_;     ///< Bluestein: e^{−πi k²/n}, k < n
-    std::vector<std::complex<double>> kernel_;    ///< Bluestein: the forward transform of the conjugate chirp, length m
+    std::vector<std::complex<double>> chirp_;  ///< Bluestein: e^{−πi k²/n}, k < n
+    std::vector<std::complex<double>> kernel_;  ///< Bluestein: the forward transform of the conjugate chirp, length m
 };
 
 /// The 2-D forward transform of a row-major width × height array, in place (rows, then columns).

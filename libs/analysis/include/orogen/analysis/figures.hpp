@@ -45,7 +45,8 @@ struct Options {
     double channel_area = 1e6;  ///< m²: drainage area above which a cell is a channel for θ, k_sn and Hack
     double channel_min_slope = 1e-4;  ///< m/m: channel cells at least this steep enter the slope–area fit
     double reference_concavity = 0.45;  ///< θ_ref of the normalised steepness k_sn = S·A^θ_ref (Wobus et al. 2006)
-    double network_area = 1e5;  ///< m²: drainage area above which a cell is on the drainage network (density, hillslopes)
+    double network_area =
+        1e5;  ///< m²: drainage area above which a cell is on the drainage network (density, hillslopes)
     double relief_radius = 1000.0;  ///< m: half-width of the square window of the local relief
     double sinuosity_reach = 1000.0;  ///< m: length of flow path over which a channel's sinuosity is taken
 };
@@ -76,12 +77,12 @@ inline constexpr std::size_t figure_count = std::size_t(FigureId::count_);
 /// How a figure is described, once, for the JSON report, the terminal table and `orogen help`.
 struct FigureInfo {
     FigureId id;
-    std::string_view key;         ///< snake_case, the JSON key: "slope_median"
-    std::string_view label;       ///< short, for a table column: "median slope"
-    std::string_view unit;        ///< "°", "%", "m^0.9", "" for none
+    std::string_view key;  ///< snake_case, the JSON key: "slope_median"
+    std::string_view label;  ///< short, for a table column: "median slope"
+    std::string_view unit;  ///< "°", "%", "m^0.9", "" for none
     std::string_view definition;  ///< one sentence: how it is computed
-    std::string_view source;      ///< the citation the definition comes from
-    int decimals;                 ///< digits after the point when printed
+    std::string_view source;  ///< the citation the definition comes from
+    int decimals;  ///< digits after the point when printed
 };
 
 /// The figures' descriptions, indexed by FigureId.
@@ -118,9 +119,9 @@ struct Figures {
 
     // What was measured.
     int width = 0, height = 0;
-    double cell = 0.0;            ///< m
-    std::size_t samples = 0;      ///< measured samples (not nodata)
-    std::size_t nodata = 0;       ///< samples masked as nodata
+    double cell = 0.0;  ///< m
+    std::size_t samples = 0;  ///< measured samples (not nodata)
+    std::size_t nodata = 0;  ///< samples masked as nodata
     double minimum = 0.0, maximum = 0.0;  ///< m, over measured samples
 
     // Chart data.
@@ -132,7 +133,7 @@ struct Figures {
     /// mean power (m² · samples², unnormalised as in terrain_stats.py); `spectrum_fit` over k = 4 … n/4.
     std::vector<double> spectrum_k, spectrum_power;
     int spectrum_side = 0;  ///< n, the square crop's side
-    LineFit spectrum_fit;   ///< ln P against ln k; β = −slope
+    LineFit spectrum_fit;  ///< ln P against ln k; β = −slope
     /// Slope–area: channel cells binned by area (m², m/m); fit of ln S against ln A (θ = −slope).
     LogBins slope_area;
     LineFit slope_area_fit;

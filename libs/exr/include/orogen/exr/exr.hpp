@@ -46,9 +46,9 @@ struct Plane {
 
 struct WriteOptions {
     Compression compression = Compression::zip;
-    double cell = 1.0;                ///< written as the cellSize attribute (metres)
-    std::string layer;                ///< written as orogenLayer if not empty (one-layer files)
-    int threads = 1;                  ///< compression threads (OpenEXR's pool); the bytes do not depend on it
+    double cell = 1.0;  ///< written as the cellSize attribute (metres)
+    std::string layer;  ///< written as orogenLayer if not empty (one-layer files)
+    int threads = 1;  ///< compression threads (OpenEXR's pool); the bytes do not depend on it
 };
 
 /// Writes `planes` (each width × height floats) as FLOAT channels of one scanline EXR at `path` (a temporary
@@ -75,19 +75,19 @@ struct ChannelInfo {
 struct FileInfo {
     int width = 0, height = 0;
     std::vector<ChannelInfo> channels;  ///< as the file lists them (alphabetical)
-    std::optional<double> cell;         ///< the cellSize attribute, metres, if present
-    std::string height_units;           ///< the heightUnits attribute, "" if absent
-    std::string compression;            ///< "zip", "piz"...
+    std::optional<double> cell;  ///< the cellSize attribute, metres, if present
+    std::string height_units;  ///< the heightUnits attribute, "" if absent
+    std::string compression;  ///< "zip", "piz"...
     bool tiled = false;
     const ChannelInfo* find(const std::string& name) const;
     std::string channel_list() const;  ///< "A, B, Y" — for messages
 };
 
 struct ReadOptions {
-    std::string channel = "Y";            ///< read as the heights
-    std::vector<std::string> layers;      ///< channels read as layers of the same name
-    bool all_layers = false;              ///< every other readable channel as a layer
-    double cell = 0.0;                    ///< metres; 0 = the cellSize attribute
+    std::string channel = "Y";  ///< read as the heights
+    std::vector<std::string> layers;  ///< channels read as layers of the same name
+    bool all_layers = false;  ///< every other readable channel as a layer
+    double cell = 0.0;  ///< metres; 0 = the cellSize attribute
 };
 
 /// A BadInput about the channels asked for; `param` names the parameter to blame ("channel" or "layers").

@@ -13,9 +13,9 @@
 namespace orogen::png_export {
 
 enum class Tonemap {
-    clamp,     ///< values above 1 clip
+    clamp,  ///< values above 1 clip
     reinhard,  ///< c / (1 + c) on the luminance, hue kept
-    aces,      ///< Narkowicz's fit of the ACES filmic curve, per channel
+    aces,  ///< Narkowicz's fit of the ACES filmic curve, per channel
 };
 
 /// "clamp" | "reinhard" | "aces"; throws orogen::BadInput naming the choices otherwise.

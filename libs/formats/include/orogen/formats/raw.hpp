@@ -36,15 +36,16 @@ std::vector<std::uint16_t> quantize16(ConstGridView heights, Range range, std::s
 inline double dequantize16(std::uint16_t v, Range range) { return range.low + (range.high - range.low) * v / 65535.0; }
 
 struct Written {
-    Range range;               ///< the range written to the sidecar
-    std::size_t clamped = 0;   ///< samples outside a given range (r16 only)
+    Range range;  ///< the range written to the sidecar
+    std::size_t clamped = 0;  ///< samples outside a given range (r16 only)
     std::filesystem::path sidecar;
 };
 
 /// Write `heights` to `target` (.r16 or .r32) and the sidecar `target`.json,
 /// both atomically and together. `range` (r16 only): the heights mapped to 0
 /// and 65535; nullopt = the terrain's own min–max.
-Written write_raw(ConstGridView heights, const std::filesystem::path& target, std::optional<Range> range = std::nullopt);
+Written write_raw(ConstGridView heights, const std::filesystem::path& target,
+                  std::optional<Range> range = std::nullopt);
 
 /// The sidecar's text (JSON).
 std::string sidecar_json(Format format, int width, int height, double cell, Range range);
@@ -55,8 +56,8 @@ std::string sidecar_json(Format format, int width, int height, double cell, Rang
 struct Sidecar {
     Format format = Format::r16;
     int width = 0, height = 0;
-    double cell = 1.0;   ///< metres
-    Range range;         ///< r16: heights of 0 and 65535, metres
+    double cell = 1.0;  ///< metres
+    Range range;  ///< r16: heights of 0 and 65535, metres
 };
 
 /// Parse a sidecar's text. Throws orogen::BadInput naming `name` and the field that is wrong (not JSON,

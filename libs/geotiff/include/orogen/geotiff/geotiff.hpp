@@ -42,7 +42,7 @@ struct WriteOptions {
     std::optional<double> nodata;  ///< written as the bands' nodata value
     Compression compression = Compression::deflate;
     bool tiled = false;  ///< 256 × 256 tiles instead of strips
-    bool cog = false;    ///< Cloud-Optimized GeoTIFF (tiled, with overviews)
+    bool cog = false;  ///< Cloud-Optimized GeoTIFF (tiled, with overviews)
     std::vector<std::string> layers;  ///< written as extra bands, in this order
     int threads = 0;  ///< compression threads (0 = all cores); the bytes do not depend on it
 };
@@ -64,8 +64,8 @@ void write(const Heightmap& terrain, const std::filesystem::path& path, const Wr
 struct RasterInfo {
     int width = 0, height = 0;
     int bands = 0;
-    std::string driver;       ///< GDAL's short name: GTiff, SRTMHGT, AAIGrid, USGSDEM...
-    std::string crs_wkt;      ///< "" if none
+    std::string driver;  ///< GDAL's short name: GTiff, SRTMHGT, AAIGrid, USGSDEM...
+    std::string crs_wkt;  ///< "" if none
     bool geographic = false;  ///< CRS in degrees
     double geotransform[6] = {0, 1, 0, 0, 0, 1};
     bool has_geotransform = false;

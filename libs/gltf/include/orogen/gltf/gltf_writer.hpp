@@ -16,9 +16,9 @@ namespace orogen::gltf {
 
 struct Options {
     double vertical_scale = 1.0;  ///< vertical exaggeration (heights × scale)
-    int decimate = 1;             ///< keep every k-th vertex, k ≥ 1
-    int chunks = 0;               ///< meshes per side; 0 = fewest that keep 16-bit indices
-    int texture_size = 2048;      ///< largest side of the baked colour texture, pixels
+    int decimate = 1;  ///< keep every k-th vertex, k ≥ 1
+    int chunks = 0;  ///< meshes per side; 0 = fewest that keep 16-bit indices
+    int texture_size = 2048;  ///< largest side of the baked colour texture, pixels
 };
 
 struct Summary {
@@ -36,9 +36,9 @@ Summary write_gltf(ConstGridView heights, const Options& options, const std::fil
 /// One textured mesh: a chunk of a tiled terrain (export:tiles format=glb).
 struct MeshData {
     std::span<const float> positions, normals;  ///< 3 per vertex (m; unit)
-    std::span<const std::uint16_t> texcoords;   ///< 2 per vertex, normalised
-    std::span<const std::uint32_t> indices;     ///< 3 per triangle; written 16-bit when the vertices allow
-    std::array<float, 3> min{}, max{};          ///< of the positions, exactly
+    std::span<const std::uint16_t> texcoords;  ///< 2 per vertex, normalised
+    std::span<const std::uint32_t> indices;  ///< 3 per triangle; written 16-bit when the vertices allow
+    std::array<float, 3> min{}, max{};  ///< of the positions, exactly
 };
 
 /// Write `mesh` with the PNG `png` as its base colour to `target` (.glb or .gltf), as one node named

@@ -54,11 +54,11 @@ inline constexpr std::size_t max_16bit_vertices = 65535;
 struct TerrainMesh {
     ConstGridView heights;
     double vertical_scale = 1.0;  ///< multiplies heights (vertical exaggeration)
-    std::vector<int> columns;     ///< kept sample x indices
-    std::vector<int> rows;        ///< kept sample y indices
+    std::vector<int> columns;  ///< kept sample x indices
+    std::vector<int> rows;  ///< kept sample y indices
     std::vector<MeshChunk> chunks;
 
-    std::size_t vertex_count() const;    ///< over all chunks (borders counted per chunk)
+    std::size_t vertex_count() const;  ///< over all chunks (borders counted per chunk)
     std::size_t triangle_count() const;
 };
 

@@ -58,5 +58,4 @@ int face_containing(const Arrangement& arrangement, Point2 p);
 /// neighbours taken in ascending index order, as the thesis's DFS.
 std::vector<int> depth_first_order(const Arrangement& arrangement, int start);
 
-
 }  // namespace orogen::rmp

@@ -19,7 +19,7 @@
 namespace orogen::rmp {
 
 struct RangeParams {
-    int cones = 100;      // Voronoi sites over the whole grid
+    int cones = 100;  // Voronoi sites over the whole grid
     double height = 1.0;  // metres raised per call
     double jitter = 0.0;  // 0: every crossed cell by `height`; >0: each cell by height*(1 + jitter*u), u in [-1,1)
 };
@@ -34,7 +34,7 @@ int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params,
 /// The same range of a width × height grid, added only to the samples of `window` (global sample
 /// coordinates; `terrain` and `uplift` hold exactly them): a rank's tile in a tiled run gets the bits the
 /// whole grid gets there. Returns the number of cells raised (over the whole grid).
-int raise_range(GridView terrain, int width, int height, int x0, int y0, Point2 a, Point2 b,
-                const RangeParams& params, std::uint64_t seed, GridView* uplift = nullptr);
+int raise_range(GridView terrain, int width, int height, int x0, int y0, Point2 a, Point2 b, const RangeParams& params,
+                std::uint64_t seed, GridView* uplift = nullptr);
 
 }  // namespace orogen::rmp

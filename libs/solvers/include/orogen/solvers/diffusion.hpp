@@ -38,7 +38,7 @@ namespace orogen::diffusion {
 
 enum class Scheme {
     implicit,  ///< locally one-dimensional backward Euler (monotone, first order)
-    adi,       ///< Peaceman–Rachford ADI (second order, can ring at r ≫ 1)
+    adi,  ///< Peaceman–Rachford ADI (second order, can ring at r ≫ 1)
 };
 
 /// Which sides hold their height (fixed) rather than let nothing through (closed).
@@ -93,15 +93,15 @@ private:
     void edge_columns(const double* g);
 
     Tiling* tiles_ = nullptr;
-    int W_, H_;    // the whole grid, vertices
+    int W_, H_;  // the whole grid, vertices
     int x0_, y0_;  // the tile's first vertex in it
     int tw_, th_;  // the tile
     double cell_;
     Settings settings_;
-    std::vector<double> scratch_;   // h* between the two sweeps
+    std::vector<double> scratch_;  // h* between the two sweeps
     std::vector<double> scratch2_;  // nonlinear: the sweeps' eliminated coefficients c'
-    std::vector<double> kx_, ky_;   // nonlinear: per-link diffusivity factors (see nonlinear_step)
-    std::vector<double> carry_;     // the lines' carried values
+    std::vector<double> kx_, ky_;  // nonlinear: per-link diffusivity factors (see nonlinear_step)
+    std::vector<double> carry_;  // the lines' carried values
     std::vector<double> north_, south_, west_, east_;  // the neighbours' edge lines
 };
 

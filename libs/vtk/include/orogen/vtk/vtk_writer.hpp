@@ -55,10 +55,10 @@ enum class Up { z, y };
 Up up_from_name(const std::string& name);
 
 struct Options {
-    Up up = Up::z;                ///< frame of reference of every point and vector
-    bool compress = false;        ///< zlib-compress the arrays (smaller, slower)
+    Up up = Up::z;  ///< frame of reference of every point and vector
+    bool compress = false;  ///< zlib-compress the arrays (smaller, slower)
     double vertical_scale = 1.0;  ///< .vtp heightmap mesh only
-    int decimate = 1;             ///< .vtp heightmap mesh only: keep every k-th vertex
+    int decimate = 1;  ///< .vtp heightmap mesh only: keep every k-th vertex
 };
 
 /// Heightmap (+ named layers of the same size) as .vti or .vtp, by `target`'s extension.
