@@ -64,6 +64,23 @@ float fbm_filtered(vec2 p, int octaves, float footprint) {
     return sum * 1.07;
 }
 
+// A texture sampled with the cubic B-spline (C2: its level sets have no corners) at `s`, in samples
+// (sample (x, y) at integer s, texel centres), from four bilinear taps (GPU Gems 2, ch. 20); the texture
+// must filter linearly and clamp to its edge. The B-spline approximates: it smooths a field over about a
+// sample, so a one-sample spike keeps 4/9 of its height.
+vec4 bspline(sampler2D tex, vec2 s, vec2 size) {
+    vec2 i = floor(s), f = s - i;
+    vec2 f2 = f * f, f3 = f2 * f;
+    vec2 w0 = (1.0 - 3.0 * f + 3.0 * f2 - f3) / 6.0;
+    vec2 w1 = (4.0 - 6.0 * f2 + 3.0 * f3) / 6.0;
+    vec2 w2 = (1.0 + 3.0 * f + 3.0 * f2 - 3.0 * f3) / 6.0;
+    vec2 w3 = f3 / 6.0;
+    vec2 g0 = w0 + w1, g1 = w2 + w3;
+    vec2 t0 = (i - 1.0 + w1 / g0 + 0.5) / size, t1 = (i + 1.0 + w3 / g1 + 0.5) / size;
+    return g0.y * (g0.x * texture(tex, vec2(t0.x, t0.y)) + g1.x * texture(tex, vec2(t1.x, t0.y))) +
+           g1.y * (g0.x * texture(tex, vec2(t0.x, t1.y)) + g1.x * texture(tex, vec2(t1.x, t1.y)));
+}
+
 // The sky: a gradient from a hazy horizon to a deeper zenith, brighter and
 // warmer towards the sun (single-scattering look), and the sun's disc (HDR,
 // so the bloom makes it glow). `dir` is a unit view ray, y up.

@@ -6,8 +6,11 @@
 // (Beer–Lambert), then fogged. Blended over the terrain with
 // glBlendFuncSeparate(ONE, SRC_ALPHA, ZERO, ONE): alpha is how much of the
 // ground shows through (the frame's own alpha stays 1).
+// Rivers and lakes (the `water` layer) are found per fragment from the layer
+// at full resolution, smoothed by the cubic B-spline: the shore is a smooth
+// curve where the smoothed wet field crosses one half, faded over a pixel, not
+// the cells' or the mesh's edges.
 in vec3 world;
-in float depth;
 uniform vec3 eye;
 uniform float time;              // s, moves the waves
 uniform float wave_height;       // m
@@ -20,9 +23,15 @@ uniform vec3 ambient_colour;
 uniform int sea_plane;           // 1: depth = sea level − ground (heights), deep beyond the terrain
 uniform float sea_level;
 uniform sampler2D heights;
+uniform sampler2D surface;       // RGBA32F per sample: water level (m), depth (m), wet (0/1), unused
 uniform ivec2 grid;
 uniform float cell;
+uniform float turbidity;         // optical depth of the river's silt, added to depth / clarity
 out vec4 colour;
+
+const float shore = 0.45;        // the smoothed wet field's level at the shore (a one-sample puddle peaks at 0.44)
+
+float calm_waves = 1.0;  // rivers: a fraction of wave_height
 
 // Height field of the waves (m) at xz: four directional sines and noise.
 float waves(vec2 p) {
@@ -32,17 +41,27 @@ float waves(vec2 p) {
     h += 0.18 * sin(dot(p, vec2(0.20, -0.98)) * 0.230 + time * 1.9);
     h += 0.12 * sin(dot(p, vec2(-0.93, -0.37)) * 0.370 + time * 2.3);
     h += 0.35 * simplex(p * 0.05 + vec2(time * 0.05, 0.0)) + 0.18 * simplex(p * 0.16 - vec2(0.0, time * 0.08));
-    return h * wave_height;
+    return h * wave_height * calm_waves;
 }
 
 void main() {
-    float water_depth = depth;
+    float water_depth, edge = 1.0, silt = 0.0, calm = 1.0;
     if (sea_plane == 1) {
         vec2 s = world.xz / cell;
         bool inside = all(greaterThanEqual(s, vec2(0.0))) && all(lessThanEqual(s, vec2(grid - 1)));
         water_depth = inside ? sea_level - texture(heights, (s + 0.5) / vec2(grid)).r : 200.0;
+    } else {
+        vec4 layer = bspline(surface, world.xz / cell, vec2(grid));
+        float soft = max(fwidth(layer.b), 1e-4);  // the wet field's change across a pixel: antialiased shore
+        edge = smoothstep(shore - soft, shore + soft, layer.b);
+        water_depth = edge > 0.0 ? max(layer.g, 1e-3) : 0.0;
+        // Rivers carry silt (a film of rain in a hollow hardly any: it stays clear), and their ripples are
+        // small: as deep as the water, at least 1/6 of the waves.
+        silt = turbidity * smoothstep(0.1, 0.8, layer.g);
+        calm = clamp(layer.g / 3.0, 1.0 / 6.0, 1.0);
     }
     if (water_depth <= 0.0) discard;
+    calm_waves = calm;
     const float e = 0.5;  // m, finite-difference step
     float h0 = waves(world.xz);
     vec3 n = normalize(vec3(-(waves(world.xz + vec2(e, 0.0)) - h0) / e, 1.0,
@@ -66,11 +85,12 @@ void main() {
     reflected += sun_colour * sun_glint;
     float lambert = max(sun_direction.y, 0.0);
     vec3 body = water_colour * (sun_colour * lambert + ambient_colour);
-    float transmitted = exp(-water_depth / clarity);  // of the ground's light
+    float transmitted = exp(-water_depth / clarity - silt);  // of the ground's light
     vec3 c = fresnel * reflected + (1.0 - fresnel) * (1.0 - transmitted) * body;
     float alpha = (1.0 - fresnel) * transmitted;
     // fog: the water's own light and what shows through fade alike
     float f = 1.0 - exp(-fog_density * distance(eye, world));
     c = mix(c, sky_colour(-v, 0.0) * (1.0 - alpha), f);
-    colour = vec4(c, alpha * (1.0 - f));
+    // at the shore the water fades out over a pixel: edge of it over the ground
+    colour = sea_plane == 1 ? vec4(c, alpha * (1.0 - f)) : vec4(c * edge, 1.0 - edge * (1.0 - alpha * (1.0 - f)));
 }

@@ -1,8 +1,9 @@
 #version 450 core
 // The water surface as the terrain's grid: each vertex at the water's level
-// (sea level, or the ground plus the `water` layer), with the water depth
-// beside it; the fragment shader drops what lies above the water.
-uniform sampler2D surface;    // RG32F: water surface height (m), water depth (m)
+// (sea level, or the ground plus the `water` layer). Where the ground is dry
+// the vertex lies on the ground, so the grid drapes the terrain and the
+// fragment shader decides, from the layer at full resolution, where water is.
+uniform sampler2D surface;    // RGBA32F: water level (m), depth (m), wet (0/1), unused
 uniform ivec2 grid;
 uniform int stride;
 uniform ivec2 kept;
@@ -13,18 +14,14 @@ uniform int sea_plane;        // 1: a sea, one quad at sea_level out to plane_ex
 uniform float sea_level;      // m
 uniform vec4 plane_extent;
 out vec3 world;
-out float depth;
 void main() {
     if (sea_plane == 1) {
         vec2 f = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1));
         world = vec3(mix(plane_extent.x, plane_extent.z, f.x), sea_level * exaggeration, mix(plane_extent.y, plane_extent.w, f.y));
-        depth = 1.0;  // the fragment shader measures it against the ground
         gl_Position = view_projection * vec4(world, 1.0);
         return;
     }
     ivec2 s = min(ivec2(gl_VertexID % kept.x, gl_VertexID / kept.x) * stride, grid - 1);
-    vec2 sd = texelFetch(surface, s, 0).rg;
-    world = vec3(float(s.x) * cell, sd.x * exaggeration, float(s.y) * cell);
-    depth = sd.y;
+    world = vec3(float(s.x) * cell, texelFetch(surface, s, 0).r * exaggeration, float(s.y) * cell);
     gl_Position = view_projection * vec4(world, 1.0);
 }

@@ -29,6 +29,9 @@ namespace orogen::render {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
+/// Optical depth of the silt in rivers and lakes, on top of depth / clarity: thin water still reads as
+/// water (a 0.3 m river shows 55 % of its bed instead of 93 %).
+constexpr float kRiverSilt = 0.6f;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -70,8 +73,11 @@ glm::dvec3 direction(double azimuth_degrees, double elevation_degrees) {
 
 std::array<std::array<float, 3>, 4> Style::default_materials() {
     std::array<std::array<float, 3>, 4> m{};
-    const std::array<std::array<std::uint8_t, 3>, 4> srgb{terrain::sand_colour, terrain::grass_colour,
-                                                          terrain::rock_colour, terrain::snow_colour};
+    // Vegetation seen from the air is darker and more olive than the exports' map green (#567d3a), which
+    // read as a lawn in the lit scene; sand, rock and snow are the exports'.
+    constexpr std::array<std::uint8_t, 3> vegetation{88, 104, 56};
+    const std::array<std::array<std::uint8_t, 3>, 4> srgb{terrain::sand_colour, vegetation, terrain::rock_colour,
+                                                          terrain::snow_colour};
     for (std::size_t i = 0; i < 4; ++i)
         for (std::size_t c = 0; c < 3; ++c) m[i][c] = gl::srgb_to_linear(srgb[i][c]);
     return m;
@@ -225,20 +231,22 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
     if (style_.texture_scale <= 0) style_.texture_scale = std::max(m.extent_x(), m.extent_z()) / 8.0;
     if (style_.particle_radius <= 0) style_.particle_radius = 3.0 * m.terrain->cell();
 
-    // Water from the layer: surface and depth per sample (the sea is one plane, drawn apart).
+    // Water from the layer, per sample: its level (where the grid's water vertices stand), its depth and
+    // whether it is wet (deeper than water_min_depth); the water shader smooths the last two into the shore.
+    // The sea is one plane, drawn apart.
     const bool layer = !style_.water_layer.empty() && m.terrain->has_layer(style_.water_layer);
     std::vector<float> surface;
     if (layer) {
-        surface.resize(2 * m.terrain->size());
+        surface.resize(4 * m.terrain->size());
         const ConstGridView h = m.terrain->view();
         const ConstGridView w = m.terrain->layer(style_.water_layer);
         const float min_depth = float(style_.water_min_depth);
         for (std::size_t i = 0; i < m.terrain->size(); ++i) {
-            // Continuous across the shore: a dry vertex gets a negative depth,
-            // so the fragment shader cuts the water where the depth crosses 0.
-            surface[2 * i] = h.data[i] + std::max(w.data[i], 0.0f);
-            surface[2 * i + 1] = w.data[i] - min_depth;
-            m.has_water = m.has_water || w.data[i] > min_depth;
+            const bool wet = w.data[i] > min_depth;
+            surface[4 * i] = h.data[i] + std::max(w.data[i], 0.0f);
+            surface[4 * i + 1] = wet ? w.data[i] : 0.0f;
+            surface[4 * i + 2] = wet ? 1.0f : 0.0f;
+            m.has_water = m.has_water || wet;
         }
     }
 
@@ -255,9 +263,11 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
     if (m.has_water) {
         glGenTextures(1, &m.surface);
         glBindTexture(GL_TEXTURE_2D, m.surface);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RG32F, m.width, m.height, 0, GL_RG, GL_FLOAT, surface.data());
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.width, m.height, 0, GL_RGBA, GL_FLOAT, surface.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // the shader's B-spline taps
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
 
     glGenVertexArrays(1, &m.vao);
@@ -746,9 +756,17 @@ void TerrainRenderer::Impl::draw_water(const Frame& f, const Style& st, const gl
     glBindVertexArray(vao);
     if (has_water) {
         // Farthest strips first: the water is blended, and where it overlaps itself the nearer must come last.
+        // Where the ground is dry the grid lies on the terrain's own triangles, and the shader draws water
+        // there wherever the layer (at full resolution, between the mesh's vertices) says: in front of them.
         set(program, "sea_plane", 0);
+        set(program, "turbidity", kRiverSilt);
+        glDepthFunc(GL_LEQUAL);
+        glEnable(GL_POLYGON_OFFSET_FILL);
+        glPolygonOffset(-1.0f, -4.0f);
         const auto back_to_front = Order(int(front_to_back(f.eye)) ^ 1);
         glDrawElements(GL_TRIANGLE_STRIP, bind_order(back_to_front), GL_UNSIGNED_INT, nullptr);
+        glDisable(GL_POLYGON_OFFSET_FILL);
+        glDepthFunc(GL_LESS);
     }
     if (st.sea) {
         const double reach = f.radius * 38.0;

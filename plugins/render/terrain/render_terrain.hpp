@@ -40,7 +40,8 @@ struct Camera {
 /// How the terrain looks.
 struct Style {
     terrain::SplatRules splat;  ///< the bands and slopes (the thesis's by default)
-    /// Linear albedo of sand, grass, rock, snow (default: terrain_mesh.hpp's sRGB colours, decoded).
+    /// Linear albedo of sand, grass, rock, snow (default: terrain_mesh.hpp's sRGB colours, decoded, with a darker
+    /// olive for the vegetation).
     std::array<std::array<float, 3>, 4> materials = default_materials();
     double jitter = 0.03;          ///< noise on the height bands, fraction of the height range
     double texture_scale = 0.0;    ///< m, size of the coarsest texture features; 0: an eighth of the terrain's width
