@@ -268,8 +268,9 @@ OROGEN_PLUGIN("render-terrain", "0.1.0", registry) {
         .summary = "draw the terrain (splatting, shadows, sky, water, haze) as a linear HDR image, through OSMesa",
         .description =
             "The thesis's texture splatting (sand, grass, rock, snow by height; steep slopes turn grass and snow\n"
-            "to rock) with procedural textures, lit by the sun (shadow map) and the sky, with water from the\n"
-            "'water' layer or a sea, and aerial perspective. Renders headless (Mesa's llvmpipe, no display).\n"
+            "to rock), with slope and exposure (steep faces rock at any height, vegetation in hollows, bare\n"
+            "ridges, sun-facing slopes drier) and procedural textures, lit by the sun (shadow map) and the sky,\n"
+            "with water from the 'water' layer (smooth shores) or a sea, and aerial perspective. Renders headless (Mesa's llvmpipe, no display).\n"
             "The image is linear float RGBA (HDR): chain render:bloom and export:png / export:video.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "the heightmap to draw"},
                    {"particles", ValueType::particles, Need::optional, "particles to draw as lit spheres (one frame)"}},

@@ -115,6 +115,112 @@ TEST(Splatting, TheShaderFollowsTheRulesOfSplatWeights) {
     }
 }
 
+// Issue 32, item 5: steep faces are rock at every height; the thesis's rule (and the exports) leave sand on
+// a cliff at low altitude, which read as bleached cliffs.
+TEST(Splatting, ASteepFaceAtSandHeightIsRockAndGentleSlopesThereAreNotSand) {
+    // Range 0..1000 m; the middle rises to the east around 100 m (t ≈ 0.1: the sand band), at 62° (steeper
+    // than rock_slope_full: all rock) and at 30°.
+    const int n = 65;
+    auto rising = [&](double degrees) {
+        auto hm = grid(n, 1.0, 0.0f);
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                hm->view().at(x, y) = float(100.0 + std::tan(degrees * std::numbers::pi / 180) * (x - 32));
+        hm->view().at(0, 0) = 0.0f;
+        hm->view().at(n - 1, n - 1) = 1000.0f;
+        return hm;
+    };
+    const auto colours = Style::default_materials();
+    Style s = albedo();
+    s.jitter = 0;
+    const Image cliff = TerrainRenderer(rising(62), s).render(64, 64, top());
+    const Image slope = TerrainRenderer(rising(30), s).render(64, 64, top());
+    for (int y = 16; y < 48; ++y)
+        for (int x = 16; x < 48; ++x) {
+            EXPECT_EQ(nearest(cliff, std::size_t(y * 64 + x), colours), rock) << "62° pixel " << x << "," << y;
+            EXPECT_NE(nearest(slope, std::size_t(y * 64 + x), colours), sand) << "30° pixel " << x << "," << y;
+        }
+}
+
+// Issue 32, item 5: hollows are darker than open ground and ridges (the sky's light reaches less of them),
+// and hold vegetation where flat ground at the same height is sand.
+TEST(Splatting, AHollowIsDarkerAndGreenerThanTheFlatAroundIt) {
+    const int n = 129;
+    auto hm = grid(n, 10.0, 100.0f);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const double r = std::hypot(x - 64.0, y - 64.0) * 10.0;  // m
+            if (r < 120) hm->view().at(x, y) = float(100.0 - 20.0 * (1 + std::cos(std::numbers::pi * r / 120)));
+        }
+    hm->view().at(0, 0) = 1000.0f;  // range 60..1000 m: the plain (t ≈ 0.04) is sand
+    Style s;
+    s.jitter = 0;
+    s.haze = 0;
+    s.sun_elevation = 60;
+    const Image lit = TerrainRenderer(hm, s).render(128, 128, top());
+    s.output = Style::Output::albedo;
+    const Image albedo = TerrainRenderer(hm, s).render(128, 128, top());
+    auto mean = [](const Image& im, int x0, int x1, int c) {
+        double sum = 0;
+        for (int y = x0; y <= x1; ++y)
+            for (int x = x0; x <= x1; ++x) sum += im.rgba32f[4 * std::size_t(y * 128 + x) + std::size_t(c)];
+        return sum / ((x1 - x0 + 1) * (x1 - x0 + 1));
+    };
+    // The hollow's floor (the middle 6 × 6 pixels) against open plain near a corner away from the column.
+    const double floor_green = mean(albedo, 61, 66, 1) / mean(albedo, 61, 66, 0);
+    const double plain_green = mean(albedo, 100, 110, 1) / mean(albedo, 100, 110, 0);
+    EXPECT_GT(floor_green, 1.1 * plain_green) << "green/red in the hollow " << floor_green << ", on the plain " << plain_green;
+    const auto colours = Style::default_materials();
+    EXPECT_EQ(nearest(albedo, std::size_t(64 * 128 + 64), colours), grass);
+    EXPECT_EQ(nearest(albedo, std::size_t(105 * 128 + 105), colours), sand);
+    const double floor_light = mean(lit, 61, 66, 1) / mean(albedo, 61, 66, 1);
+    const double plain_light = mean(lit, 100, 110, 1) / mean(albedo, 100, 110, 1);
+    EXPECT_LT(floor_light, 0.9 * plain_light) << "light on the hollow's floor " << floor_light << ", on the plain " << plain_light;
+}
+
+// Issue 32, item 5: a river from the water layer is a smooth ribbon, not cells: a one-sample-wide river
+// running diagonally across the grid (a staircase of wet samples) is drawn, seen from above, as a band of
+// nearly even width whose middle follows the diagonal.
+TEST(Water, ADiagonalRiverOfSingleCellsIsASmoothRibbon) {
+    const int n = 33, px = 264;  // 8 pixels a cell
+    auto make = [&](bool with_water) {
+        auto hm = grid(n, 10.0, 50.0f);
+        hm->view().at(0, 0) = 0.0f;
+        hm->view().at(n - 1, 0) = 100.0f;
+        if (with_water) {
+            GridView water = hm->layer("water");
+            for (int i = 2; i < n - 2; ++i) water.at(i, i) = 1.0f;
+        }
+        return hm;
+    };
+    Style s;
+    s.haze = 0;
+    s.wave_height = 0;
+    s.sun_elevation = 60;
+    const Image wet = TerrainRenderer(make(true), s).render(px, px, top());
+    const Image dry = TerrainRenderer(make(false), s).render(px, px, top());
+    // Along lines across the river (perpendicular to it: x + y constant), the water's width in pixels.
+    std::vector<double> widths;
+    for (int k = 10 * 8; k <= 22 * 8; ++k) {  // x + y = 2k, away from the river's ends
+        int first = -1, last = -1;
+        for (int d = -24; d <= 24; ++d) {
+            const int x = k + d, y = k - d;
+            const std::size_t i = 4 * std::size_t(y * px + x);
+            double diff = 0;
+            for (int c = 0; c < 3; ++c) diff += std::abs(wet.rgba32f[i + std::size_t(c)] - dry.rgba32f[i + std::size_t(c)]);
+            if (diff > 0.05) {
+                if (first < 0) first = d;
+                last = d;
+            }
+        }
+        ASSERT_GE(first, 0) << "no water across the river at x + y = " << 2 * k << " (the river is broken)";
+        EXPECT_LE(std::abs(first + last), 3) << "the river's middle strays from the diagonal at x + y = " << 2 * k;
+        widths.push_back(last - first + 1);
+    }
+    const double lo = *std::min_element(widths.begin(), widths.end()), hi = *std::max_element(widths.begin(), widths.end());
+    EXPECT_GE(lo, 0.7 * hi) << "the river's width runs from " << lo << " to " << hi << " px (a sawtooth or beads)";
+}
+
 TEST(Shadows, ATallColumnsShadowFallsAwayFromTheSun) {
     // A 300 m column in the middle of a plain, the sun in the east at 30°:
     // the shadow (300 m / tan 30° = 520 m = 52 cells long) lies to the west.
