@@ -41,7 +41,7 @@ TSAN_BUILD ?= build-tsan
 # the cache's parallel copies and hashes, and the kernel tests that run specs on several threads. Not here: the
 # render passes, export:video and export:paraview (their threads are llvmpipe's, FFmpeg's and ParaView's, not
 # instrumented) — CI's ASan phase covers their code (ASAN_CI).
-TSAN_ONLY  ?= /plugins/(erode|generate|tectonics|import)/[^/]+$$|/plugins/export/(png|raw|gltf|vdb|vtk|geotiff|exr|maps|tiles)$$|/tests/plugins/(thermal|hydraulic|pipe|sph|stream_power|diffusion|plates|diamond_square|fault|rmp|shape|png_export|raw|gltf|vdb|geotiff|exr|maps|tiles)$$|/tests/(cache|kernel)$$|/tests/libs/[^/]+$$
+TSAN_ONLY  ?= ^/plugins/(erode|generate|tectonics|import)/[^/]+$$|^/plugins/export/(png|raw|gltf|vdb|vtk|geotiff|exr|maps|tiles)$$|^/tests/plugins/(thermal|hydraulic|pipe|sph|stream_power)$$|^/tests/plugins/(erode|generate|tectonics)/[^/]+$$|^/tests/plugins/export/(png|raw|gltf|vdb|geotiff|exr|maps|tiles)$$|^/tests/(cache|kernel)$$|^/tests/libs/(analysis|formats|mesh|relief|solvers)$$
 # Tests TSan gains nothing from, left to the other phases (they were half of the TSan phase's test time):
 # check-time diagnostics, which run no thread (the kernel's run under ASan+UBSan in asan-ci, the plugins'
 # in the release suite), and the long physics validations (dam break, hydrostatics, experiment 4.1, the
@@ -61,7 +61,7 @@ TSAN_SKIP  ?= ^Specs/BadSpec\.|^Confinement\.|^Cli\.|^Inputs\.|^CacheCommand\.|^
 # TSan+UBSan (TSAN_ONLY). Both sanitizers over every test would not fit CI's 30 minutes on 2 cores
 # (docs/hardening.md).
 ASAN_ONLY  ?=
-ASAN_CI     = /tests/(kernel|fuzz|cache|pipelines)|/tests/plugins/(render|analyze)$$|/tests/libs/[^/]+$$|/plugins/[^/]+/[^/]+$$
+ASAN_CI     = ^/tests/(kernel|fuzz|cache|pipelines)|^/tests/plugins/(render|render/terrain|analyze/terrain)$$|^/tests/libs/[^/]+$$|^/plugins/[^/]+/[^/]+$$
 FUZZ_SECONDS ?= 20
 FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000

@@ -1,7 +1,7 @@
 // Golden outputs of the shipped pipelines. When a change to a node alters them
 // on purpose, regenerate with OROGEN_UPDATE_GOLDEN=1 build/tests/test_pipelines
 // and say so in the commit. (pipelines/rmp-* and plates-* have their own golden
-// tests in tests/plugins/rmp and tests/plugins/plates.)
+// tests in tests/plugins/generate/rmp and tests/plugins/tectonics/plates.)
 #include <orogen/io.hpp>
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-# Run by pvbatch (tests/plugins/paraview/pvbatch_test.cpp):
+# Run by pvbatch (tests/plugins/export/paraview/pvbatch_test.cpp):
 #   pvbatch inspect_state.py STATE.py OUT_FOLDER
 # Runs the shipped state script as a user would (`pvbatch STATE.py --screenshot
 # OUT/first.png --size 640x400 --save-state OUT/view.pvsm`), then reports what ParaView built, as JSON in

@@ -1,7 +1,7 @@
 // export:vdb — files read back with OpenVDB: grid classes, voxel sizes, sampled values.
 #include "vdb_writer.hpp"
 
-#include "../raw/export_test_support.hpp"
+#include "export_test_support.hpp"
 #include "orogen_test.hpp"
 
 #include <orogen/error.hpp>

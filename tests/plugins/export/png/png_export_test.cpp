@@ -1,7 +1,7 @@
 // export:png's layer= and hillshade=: the core, and 16-bit round trips through the binary.
 #include <orogen/formats/heightmap_png.hpp>
 
-#include "../raw/export_test_support.hpp"
+#include "export_test_support.hpp"
 #include "orogen_test.hpp"
 
 #include <orogen/io.hpp>

@@ -1,7 +1,7 @@
 // export:vtk — every file read back with VTK's own XML readers.
 #include <orogen/vtk/vtk_writer.hpp>
 
-#include "../raw/export_test_support.hpp"
+#include "export_test_support.hpp"
 #include "orogen_test.hpp"
 
 #include <orogen/error.hpp>

@@ -1,7 +1,7 @@
 // The mesh layout and splat colours shared by export:gltf and export:vtk.
 #include <orogen/mesh/terrain_mesh.hpp>
 
-#include "../raw/export_test_support.hpp"
+#include "export_test_support.hpp"
 
 #include <orogen/error.hpp>
 

@@ -1,5 +1,5 @@
 // export:paraview-state — the script's choices, and the node run through the CLI.
-// (tests/plugins/paraview/pvbatch_test.cpp runs the script in ParaView itself.)
+// (tests/plugins/export/paraview/pvbatch_test.cpp runs the script in ParaView itself.)
 #include "paraview_state.hpp"
 
 #include "orogen_test.hpp"

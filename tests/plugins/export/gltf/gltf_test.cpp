@@ -1,7 +1,7 @@
 // export:gltf — files read back with tinygltf and checked by the Khronos validator.
 #include <orogen/gltf/gltf_writer.hpp>
 
-#include "../raw/export_test_support.hpp"
+#include "export_test_support.hpp"
 #include "orogen_test.hpp"
 
 #include <orogen/error.hpp>
