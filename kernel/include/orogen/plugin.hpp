@@ -30,7 +30,10 @@
 /// 4: NodeDescriptor::tiled_timelapse, Timelapse's tiled constructor (its layout), Tiling::carry.
 /// 5: NodeDescriptor::untiled_because, Tiling::exchange_double_halos and Tiling::gather_to_rank0.
 /// 6: Tiling::scatter_from_rank0 (a series input of a tiled node stays on rank 0).
-#define OROGEN_PLUGIN_API_VERSION 6
+/// 7: Tiling in the shape of PETSc's DMDA (orogen/tiles.hpp): the ghost width is the node's tile_halo,
+///    ghosted grids and one typed exchange, typed reductions with an operator, gather() to rank 0 or to
+///    every rank, TiledFields for a grid eroder's tiled loop; six virtual primitives instead of twenty.
+#define OROGEN_PLUGIN_API_VERSION 7
 
 namespace orogen {
 

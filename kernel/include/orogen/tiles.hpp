@@ -8,20 +8,30 @@
 // over the whole grid, the kernel gathering its inputs there.
 //
 // A tiled node must give, on every vertex of its tile, the very bits the
-// single-process run gives there (the seam tests compare the bytes). The
-// halo exchange below hands it the vertices of the neighbouring tiles it
-// needs. No MPI header appears here: the kernel implements the exchange.
+// single-process run gives there (the seam tests compare the bytes).
+//
+// The shape is PETSc's DMDA: the layout (the split, this rank's corners and
+// its ghosted corners), the ghost width declared once (tile_halo), ghosted
+// grids with one exchange for any number of them and any value type, and
+// typed reductions with an operator. Everything is built over six virtual
+// primitives the kernel implements; no MPI header appears here. A tiled grid
+// eroder's loop (grow, exchange, step, check, copy back) is TiledFields below.
 #pragma once
 
 #include <orogen/error.hpp>
 #include <orogen/grid.hpp>
 
+#include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <memory>
 #include <span>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <vector>
 
 namespace orogen {
@@ -35,6 +45,19 @@ struct TileRect {
     int x1() const { return x0 + width; }
     int y1() const { return y0 + height; }
     bool operator==(const TileRect&) const = default;
+};
+
+/// The grid cut into rows × cols tiles; tile i = r·cols + c is rank i's.
+/// Cuts fall at floor(k·size/parts) (the kernel's split_grid): tiles differ
+/// in size by at most one vertex, and nothing is aligned to powers of two.
+struct TileSplit {
+    int grid_width = 0, grid_height = 0;
+    int rows = 1, cols = 1;
+    std::vector<int> xs, ys;  ///< cols+1 and rows+1 cut positions
+    int count() const { return rows * cols; }
+    TileRect tile(int index) const;
+    int smallest_width() const;
+    int smallest_height() const;
 };
 
 /// Sample positions along one axis of the whole grid, increasing: first,
@@ -59,110 +82,95 @@ private:
     int exit_code_;
 };
 
-/// The split of a tiled run, as one rank sees it.
+/// The split of a tiled run, as one rank sees it while one node runs.
+///
+/// "Collective" below: every rank calls it, in the same order. Every
+/// collective but carry() opens with the ranks' failure agreement: if another
+/// rank failed before the call, it throws PeerFailed (let it pass).
 class Tiling {
 public:
     virtual ~Tiling() = default;
-    virtual int rank() const = 0;
-    virtual int ranks() const = 0;
-    virtual int grid_width() const = 0;   ///< the whole grid, vertices
-    virtual int grid_height() const = 0;
+
+    // ------------------------------------------------------------ the layout
+
+    int rank() const { return rank_; }
+    int ranks() const { return split_.count(); }
+    int grid_width() const { return split_.grid_width; }  ///< the whole grid, vertices
+    int grid_height() const { return split_.grid_height; }
     /// This rank's tile: what its heightmaps hold.
-    virtual TileRect owned() const = 0;
+    TileRect owned() const { return split_.tile(rank_); }
     /// Rank `rank`'s tile (0 ≤ rank < ranks()).
-    virtual TileRect tile(int rank) const = 0;
-    /// `owned` grown by `halo` vertices on every side, clipped to the grid.
-    TileRect grown(int halo) const;
-
-    /// Collective (every rank calls it, in the same order): fills the part of
-    /// `held` (a grid covering grown(halo)) outside `owned` with the
-    /// neighbouring ranks' tiles, corners included. The owned part is sent,
-    /// never changed. Needs every tile to be at least `halo` vertices wide and
-    /// high (the kernel checks this at check time against the node's
-    /// tile_halo). Throws PeerFailed if another rank failed before the call.
-    virtual void exchange_halo(GridView held, int halo) = 0;
-    /// Seconds spent so far in exchange_halo() waiting for every rank to arrive
-    /// (its opening agreement), as opposed to moving the halo: under load or
-    /// with uneven tiles, most of an exchange's time is this wait.
-    virtual double seconds_waiting() const = 0;
-    /// The line a tiled sweeping eroder reports when it ends (NodeContext::info):
-    /// "rank R of N: tile WxH at (X, Y), STEPS steps: sweeps S s, halo exchange
-    /// E s (P %), of which waiting for the other ranks W s", W counted from
-    /// `waited_before` (seconds_waiting() when the node started).
-    std::string sweep_note(std::int64_t steps, double sweeping_s, double exchanging_s, double waited_before) const;
-    /// Collective: the least and greatest of each rank's `lo`/`hi` (exact).
-    virtual void min_max(float& lo, float& hi) = 0;
-
-    // For eroders whose every step needs global reductions (erode:pipe's
-    // CFL limit and sediment fix-up): several fields at once, and sums in
-    // the single process's order.
-
-    /// Collective: exchange_halo() for several grids of the same size (each
-    /// covering grown(halo)) at once: one opening agreement and one message
-    /// per side, whatever the number of grids.
-    virtual void exchange_halos(std::span<const GridView> held, int halo) = 0;
-    /// Collective: element by element, the greatest of every rank's
-    /// `values[0..count)`, on every rank (exact: a maximum does not round).
-    /// Opens with the failure agreement (throws PeerFailed).
-    virtual void max_all(float* values, int count) = 0;
-    /// Collective, along each row of tiles from west to east: `carry` holds
-    /// `per_row` values for each of this tile's rows; they come in from the
-    /// west neighbour (the westmost tile keeps what the caller put there),
-    /// `advance(first, count)` carries rows [first, first + count) of them over
-    /// this tile's columns, and they go on to the east neighbour. This
-    /// reproduces a single process's sequential accumulation along whole rows
-    /// (floating-point sums are not associative, so partial sums per tile
-    /// would not give its bits). The rows travel in blocks, so that a tile
-    /// works on a block while its east neighbour works on the one before: the
-    /// chain costs about one tile's pass plus a block's per tile to the east,
-    /// not a whole pass per tile. Every tile of a row of tiles has the same
-    /// rows. The caller must not throw between its last collective and this
-    /// call on one rank only (a west neighbour that never sends would hang it).
-    virtual void carry_east(std::span<double> carry, int per_row,
-                            const std::function<void(int first, int count)>& advance) = 0;
-    /// Collective: `per_row` values for each row of the whole grid, in row
-    /// order, on every rank, taken from the eastmost tile of each row of
-    /// tiles (`mine`: owned().height × per_row values there; ignored
-    /// elsewhere). With carry_east(): whole-row results, then summed in row
-    /// order by every rank alike.
-    virtual std::vector<double> gather_rows(std::span<const double> mine, int per_row) = 0;
-    /// Whether this tile is the eastmost of its row of tiles (the one whose `mine` gather_rows() takes).
-    bool eastmost() const { return owned().x1() == grid_width(); }
-
-    // For nodes whose pieces of work do not follow the tiles (export:tiles'
-    // engine tiles straddle them): any rectangle of the grid, from whichever
-    // ranks hold it.
-
+    TileRect tile(int rank) const { return split_.tile(rank); }
     /// The rank whose tile holds vertex (x, y) of the whole grid.
     int rank_at(int x, int y) const;
-    /// Collective: every rank asks for one rectangle `want` inside the whole
-    /// grid (width or height 0: nothing) and gets its values, row-major, taken
-    /// from the tiles that hold them. `mine`: this rank's tile, owned().width ×
-    /// owned().height values, row-major. Opens with the failure agreement
-    /// (throws PeerFailed).
+    /// Whether this tile is the eastmost of its row of tiles.
+    bool eastmost() const { return owned().x1() == grid_width(); }
+
+    // ------------------------------------------------------- ghosted grids
+
+    /// The ghost width: the node's NodeDescriptor::tile_halo, declared there
+    /// once. The kernel has checked that every tile is at least this wide and
+    /// high.
+    int halo() const { return halo_; }
+    /// owned() grown by halo() vertices on every side, clipped to the grid:
+    /// what a ghosted grid covers.
+    TileRect ghosted() const;
+    /// A ghosted grid holding `tile` (owned().width × owned().height values,
+    /// row-major) in its owned part, T() in the ghosts (exchange() fills them).
+    template <typename T>
+    std::vector<T> ghosted_copy(const T* tile) const;
+    /// Collective: fills the ghosts of each of `grids` (ghosted grids,
+    /// row-major) with the neighbouring ranks' owned values, corners included;
+    /// the owned parts are sent, never changed. One opening agreement and one
+    /// message per side, whatever the number of grids. T: float, double or
+    /// std::int64_t (whole numbers, cell indices).
+    template <typename T>
+    void exchange(std::span<T* const> grids);
+    /// exchange() of float views, each of the ghosted() size (else Error).
+    void exchange(std::span<const GridView> grids);
+    void exchange(GridView grid) { exchange(std::span<const GridView>(&grid, 1)); }
+
+    // ---------------------------------------------------------- reductions
+
+    enum class Reduce { sum, min, max };
+    /// Collective: element by element, every rank's `values` combined by `op`,
+    /// on every rank, in rank order (a sum adds rank 0's, then rank 1's, ...
+    /// to 0: the same bits everywhere, whatever MPI's reduction tree; exact
+    /// for integers below 2^53 in a double). T: float, double, std::int64_t.
+    /// Every rank gives as many values.
+    template <typename T>
+    void reduce(std::span<T> values, Reduce op);
+    template <typename T>
+    T reduce(T value, Reduce op) {
+        reduce(std::span<T>(&value, 1), op);
+        return value;
+    }
+
+    // ------------------------------------------------------ moving bytes
+
+    enum class Gather { to_rank0, to_every_rank };
+    /// Collective: every rank's `bytes`, in rank order, on rank 0 (empty
+    /// elsewhere) or on every rank. With share_from_rank0(): rank 0 solves
+    /// what the tiles sent and hands every rank the answer.
+    virtual std::vector<std::string> gather(std::string_view bytes, Gather where) = 0;
+    /// Collective: rank 0's `bytes` on every rank (others' are replaced).
+    virtual void share_from_rank0(std::string& bytes) = 0;
+    /// Collective: rank 0's whole-grid heightmap `whole` (its heights and
+    /// layers; ignored on the other ranks) cut into tiles, every rank getting
+    /// its own (a series input of a tiled node stays on rank 0). Throws
+    /// BadInput if `whole` is not the grid's size.
+    virtual std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) = 0;
+    /// Collective: every rank asks for the values at every (columns.at(i),
+    /// rows.at(j)) of the whole grid, row-major, columns.size() × rows.size()
+    /// of them (either empty: nothing), and gets them from the tiles that hold
+    /// them. `mine`: this rank's tile, owned().width × owned().height values.
+    /// Every position must lie inside the grid. For pieces of work that do not
+    /// follow the tiles (export:tiles' engine tiles, a level of detail).
+    virtual std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) = 0;
+    /// fetch_samples() of one rectangle `want` (width or height 0: nothing).
     std::vector<float> fetch(const float* mine, TileRect want) {
         return fetch_samples(mine, {want.x0, 1, want.width, -1}, {want.y0, 1, want.height, -1});
     }
-    /// Collective: fetch() of a lattice: the values at every (columns.at(i),
-    /// rows.at(j)), row-major, columns.size() × rows.size() of them (either
-    /// empty: nothing). Every position must lie inside the grid. For a level
-    /// of detail that covers a large area at a fraction of its samples.
-    virtual std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) = 0;
-    /// Collective: the sum of every rank's `value`, added in rank order on
-    /// every rank (the same bits everywhere; exact for integers below 2^53).
-    /// Opens with the failure agreement.
-    virtual double sum_all(double value) = 0;
-
-    // For nodes that compute something once for the whole grid and draw it
-    // into every tile (tectonics:plates runs Box2D on rank 0).
-
-    /// Collective: rank 0's `bytes` on every rank (others' are replaced).
-    /// Opens with the failure agreement, so rank 0 failing before the call
-    /// ends the others with PeerFailed rather than a hang.
-    virtual void share_from_rank0(std::string& bytes) = 0;
-
-    // For line solvers whose recurrence runs across the whole grid
-    // (erode:diffusion's tridiagonal sweeps).
 
     /// Which way carry() goes: along each row of tiles (east: from the west
     /// neighbour to the east one; west: the reverse), or along each column of
@@ -170,38 +178,149 @@ public:
     /// reverse).
     enum class Toward { east, west, south, north };
     /// Collective, along each row (east, west) or column (south, north) of
-    /// tiles: carry_east() in any of the four directions. `values` holds
-    /// `per_line` values for each line of this tile: its rows going east or
-    /// west, its columns going south or north. They come in from the upstream
-    /// neighbour (the first tile keeps what the caller put there),
-    /// `advance(first, count)` carries lines [first, first + count) over this
-    /// tile, and they go on downstream, in blocks of lines so that neighbours
-    /// overlap. A Thomas solve along whole rows is a forward carry east (the
-    /// eliminated coefficients) and a backward one west (the solution); with an
-    /// advance that swaps what came in for the tile's own edge, a carry is also
-    /// an edge exchange in one direction. Same caveat as carry_east().
+    /// tiles: `values` holds `per_line` values for each line of this tile (its
+    /// rows going east or west, its columns going south or north). They come
+    /// in from the upstream neighbour (the first tile keeps what the caller
+    /// put there), `advance(first, count)` carries lines [first, first +
+    /// count) over this tile, and they go on downstream, in blocks of lines
+    /// so that neighbours overlap: the chain costs about one tile's pass plus
+    /// a block's per tile downstream. This reproduces a single process's
+    /// sequential recurrence along whole lines (floating-point sums are not
+    /// associative; a Thomas solve is a carry east then one west). No opening
+    /// agreement: the caller must not throw between its last collective and
+    /// this call on one rank only (an upstream neighbour that never sends
+    /// would hang it).
     virtual void carry(Toward toward, std::span<double> values, int per_line,
                        const std::function<void(int first, int count)>& advance) = 0;
+    /// Collective: `per_row` values for each row of the whole grid, in row
+    /// order, on every rank, taken from the eastmost tile of each row of tiles
+    /// (`mine`: owned().height × per_row values there; ignored elsewhere).
+    /// With carry() east: whole-row results, then summed in row order by every
+    /// rank alike.
+    std::vector<double> gather_rows(std::span<const double> mine, int per_row);
 
-    // For nodes that solve a graph spanning the tiles (erode:stream-power's
-    // drainage: every tile routes its own cells, rank 0 joins the tiles' edges).
+    /// Seconds this node has spent so far in the opening agreements of its
+    /// collectives, waiting for every rank to arrive (as opposed to moving
+    /// data): under load or with uneven tiles, most of an exchange is this.
+    double seconds_waiting() const { return waiting_; }
 
-    /// Collective: exchange_halos() for grids of doubles (each covering
-    /// grown(halo), row-major): heights a double-precision model carries
-    /// between steps, or whole numbers below 2^53 (cell indices, counts).
-    virtual void exchange_double_halos(std::span<double* const> held, int halo) = 0;
-    /// Collective: every rank's `bytes`, in rank order, on rank 0 (empty
-    /// elsewhere). With share_from_rank0(): rank 0 solves what the tiles sent
-    /// and hands every rank the answer. Opens with the failure agreement.
-    virtual std::vector<std::string> gather_to_rank0(const std::string& bytes) = 0;
-    // For nodes that read a whole value rank 0 holds: a series input of a
-    // tiled node stays there (the other ranks get a series of no frames), as
-    // erode:stream-power's uplift_history.
-    /// Collective: rank 0's whole-grid heightmap `whole` (its heights and
-    /// layers; ignored on the other ranks) cut into tiles, every rank getting
-    /// its own. Opens with the failure agreement. Throws BadInput if `whole`
-    /// is not the grid's size.
-    virtual std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) = 0;
+protected:
+    Tiling(TileSplit split, int rank, int halo) : split_(std::move(split)), rank_(rank), halo_(halo) {}
+    /// The primitive under exchange(): `grids` of ghosted() size, `value_bytes` each value.
+    virtual void exchange_values(std::span<void* const> grids, std::size_t value_bytes) = 0;
+    /// Added to by the implementation's opening agreements (seconds).
+    double waiting_ = 0.0;
+
+private:
+    TileSplit split_;
+    int rank_ = 0, halo_ = 0;
 };
+
+template <typename T>
+std::vector<T> Tiling::ghosted_copy(const T* tile) const {
+    const TileRect own = owned(), g = ghosted();
+    std::vector<T> held(std::size_t(g.width) * std::size_t(g.height), T());
+    const std::size_t ox = std::size_t(own.x0 - g.x0), oy = std::size_t(own.y0 - g.y0);
+    for (std::size_t y = 0; y < std::size_t(own.height); ++y)
+        std::copy_n(tile + y * std::size_t(own.width), own.width, held.data() + (y + oy) * std::size_t(g.width) + ox);
+    return held;
+}
+
+template <typename T>
+void Tiling::exchange(std::span<T* const> grids) {
+    static_assert(std::is_same_v<T, float> || std::is_same_v<T, double> || std::is_same_v<T, std::int64_t>);
+    std::vector<void*> raw(grids.begin(), grids.end());
+    exchange_values(raw, sizeof(T));
+}
+
+template <typename T>
+void Tiling::reduce(std::span<T> values, Reduce op) {
+    static_assert(std::is_same_v<T, float> || std::is_same_v<T, double> || std::is_same_v<T, std::int64_t>);
+    const std::vector<std::string> all = gather(
+        std::string_view(reinterpret_cast<const char*>(values.data()), values.size_bytes()), Gather::to_every_rank);
+    for (const std::string& part : all)
+        if (part.size() != values.size_bytes()) throw Error("internal error: the ranks reduce different counts");
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        T acc{};
+        for (std::size_t r = 0; r < all.size(); ++r) {
+            T v;
+            std::memcpy(&v, all[r].data() + i * sizeof(T), sizeof(T));
+            if (op == Reduce::sum) acc += v;
+            else if (r == 0) acc = v;
+            else if (op == Reduce::max ? v > acc : v < acc) acc = v;  // ties keep the lower rank's
+        }
+        values[i] = acc;
+    }
+}
+
+/// The tiled loop of a grid eroder (erode:thermal, hydraulic, pipe): its
+/// fields moved from the tile into ghosted grids, their ghosts refilled by one
+/// exchange before each sweep of steps (a sweep of k steps needs a halo k
+/// stencils wide, and then leaves the owned part with the single process's
+/// bits, only the ghosts stale), the finiteness check of the owned part, the
+/// owned parts moved back into tiles, and the info line saying where the time
+/// went. Its grids live until take().
+class TiledFields {
+public:
+    TiledFields(Tiling& tiles, double cell);
+    Tiling& tiling() const { return tiles_; }
+    TileRect owned() const { return own_; }
+    TileRect ghosted() const { return ghosted_; }
+    int ox() const { return ox_; }  ///< where the owned part starts in a grid
+    int oy() const { return oy_; }
+
+    /// A new ghosted grid holding `tile` (owned().width × owned().height,
+    /// row-major) in its owned part, 0 in the ghosts.
+    GridView grow(const float* tile);
+    /// A new ghosted grid of zeros.
+    GridView zeros();
+    /// Collective: refills the ghosts of `grids` (this object's), counted as
+    /// exchanging in the info line.
+    void exchange(std::span<const GridView> grids);
+    void exchange(GridView grid) { exchange(std::span<const GridView>(&grid, 1)); }
+    /// `steps` steps in sweeps of at most `per_sweep`: before each, exchange()
+    /// of fields() (the grids the sweep reads across the tile's edge), then
+    /// sweep(first step, count) (timed as sweeping), then after(steps done).
+    template <typename Fields, typename Sweep, typename After>
+    void sweeps(std::int64_t steps, int per_sweep, Fields&& fields, Sweep&& sweep, After&& after);
+    /// Throws Error if the owned part of `grid` (one of this object's, or an
+    /// owned tile when `grid` is owned()'s size) holds a NaN or infinity:
+    /// NodeContext::check_finite's message, naming the sample by its index in
+    /// the whole grid.
+    void check_finite(ConstGridView grid, std::string_view what, std::int64_t step) const;
+    /// The owned part of `grid` (this object's) as a tile, moved to the front
+    /// of the grid's own memory (a copy into fresh memory costs page faults:
+    /// seconds of system time at 4097² on a loaded machine); the grid is gone.
+    std::vector<float> take(GridView grid);
+    /// Frees `grid` (this object's) now.
+    void drop(GridView grid) { std::vector<float>().swap(storage_of(grid)); }
+
+    /// "rank R of N: tile WxH at (X, Y), STEPS steps: sweeps S s, halo exchange
+    /// E s (P %), of which waiting for the other ranks W s".
+    std::string note(std::int64_t steps) const;
+
+private:
+    std::vector<float>& storage_of(const GridView& grid);
+    Tiling& tiles_;
+    double cell_;
+    TileRect own_, ghosted_;
+    int ox_ = 0, oy_ = 0;
+    std::vector<std::unique_ptr<std::vector<float>>> grids_;
+    std::chrono::steady_clock::duration exchanging_{}, sweeping_{};
+    double waited_before_ = 0.0;
+};
+
+template <typename Fields, typename Sweep, typename After>
+void TiledFields::sweeps(std::int64_t steps, int per_sweep, Fields&& fields, Sweep&& sweep, After&& after) {
+    for (std::int64_t i = 0; i < steps;) {
+        const int k = int(std::min<std::int64_t>(per_sweep, steps - i));
+        exchange(fields());
+        const auto t0 = std::chrono::steady_clock::now();
+        sweep(i, k);
+        sweeping_ += std::chrono::steady_clock::now() - t0;
+        i += k;
+        after(i);
+    }
+}
 
 }  // namespace orogen

@@ -1,5 +1,6 @@
 #include <orogen/error.hpp>
 #include <orogen/node.hpp>
+#include <orogen/tiles.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -123,15 +124,40 @@ bool CheckContext::require_layer(std::size_t i, std::string_view param, std::str
     return false;
 }
 
-void NodeContext::check_finite(std::span<const float> data, std::string_view what, std::int64_t step) const {
-    for (std::size_t i = 0; i < data.size(); ++i) {
-        if (!std::isfinite(data[i])) {
-            std::ostringstream msg;
-            msg << "non-finite " << what << " (" << data[i] << ") at sample " << i << " after step " << step
-                << "; the simulation became unstable";
-            throw Error(msg.str());
-        }
+namespace {
+
+/// The one finiteness check: the first NaN or infinity among `rows` rows of
+/// `width` values, row y starting at data + y·stride, throws Error naming it
+/// by its sample index: first_sample + y·sample_stride + x (its index in the
+/// whole grid when the rows are part of a tile).
+void check_finite_rows(const float* data, std::size_t width, std::size_t rows, std::size_t stride,
+                       std::int64_t first_sample, std::int64_t sample_stride, std::string_view what,
+                       std::int64_t step) {
+    for (std::size_t y = 0; y < rows; ++y) {
+        const float* row = data + y * stride;
+        for (std::size_t x = 0; x < width; ++x)
+            if (!std::isfinite(row[x])) {
+                std::ostringstream msg;
+                msg << "non-finite " << what << " (" << row[x] << ") at sample "
+                    << first_sample + std::int64_t(y) * sample_stride + std::int64_t(x) << " after step " << step
+                    << "; the simulation became unstable";
+                throw Error(msg.str());
+            }
     }
+}
+
+}  // namespace
+
+void NodeContext::check_finite(std::span<const float> data, std::string_view what, std::int64_t step) const {
+    check_finite_rows(data.data(), data.size(), 1, data.size(), 0, 0, what, step);
+}
+
+void TiledFields::check_finite(ConstGridView grid, std::string_view what, std::int64_t step) const {
+    // A ghosted grid or an owned tile: its owned part, named in the whole grid.
+    const bool tile = grid.width == own_.width && grid.height == own_.height;
+    const int x = tile ? 0 : ox_, y = tile ? 0 : oy_;
+    check_finite_rows(grid.row(y) + x, std::size_t(own_.width), std::size_t(own_.height), std::size_t(grid.width),
+                      std::int64_t(own_.y0) * tiles_.grid_width() + own_.x0, tiles_.grid_width(), what, step);
 }
 
 std::vector<std::string> split_names(std::string_view text) {

@@ -106,7 +106,9 @@ public:
     /// What the node said, for the cache to replay when its result is reused.
     const std::vector<std::string>& said() const { return said_; }
     Tiling* tiling() override {
-        return options_.tiled && !for_entry_ && TiledRun::runs_tiled(node_) ? options_.tiled : nullptr;
+        if (!options_.tiled || for_entry_ || !TiledRun::runs_tiled(node_)) return nullptr;
+        if (!tiling_) tiling_.emplace(*options_.tiled, node_.node->tile_halo);  // the node's ghost width
+        return &*tiling_;
     }
 
 private:
@@ -124,6 +126,7 @@ private:
     std::vector<fs::path>& outside_;
     std::uint64_t seed_;
     bool for_entry_;
+    std::optional<NodeTiling> tiling_;  ///< made at the node's first tiling()
 };
 
 /// The series a node mapped over input `mapped` of `inputs` yields: entry j

@@ -3,6 +3,8 @@
 #include <orogen/error.hpp>
 
 #include <algorithm>
+#include <climits>
+#include <cstdint>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -57,36 +59,31 @@ void max_all(int* values, int count) {
     check(MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_INT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
 }
 
-void min_max_all(float& lo, float& hi) {
-    float a = lo, b = hi;
-    check(MPI_Allreduce(&a, &lo, 1, MPI_FLOAT, MPI_MIN, MPI_COMM_WORLD), "MPI_Allreduce");
-    check(MPI_Allreduce(&b, &hi, 1, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
-}
-
-double sum_all(double value) {
-    // Gathered and added in rank order on every rank, so the sum does not depend on MPI's reduction tree.
-    int size = 1;
-    MPI_Comm_size(MPI_COMM_WORLD, &size);
-    std::vector<double> all(static_cast<std::size_t>(size));
-    check(MPI_Allgather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, MPI_COMM_WORLD), "MPI_Allgather");
-    double s = 0.0;
-    for (double v : all) s += v;
-    return s;
-}
-
-void barrier() { check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier"); }
-
-void max_all(float* values, int count) {
-    check(MPI_Allreduce(MPI_IN_PLACE, values, count, MPI_FLOAT, MPI_MAX, MPI_COMM_WORLD), "MPI_Allreduce");
-}
-
 void allgather(const int* send, int count, int* recv) {
     check(MPI_Allgather(send, count, MPI_INT, recv, count, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
 }
 
-void allgatherv(const double* send, int send_count, double* recv, const int* counts, const int* displs) {
-    check(MPI_Allgatherv(send, send_count, MPI_DOUBLE, recv, counts, displs, MPI_DOUBLE, MPI_COMM_WORLD),
+std::vector<std::string> allgather(std::string_view bytes) {
+    int size = 1;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    if (bytes.size() > std::size_t(INT_MAX)) throw Error("internal error: an allgather of 2 GiB or more");
+    const int mine = int(bytes.size());
+    std::vector<int> counts(static_cast<std::size_t>(size)), displs(static_cast<std::size_t>(size));
+    check(MPI_Allgather(&mine, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather");
+    std::int64_t total = 0;
+    for (int r = 0; r < size; ++r) {
+        displs[std::size_t(r)] = int(total);
+        total += counts[std::size_t(r)];
+    }
+    if (total > INT_MAX) throw Error("internal error: an allgather of 2 GiB or more");
+    std::string all(std::size_t(total), '\0');
+    check(MPI_Allgatherv(bytes.data(), mine, MPI_BYTE, all.data(), counts.data(), displs.data(), MPI_BYTE,
+                         MPI_COMM_WORLD),
           "MPI_Allgatherv");
+    std::vector<std::string> parts;
+    for (int r = 0; r < size; ++r)
+        parts.push_back(all.substr(std::size_t(displs[std::size_t(r)]), std::size_t(counts[std::size_t(r)])));
+    return parts;
 }
 
 void sendrecv(const void* send_data, std::size_t send_bytes, int to, void* recv_data, std::size_t recv_bytes, int from,
@@ -157,14 +154,8 @@ Session::Session(int&, char**&) {
 }
 Session::~Session() = default;
 void max_all(int*, int) {}
-void min_max_all(float&, float&) {}
-double sum_all(double value) { return value; }
-void barrier() {}
-void max_all(float*, int) {}
 void allgather(const int* send, int count, int* recv) { std::copy(send, send + count, recv); }
-void allgatherv(const double* send, int send_count, double* recv, const int*, const int* displs) {
-    std::copy(send, send + send_count, recv + displs[0]);
-}
+std::vector<std::string> allgather(std::string_view bytes) { return {std::string(bytes)}; }
 void sendrecv(const void*, std::size_t, int to, void*, std::size_t, int from, int) {
     if (to >= 0 || from >= 0) unavailable();
 }

@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace orogen::mpi {
 
@@ -37,18 +39,10 @@ private:
 
 /// Element by element, the largest of every rank's `values[0..count)` (in place).
 void max_all(int* values, int count);
-/// The least of every rank's `lo` and the greatest of their `hi`.
-void min_max_all(float& lo, float& hi);
-/// The sum of every rank's `value`, in rank order (exact for integers below 2^53).
-double sum_all(double value);
-void barrier();
-/// Element by element, the largest of every rank's `values[0..count)` (in place).
-void max_all(float* values, int count);
 /// Every rank's `send[0..count)` concatenated in rank order into `recv` (count × ranks values), on every rank.
 void allgather(const int* send, int count, int* recv);
-/// Every rank's `send[0..counts[rank])` concatenated in rank order into
-/// `recv` (at `displs[r]` for rank r), on every rank.
-void allgatherv(const double* send, int send_count, double* recv, const int* counts, const int* displs);
+/// Every rank's `bytes` (any size, each below 2 GiB), in rank order, on every rank.
+std::vector<std::string> allgather(std::string_view bytes);
 /// Send `send` to rank `to` and receive `recv` from rank `from` at once; -1 for
 /// either means no such neighbour (nothing sent or received). The two sizes
 /// may differ; `from` must send exactly `recv_bytes` with the same tag.

@@ -14,10 +14,10 @@
 
 namespace orogen {
 
-TileRect Tiling::grown(int halo) const {
+TileRect Tiling::ghosted() const {
     const TileRect o = owned();
-    const int x0 = std::max(0, o.x0 - halo), y0 = std::max(0, o.y0 - halo);
-    const int x1 = std::min(grid_width(), o.x1() + halo), y1 = std::min(grid_height(), o.y1() + halo);
+    const int x0 = std::max(0, o.x0 - halo_), y0 = std::max(0, o.y0 - halo_);
+    const int x1 = std::min(grid_width(), o.x1() + halo_), y1 = std::min(grid_height(), o.y1() + halo_);
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
@@ -30,16 +30,92 @@ int Tiling::rank_at(int x, int y) const {
                 std::to_string(grid_width()) + "x" + std::to_string(grid_height()) + " grid");
 }
 
-std::string Tiling::sweep_note(std::int64_t steps, double sweeping_s, double exchanging_s,
-                               double waited_before) const {
-    const TileRect own = owned();
+void Tiling::exchange(std::span<const GridView> grids) {
+    const TileRect g = ghosted();
+    std::vector<void*> data;
+    for (const GridView& held : grids) {
+        if (held.width != g.width || held.height != g.height)
+            throw Error("internal error: exchange got a " + std::to_string(held.width) + "x" +
+                        std::to_string(held.height) + " grid for a ghosted tile of " + std::to_string(g.width) + "x" +
+                        std::to_string(g.height));
+        data.push_back(held.data);
+    }
+    exchange_values(data, sizeof(float));
+}
+
+std::vector<double> Tiling::gather_rows(std::span<const double> mine, int per_row) {
+    // Rank order is row-major, so the eastmost tiles in rank order hold the rows in grid order.
+    const std::size_t n = eastmost() ? std::size_t(owned().height) * std::size_t(per_row) : 0;
+    if (n && mine.size() != n)
+        throw Error("internal error: gather_rows got " + std::to_string(mine.size()) + " values for " +
+                    std::to_string(n));
+    const auto all = gather(std::string_view(reinterpret_cast<const char*>(mine.data()), n * sizeof(double)),
+                            Gather::to_every_rank);
+    std::vector<double> rows(std::size_t(grid_height()) * std::size_t(per_row));
+    std::size_t at = 0;
+    for (const std::string& part : all) {
+        if (at * sizeof(double) + part.size() > rows.size() * sizeof(double))
+            throw Error("internal error: gather_rows got more rows than the grid has");
+        std::memcpy(rows.data() + at, part.data(), part.size());
+        at += part.size() / sizeof(double);
+    }
+    return rows;
+}
+
+// ------------------------------------------------------------------ a grid eroder's tiled loop
+
+TiledFields::TiledFields(Tiling& tiles, double cell)
+    : tiles_(tiles),
+      cell_(cell),
+      own_(tiles.owned()),
+      ghosted_(tiles.ghosted()),
+      ox_(own_.x0 - ghosted_.x0),
+      oy_(own_.y0 - ghosted_.y0),
+      waited_before_(tiles.seconds_waiting()) {}
+
+GridView TiledFields::grow(const float* tile) {
+    grids_.push_back(std::make_unique<std::vector<float>>(tiles_.ghosted_copy(tile)));
+    return {grids_.back()->data(), ghosted_.width, ghosted_.height, cell_};
+}
+
+GridView TiledFields::zeros() {
+    grids_.push_back(std::make_unique<std::vector<float>>(std::size_t(ghosted_.width) * std::size_t(ghosted_.height)));
+    return {grids_.back()->data(), ghosted_.width, ghosted_.height, cell_};
+}
+
+void TiledFields::exchange(std::span<const GridView> grids) {
+    const auto t0 = std::chrono::steady_clock::now();
+    tiles_.exchange(grids);
+    exchanging_ += std::chrono::steady_clock::now() - t0;
+}
+
+std::vector<float>& TiledFields::storage_of(const GridView& grid) {
+    for (auto& g : grids_)
+        if (g->data() == grid.data && !g->empty()) return *g;
+    throw Error("internal error: TiledFields was given a grid it does not hold");
+}
+
+std::vector<float> TiledFields::take(GridView grid) {
+    std::vector<float>& held = storage_of(grid);
+    // Row y's destination never passes its source, so rows are moved in order.
+    for (int y = 0; y < own_.height; ++y)
+        std::memmove(held.data() + std::size_t(y) * std::size_t(own_.width),
+                     held.data() + std::size_t(y + oy_) * std::size_t(ghosted_.width) + std::size_t(ox_),
+                     std::size_t(own_.width) * sizeof(float));
+    held.resize(std::size_t(own_.width) * std::size_t(own_.height));
+    return std::move(held);
+}
+
+std::string TiledFields::note(std::int64_t steps) const {
+    const double sweeping = std::chrono::duration<double>(sweeping_).count();
+    const double exchanging = std::chrono::duration<double>(exchanging_).count();
     std::ostringstream note;
     note.precision(3);
-    note << "rank " << rank() << " of " << ranks() << ": tile " << own.width << "x" << own.height << " at (" << own.x0
-         << ", " << own.y0 << "), " << steps << " steps: sweeps " << sweeping_s << " s, halo exchange "
-         << exchanging_s << " s ("
-         << (sweeping_s + exchanging_s > 0 ? 100.0 * exchanging_s / (sweeping_s + exchanging_s) : 0.0)
-         << " %), of which waiting for the other ranks " << seconds_waiting() - waited_before << " s";
+    note << "rank " << tiles_.rank() << " of " << tiles_.ranks() << ": tile " << own_.width << "x" << own_.height
+         << " at (" << own_.x0 << ", " << own_.y0 << "), " << steps << " steps: sweeps " << sweeping
+         << " s, halo exchange " << exchanging << " s ("
+         << (sweeping + exchanging > 0 ? 100.0 * exchanging / (sweeping + exchanging) : 0.0)
+         << " %), of which waiting for the other ranks " << tiles_.seconds_waiting() - waited_before_ << " s";
     return note.str();
 }
 
@@ -188,56 +264,43 @@ void copy_rect(T* grid, int stride, int x, int y, int w, int h, T* out, bool to_
 
 }  // namespace
 
-void TiledRun::agree_or_throw() {
+// ------------------------------------------------------------------ what a tiled node sees
+
+void NodeTiling::agree_or_throw() {
     const auto t0 = std::chrono::steady_clock::now();
-    const int code = agree(0);
+    const int code = run_.agree(0);
     waiting_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (code) throw PeerFailed(code, code == 2 ? Error::Kind::bad_input : Error::Kind::failed_run);
 }
 
-void TiledRun::exchange_halo(GridView held, int halo) { exchange_halos(std::span<const GridView>(&held, 1), halo); }
-
-void TiledRun::exchange_halos(std::span<const GridView> grids, int halo) {
-    const TileRect g = grown(halo);
-    std::vector<float*> data;
-    for (const GridView& held : grids) {
-        if (held.width != g.width || held.height != g.height) {
-            agree_or_throw();  // a mismatch is this rank's bug: the others still meet it at the agreement
-            throw Error("internal error: exchange_halo got a " + std::to_string(held.width) + "x" +
-                        std::to_string(held.height) + " grid for a grown tile of " + std::to_string(g.width) + "x" +
-                        std::to_string(g.height));
-        }
-        data.push_back(held.data);
-    }
-    exchange_grids(std::span<float* const>(data), halo);
-}
-
-void TiledRun::exchange_double_halos(std::span<double* const> grids, int halo) { exchange_grids(grids, halo); }
-
-template <typename T>
-void TiledRun::exchange_grids(std::span<T* const> grids, int halo) {
+void NodeTiling::exchange_values(std::span<void* const> grids, std::size_t value_bytes) {
     agree_or_throw();
-    const TileRect o = owned(), g = grown(halo);
+    const int halo = this->halo();
     if (halo == 0 || ranks() == 1 || grids.empty()) return;
-    const int r = rank_ / split_.cols, c = rank_ % split_.cols;
-    const int west = c > 0 ? rank_ - 1 : -1, east = c + 1 < split_.cols ? rank_ + 1 : -1;
-    const int north = r > 0 ? rank_ - split_.cols : -1, south = r + 1 < split_.rows ? rank_ + split_.cols : -1;
+    const TileSplit& split = run_.split();
+    const TileRect o = owned(), g = ghosted();
+    const int rank = this->rank(), r = rank / split.cols, c = rank % split.cols;
+    const int west = c > 0 ? rank - 1 : -1, east = c + 1 < split.cols ? rank + 1 : -1;
+    const int north = r > 0 ? rank - split.cols : -1, south = r + 1 < split.rows ? rank + split.cols : -1;
     const int ox = o.x0 - g.x0, oy = o.y0 - g.y0;  // the owned part inside each grid
-    const std::size_t count = grids.size(), stride = std::size_t(g.width);
-    std::vector<T> out, in;
+    // Bytes from here on: a value is `vb` bytes, a grid row `stride` of them.
+    const int vb = int(value_bytes);
+    const std::size_t count = grids.size(), stride = std::size_t(g.width) * value_bytes;
+    std::vector<char> out, in;
+    auto grid = [&](std::size_t k) { return static_cast<char*>(grids[k]); };
     // East and west: the owned rows only (the corners come with the rows below);
     // grid k's block of halo × o.height values at k·block in each message.
     auto columns = [&](int send_x, int to, int recv_x, int from, int tag) {
-        const std::size_t block = std::size_t(halo) * std::size_t(o.height);
+        const std::size_t block = std::size_t(halo) * std::size_t(o.height) * value_bytes;
         out.resize(to >= 0 ? block * count : 0);
         in.resize(from >= 0 ? block * count : 0);
         if (to >= 0)
             for (std::size_t k = 0; k < count; ++k)
-                copy_rect(grids[k], g.width, send_x, oy, halo, o.height, out.data() + k * block, false);
-        mpi::sendrecv(out.data(), out.size() * sizeof(T), to, in.data(), in.size() * sizeof(T), from, tag);
+                copy_rect(grid(k), g.width * vb, send_x * vb, oy, halo * vb, o.height, out.data() + k * block, false);
+        mpi::sendrecv(out.data(), out.size(), to, in.data(), in.size(), from, tag);
         if (from >= 0)
             for (std::size_t k = 0; k < count; ++k)
-                copy_rect(grids[k], g.width, recv_x, oy, halo, o.height, in.data() + k * block, true);
+                copy_rect(grid(k), g.width * vb, recv_x * vb, oy, halo * vb, o.height, in.data() + k * block, true);
     };
     columns(ox, west, ox + o.width, east, kTagWest);  // my first columns go west, the east's come in
     columns(ox + o.width - halo, east, ox - halo, west, kTagEast);
@@ -249,48 +312,49 @@ void TiledRun::exchange_grids(std::span<T* const> grids, int halo) {
         in.resize(from >= 0 ? block * count : 0);
         if (to >= 0)
             for (std::size_t k = 0; k < count; ++k)
-                std::memcpy(out.data() + k * block, grids[k] + std::size_t(send_y) * stride, block * sizeof(T));
-        mpi::sendrecv(out.data(), out.size() * sizeof(T), to, in.data(), in.size() * sizeof(T), from, tag);
+                std::memcpy(out.data() + k * block, grid(k) + std::size_t(send_y) * stride, block);
+        mpi::sendrecv(out.data(), out.size(), to, in.data(), in.size(), from, tag);
         if (from >= 0)
             for (std::size_t k = 0; k < count; ++k)
-                std::memcpy(grids[k] + std::size_t(recv_y) * stride, in.data() + k * block, block * sizeof(T));
+                std::memcpy(grid(k) + std::size_t(recv_y) * stride, in.data() + k * block, block);
     };
     rows(oy, north, oy + o.height, south, kTagNorth);
     rows(oy + o.height - halo, south, oy - halo, north, kTagSouth);
 }
 
-template void TiledRun::exchange_grids<float>(std::span<float* const>, int);
-template void TiledRun::exchange_grids<double>(std::span<double* const>, int);
-
-std::vector<std::string> TiledRun::gather_to_rank0(const std::string& bytes) {
+std::vector<std::string> NodeTiling::gather(std::string_view bytes, Gather where) {
     agree_or_throw();
-    return gather_text(bytes);
+    if (where == Gather::to_rank0) return run_.gather_text(std::string(bytes));
+    return mpi::allgather(bytes);
 }
 
-void TiledRun::max_all(float* values, int count) {
+void NodeTiling::share_from_rank0(std::string& bytes) {
     agree_or_throw();
-    mpi::max_all(values, count);
+    run_.broadcast(bytes);
 }
 
-void TiledRun::carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) {
-    this->carry(Toward::east, carry, per_row, advance);
+std::shared_ptr<Heightmap> NodeTiling::scatter_from_rank0(const Heightmap* whole) {
+    agree_or_throw();
+    return run_.scatter(whole);
 }
 
-void TiledRun::carry(Toward toward, std::span<double> values, int per_line, const std::function<void(int, int)>& advance) {
-    const int c = rank_ % split_.cols, r = rank_ / split_.cols;
+void NodeTiling::carry(Toward toward, std::span<double> values, int per_line,
+                       const std::function<void(int, int)>& advance) {
+    const TileSplit& split = run_.split();
+    const int rank = this->rank(), c = rank % split.cols, r = rank / split.cols;
     int from = -1, to = -1;  // upstream and downstream neighbours
     switch (toward) {
         case Toward::east:
-            from = c > 0 ? rank_ - 1 : -1, to = c + 1 < split_.cols ? rank_ + 1 : -1;
+            from = c > 0 ? rank - 1 : -1, to = c + 1 < split.cols ? rank + 1 : -1;
             break;
         case Toward::west:
-            from = c + 1 < split_.cols ? rank_ + 1 : -1, to = c > 0 ? rank_ - 1 : -1;
+            from = c + 1 < split.cols ? rank + 1 : -1, to = c > 0 ? rank - 1 : -1;
             break;
         case Toward::south:
-            from = r > 0 ? rank_ - split_.cols : -1, to = r + 1 < split_.rows ? rank_ + split_.cols : -1;
+            from = r > 0 ? rank - split.cols : -1, to = r + 1 < split.rows ? rank + split.cols : -1;
             break;
         case Toward::north:
-            from = r + 1 < split_.rows ? rank_ + split_.cols : -1, to = r > 0 ? rank_ - split_.cols : -1;
+            from = r + 1 < split.rows ? rank + split.cols : -1, to = r > 0 ? rank - split.cols : -1;
             break;
     }
     const int lines = per_line > 0 ? int(values.size() / std::size_t(per_line)) : 0;
@@ -306,24 +370,6 @@ void TiledRun::carry(Toward toward, std::span<double> values, int per_line, cons
         advance(first, count);
         if (to >= 0) mpi::send(block, bytes, to, tag);
     }
-}
-
-std::vector<double> TiledRun::gather_rows(std::span<const double> mine, int per_row) {
-    // Rank order is row-major, so the eastmost tiles in rank order hold the rows in grid order.
-    std::vector<int> counts(std::size_t(ranks()), 0), displs(std::size_t(ranks()), 0);
-    int at = 0;
-    for (int r = 0; r < ranks(); ++r) {
-        displs[std::size_t(r)] = at;
-        if (r % split_.cols == split_.cols - 1) counts[std::size_t(r)] = split_.tile(r).height * per_row;
-        at += counts[std::size_t(r)];
-    }
-    std::vector<double> all(std::size_t(split_.grid_height) * std::size_t(per_row));
-    const int n = counts[std::size_t(rank_)];
-    if (n && mine.size() != std::size_t(n))
-        throw Error("internal error: gather_rows got " + std::to_string(mine.size()) + " values for " +
-                    std::to_string(n));
-    mpi::allgatherv(mine.data(), n, all.data(), counts.data(), displs.data());
-    return all;
 }
 
 namespace {
@@ -355,7 +401,7 @@ bool valid_axis(const AxisSamples& axis, int extent) {
 
 }  // namespace
 
-std::vector<float> TiledRun::fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) {
+std::vector<float> NodeTiling::fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) {
     agree_or_throw();
     if (!valid_axis(columns, grid_width()) || !valid_axis(rows, grid_height()))
         throw Error("internal error: fetch of samples outside the " + std::to_string(grid_width()) + "x" +
@@ -387,7 +433,7 @@ std::vector<float> TiledRun::fetch_samples(const float* mine, AxisSamples column
     // Round s: send to rank + s what it wants of this tile, receive from rank − s what it holds of the
     // lattice. Both ends of a pair compute the same part, so an empty one is skipped on both.
     for (int s = 0; s < n; ++s) {
-        const int to = (rank_ + s) % n, from = (rank_ - s + n) % n;
+        const int to = (rank() + s) % n, from = (rank() - s + n) % n;
         const auto [to_cols, to_rows] = want_of(to);
         const Part give = part(o, to_cols, to_rows), take = part(tile(from), columns, rows);
         give_buffer.resize(give.size());
@@ -410,22 +456,7 @@ std::vector<float> TiledRun::fetch_samples(const float* mine, AxisSamples column
     return out;
 }
 
-double TiledRun::sum_all(double value) {
-    agree_or_throw();
-    return mpi::sum_all(value);
-}
-
-void TiledRun::share_from_rank0(std::string& bytes) {
-    agree_or_throw();
-    mpi::broadcast(bytes);
-}
-
 void TiledRun::broadcast(std::string& text) { mpi::broadcast(text); }
-
-std::shared_ptr<Heightmap> TiledRun::scatter_from_rank0(const Heightmap* whole) {
-    agree_or_throw();
-    return scatter(whole);
-}
 
 std::vector<std::string> TiledRun::gather_text(const std::string& text) {
     if (rank_ != 0) {
@@ -443,11 +474,6 @@ std::vector<std::string> TiledRun::gather_text(const std::string& text) {
         if (n) mpi::recv(all[std::size_t(r)].data(), std::size_t(n), r, kTagText);
     }
     return all;
-}
-
-void TiledRun::min_max(float& lo, float& hi) {
-    agree_or_throw();
-    mpi::min_max_all(lo, hi);
 }
 
 std::shared_ptr<Heightmap> TiledRun::gather(const Heightmap* tile) {

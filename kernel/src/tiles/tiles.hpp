@@ -19,19 +19,7 @@
 
 namespace orogen {
 
-/// The grid cut into rows × cols tiles; tile i = r·cols + c is rank i's.
-/// Cuts fall at floor(k·size/parts): tiles differ in size by at most one
-/// vertex, and nothing is aligned to powers of two.
-struct TileSplit {
-    int grid_width = 0, grid_height = 0;
-    int rows = 1, cols = 1;
-    std::vector<int> xs, ys;  ///< cols+1 and rows+1 cut positions
-    int count() const { return rows * cols; }
-    TileRect tile(int index) const;
-    int smallest_width() const;
-    int smallest_height() const;
-};
-
+/// The grid cut into rows × cols tiles (TileSplit, orogen/tiles.hpp).
 TileSplit split_grid(int width, int height, int rows, int cols);
 
 /// "RxC" (rows x columns, e.g. "2x3") → {R, C}; nullopt if it is not that.
@@ -52,32 +40,15 @@ struct TiledCheckOptions {
 /// small enough to run whole on rank 0. Errors go to `diags` at the node.
 void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptions& options, spec::Diagnostics& diags);
 
-/// One rank's side of a tiled run.
-class TiledRun final : public Tiling {
+/// One rank's side of a tiled run: what the runner consults around every node.
+class TiledRun {
 public:
     TiledRun(TileSplit split, int rank) : split_(std::move(split)), rank_(rank) {}
 
-    int rank() const override { return rank_; }
-    int ranks() const override { return split_.count(); }
-    int grid_width() const override { return split_.grid_width; }
-    int grid_height() const override { return split_.grid_height; }
-    TileRect owned() const override { return split_.tile(rank_); }
-    TileRect tile(int rank) const override { return split_.tile(rank); }
-    void exchange_halo(GridView held, int halo) override;
-    void min_max(float& lo, float& hi) override;
-    void exchange_halos(std::span<const GridView> held, int halo) override;
-    void max_all(float* values, int count) override;
-    void carry_east(std::span<double> carry, int per_row, const std::function<void(int, int)>& advance) override;
-    void carry(Toward toward, std::span<double> values, int per_line,
-               const std::function<void(int, int)>& advance) override;
-    std::vector<double> gather_rows(std::span<const double> mine, int per_row) override;
-    double seconds_waiting() const override { return waiting_; }
-    std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) override;
-    double sum_all(double value) override;
-    void share_from_rank0(std::string& bytes) override;
-    void exchange_double_halos(std::span<double* const> held, int halo) override;
-    std::vector<std::string> gather_to_rank0(const std::string& bytes) override;
-    std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) override;
+    int rank() const { return rank_; }
+    int ranks() const { return split_.count(); }
+    TileRect owned() const { return split_.tile(rank_); }
+    const TileSplit& split() const { return split_; }
 
     /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
     static bool runs_tiled(const PlannedNode& node);
@@ -104,19 +75,35 @@ public:
     /// Collective: every rank's `text`, in rank order, on rank 0 (empty elsewhere).
     std::vector<std::string> gather_text(const std::string& text);
 
-    const TileSplit& split() const { return split_; }
-
 private:
-    /// The opening agreement of every collective a tiled node calls: throws PeerFailed if a rank failed.
-    void agree_or_throw();
-    /// exchange_halos() over grids of T (float or double), `width` values per row of grown(halo).
-    template <typename T>
-    void exchange_grids(std::span<T* const> grids, int halo);
     enum class Place { tiles, rank0 };
     TileSplit split_;
     int rank_;
-    double waiting_ = 0.0;
     std::map<std::string, Place, std::less<>> places_;
+};
+
+/// What one tiled node sees of the run (NodeContext::tiling()): the run's
+/// split with the node's ghost width, and the primitives over MPI. Each
+/// collective but carry() opens with the run's failure agreement, its wait
+/// counted in seconds_waiting().
+class NodeTiling final : public Tiling {
+public:
+    NodeTiling(TiledRun& run, int halo) : Tiling(run.split(), run.rank(), halo), run_(run) {}
+
+    std::vector<std::string> gather(std::string_view bytes, Gather where) override;
+    void share_from_rank0(std::string& bytes) override;
+    std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) override;
+    std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) override;
+    void carry(Toward toward, std::span<double> values, int per_line,
+               const std::function<void(int, int)>& advance) override;
+
+protected:
+    void exchange_values(std::span<void* const> grids, std::size_t value_bytes) override;
+
+private:
+    /// The opening agreement: throws PeerFailed if a rank failed.
+    void agree_or_throw();
+    TiledRun& run_;
 };
 
 }  // namespace orogen

@@ -6,6 +6,7 @@
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -26,46 +27,24 @@ constexpr int kStepsPerSweep = 4;
 /// terrain (the slope). So a sweep of kStepsPerSweep steps needs this many.
 constexpr int kTileHalo = 3 * kStepsPerSweep;
 
-/// check_finite()'s message, with the sample's index in the whole grid (a tiled run holds a tile).
-void check_finite_owned(ConstGridView held, const TileRect& own, int ox, int oy, int grid_width, const char* what,
-                        std::int64_t step) {
-    for (int y = 0; y < own.height; ++y)
-        for (int x = 0; x < own.width; ++x)
-            if (const float v = held.row(y + oy)[ox + x]; !std::isfinite(v)) {
-                std::ostringstream msg;
-                msg << "non-finite " << what << " (" << v << ") at sample "
-                    << std::int64_t(own.y0 + y) * grid_width + (own.x0 + x) << " after step " << step
-                    << "; the simulation became unstable";
-                throw Error(msg.str());
-            }
-}
-
 /// One rank's tile of a tiled run (orogen/tiles.hpp). The step is a pure
 /// function of the previous state (no global sums), so the rank works on its
-/// tile grown by kTileHalo: before each sweep of kStepsPerSweep steps the
-/// halo of terrain, water and sediment is refilled from the neighbours; the
-/// sweep treats the grown tile's edge as the map's edge, whose wrong effect
-/// travels 3 vertices a step, so after the sweep the owned vertices hold the
-/// single process's bits and only the halo is stale. Once more at the end,
-/// for the `flow` and `hardness` layers (stencils of 2 and 1 vertices).
+/// tile grown by kTileHalo (TiledFields): before each sweep of kStepsPerSweep
+/// steps the halo of terrain, water and sediment is refilled from the
+/// neighbours; the sweep treats the grown tile's edge as the map's edge, whose
+/// wrong effect travels 3 vertices a step, so after the sweep the owned
+/// vertices hold the single process's bits and only the halo is stale. Once
+/// more at the end, for the `flow` and `hardness` layers (stencils of 2 and 1
+/// vertices).
 std::shared_ptr<Series> run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm, const hydraulic::Settings& s,
                                   const float* layer, std::int64_t iterations) {
-    const TileRect own = tiles.owned(), grown = tiles.grown(kTileHalo);
-    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
-    const std::size_t n = std::size_t(grown.width) * std::size_t(grown.height);
-    const double cell = hm.cell();
-    auto to_grown = [&](const float* tile, float* held) {
-        for (int y = 0; y < own.height; ++y)
-            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
-                      held + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox));
-    };
-    std::vector<float> held_layer;
+    TiledFields fields(tiles, hm.cell());
+    GridView held_layer;
     if (layer) {  // the hardness of the halo too, once: it does not change
-        held_layer.assign(n, 0.0f);
-        to_grown(layer, held_layer.data());
-        tiles.exchange_halo({held_layer.data(), grown.width, grown.height, cell}, kTileHalo);
+        held_layer = fields.grow(layer);
+        fields.exchange(held_layer);
     }
-    const float* hard = layer ? held_layer.data() : nullptr;
+    const float* hard = held_layer.data;
     // Two states (double-buffered): terrain, water, sediment each, the tile
     // grown by the halo. The tile's water and sediment layers (an input's, or
     // none: zero) move into the first state one at a time, each dropped as
@@ -74,81 +53,53 @@ std::shared_ptr<Series> run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm
     // beside the six grown grids, as one process holds 8 whole grids. Filling
     // all six first and dropping the two layers after was two grids more per
     // rank (docs/benchmarks.md, "Tiled Olsen hydraulic erosion").
-    std::vector<float> storage[6];
-    auto grid = [&](int k) { return GridView{storage[k].data(), grown.width, grown.height, cell}; };
-    storage[0].assign(n, 0.0f);
-    to_grown(hm.heights().data(), storage[0].data());
-    for (int k : {1, 2}) {
-        const char* name = k == 1 ? "water" : "sediment";
-        storage[k].assign(n, 0.0f);
-        if (hm.has_layer(name)) {
-            to_grown(std::as_const(hm).layer(name).data, storage[k].data());
-            hm.remove_layer(name);
-        }
-    }
-    for (int k : {3, 4, 5}) storage[k].assign(n, 0.0f);
-    hydraulic::State a{grid(0), grid(1), grid(2)}, b{grid(3), grid(4), grid(5)};
+    const GridView height = fields.grow(hm.heights().data());
+    auto grow_layer = [&](const char* name) {
+        if (!hm.has_layer(name)) return fields.zeros();
+        const GridView g = fields.grow(std::as_const(hm).layer(name).data);
+        hm.remove_layer(name);
+        return g;
+    };
+    const GridView water = grow_layer("water");
+    const GridView sediment = grow_layer("sediment");
+    hydraulic::State a{height, water, sediment}, b{fields.zeros(), fields.zeros(), fields.zeros()};
+    const int ox = fields.ox(), oy = fields.oy();
     // Snapshots after every step, as run()'s; rank 0 holds them. The first has the water layer run() makes.
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0, tiles);  // time = step count
     lapse.record(0, a.height, a.water.data, ox, oy);
-    using clock = std::chrono::steady_clock;
-    clock::duration exchanging{}, sweeping{};  // for the info line (docs/benchmarks.md)
-    const double waited_before = tiles.seconds_waiting();
-    auto exchange = [&] {
-        const auto t0 = clock::now();
-        const GridView grids[] = {a.height, a.water, a.sediment};
-        tiles.exchange_halos(grids, kTileHalo);
-        exchanging += clock::now() - t0;
-    };
-    for (std::int64_t i = 0; i < iterations;) {
-        const int k = int(std::min<std::int64_t>(kStepsPerSweep, iterations - i));
-        exchange();
-        const auto t1 = clock::now();
-        for (int j = 0; j < k; ++j) {
-            hydraulic::step({a.height, a.water, a.sediment}, b, s, hard);
-            std::swap(a, b);
-            ++i;
-            lapse.record(i, a.height, a.water.data, ox, oy);
-            ctx.check_cancelled();
-            if (i % 64 == 0 || i == iterations) {  // as run() checks
-                check_finite_owned(a.height, own, ox, oy, tiles.grid_width(), "height", i);
-                check_finite_owned(a.water, own, ox, oy, tiles.grid_width(), "water", i);
-                check_finite_owned(a.sediment, own, ox, oy, tiles.grid_width(), "sediment", i);
-                ctx.progress(double(i) / double(iterations));
+    fields.sweeps(
+        iterations, kStepsPerSweep, [&] { return std::array{a.height, a.water, a.sediment}; },
+        [&](std::int64_t first, int k) {
+            for (std::int64_t i = first + 1; i <= first + k; ++i) {
+                hydraulic::step({a.height, a.water, a.sediment}, b, s, hard);
+                std::swap(a, b);
+                lapse.record(i, a.height, a.water.data, ox, oy);
+                ctx.check_cancelled();
+                if (i % 64 == 0 || i == iterations) {  // as run() checks
+                    fields.check_finite(a.height, "height", i);
+                    fields.check_finite(a.water, "water", i);
+                    fields.check_finite(a.sediment, "sediment", i);
+                    ctx.progress(double(i) / double(iterations));
+                }
             }
-        }
-        sweeping += clock::now() - t1;
-    }
-    exchange();  // the halo `flow` and `hardness` read
-    const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
-    ctx.info(tiles.sweep_note(iterations, sw, ex, waited_before));
+        },
+        [](std::int64_t) {});
+    fields.exchange(std::array{a.height, a.water, a.sediment});  // the halo `flow` and `hardness` read
+    ctx.info(fields.note(iterations));
     // The layers run() adds, from the final state (b's grids are free now: scratch for them).
     for (const char* l : {"flux_west", "flux_east", "flux_north", "flux_south"}) hm.remove_layer(l);
     hydraulic::outflow({a.height, a.water, a.sediment}, s, hard, b.height);
     const bool steep = s.hardness == hydraulic::Hardness::steepness;
     if (steep) hydraulic::steepness_hardness(a.height, b.water);
-    // Each grid back as a tile, its owned part moved to its front in place (a
-    // copy into fresh memory costs page faults: seconds of system time at
-    // 4097² on a loaded machine). Row y's destination never passes its source.
-    auto take = [&](const GridView& g) {
-        std::vector<float>* owner = nullptr;
-        for (auto& v : storage)
-            if (v.data() == g.data) owner = &v;
-        for (int y = 0; y < own.height; ++y)
-            std::memmove(owner->data() + std::size_t(y) * std::size_t(own.width),
-                         owner->data() + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox),
-                         std::size_t(own.width) * sizeof(float));
-        owner->resize(std::size_t(own.width) * std::size_t(own.height));
-        return std::move(*owner);
-    };
-    std::vector<float>().swap(held_layer);
-    std::vector<float> after = take(a.height);
+    // Each grid back as a tile, its owned part moved to its front in place (TiledFields::take).
+    if (layer) fields.drop(held_layer);
+    std::vector<float> after = fields.take(a.height);
     GridView eroded = hm.layer("eroded", 0.0f);
     for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm.heights()[i];
-    hm.set_layer("water", take(a.water));
-    hm.set_layer("sediment", take(a.sediment));
-    hm.set_layer("flow", take(b.height));
-    if (steep) hm.set_layer("hardness", take(b.water));
+    hm.set_layer("water", fields.take(a.water));
+    hm.set_layer("sediment", fields.take(a.sediment));
+    hm.set_layer("flow", fields.take(b.height));
+    if (steep) hm.set_layer("hardness", fields.take(b.water));
     hm.heights() = std::move(after);
     lapse.finish(iterations, hm);
     return lapse.enabled() ? lapse.series() : nullptr;

@@ -33,19 +33,6 @@ std::string suspended_line(const pipe::Solver& solver) {
     return msg.str();
 }
 
-/// check_finite()'s message, with the sample's index in the whole grid (a tiled run holds a tile).
-void check_finite_tile(const float* v, const TileRect& own, int grid_width, const char* what, std::int64_t step) {
-    for (int y = 0; y < own.height; ++y)
-        for (int x = 0; x < own.width; ++x)
-            if (const float f = v[std::size_t(y) * std::size_t(own.width) + std::size_t(x)]; !std::isfinite(f)) {
-                std::ostringstream msg;
-                msg << "non-finite " << what << " (" << f << ") at sample "
-                    << std::int64_t(own.y0 + y) * grid_width + (own.x0 + x) << " after step " << step
-                    << "; the simulation became unstable";
-                throw Error(msg.str());
-            }
-}
-
 /// One rank's tile of a tiled run (orogen/tiles.hpp). The state moves into
 /// grids covering the tile grown by pipe::kTileHalo (the tile's own layers
 /// are dropped meanwhile, so memory stays about the single process's per
@@ -54,51 +41,29 @@ void check_finite_tile(const float* v, const TileRect& own, int grid_width, cons
 /// process's bits; then the owned part goes back into the tile's layers.
 NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap> hm, const pipe::Settings& s,
                       std::vector<float> mask) {
-    const TileRect own = tiles.owned(), grown = tiles.grown(pipe::kTileHalo);
-    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
-    const std::size_t grown_size = std::size_t(grown.width) * std::size_t(grown.height);
-    const double cell = hm->cell();
-    auto to_grown = [&](const float* tile) {
-        std::vector<float> held(grown_size, 0.0f);
-        for (int y = 0; y < own.height; ++y)
-            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
-                      held.begin() + std::ptrdiff_t(std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox)));
-        return held;
-    };
-    // The owned part moved to the front of the grown grid, which then is the
-    // tile (it keeps the grown capacity, a few halo rows more: fresh memory
-    // for a copy costs page faults, several seconds of system time for the
-    // 8 grids of a 4097² run on a loaded machine). Row y's destination never
-    // passes its source, so rows are moved in order.
-    auto to_tile = [&](std::vector<float>&& held) {
-        for (int y = 0; y < own.height; ++y)
-            std::memmove(held.data() + std::size_t(y) * std::size_t(own.width),
-                         held.data() + std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox),
-                         std::size_t(own.width) * sizeof(float));
-        held.resize(std::size_t(own.width) * std::size_t(own.height));
-        return std::move(held);
-    };
+    TiledFields fields(tiles, hm->cell());
+    const TileRect own = fields.owned();
+    const int ox = fields.ox(), oy = fields.oy();
     // 0 height, 1 water, 2 sediment, 3-6 fluxes, 7 flow (speed).
     const char* names[] = {"", "water", "sediment", kFluxLayers[0], kFluxLayers[1], kFluxLayers[2], kFluxLayers[3],
                            "flow"};
-    std::vector<float> held[8];
-    held[0] = to_grown(hm->heights().data());
+    GridView held[8];
+    held[0] = fields.grow(hm->heights().data());
     for (int k = 1; k < 8; ++k) {
         if (hm->has_layer(names[k])) {
-            held[k] = to_grown(std::as_const(*hm).layer(names[k]).data);
+            held[k] = fields.grow(std::as_const(*hm).layer(names[k]).data);
             hm->remove_layer(names[k]);
         } else {
-            held[k].assign(grown_size, 0.0f);  // a new state starts at 0, as the layer would
+            held[k] = fields.zeros();  // a new state starts at 0, as the layer would
         }
     }
-    auto view = [&](int k) { return GridView{held[k].data(), grown.width, grown.height, cell}; };
-    std::vector<float> held_mask;
+    GridView held_mask;
     if (!mask.empty()) {  // the rain factors of the halo too, once: they do not change
-        held_mask = to_grown(mask.data());
+        held_mask = fields.grow(mask.data());
         std::vector<float>().swap(mask);
-        tiles.exchange_halo({held_mask.data(), grown.width, grown.height, cell}, pipe::kTileHalo);
+        fields.exchange(held_mask);
     }
-    pipe::State st{view(0), view(1), view(2), view(3), view(4), view(5), view(6), view(7)};
+    pipe::State st{held[0], held[1], held[2], held[3], held[4], held[5], held[6], held[7]};
     const std::int64_t steps = ctx.integer("steps");
     const double dt = ctx.real("dt");
     using clock = std::chrono::steady_clock;
@@ -109,7 +74,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     Timelapse lapse(ctx.integer("timelapse_every"), dt, tiles);  // time in seconds
     lapse.record(0, st.height, st.water.data, ox, oy);
     {
-        pipe::Solver solver(st, s, held_mask.empty() ? nullptr : held_mask.data(), &tiles);
+        pipe::Solver solver(st, s, held_mask.data, &tiles);
         for (std::int64_t i = 1; i <= steps; ++i) {
             ctx.check_cancelled();
             solver.advance(dt, i);
@@ -133,14 +98,14 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
         ctx.info(msg.str());
         if (tiles.rank() == 0) ctx.info(suspended_line(solver));
     }
-    std::vector<float>().swap(held_mask);
-    // The owned parts back into the tile (moved within each grid, see to_tile).
-    std::vector<float> after = to_tile(std::move(held[0]));
-    for (int k = 1; k < 8; ++k) hm->set_layer(names[k], to_tile(std::move(held[k])));
+    if (held_mask.data) fields.drop(held_mask);
+    // The owned parts back into the tile (moved within each grid, TiledFields::take).
+    std::vector<float> after = fields.take(held[0]);
+    for (int k = 1; k < 8; ++k) hm->set_layer(names[k], fields.take(held[k]));
     // As run() checks: in a tiled run the solver's own check covers each sub-step already.
-    check_finite_tile(after.data(), own, tiles.grid_width(), "height", steps);
-    check_finite_tile(std::as_const(*hm).layer("water").data, own, tiles.grid_width(), "water", steps);
-    check_finite_tile(std::as_const(*hm).layer("sediment").data, own, tiles.grid_width(), "sediment", steps);
+    fields.check_finite({after.data(), own.width, own.height, hm->cell()}, "height", steps);
+    fields.check_finite(std::as_const(*hm).layer("water"), "water", steps);
+    fields.check_finite(std::as_const(*hm).layer("sediment"), "sediment", steps);
     GridView eroded = hm->layer("eroded", 0.0f);
     for (std::size_t i = 0; i < after.size(); ++i) eroded.data[i] += after[i] - hm->heights()[i];
     hm->heights() = std::move(after);

@@ -421,7 +421,7 @@ void Solver::Impl::exchange() {
     const double cell = st.height.cell;
     const GridView grids[] = {{b_cur, w, h, cell}, st.water, st.sediment, st.flux_west, st.flux_east,
                               st.flux_north, st.flux_south};
-    tiles->exchange_halos(grids, kTileHalo);
+    tiles->exchange(grids);
     exchanging += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     cpu_exchanging += process_cpu_seconds() - c0;
 }
@@ -445,7 +445,7 @@ void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& to
     // the tiles of its row, then the rows in order, as one process adds them.
     const int full = gw - gw % 8;
     carry.assign(std::size_t(oh) * kCarry, 0.0);
-    tiles->carry_east(carry, kCarry, [&](int first, int count) {
+    tiles->carry(Tiling::Toward::east, carry, kCarry, [&](int first, int count) {
         parallel_for(first, first + count, 16, [&](std::int64_t r0, std::int64_t r1) {
             FlushDenormals ftz;  // as in the sweep: denormal inputs read as 0
             for (std::int64_t r = r0; r < r1; ++r) {
@@ -470,7 +470,7 @@ void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& to
         total_s1 += rows[2 * y];
         total_new += rows[2 * y + 1];
     }
-    tiles->max_all(m, 3);
+    tiles->reduce(std::span<float>(m), Tiling::Reduce::max);
     vm = m[0];
     dm = m[1];
     finite = m[2] == 0.0f;
@@ -489,7 +489,7 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
     m.n = state.height.size();
     m.tiles = tiling;
     if (tiling) {
-        const TileRect own = tiling->owned(), grown = tiling->grown(kTileHalo);
+        const TileRect own = tiling->owned(), grown = tiling->ghosted();
         if (grown.width != m.w || grown.height != m.h)
             throw Error("pipe::Solver: a tiled run's state grids must cover the grown tile");
         m.ox = own.x0 - grown.x0;
@@ -544,7 +544,7 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
         vd[0] = std::max(vd[0], m.row_vmax[std::size_t(y)]);
         vd[1] = std::max(vd[1], m.row_dmax[std::size_t(y)]);
     }
-    if (tiling) tiling->max_all(vd, 2);  // the whole grid's (a maximum is exact in any order)
+    if (tiling) tiling->reduce(std::span<float>(vd), Tiling::Reduce::max);  // the whole grid's (a maximum is exact in any order)
     m.vmax = double(vd[0]);
     m.dmax = double(vd[1]);
 }

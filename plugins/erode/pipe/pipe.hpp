@@ -101,7 +101,7 @@ public:
     /// `rain_mask` (optional) holds one non-negative factor per cell.
     ///
     /// With `tiling` (a tiled run, orogen/tiles.hpp), the state grids and the
-    /// mask cover this rank's tile grown by kTileHalo (tiling->grown()); the
+    /// mask cover this rank's ghosted tile (tiling->ghosted(), kTileHalo wide); the
     /// owned part holds the state, the mask must be valid on the halo too
     /// (the caller exchanges it once). Before each sub-step the solver refills
     /// the halo of every field a sub-step reads across a tile edge (terrain,

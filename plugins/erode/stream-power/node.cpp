@@ -56,23 +56,7 @@ std::optional<std::optional<double>> parse_base_level(const std::string& text) {
 }
 
 /// The largest of every rank's `v` (exact), or `v` itself without tiles.
-double largest(Tiling* tiles, double v) {
-    if (!tiles) return v;
-    const auto all = tiles->gather_to_rank0(std::string(reinterpret_cast<const char*>(&v), sizeof v));
-    std::string answer;
-    if (tiles->rank() == 0) {
-        double m = v;
-        for (const auto& b : all) {
-            double x = 0.0;
-            std::memcpy(&x, b.data(), sizeof x);
-            m = std::max(m, x);
-        }
-        answer.assign(reinterpret_cast<const char*>(&m), sizeof m);
-    }
-    tiles->share_from_rank0(answer);
-    std::memcpy(&v, answer.data(), sizeof v);
-    return v;
-}
+double largest(Tiling* tiles, double v) { return tiles ? tiles->reduce(v, Tiling::Reduce::max) : v; }
 
 /// The model of one process (Model) or of this rank's tile (TiledModel, joined with the other ranks'
 /// tiles: the same bits as one process), behind the few calls the node makes.
@@ -360,7 +344,10 @@ NodeOutputs run(NodeContext& ctx) {
     const std::vector<float>& out = hm->heights();
     auto [lo, hi] = std::minmax_element(out.begin(), out.end());
     float low = *lo, high = *hi;
-    if (tiles) tiles->min_max(low, high);
+    if (tiles) {
+        low = tiles->reduce(low, Tiling::Reduce::min);
+        high = tiles->reduce(high, Tiling::Reduce::max);
+    }
     const double seconds = std::chrono::duration<double>(clock::now() - started).count();
     std::ostringstream msg;
     msg << last << " steps of " << dt << " yr; " << pits << " pits resolved; relief " << (high - low) << " m";

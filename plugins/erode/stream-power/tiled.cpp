@@ -96,7 +96,7 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
                        const Settings& settings)
     : tiles_(tiles),
       own_(tiles.owned()),
-      grown_(tiles.grown(1)),
+      grown_(tiles.ghosted()),
       W_(tiles.grid_width()),
       H_(tiles.grid_height()),
       cell_(cell),
@@ -116,7 +116,7 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
             if (mine.cell < 0 || h_[l] < mine.h) mine = {h_[l], global(l)};
         std::string bytes;
         put(bytes, std::vector<Lowest>{mine});
-        const auto all = joined([&] { return tiles_.gather_to_rank0(bytes); });
+        const auto all = joined([&] { return tiles_.gather(bytes, Tiling::Gather::to_rank0); });
         std::string answer;
         if (tiles_.rank() == 0) {
             Lowest best{0.0, -1};
@@ -303,13 +303,13 @@ void TiledModel::route(double* h) {
         std::copy(h + std::size_t(y) * std::size_t(own_.width), h + std::size_t(y + 1) * std::size_t(own_.width),
                   grown_h_.begin() + std::ptrdiff_t(std::size_t(y + oy) * gw + std::size_t(ox)));
     double* grids[] = {grown_h_.data()};
-    joined([&] { return tiles_.exchange_double_halos(grids, 1); });
+    joined([&] { return tiles_.exchange(std::span<double* const>(grids)); });
     directions();
     build_trees();
     std::int64_t pits = 0;
     for (const std::int32_t t : trees_)
         if (dir_[std::size_t(t)] < 0 && !outlet_[std::size_t(t)]) ++pits;
-    pits_ = std::int64_t(joined([&] { return tiles_.sum_all(double(pits)); }));
+    pits_ = std::int64_t(joined([&] { return tiles_.reduce(double(pits), Tiling::Reduce::sum); }));
     if (pits_ > 0) resolve_pits(h);
 }
 
@@ -317,7 +317,7 @@ void TiledModel::resolve_pits(double* h) {
     const std::size_t n = h_.size();
     const bool root0 = tiles_.rank() == 0;
     // 1. Basins: rank 0 follows every exit over the tiles' edges to its pit or outlet.
-    std::vector<std::string> all = joined([&] { return tiles_.gather_to_rank0(edge_hops()); });
+    std::vector<std::string> all = joined([&] { return tiles_.gather(edge_hops(), Tiling::Gather::to_rank0); });
     EdgeMap edges;
     std::string answer;
     if (root0) {
@@ -366,7 +366,7 @@ void TiledModel::resolve_pits(double* h) {
     grown_label_.assign(grown_h_.size(), -1.0);
     for (std::size_t l = 0; l < n; ++l) grown_label_[grown_index(l)] = double(label_[l]);  // exact below 2^53
     double* grids[] = {grown_label_.data()};
-    joined([&] { return tiles_.exchange_double_halos(grids, 1); });
+    joined([&] { return tiles_.exchange(std::span<double* const>(grids)); });
     const std::int64_t gw = grown_.width;
     // Collected tree by tree (a tree lies in one basin), each tree keeping its
     // lowest link per neighbouring basin (Link's i, j, a, b here: whole-grid
@@ -430,7 +430,7 @@ void TiledModel::resolve_pits(double* h) {
     put(mine, forest.deferred);
     put(mine, forest.edges);
     put(mine, hops);
-    all = joined([&] { return tiles_.gather_to_rank0(mine); });
+    all = joined([&] { return tiles_.gather(mine, Tiling::Gather::to_rank0); });
     // 4. Rank 0: the joined tree's key basins, and the pieces of each anchor's path from its pass down to its pit.
     answer.clear();
     if (root0) {
@@ -534,7 +534,7 @@ void TiledModel::accumulate() {
                 exits.push_back({global(std::size_t(t)), count_[std::size_t(t)], receiver_global(std::size_t(t))});
         std::string mine = edge_hops();
         put(mine, exits);
-        const auto all = joined([&] { return tiles_.gather_to_rank0(mine); });
+        const auto all = joined([&] { return tiles_.gather(mine, Tiling::Gather::to_rank0); });
         std::string answer;
         if (tiles_.rank() == 0) {
             // Each exit's count goes to the edge cell it drains into, and with the
@@ -606,7 +606,9 @@ void TiledModel::propagate(std::vector<double>& v, const std::function<void(std:
             waiting.push_back(t);
     }
     rounds_ = 1;
-    double left = tiles_.ranks() > 1 ? joined([&] { return tiles_.sum_all(double(waiting.size())); }) : 0.0;
+    double left = tiles_.ranks() > 1
+                      ? joined([&] { return tiles_.reduce(double(waiting.size()), Tiling::Reduce::sum); })
+                      : 0.0;
     if (left > 0.0) {
         grown_v_.assign(grown_h_.size(), 0.0);
         grown_done_.assign(grown_h_.size(), 0.0);
@@ -619,7 +621,7 @@ void TiledModel::propagate(std::vector<double>& v, const std::function<void(std:
             grown_done_[grown_index(std::size_t(l))] = done[std::size_t(tree_of_[std::size_t(l)])];
         }
         double* grids[] = {grown_v_.data(), grown_done_.data()};
-        joined([&] { return tiles_.exchange_double_halos(grids, 1); });
+        joined([&] { return tiles_.exchange(std::span<double* const>(grids)); });
         std::vector<std::size_t> still;
         for (const std::size_t t : waiting) {
             const auto l = std::size_t(trees_[t]);
@@ -631,7 +633,7 @@ void TiledModel::propagate(std::vector<double>& v, const std::function<void(std:
                 still.push_back(t);
         }
         waiting.swap(still);
-        const double now = joined([&] { return tiles_.sum_all(double(waiting.size())); });
+        const double now = joined([&] { return tiles_.reduce(double(waiting.size()), Tiling::Reduce::sum); });
         if (now >= left) throw std::logic_error("stream-power: the solve down the rivers made no progress");
         left = now;
     }

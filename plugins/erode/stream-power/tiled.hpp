@@ -149,7 +149,7 @@ private:
     std::vector<std::int64_t> tree_start_;  // each tree's first position in stack_ (+ end)
     std::vector<std::int32_t> stack_;     // the trees, each receiver before its donors
     std::vector<std::int32_t> edge_;      // the tile's edge cells, local indices
-    std::vector<double> grown_h_, grown_v_, grown_done_, grown_label_;  // over grown(1)
+    std::vector<double> grown_h_, grown_v_, grown_done_, grown_label_;  // over ghosted() (halo 1)
     std::vector<std::int64_t> label_;     // resolve_pits: each cell's basin (its pit or outlet)
     std::vector<double> count_, area_;    // cells upstream (with itself), m²
     std::vector<double> pow_table_;

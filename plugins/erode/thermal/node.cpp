@@ -6,6 +6,7 @@
 #include <orogen/timelapse.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -35,69 +36,40 @@ void add_layers(Heightmap& hm, const float* before, const float* after, const th
 }
 
 /// One rank's tile of a tiled run (orogen/tiles.hpp). The rank works on its
-/// tile grown by kTileHalo vertices: before each sweep of kStepsPerSweep
-/// steps the halo is refilled from the neighbours; the sweep treats the edge
-/// of the grown tile as a wall, whose wrong effect travels 2 vertices a step,
-/// so after the sweep the owned vertices are exactly the whole grid's (the
-/// same operations on the same inputs, bit for bit), and only the halo is stale.
+/// tile grown by kTileHalo vertices (TiledFields): before each sweep of
+/// kStepsPerSweep steps the halo is refilled from the neighbours; the sweep
+/// treats the edge of the grown tile as a wall, whose wrong effect travels 2
+/// vertices a step, so after the sweep the owned vertices are exactly the
+/// whole grid's (the same operations on the same inputs, bit for bit), and
+/// only the halo is stale.
 NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap> hm, const thermal::Settings& s,
                       const float* layer) {
-    const TileRect own = tiles.owned(), grown = tiles.grown(kTileHalo);
-    const int ox = own.x0 - grown.x0, oy = own.y0 - grown.y0;
-    auto copy_in = [&](const float* tile, std::vector<float>& held) {
-        held.assign(std::size_t(grown.width) * std::size_t(grown.height), 0.0f);
-        for (int y = 0; y < own.height; ++y)
-            std::copy(tile + std::size_t(y) * std::size_t(own.width), tile + std::size_t(y + 1) * std::size_t(own.width),
-                      held.begin() + std::ptrdiff_t(std::size_t(y + oy) * std::size_t(grown.width) + std::size_t(ox)));
-    };
-    std::vector<float> held, held_layer;
-    copy_in(hm->heights().data(), held);
-    GridView view{held.data(), grown.width, grown.height, hm->cell()};
+    TiledFields fields(tiles, hm->cell());
+    const GridView view = fields.grow(hm->heights().data());
+    GridView held_layer;
     if (layer) {  // the hardness of the halo too, once: it does not change
-        copy_in(layer, held_layer);
-        tiles.exchange_halo({held_layer.data(), grown.width, grown.height, hm->cell()}, kTileHalo);
+        held_layer = fields.grow(layer);
+        fields.exchange(held_layer);
     }
     const std::int64_t iterations = ctx.integer("iterations");
     // Snapshots at the ends of the sweeps, as run()'s (erode() calls back once a sweep); rank 0 holds them.
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0, tiles);
     lapse.record(0, *hm);
-    using clock = std::chrono::steady_clock;
-    clock::duration exchanging{}, sweeping{};  // for the figure in the info line (docs/benchmarks.md)
-    const double waited_before = tiles.seconds_waiting();
-    for (std::int64_t i = 0; i < iterations;) {
-        const int k = int(std::min<std::int64_t>(thermal::kStepsPerSweep, iterations - i));
-        const auto t0 = clock::now();
-        tiles.exchange_halo(view, kTileHalo);
-        const auto t1 = clock::now();
-        thermal::steps(view, view, k, s, layer ? held_layer.data() : nullptr);
-        exchanging += t1 - t0;
-        sweeping += clock::now() - t1;
-        i += k;
-        lapse.record(i, view, nullptr, ox, oy);
-        ctx.check_cancelled();
-        if (i % 64 == 0 || i == iterations) {  // as run() does
-            for (int y = 0; y < own.height; ++y)
-                for (int x = 0; x < own.width; ++x)
-                    if (const float v = view.row(y + oy)[ox + x]; !std::isfinite(v)) {
-                        // check_finite()'s message, with the sample's index in the whole grid.
-                        std::ostringstream msg;
-                        msg << "non-finite height (" << v << ") at sample "
-                            << std::int64_t(own.y0 + y) * tiles.grid_width() + (own.x0 + x) << " after step " << i
-                            << "; the simulation became unstable";
-                        throw Error(msg.str());
-                    }
-            ctx.progress(double(i) / double(iterations));
-        }
-    }
-    const double ex = std::chrono::duration<double>(exchanging).count(), sw = std::chrono::duration<double>(sweeping).count();
-    ctx.info(tiles.sweep_note(iterations, sw, ex, waited_before));
-    std::vector<float>().swap(held_layer);  // freed now (assigning {} would keep the capacity)
+    fields.sweeps(
+        iterations, thermal::kStepsPerSweep, [&] { return std::array{view}; },
+        [&](std::int64_t, int k) { thermal::steps(view, view, k, s, held_layer.data); },
+        [&](std::int64_t i) {
+            lapse.record(i, view, nullptr, fields.ox(), fields.oy());
+            ctx.check_cancelled();
+            if (i % 64 == 0 || i == iterations) {  // as run() does
+                fields.check_finite(view, "height", i);
+                ctx.progress(double(i) / double(iterations));
+            }
+        });
+    ctx.info(fields.note(iterations));
+    if (layer) fields.drop(held_layer);
     // The owned part back into the tile; the tile's old heights are `before` for the layers.
-    std::vector<float> after(hm->size());
-    for (int y = 0; y < own.height; ++y)
-        std::copy(view.row(y + oy) + ox, view.row(y + oy) + ox + own.width,
-                  after.begin() + std::ptrdiff_t(std::size_t(y) * std::size_t(own.width)));
-    std::vector<float>().swap(held);
+    std::vector<float> after = fields.take(view);
     add_layers(*hm, hm->heights().data(), after.data(), s);
     hm->heights() = std::move(after);
     lapse.finish(iterations, *hm);
@@ -122,7 +94,10 @@ NodeOutputs run(NodeContext& ctx) {
         const auto [lo, hi] = std::minmax_element(hm->heights().begin(), hm->heights().end());
         s.height_min = hm->heights().empty() ? 0.0f : *lo;
         s.height_max = hm->heights().empty() ? 1.0f : *hi;
-        if (Tiling* tiles = ctx.tiling()) tiles->min_max(s.height_min, s.height_max);  // the whole grid's range
+        if (Tiling* tiles = ctx.tiling()) {  // the whole grid's range
+            s.height_min = tiles->reduce(s.height_min, Tiling::Reduce::min);
+            s.height_max = tiles->reduce(s.height_max, Tiling::Reduce::max);
+        }
     } else {
         s.hardness = thermal::Hardness::layer;
         if (!hm->has_layer(hardness))

@@ -75,7 +75,10 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
     if (width < 2 || height < 2) throw BadInput("export:tiles: the terrain needs at least 2 × 2 samples");
     const raw::Range range = raw::min_max(hm.view());
     float lo = float(range.low), hi = float(range.high);
-    if (tiling) tiling->min_max(lo, hi);
+    if (tiling) {  // the whole grid's (float minima and maxima are exact in any order)
+        lo = tiling->reduce(lo, Tiling::Reduce::min);
+        hi = tiling->reduce(hi, Tiling::Reduce::max);
+    }
 
     const std::vector<lod::Chunk> chunks = lod::pyramid(width, height, tile_size, index_path.stem().string());
     const int levels = chunks.back().level + 1;
@@ -88,7 +91,7 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
     for (std::size_t i : mine) targets.push_back(ctx.output_path((folder / chunks[i].file).string()));
     // Every rank takes part in as many fetches as the rank with the most chunks.
     float most = float(mine.size());
-    if (tiling) tiling->max_all(&most, 1);
+    if (tiling) most = tiling->reduce(most, Tiling::Reduce::max);
     // Per chunk, for the tileset: deviation, min x y z, max x y z (floats: a maximum over the ranks
     // merges them exactly; one process rounds them the same way).
     constexpr int kInfo = 7;
@@ -137,7 +140,7 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
         });
         ctx.progress(double(std::min(end, mine.size())) / double(std::max<std::size_t>(mine.size(), 1)));
     }
-    if (tiling) tiling->max_all(info.data(), int(info.size()));
+    if (tiling) tiling->reduce(std::span<float>(info), Tiling::Reduce::max);
     if (rank != 0) return {};
     std::vector<lod::Written> written(chunks.size());
     for (std::size_t i = 0; i < chunks.size(); ++i) {
@@ -182,7 +185,8 @@ NodeOutputs run(NodeContext& ctx) {
         index.range = raw::min_max(hm.view());
         if (tiling) {  // the whole grid's (float minima and maxima are exact in any order)
             float lo = float(index.range.low), hi = float(index.range.high);
-            tiling->min_max(lo, hi);
+            lo = tiling->reduce(lo, Tiling::Reduce::min);
+            hi = tiling->reduce(hi, Tiling::Reduce::max);
             index.range = {double(lo), double(hi)};
         }
     }
@@ -263,7 +267,7 @@ NodeOutputs run(NodeContext& ctx) {
     }
     std::size_t outside = 0;
     for (std::size_t c : clamped) outside += c;
-    if (tiling) outside = std::size_t(tiling->sum_all(double(outside)));
+    if (tiling) outside = std::size_t(tiling->reduce(std::int64_t(outside), Tiling::Reduce::sum));
     if (outside > 0) ctx.warn(std::to_string(outside) + " samples lie outside low..high and were clamped to its ends");
 
     for (std::size_t i = 0; i < raw_vrts.size(); ++i) {

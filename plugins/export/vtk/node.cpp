@@ -80,17 +80,11 @@ NodeOutputs run_tiles(NodeContext& ctx) {
         return TileRect{t.x0, t.y0, std::min(t.x1() + 1, width) - t.x0, std::min(t.y1() + 1, height) - t.y0};
     };
     const TileRect own = tile_of(rank), piece = piece_of(rank);
-    const TileRect grown = tiles ? tiles->grown(1) : own;
-    // Each grid (heights, then the layers by name) grown by the halo, exchanged, cut to the piece.
+    const TileRect grown = tiles ? tiles->ghosted() : own;  // tile_halo 1
+    // Each grid (heights, then the layers by name) ghosted, exchanged, cut to the piece.
     auto piece_grid = [&](const float* tile) {
-        std::vector<float> held(std::size_t(grown.width) * std::size_t(grown.height));
-        for (int y = 0; y < own.height; ++y)
-            std::copy(tile + std::size_t(y) * std::size_t(own.width),
-                      tile + std::size_t(y + 1) * std::size_t(own.width),
-                      held.begin() +
-                          std::ptrdiff_t(std::size_t(y + own.y0 - grown.y0) * std::size_t(grown.width) +
-                                         std::size_t(own.x0 - grown.x0)));
-        if (tiles) tiles->exchange_halo({held.data(), grown.width, grown.height, hm.cell()}, 1);
+        std::vector<float> held = tiles ? tiles->ghosted_copy(tile) : std::vector<float>(tile, tile + hm.size());
+        if (tiles) tiles->exchange({held.data(), grown.width, grown.height, hm.cell()});
         std::vector<float> out(std::size_t(piece.width) * std::size_t(piece.height));
         for (int y = 0; y < piece.height; ++y) {
             const float* src = held.data() + std::size_t(piece.y0 - grown.y0 + y) * std::size_t(grown.width) +
