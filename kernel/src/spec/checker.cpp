@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <set>
 #include <sstream>
 #include <unistd.h>
 
@@ -170,13 +171,18 @@ std::optional<ParamValue> convert(const Param& p, const Literal& l, const std::s
     return std::nullopt;
 }
 
+/// Thrown to a node's check hook that reads a parameter with an error: the hook stops there, quietly.
+/// Not a std::exception, so a hook that catches those does not swallow it.
+struct InvalidParamRead {};
+
 class CheckContextImpl : public CheckContext {
 public:
     CheckContextImpl(const GridSpec& grid, std::vector<const ValueInfo*> inputs, const PlannedNode& node,
                      const std::map<std::string, Location, std::less<>>& param_where, const Location& call_where,
-                     const fs::path& spec_folder, Diagnostics& diags, ValueInfo output)
+                     const fs::path& spec_folder, Diagnostics& diags, ValueInfo output,
+                     const std::set<std::string, std::less<>>& invalid)
         : grid_(grid), inputs_(std::move(inputs)), node_(node), param_where_(param_where), call_where_(call_where),
-          spec_folder_(spec_folder), diags_(diags), output_(std::move(output)) {}
+          spec_folder_(spec_folder), diags_(diags), output_(std::move(output)), invalid_(invalid) {}
 
     const GridSpec& grid() const override { return grid_; }
     double memory_share() const override { return TiledRun::runs_tiled(node_) ? tiled_share_ : 1.0; }
@@ -184,6 +190,7 @@ public:
     const ValueInfo* input(std::size_t i) const override { return i < inputs_.size() ? inputs_[i] : nullptr; }
     bool given(std::string_view param) const override { return node_.given.count(param) > 0; }
     const ParamValue& param(std::string_view name) const override {
+        if (invalid_.count(name)) throw InvalidParamRead{};
         auto it = node_.params.find(name);
         if (it == node_.params.end())
             throw Error("internal error: " + node_.node->qualified_name() + " has no parameter '" + std::string(name) + "'");
@@ -220,6 +227,7 @@ private:
     Diagnostics& diags_;
     ValueInfo output_;
     std::map<std::string, ValueInfo, std::less<>> sides_;
+    const std::set<std::string, std::less<>>& invalid_;
     int errors_ = 0;
 };
 
@@ -227,415 +235,502 @@ bool has_extension(const std::string& path, const std::string& ext) {
     return path.size() >= ext.size() && lower(path.substr(path.size() - ext.size())) == lower(ext);
 }
 
-}  // namespace
-
-Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& spec_path, const CheckOptions& options,
-           Diagnostics& diags) {
-    Plan plan;
-    plan.spec_path = spec_path;
-    plan.spec_folder = spec_path.parent_path();  // "" for a spec in the current folder: paths stay as written
-    plan.source = parsed.source;
-    plan.overrides = options.overrides;
-    const Location file_start{parsed.source, 1, 1, 1};
-
-    // --- header statements
-    if (!parsed.version) {
-        diags.error(file_start, "a spec starts with its format version: add `orogen 1` as the first line");
-    } else if (*parsed.version != 1) {
-        diags.error(parsed.version_where, "format version " + std::to_string(*parsed.version) +
-                                              " is not supported; this orogen reads `orogen 1`");
+/// The checker's walk over one spec: the state that outlives one statement, and a named step for each part
+/// of a statement's check. Every step reports what it finds and goes on, so one `orogen check` shows every
+/// mistake at once.
+class Checker {
+public:
+    Checker(const spec::Spec& parsed, const Registry& registry, const fs::path& spec_path, const CheckOptions& options,
+            Diagnostics& diags)
+        : parsed_(parsed), registry_(registry), options_(options), diags_(diags), file_start_{parsed.source, 1, 1, 1} {
+        plan_.spec_path = spec_path;
+        plan_.spec_folder = spec_path.parent_path();  // "" for a spec in the current folder: paths stay as written
+        plan_.source = parsed.source;
+        plan_.overrides = options.overrides;
     }
-    plan.seed = options.seed ? *options.seed : parsed.seed.value_or(0);
-    plan.grid.width = parsed.grid_width;
-    plan.grid.height = parsed.grid_height;
-    plan.grid.cell = parsed.grid_cell;
-    plan.grid_given = parsed.has_grid;
-    plan.cell_given = parsed.has_cell;
-    if (const std::string problem = heightmap_memory_problem(plan.grid.width, plan.grid.height,
-                                                             options.heightmap_memory_limit);
-        !problem.empty())
-        diags.error(parsed.has_grid ? parsed.grid_where : file_start,
-                    "grid " + std::to_string(plan.grid.width) + "x" + std::to_string(plan.grid.height) + " " + problem);
 
-    // --- overrides: parse each, then find its statement
+    Plan run() {
+        check_header();
+        parse_overrides();
+        index_names();
+        for (std::size_t si = 0; si < parsed_.statements.size(); ++si) check_statement(si);
+        report_unused_overrides();
+        warn_if_nothing_is_written();
+        return std::move(plan_);
+    }
+
+private:
     struct PendingOverride {
         spec::Override o;
         bool used = false;
     };
-    std::vector<PendingOverride> overrides;
-    int override_order = 0;
-    for (const auto& text : options.overrides) {
-        auto src = std::make_shared<spec::Source>("--set " + text, text, ++override_order);
-        if (auto o = spec::parse_override(src, diags)) overrides.push_back({std::move(*o)});
+
+    /// One statement's node while it is checked.
+    struct NodeCheck {
+        NodeCheck(const spec::Statement& statement, const NodeDescriptor* descriptor)
+            : st(statement), node(descriptor) {}
+        const spec::Statement& st;
+        const NodeDescriptor* node;
+        PlannedNode planned;
+        bool inputs_ok = true;
+        std::vector<const ValueInfo*> input_infos;
+        std::unique_ptr<ValueInfo> mapped_entry;  ///< what the check hook sees of a mapped series input
+        std::map<std::string, Location, std::less<>> param_where;
+        std::map<std::string, const Literal*, std::less<>> literals;
+        std::set<std::string, std::less<>> invalid;  ///< parameters with an error: the check hook must not read them
+    };
+
+    void check_header() {
+        if (!parsed_.version) {
+            diags_.error(file_start_, "a spec starts with its format version: add `orogen 1` as the first line");
+        } else if (*parsed_.version != 1) {
+            diags_.error(parsed_.version_where, "format version " + std::to_string(*parsed_.version) +
+                                                    " is not supported; this orogen reads `orogen 1`");
+        }
+        plan_.seed = options_.seed ? *options_.seed : parsed_.seed.value_or(0);
+        plan_.grid.width = parsed_.grid_width;
+        plan_.grid.height = parsed_.grid_height;
+        plan_.grid.cell = parsed_.grid_cell;
+        plan_.grid_given = parsed_.has_grid;
+        plan_.cell_given = parsed_.has_cell;
+        if (const std::string problem =
+                heightmap_memory_problem(plan_.grid.width, plan_.grid.height, options_.heightmap_memory_limit);
+            !problem.empty())
+            diags_.error(parsed_.has_grid ? parsed_.grid_where : file_start_,
+                         "grid " + std::to_string(plan_.grid.width) + "x" + std::to_string(plan_.grid.height) + " " + problem);
     }
 
-    // --- nodes
-    std::map<std::string, ValueInfo, std::less<>> values;          // value key → info
-    std::map<std::string, Location, std::less<>> defined_at;       // value name → statement
-    std::map<std::string, Location, std::less<>> output_files;     // output path → where
-    std::map<std::string, int, std::less<>> unnamed_count;
-    std::set<std::string, std::less<>> poisoned;                    // names whose node is unknown
-    std::vector<std::string> all_nodes;
-    for (const auto* n : registry.nodes()) all_nodes.push_back(n->qualified_name());
-    // Where each name is defined, for "'x' is defined later, on line N".
-    std::map<std::string, Location, std::less<>> defined_anywhere;
-    for (const auto& st : parsed.statements)
-        if (!st.name.empty()) defined_anywhere.emplace(st.name, st.name_where);
-    // The value key of each call written where an input goes (its label: kind:node, kind:node#2, ...).
-    std::vector<std::string> nested_key(parsed.statements.size());
-    std::vector<std::string> labels;  // every node's label, for --set's "did you mean"
+    /// Each --set parsed as its own little source, so its errors point into the override.
+    void parse_overrides() {
+        int override_order = 0;
+        for (const auto& text : options_.overrides) {
+            auto src = std::make_shared<spec::Source>("--set " + text, text, ++override_order);
+            if (auto o = spec::parse_override(src, diags_)) overrides_.push_back({std::move(*o)});
+        }
+    }
 
-    for (std::size_t si = 0; si < parsed.statements.size(); ++si) {
-        const auto& st = parsed.statements[si];
+    void index_names() {
+        for (const auto* n : registry_.nodes()) all_nodes_.push_back(n->qualified_name());
+        for (const auto& st : parsed_.statements)
+            if (!st.name.empty()) defined_anywhere_.emplace(st.name, st.name_where);
+        nested_key_.assign(parsed_.statements.size(), "");
+    }
+
+    void check_statement(std::size_t si) {
+        const auto& st = parsed_.statements[si];
         const auto& call = st.call;
-        const NodeDescriptor* node = registry.find(call.qualified());
-        // Unnamed calls (exporters, and calls written where an input goes) are labelled kind:node, then
-        // kind:node#2, #3...: the label seeds the node, and --set reaches it by its label.
+        const std::string label = label_of(si);
+        if (!st.name.empty())
+            if (auto it = defined_at_.find(st.name); it != defined_at_.end())
+                diags_.error(st.name_where, "'" + st.name + "' is already defined on line " +
+                                                std::to_string(it->second.line) + "; give this value another name");
+        const NodeDescriptor* node = registry_.find(call.qualified());
+        if (!node) {
+            report_unknown_node(st, label);
+            return;
+        }
+        NodeCheck nc(st, node);
+        nc.planned.node = node;
+        nc.planned.value_name = st.nested ? label : st.name;  // a label holds ':', so it never meets a name
+        nc.planned.in_place = st.nested;
+        nc.planned.label = label;
+        nc.planned.where = call.where;
+        check_inputs(nc);
+        gather_params(nc);
+        convert_params(nc);
+        check_paths(nc);
+        auto [out, sides] = node_output(nc);
+        define_value(nc, std::move(out), std::move(sides));
+    }
+
+    /// Unnamed calls (exporters, and calls written where an input goes) are labelled kind:node, then
+    /// kind:node#2, #3...: the label seeds the node, and --set reaches it by its label.
+    std::string label_of(std::size_t si) {
+        const auto& st = parsed_.statements[si];
         std::string label = st.name;
         if (st.name.empty()) {
-            label = call.qualified();
-            if (++unnamed_count[call.qualified()] > 1) label += "#" + std::to_string(unnamed_count[call.qualified()]);
+            const std::string q = st.call.qualified();
+            label = q;
+            if (++unnamed_count_[q] > 1) label += "#" + std::to_string(unnamed_count_[q]);
         }
-        labels.push_back(label);
-        if (st.nested) nested_key[si] = label;
-        if (st.name.size()) {
-            if (auto it = defined_at.find(st.name); it != defined_at.end()) {
-                diags.error(st.name_where, "'" + st.name + "' is already defined on line " +
-                                               std::to_string(it->second.line) + "; give this value another name");
-            }
-        }
-        if (!node) {
-            std::string msg = "unknown node '" + call.qualified() + "'";
-            const std::string guess = spec::closest(call.qualified(), all_nodes);
-            if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
-            else msg += "; `orogen list` shows the nodes the loaded plugins provide";
-            diags.error(call.where, msg);
-            if (!st.name.empty() || st.nested) {
-                if (!st.name.empty()) defined_at.emplace(st.name, st.name_where);
-                values.emplace(label, ValueInfo{});  // so later uses do not also say "undefined"
-                poisoned.insert(label);
-            }
-            continue;
-        }
+        labels_.push_back(label);
+        if (st.nested) nested_key_[si] = label;
+        return label;
+    }
 
-        PlannedNode planned;
-        planned.node = node;
-        planned.value_name = st.nested ? label : st.name;  // a label holds ':', so it never meets a name
-        planned.in_place = st.nested;
-        planned.label = label;
-        planned.where = call.where;
+    void report_unknown_node(const spec::Statement& st, const std::string& label) {
+        std::string msg = "unknown node '" + st.call.qualified() + "'";
+        const std::string guess = spec::closest(st.call.qualified(), all_nodes_);
+        if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+        else msg += "; `orogen list` shows the nodes the loaded plugins provide";
+        diags_.error(st.call.where, msg);
+        if (!st.name.empty() || st.nested) {
+            if (!st.name.empty()) defined_at_.emplace(st.name, st.name_where);
+            values_.emplace(label, ValueInfo{});  // so later uses do not also say "undefined"
+            poisoned_.insert(label);
+        }
+    }
 
-        // Inputs
-        bool inputs_ok = true;
-        std::unique_ptr<ValueInfo> mapped_entry;  // what the check hook sees of a mapped series input
-        std::vector<const ValueInfo*> input_infos(node->inputs.size(), nullptr);
-        planned.inputs.assign(node->inputs.size(), "");
+    void check_inputs(NodeCheck& nc) {
+        const auto& call = nc.st.call;
+        const NodeDescriptor* node = nc.node;
+        nc.input_infos.assign(node->inputs.size(), nullptr);
+        nc.planned.inputs.assign(node->inputs.size(), "");
         if (call.inputs.size() > node->inputs.size()) {
             const auto& extra = call.inputs[node->inputs.size()];
-            diags.error(extra.where, call.qualified() + " takes " +
-                                         (node->inputs.empty() ? std::string("no inputs")
-                                                               : "at most " + std::to_string(node->inputs.size()) +
-                                                                     (node->inputs.size() == 1 ? " input" : " inputs")) +
-                                         ", but '" + extra.full() + "' is input " +
-                                         std::to_string(node->inputs.size() + 1));
-            inputs_ok = false;
+            diags_.error(extra.where, call.qualified() + " takes " +
+                                          (node->inputs.empty() ? std::string("no inputs")
+                                                                : "at most " + std::to_string(node->inputs.size()) +
+                                                                      (node->inputs.size() == 1 ? " input" : " inputs")) +
+                                          ", but '" + extra.full() + "' is input " + std::to_string(node->inputs.size() + 1));
+            nc.inputs_ok = false;
         }
-        for (std::size_t i = 0; i < call.inputs.size() && i < node->inputs.size(); ++i) {
-            const auto& in = call.inputs[i];
-            const auto& want = node->inputs[i];
-            const std::string key = in.statement >= 0 ? nested_key[std::size_t(in.statement)] : in.full();
-            auto it = values.find(key);
-            if (it == values.end()) {
-                if (!in.side.empty() && values.count(in.name)) {
-                    diags.error(in.where, "'" + in.name + "' has no side value '" + in.side + "'");
-                } else {
-                    std::vector<std::string> names;
-                    for (const auto& [k, _] : values)
-                        if (k.find(':') == std::string::npos) names.push_back(k);  // not the labels of calls in place
-                    std::string msg = "'" + in.full() + "' is not defined";
-                    if (auto later = defined_anywhere.find(in.name);
-                        later != defined_anywhere.end() && defined_at.count(in.name) == 0) {
-                        msg += " yet: it is defined later, on line " + std::to_string(later->second.line) +
-                               "; move that line above this one (a node reads only values made before it)";
-                    } else if (defined_at.count(in.name) == 0) {
-                        const std::string guess = spec::closest(in.full(), names);
-                        msg += guess.empty() ? "; define it with `" + in.name + " = kind:node(...)` on an earlier line"
-                                             : "; did you mean '" + guess + "'?";
-                    }
-                    diags.error(in.where, msg);
-                }
-                inputs_ok = false;
-                continue;
-            }
-            if (poisoned.count(in.statement >= 0 ? key : in.name)) {  // its node is unknown: that error was reported already
-                inputs_ok = false;
-                continue;
-            }
-            if (it->second.type == ValueType::none) {
-                diags.error(in.where, "'" + in.full() + "' holds no value (its node only writes files)");
-                inputs_ok = false;
-                continue;
-            }
-            // One value, a series, or either; a series given for one value maps the node over it.
-            const ValueInfo& have = it->second;
-            const bool have_series = have.type == ValueType::series;
-            const ValueType have_entry = have_series ? have.element : have.type;
-            const bool maps = want.many == Many::one && have_series && node->output != ValueType::none &&
-                              !node->output_series && planned.mapped_input < 0;
-            // An input declared ValueType::none takes any value; the node's check hook says which it accepts.
-            const bool fits = (want.type == ValueType::none || have_entry == want.type) &&
-                              (want.many == Many::either || (want.many == Many::series) == have_series || maps);
-            if (!fits) {
-                std::string msg = call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name +
-                                  "') must be a " + describe_type(want.type, want.many == Many::series) +
-                                  (want.many == Many::either ? " or a " + describe_type(want.type, true) : "") +
-                                  ", but '" + in.full() + "' is a " + describe_type(have_entry, have_series);
-                if ((want.type == ValueType::none || have_entry == want.type) && want.many == Many::one && have_series)
-                    msg += node->output == ValueType::none
-                               ? " (a node that only writes files is not mapped over a series)"
-                               : " (a node is mapped over one series input at a time)";
-                diags.error(in.where, msg);
-                inputs_ok = false;
-                continue;
-            }
-            if (maps) {
-                planned.mapped_input = int(i);
-                ValueInfo entry = have;  // the node's check hook sees one entry
-                entry.type = have.element;
-                entry.element = ValueType::none;
-                entry.count = 0;
-                mapped_entry = std::make_unique<ValueInfo>(std::move(entry));
-                input_infos[i] = mapped_entry.get();
-            } else {
-                input_infos[i] = &have;
-            }
-            planned.inputs[i] = key;
-        }
+        for (std::size_t i = 0; i < call.inputs.size() && i < node->inputs.size(); ++i) check_input(nc, i);
         for (std::size_t i = call.inputs.size(); i < node->inputs.size(); ++i) {
-            if (node->inputs[i].need == Need::required) {
-                diags.error(call.where, call.qualified() + " needs input " + std::to_string(i + 1) + " ('" +
-                                            node->inputs[i].name + "', a " +
-                                            describe_type(node->inputs[i].type, node->inputs[i].many == Many::series) +
-                                            "): " +
-                                            call.qualified() + "(NAME, ...)");
-                inputs_ok = false;
-            }
+            if (node->inputs[i].need != Need::required) continue;
+            diags_.error(call.where, call.qualified() + " needs input " + std::to_string(i + 1) + " ('" +
+                                         node->inputs[i].name + "', a " +
+                                         describe_type(node->inputs[i].type, node->inputs[i].many == Many::series) +
+                                         "): " + call.qualified() + "(NAME, ...)");
+            nc.inputs_ok = false;
         }
+    }
 
-        // Parameters: spec arguments, then overrides on top.
-        bool params_ok = true;
-        std::map<std::string, Location, std::less<>> param_where;
+    void report_undefined_input(const spec::Input& in) {
+        if (!in.side.empty() && values_.count(in.name)) {
+            diags_.error(in.where, "'" + in.name + "' has no side value '" + in.side + "'");
+            return;
+        }
+        std::vector<std::string> names;
+        for (const auto& [k, _] : values_)
+            if (k.find(':') == std::string::npos) names.push_back(k);  // not the labels of calls in place
+        std::string msg = "'" + in.full() + "' is not defined";
+        if (auto later = defined_anywhere_.find(in.name); later != defined_anywhere_.end() && defined_at_.count(in.name) == 0) {
+            msg += " yet: it is defined later, on line " + std::to_string(later->second.line) +
+                   "; move that line above this one (a node reads only values made before it)";
+        } else if (defined_at_.count(in.name) == 0) {
+            const std::string guess = spec::closest(in.full(), names);
+            msg += guess.empty() ? "; define it with `" + in.name + " = kind:node(...)` on an earlier line"
+                                 : "; did you mean '" + guess + "'?";
+        }
+        diags_.error(in.where, msg);
+    }
+
+    void check_input(NodeCheck& nc, std::size_t i) {
+        const auto& call = nc.st.call;
+        const NodeDescriptor* node = nc.node;
+        const auto& in = call.inputs[i];
+        const auto& want = node->inputs[i];
+        const std::string key = in.statement >= 0 ? nested_key_[std::size_t(in.statement)] : in.full();
+        auto it = values_.find(key);
+        if (it == values_.end()) {
+            report_undefined_input(in);
+            nc.inputs_ok = false;
+            return;
+        }
+        if (poisoned_.count(in.statement >= 0 ? key : in.name)) {  // its node is unknown: that error was reported already
+            nc.inputs_ok = false;
+            return;
+        }
+        if (it->second.type == ValueType::none) {
+            diags_.error(in.where, "'" + in.full() + "' holds no value (its node only writes files)");
+            nc.inputs_ok = false;
+            return;
+        }
+        // One value, a series, or either; a series given for one value maps the node over it.
+        const ValueInfo& have = it->second;
+        const bool have_series = have.type == ValueType::series;
+        const ValueType have_entry = have_series ? have.element : have.type;
+        const bool maps = want.many == Many::one && have_series && node->output != ValueType::none &&
+                          !node->output_series && nc.planned.mapped_input < 0;
+        // An input declared ValueType::none takes any value; the node's check hook says which it accepts.
+        const bool fits = (want.type == ValueType::none || have_entry == want.type) &&
+                          (want.many == Many::either || (want.many == Many::series) == have_series || maps);
+        if (!fits) {
+            std::string msg = call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name + "') must be a " +
+                              describe_type(want.type, want.many == Many::series) +
+                              (want.many == Many::either ? " or a " + describe_type(want.type, true) : "") + ", but '" +
+                              in.full() + "' is a " + describe_type(have_entry, have_series);
+            if ((want.type == ValueType::none || have_entry == want.type) && want.many == Many::one && have_series)
+                msg += node->output == ValueType::none ? " (a node that only writes files is not mapped over a series)"
+                                                       : " (a node is mapped over one series input at a time)";
+            diags_.error(in.where, msg);
+            nc.inputs_ok = false;
+            return;
+        }
+        if (maps) {
+            nc.planned.mapped_input = int(i);
+            ValueInfo entry = have;  // the node's check hook sees one entry
+            entry.type = have.element;
+            entry.element = ValueType::none;
+            entry.count = 0;
+            nc.mapped_entry = std::make_unique<ValueInfo>(std::move(entry));
+            nc.input_infos[i] = nc.mapped_entry.get();
+        } else {
+            nc.input_infos[i] = &have;
+        }
+        nc.planned.inputs[i] = key;
+    }
+
+    /// The literal of each parameter: spec arguments, then overrides on top.
+    void gather_params(NodeCheck& nc) {
+        const auto& call = nc.st.call;
+        const NodeDescriptor* node = nc.node;
         std::vector<std::string> param_names;
         for (const auto& p : node->params) param_names.push_back(p.name);
-        std::map<std::string, const Literal*, std::less<>> literals;
         for (const auto& arg : call.params) {
             const Param* p = node->find_param(arg.key);
             if (!p) {
                 std::string msg = call.qualified() + " has no parameter '" + arg.key + "'";
                 const std::string guess = spec::closest(arg.key, param_names);
-                msg += guess.empty() ? "; `orogen help " + call.qualified() + "` lists them"
-                                     : "; did you mean '" + guess + "'?";
-                diags.error(arg.key_where, msg);
-                params_ok = false;
+                msg += guess.empty() ? "; `orogen help " + call.qualified() + "` lists them" : "; did you mean '" + guess + "'?";
+                diags_.error(arg.key_where, msg);
                 continue;
             }
-            if (literals.count(arg.key)) {
-                diags.error(arg.key_where, "'" + arg.key + "' is set twice in this call");
-                params_ok = false;
+            if (nc.literals.count(arg.key)) {
+                diags_.error(arg.key_where, "'" + arg.key + "' is set twice in this call");
+                nc.invalid.insert(arg.key);
                 continue;
             }
-            literals[arg.key] = &arg.value;
-            param_where[arg.key] = arg.value.where;
+            nc.literals[arg.key] = &arg.value;
+            nc.param_where[arg.key] = arg.value.where;
         }
-        for (auto& o : overrides) {
-            if (o.o.target != label) continue;
+        for (auto& o : overrides_) {
+            if (o.o.target != nc.planned.label) continue;
             o.used = true;
-            const Param* p = node->find_param(o.o.param);
-            if (!p) {
-                std::string msg = call.qualified() + " ('" + label + "') has no parameter '" + o.o.param + "'";
+            if (!node->find_param(o.o.param)) {
+                std::string msg =
+                    call.qualified() + " ('" + nc.planned.label + "') has no parameter '" + o.o.param + "'";
                 const std::string guess = spec::closest(o.o.param, param_names);
                 if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
-                diags.error(o.o.param_where, msg);
-                params_ok = false;
+                diags_.error(o.o.param_where, msg);
                 continue;
             }
-            literals[o.o.param] = &o.o.value;
-            param_where[o.o.param] = o.o.value.where;
+            nc.literals[o.o.param] = &o.o.value;
+            nc.param_where[o.o.param] = o.o.value.where;
         }
-        for (const auto& p : node->params) {
-            auto it = literals.find(p.name);
-            if (it == literals.end()) {
+    }
+
+    /// Each parameter converted and range-checked on its own; one that fails is marked invalid.
+    void convert_params(NodeCheck& nc) {
+        const auto& call = nc.st.call;
+        for (const auto& p : nc.node->params) {
+            auto it = nc.literals.find(p.name);
+            if (it == nc.literals.end()) {
                 if (p.required()) {
-                    diags.error(call.where, call.qualified() + " needs parameter '" + p.name + "'" +
-                                                (p.help_text.empty() ? "" : " (" + p.help_text + ")"));
-                    params_ok = false;
+                    diags_.error(call.where, call.qualified() + " needs parameter '" + p.name + "'" +
+                                                 (p.help_text.empty() ? "" : " (" + p.help_text + ")"));
+                    nc.invalid.insert(p.name);
                 } else {
-                    planned.params[p.name] = p.default_value;
+                    nc.planned.params[p.name] = p.default_value;
                 }
                 continue;
             }
-            auto v = convert(p, *it->second, call.qualified(), diags);
+            auto v = convert(p, *it->second, call.qualified(), diags_);
             if (!v) {
-                params_ok = false;
+                nc.invalid.insert(p.name);
                 continue;
             }
-            planned.params[p.name] = std::move(*v);
-            planned.given.insert(p.name);
+            nc.planned.params[p.name] = std::move(*v);
+            nc.planned.given.insert(p.name);
         }
+    }
 
-        // Paths
-        if (params_ok) {
-            for (const auto& p : node->params) {
-                if (p.type != ParamType::path) continue;
-                auto it = planned.params.find(p.name);
-                if (it == planned.params.end() || !std::holds_alternative<std::string>(it->second)) continue;
-                const std::string& value = std::get<std::string>(it->second);
-                const Location where = param_where.count(p.name) ? param_where[p.name] : call.where;
-                if (p.path_role == PathRole::input) {
-                    const fs::path resolved = fs::path(value).is_absolute() ? fs::path(value) : plan.spec_folder / value;
-                    std::error_code ec;
-                    if (!fs::exists(resolved, ec)) {
-                        diags.error(where, "no such file: " + value +
-                                               (fs::path(value).is_absolute() ? std::string()
-                                                                              : " (looked for " + resolved.string() +
-                                                                                    "; input paths are relative to the spec's folder)"));
-                        params_ok = false;
-                    } else if (const std::string problem = regular_file_problem(resolved); !problem.empty()) {
-                        diags.error(where, value + " " + problem);
-                        params_ok = false;
-                    }
-                } else {
-                    if (!p.choices.empty()) {
-                        bool ok = false;
-                        std::string list;
-                        for (const auto& ext : p.choices) {
-                            ok = ok || has_extension(value, ext);
-                            list += (list.empty() ? "" : ", ") + ext;
-                        }
-                        if (!ok) {
-                            diags.error(where, call.qualified() + " writes " + list + " files; '" + value +
-                                                   "' has another extension");
-                            params_ok = false;
-                            continue;
-                        }
-                    }
-                    const fs::path out(value);
-                    const OutputPlace place = place_output(options.out_dir, value);
-                    if (!place.inside && !options.allow_outside_out) {
-                        diags.error(where, call.qualified() + ": " + outside_out_message(options.out_dir, value, place));
-                        params_ok = false;
-                        continue;
-                    }
-                    if (out.is_absolute()) {
-                        std::error_code ec;
-                        if (!fs::is_directory(out.parent_path(), ec)) {
-                            diags.error(where, "cannot write " + value + ": folder " + out.parent_path().string() +
-                                                   " does not exist");
-                            params_ok = false;
-                            continue;
-                        }
-                    }
-                    const std::string key = place.resolved.string();
-                    if (auto prev = output_files.find(key); prev != output_files.end()) {
-                        diags.error(where, "'" + value + "' is already written by the node on line " +
-                                               std::to_string(prev->second.line) + "; give each output its own path");
-                        params_ok = false;
-                        continue;
-                    }
-                    output_files.emplace(key, where);
-                    planned.output_files.push_back(value);
-                }
+    /// Every valid path parameter: inputs exist, outputs have an allowed extension, stay in --out, and are
+    /// written by one node.
+    void check_paths(NodeCheck& nc) {
+        for (const auto& p : nc.node->params) {
+            if (p.type != ParamType::path || nc.invalid.count(p.name)) continue;
+            auto it = nc.planned.params.find(p.name);
+            if (it == nc.planned.params.end() || !std::holds_alternative<std::string>(it->second)) continue;
+            const std::string& value = std::get<std::string>(it->second);
+            const Location where = nc.param_where.count(p.name) ? nc.param_where[p.name] : nc.st.call.where;
+            const bool ok = p.path_role == PathRole::input ? input_path_ok(value, where)
+                                                           : output_path_ok(nc, p, value, where);
+            if (!ok) nc.invalid.insert(p.name);
+        }
+    }
+
+    bool input_path_ok(const std::string& value, const Location& where) {
+        const fs::path resolved = fs::path(value).is_absolute() ? fs::path(value) : plan_.spec_folder / value;
+        std::error_code ec;
+        if (!fs::exists(resolved, ec)) {
+            diags_.error(where, "no such file: " + value +
+                                    (fs::path(value).is_absolute()
+                                         ? std::string()
+                                         : " (looked for " + resolved.string() + "; input paths are relative to the spec's folder)"));
+            return false;
+        }
+        if (const std::string problem = regular_file_problem(resolved); !problem.empty()) {
+            diags_.error(where, value + " " + problem);
+            return false;
+        }
+        return true;
+    }
+
+    bool output_path_ok(NodeCheck& nc, const Param& p, const std::string& value, const Location& where) {
+        const std::string node_name = nc.st.call.qualified();
+        if (!p.choices.empty()) {
+            bool ok = false;
+            std::string list;
+            for (const auto& ext : p.choices) {
+                ok = ok || has_extension(value, ext);
+                list += (list.empty() ? "" : ", ") + ext;
+            }
+            if (!ok) {
+                diags_.error(where, node_name + " writes " + list + " files; '" + value + "' has another extension");
+                return false;
             }
         }
+        const fs::path out(value);
+        const OutputPlace place = place_output(options_.out_dir, value);
+        if (!place.inside && !options_.allow_outside_out) {
+            diags_.error(where, node_name + ": " + outside_out_message(options_.out_dir, value, place));
+            return false;
+        }
+        if (out.is_absolute()) {
+            std::error_code ec;
+            if (!fs::is_directory(out.parent_path(), ec)) {
+                diags_.error(where, "cannot write " + value + ": folder " + out.parent_path().string() + " does not exist");
+                return false;
+            }
+        }
+        const std::string key = place.resolved.string();
+        if (auto prev = output_files_.find(key); prev != output_files_.end()) {
+            diags_.error(where, "'" + value + "' is already written by the node on line " +
+                                    std::to_string(prev->second.line) + "; give each output its own path");
+            return false;
+        }
+        output_files_.emplace(key, where);
+        nc.planned.output_files.push_back(value);
+        return true;
+    }
 
-        // Output info: by default, the first heightmap input's (or the grid), plus declared layers.
+    /// What the node makes: by default the first heightmap input's info (or the grid's) plus declared layers,
+    /// then whatever its check hook says; side values as declared.
+    std::pair<ValueInfo, std::map<std::string, ValueInfo, std::less<>>> node_output(NodeCheck& nc) {
+        const NodeDescriptor* node = nc.node;
         ValueInfo out;
         out.type = node->output;
         if (node->output == ValueType::heightmap) {
             const ValueInfo* base = nullptr;
-            for (std::size_t i = 0; i < node->inputs.size(); ++i)
-                if (input_infos[i] && node->inputs[i].type == ValueType::heightmap) {
-                    base = input_infos[i];
-                    break;
-                }
+            for (std::size_t i = 0; i < node->inputs.size() && !base; ++i)
+                if (nc.input_infos[i] && node->inputs[i].type == ValueType::heightmap) base = nc.input_infos[i];
             if (base) {
                 out = *base;
             } else {
-                out.width = plan.grid.width;
-                out.height = plan.grid.height;
-                out.cell = plan.grid.cell;
+                out.width = plan_.grid.width;
+                out.height = plan_.grid.height;
+                out.cell = plan_.grid.cell;
             }
             out.type = ValueType::heightmap;
             out.element = ValueType::none;  // the base may have been a series of heightmaps
             out.count = 0;
             for (const auto& l : node->adds_layers) out.layers.insert(l);
         }
-
         // What the side values hold; a mapped node's hold nothing (it ran once per entry).
         std::map<std::string, ValueInfo, std::less<>> sides;
         for (const auto& side : node->side_outputs) {
             ValueInfo si;
-            si.type = planned.mapped_input >= 0 ? ValueType::none : side.series ? ValueType::series : side.type;
-            if (side.series && planned.mapped_input < 0) si.element = side.type;
+            si.type = nc.planned.mapped_input >= 0 ? ValueType::none : side.series ? ValueType::series : side.type;
+            if (side.series && nc.planned.mapped_input < 0) si.element = side.type;
             sides[side.name] = si;
         }
-        // The node's own check, once everything it reads is known to be valid.
-        if (inputs_ok && params_ok && node->check) {
-            CheckContextImpl ctx(plan.grid, input_infos, planned, param_where, call.where, plan.spec_folder, diags,
-                                 std::move(out));
-            ctx.set_sides(std::move(sides));
-            ctx.set_tiled_share(options.tiled_memory_share);
-            try {
-                node->check(ctx);
-            } catch (const std::exception& e) {
-                diags.error(call.where, call.qualified() + ": " + e.what());
-            }
-            out = ctx.take_output();
-            sides = ctx.take_sides();
-        }
+        if (nc.inputs_ok && node->check) run_check_hook(nc, out, sides);
         // A series output: `out` describes its entries.
-        if (node->output_series || planned.mapped_input >= 0) {
+        if (node->output_series || nc.planned.mapped_input >= 0) {
             out.element = out.type;
             out.type = ValueType::series;
-            if (planned.mapped_input >= 0) out.count = values[planned.inputs[std::size_t(planned.mapped_input)]].count;
+            if (nc.planned.mapped_input >= 0)
+                out.count = values_[nc.planned.inputs[std::size_t(nc.planned.mapped_input)]].count;
         }
+        return {std::move(out), std::move(sides)};
+    }
 
+    /// The node's own check, once everything it reads is known: it runs even if some parameters have errors
+    /// (so its cross-parameter checks of the valid ones are reported too), and stops quietly where it reads
+    /// a parameter with an error (that error was reported; a check on a wrong value would only add noise).
+    void run_check_hook(NodeCheck& nc, ValueInfo& out, std::map<std::string, ValueInfo, std::less<>>& sides) {
+        const auto& call = nc.st.call;
+        CheckContextImpl ctx(plan_.grid, nc.input_infos, nc.planned, nc.param_where, call.where, plan_.spec_folder,
+                             diags_, std::move(out), nc.invalid);
+        ctx.set_sides(std::move(sides));
+        ctx.set_tiled_share(options_.tiled_memory_share);
+        try {
+            nc.node->check(ctx);
+        } catch (const InvalidParamRead&) {
+            // stopped at a parameter whose error is already reported
+        } catch (const std::exception& e) {
+            diags_.error(call.where, call.qualified() + ": " + e.what());
+        }
+        out = ctx.take_output();
+        sides = ctx.take_sides();
+    }
+
+    void define_value(NodeCheck& nc, ValueInfo out, std::map<std::string, ValueInfo, std::less<>> sides) {
+        const auto& st = nc.st;
         if (!st.name.empty()) {
-            defined_at.emplace(st.name, st.name_where);
-            values[st.name] = out;
-            for (auto& [side, info] : sides) values[st.name + "." + side] = std::move(info);
+            defined_at_.emplace(st.name, st.name_where);
+            values_[st.name] = out;
+            for (auto& [side, info] : sides) values_[st.name + "." + side] = std::move(info);
         } else if (st.nested) {
-            values[label] = out;
+            values_[nc.planned.label] = out;
         }
-        for (const auto& in : planned.inputs)
-            if (!in.empty()) plan.last_use[in] = plan.nodes.size();
-        plan.nodes.push_back(std::move(planned));
+        for (const auto& in : nc.planned.inputs)
+            if (!in.empty()) plan_.last_use[in] = plan_.nodes.size();
+        plan_.nodes.push_back(std::move(nc.planned));
     }
 
-    for (const auto& o : overrides) {
-        if (o.used) continue;
-        std::string msg = "--set names '" + o.o.target + "', but the spec has no value or node of that name";
-        const std::string guess = spec::closest(o.o.target, labels);
-        if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
-        else msg += "; an unnamed node is set by its label in the timing table (kind:node, then kind:node#2, ...)";
-        diags.error(o.o.target_where, msg);
+    void report_unused_overrides() {
+        for (const auto& o : overrides_) {
+            if (o.used) continue;
+            std::string msg = "--set names '" + o.o.target + "', but the spec has no value or node of that name";
+            const std::string guess = spec::closest(o.o.target, labels_);
+            if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+            else msg += "; an unnamed node is set by its label in the timing table (kind:node, then kind:node#2, ...)";
+            diags_.error(o.o.target_where, msg);
+        }
     }
 
-    // A spec that writes nothing runs, and leaves only manifest.json: say so before it runs.
-    const bool writes = std::any_of(plan.nodes.begin(), plan.nodes.end(),
-                                    [](const PlannedNode& n) { return !n.output_files.empty(); });
-    if (!diags.has_errors() && !writes) {
+    /// A spec that writes nothing runs, and leaves only manifest.json: say so before it runs.
+    void warn_if_nothing_is_written() {
+        const bool writes = std::any_of(plan_.nodes.begin(), plan_.nodes.end(),
+                                        [](const PlannedNode& n) { return !n.output_files.empty(); });
+        if (diags_.has_errors() || writes) return;
         std::string last;  // the last named heightmap or image, for the example
-        for (const auto& n : plan.nodes)
+        for (const auto& n : plan_.nodes)
             if (!n.value_name.empty() && n.value_name.find(':') == std::string::npos &&
                 (n.node->output == ValueType::heightmap || n.node->output == ValueType::image))
                 last = n.value_name;
-        diags.warning(Location{parsed.source, 1, 1, 0},
-                      "this spec writes no files: a run would leave only manifest.json; add an exporter, e.g. " +
-                          (last.empty() ? std::string("export:png(NAME, path=\"NAME.png\")")
-                                        : "export:png(" + last + ", path=\"" + last + ".png\")"));
+        diags_.warning(Location{parsed_.source, 1, 1, 0},
+                       "this spec writes no files: a run would leave only manifest.json; add an exporter, e.g. " +
+                           (last.empty() ? std::string("export:png(NAME, path=\"NAME.png\")")
+                                         : "export:png(" + last + ", path=\"" + last + ".png\")"));
     }
-    return plan;
+
+    const spec::Spec& parsed_;
+    const Registry& registry_;
+    const CheckOptions& options_;
+    Diagnostics& diags_;
+    const Location file_start_;
+    Plan plan_;
+    std::vector<PendingOverride> overrides_;
+    std::map<std::string, ValueInfo, std::less<>> values_;       // value key → info
+    std::map<std::string, Location, std::less<>> defined_at_;    // value name → statement
+    std::map<std::string, Location, std::less<>> output_files_;  // output path → where
+    std::map<std::string, int, std::less<>> unnamed_count_;
+    std::set<std::string, std::less<>> poisoned_;  // names whose node is unknown
+    std::vector<std::string> all_nodes_;
+    std::map<std::string, Location, std::less<>> defined_anywhere_;  // for "'x' is defined later, on line N"
+    std::vector<std::string> nested_key_;  // value key of each call written where an input goes (its label)
+    std::vector<std::string> labels_;      // every node's label, for --set's "did you mean"
+};
+
+}  // namespace
+
+Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& spec_path, const CheckOptions& options,
+           Diagnostics& diags) {
+    return Checker(parsed, registry, spec_path, options, diags).run();
 }
 
 }  // namespace orogen
