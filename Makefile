@@ -61,7 +61,7 @@ TSAN_SKIP  ?= ^Specs/BadSpec\.|^Confinement\.|^Cli\.|^Inputs\.|^CacheCommand\.|^
 # TSan+UBSan (TSAN_ONLY). Both sanitizers over every test would not fit CI's 30 minutes on 2 cores
 # (docs/hardening.md).
 ASAN_ONLY  ?=
-ASAN_CI     = ^/tests/(kernel|fuzz|cache|pipelines)|^/tests/plugins/(render|render/terrain|analyze/terrain)$$|^/tests/libs/[^/]+$$|^/plugins/[^/]+/[^/]+$$
+ASAN_CI     = ^/tests/(kernel|fuzz|cache|pipelines)|^/tests/plugins/(render|analyze)/terrain$$|^/tests/libs/[^/]+$$|^/plugins/[^/]+/[^/]+$$
 FUZZ_SECONDS ?= 20
 FUZZ_SEED    ?= 1
 FUZZ_RUNS    ?= 1000000

@@ -82,7 +82,7 @@ TEST_P(Pipeline, GivesTheSameBytesOnOneAndTwoThreadsAndMatchesItsGoldenHashes) {
     std::string text;  // the `sha256sum` format: "<hash>  <file>"
     for (const auto& [file, hash] : one) {
         // Frames drawn by llvmpipe repeat exactly on one machine (checked above) but their
-        // bytes follow the CPU's vector width (AVX2 or AVX-512 code); tests/plugins/render
+        // bytes follow the CPU's vector width (AVX2 or AVX-512 code); tests/plugins/render/terrain
         // compares rendered frames to golden images by PSNR instead.
         if (file == "beauty.png" || file == "turntable.mp4") continue;
         text += hash + "  " + file + "\n";

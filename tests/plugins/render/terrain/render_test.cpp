@@ -501,7 +501,7 @@ TEST(Golden, TheSceneMatchesItsGoldenImageAndRepeatsExactly) {
     ASSERT_EQ(a.rgba32f.size(), b.rgba32f.size());
     EXPECT_TRUE(a.rgba32f == b.rgba32f) << "the same scene rendered twice differs";
     const auto bytes = png_export::to_srgb8(a, png_export::Tonemap::aces, 0);
-    const std::filesystem::path golden = std::filesystem::path(OROGEN_SOURCE_DIR) / "tests/plugins/render/golden_scene.png";
+    const std::filesystem::path golden = std::filesystem::path(OROGEN_SOURCE_DIR) / "tests/plugins/render/terrain/golden_scene.png";
     if (std::getenv("OROGEN_UPDATE_GOLDEN")) {
         AtomicFile f(golden);
         write_rgba_png(f.stream(), a.width, a.height, bytes);
