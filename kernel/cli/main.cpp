@@ -207,20 +207,6 @@ std::optional<cache::Settings> cache_settings(const Args& args) {
     return s;
 }
 
-std::string human_bytes(std::uint64_t n) {
-    const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
-    double v = double(n);
-    int u = 0;
-    while (v >= 1024 && u < 4) {
-        v /= 1024;
-        ++u;
-    }
-    char buf[64];
-    if (u == 0) std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(n));
-    else std::snprintf(buf, sizeof buf, "%.1f %s", v, units[u]);
-    return buf;
-}
-
 std::string utc_time(std::int64_t ns) {
     const std::time_t t = std::time_t(ns / 1'000'000'000);
     std::tm tm{};
@@ -247,13 +233,13 @@ int cmd_cache(const Args& args) {
         const cache::Cleared c = cache::clear_folder(folder);
         for (const auto& f : c.failures) std::fprintf(stderr, "orogen: error: cannot remove %s\n", f.c_str());
         std::printf("removed %llu cache entr%s (%s) from %s\n", static_cast<unsigned long long>(c.entries),
-                    c.entries == 1 ? "y" : "ies", human_bytes(c.bytes).c_str(), folder.c_str());
+                    c.entries == 1 ? "y" : "ies", human_bytes(double(c.bytes)).c_str(), folder.c_str());
         return c.failures.empty() ? exit_ok : exit_failed;
     }
     const cache::FolderFacts f = cache::folder_facts(folder);
     std::printf("cache folder: %s%s\n", folder.c_str(), f.exists ? "" : " (does not exist yet: nothing kept)");
-    std::printf("entries:      %llu (%s)\n", static_cast<unsigned long long>(f.entries), human_bytes(f.bytes).c_str());
-    std::printf("limit:        %s%s\n", human_bytes(args.cache_size).c_str(),
+    std::printf("entries:      %llu (%s)\n", static_cast<unsigned long long>(f.entries), human_bytes(double(f.bytes)).c_str());
+    std::printf("limit:        %s%s\n", human_bytes(double(args.cache_size)).c_str(),
                 args.cache_size == cache::Settings{}.max_bytes ? " (the default; a run's --cache-size sets its own)" : " (--cache-size)");
     if (f.entries > 0) {
         std::printf("oldest:       %s (least recently used)\n", utc_time(f.oldest_ns).c_str());
@@ -261,7 +247,7 @@ int cmd_cache(const Args& args) {
     }
     if (f.temporaries > 0)
         std::printf("temporaries:  %llu (%s) being written by a run, or left by a killed one (removed after an hour)\n",
-                    static_cast<unsigned long long>(f.temporaries), human_bytes(f.temporary_bytes).c_str());
+                    static_cast<unsigned long long>(f.temporaries), human_bytes(double(f.temporary_bytes)).c_str());
     if (f.bytes > args.cache_size)
         std::printf("over the limit: the next run that keeps a result evicts the least recently used entries\n");
     return exit_ok;

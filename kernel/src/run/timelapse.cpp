@@ -1,7 +1,7 @@
 #include <orogen/error.hpp>
 #include <orogen/timelapse.hpp>
 
-#include "spec/plan.hpp"  // human_bytes
+#include <orogen/io.hpp>  // human_bytes
 
 #include <algorithm>
 

@@ -61,7 +61,4 @@ struct CheckOptions {
 Plan check(const spec::Spec& parsed, const Registry& registry, const std::filesystem::path& spec_path,
            const CheckOptions& options, spec::Diagnostics& diags);
 
-/// "3.6 TiB", "512 MiB".
-std::string human_bytes(double bytes);
-
 }  // namespace orogen

@@ -3,6 +3,7 @@
 #include "tiled.hpp"
 
 #include <orogen/error.hpp>
+#include <orogen/io.hpp>
 #include <orogen/plugin.hpp>
 #include <orogen/timelapse.hpp>
 
@@ -417,11 +418,9 @@ void check(CheckContext& ctx) {
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (have > 0 && need > 0.5 * have) {
         std::ostringstream msg;
-        msg.setf(std::ios::fixed);
-        msg.precision(1);
-        msg << "a " << w << " x " << hgt << " grid needs " << need / 1e9 << " GB for the landscape model"
+        msg << "a " << w << " x " << hgt << " grid needs " << human_bytes(need) << " for the landscape model"
             << (ctx.memory_share() < 1.0 ? " (this machine's tiles)" : "") << ", more than half of this machine's "
-            << have / 1e9 << " GB; use a smaller grid" << (ctx.memory_share() < 1.0 ? " or more machines" : "");
+            << human_bytes(have) << "; use a smaller grid" << (ctx.memory_share() < 1.0 ? " or more machines" : "");
         ctx.error("", msg.str());
     }
     check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));
