@@ -313,21 +313,35 @@ void TiledModel::route(double* h) {
     if (pits_ > 0) resolve_pits(h);
 }
 
-void TiledModel::resolve_pits(double* h) {
-    const std::size_t n = h_.size();
-    const bool root0 = tiles_.rank() == 0;
-    // 1. Basins: rank 0 follows every exit over the tiles' edges to its pit or outlet.
-    std::vector<std::string> all = joined([&] { return tiles_.gather(edge_hops(), Tiling::Gather::to_rank0); });
+/// What resolve_pits' steps pass on: rank 0's map of exits over the tiles' edges, the messages gathered
+/// to rank 0 and the answer it shares, and this tile's contracted forest of basins.
+struct TiledModel::ResolveState {
     EdgeMap edges;
+    std::vector<std::string> all;
     std::string answer;
-    if (root0) {
-        for (const auto& m : all) {
+    TileForest forest;
+};
+
+void TiledModel::resolve_pits(double* h) {
+    ResolveState st;
+    label_basins(st);
+    settle_tile_lakes(st, links_between_basins());
+    join_on_rank0(st);
+    apply_joined(st, h);
+}
+
+void TiledModel::label_basins(ResolveState& st) {
+    const std::size_t n = h_.size();
+    // 1. Basins: rank 0 follows every exit over the tiles' edges to its pit or outlet.
+    st.all = joined([&] { return tiles_.gather(edge_hops(), Tiling::Gather::to_rank0); });
+    if (tiles_.rank() == 0) {
+        for (const auto& m : st.all) {
             std::size_t at = 0;
-            read_edges(m, at, edges);
+            read_edges(m, at, st.edges);
         }
         std::vector<ExitBasin> exit_basin;
         std::unordered_map<std::int64_t, std::int64_t> basin_of;  // exit → basin
-        for (const auto& [cell, end] : edges) {
+        for (const auto& [cell, end] : st.edges) {
             if (end.second < 0 || basin_of.count(end.first)) continue;
             // Follow the exit's water; every exit met on the way gets the same basin.
             std::vector<std::int64_t> path;
@@ -339,20 +353,20 @@ void TiledModel::resolve_pits(double* h) {
                     break;
                 }
                 path.push_back(at.first);
-                if (path.size() > edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
-                at = edge_of(edges, at.second);
+                if (path.size() > st.edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
+                at = edge_of(st.edges, at.second);
             }
             if (basin < 0) basin = at.first;
             for (const std::int64_t e : path) basin_of[e] = basin;
         }
         for (const auto& [e, b] : basin_of) exit_basin.push_back({e, b});
-        put(answer, exit_basin);
+        put(st.answer, exit_basin);
     }
-    joined([&] { return tiles_.share_from_rank0(answer); });
+    joined([&] { return tiles_.share_from_rank0(st.answer); });
     {
         std::size_t at = 0;
         std::unordered_map<std::int64_t, std::int64_t> basin_of;
-        for (const ExitBasin& e : take<ExitBasin>(answer, at)) basin_of[e.exit] = e.basin;
+        for (const ExitBasin& e : take<ExitBasin>(st.answer, at)) basin_of[e.exit] = e.basin;
         std::vector<std::int64_t> tree_basin(trees_.size());
         for (std::size_t t = 0; t < trees_.size(); ++t) {
             const auto l = std::size_t(trees_[t]);
@@ -361,6 +375,10 @@ void TiledModel::resolve_pits(double* h) {
         label_.resize(n);
         for (std::size_t l = 0; l < n; ++l) label_[l] = tree_basin[std::size_t(tree_of_[l])];
     }
+}
+
+std::vector<Link> TiledModel::links_between_basins() {
+    const std::size_t n = h_.size();
     // 2. Every tile's lowest link per pair of basins, from its cells in pit basins
     // (an edge between two pit basins from its lower-index cell only, as FlowRouter).
     grown_label_.assign(grown_h_.size(), -1.0);
@@ -408,11 +426,15 @@ void TiledModel::resolve_pits(double* h) {
         links.insert(links.end(), tree_links.begin(), tree_links.end());
     }
     lowest_per_pair(links);
+    return links;
+}
+
+void TiledModel::settle_tile_lakes(ResolveState& st, std::vector<Link> links) {
     // 3. The lakes settled here: the basins with their pit in this tile and no
     // cell on its edge have all their links among the tile's (basin_join.hpp).
     std::unordered_set<std::int64_t> on_edge;
     for (const std::int32_t l : edge_) on_edge.insert(label_[std::size_t(l)]);
-    const TileForest forest = contract_tile(std::move(links), [&](std::int64_t basin) {
+    st.forest = contract_tile(std::move(links), [&](std::int64_t basin) {
         return local_of(basin) >= 0 && on_edge.count(basin) == 0;
     });
     // Rank 0 gets the rest, with the ends of the local trees of the cells it may cut paths from.
@@ -423,26 +445,29 @@ void TiledModel::resolve_pits(double* h) {
             hops.push_back({cell, hp.tree, hp.next});
         }
     };
-    for (const Link& l : forest.deferred) hop_of(l.i), hop_of(l.j);
-    for (const ForestEdge& e : forest.edges) hop_of(e.first.i), hop_of(e.first.j);
+    for (const Link& l : st.forest.deferred) hop_of(l.i), hop_of(l.j);
+    for (const ForestEdge& e : st.forest.edges) hop_of(e.first.i), hop_of(e.first.j);
     std::string mine;
-    put(mine, forest.anchors);
-    put(mine, forest.deferred);
-    put(mine, forest.edges);
+    put(mine, st.forest.anchors);
+    put(mine, st.forest.deferred);
+    put(mine, st.forest.edges);
     put(mine, hops);
-    all = joined([&] { return tiles_.gather(mine, Tiling::Gather::to_rank0); });
+    st.all = joined([&] { return tiles_.gather(mine, Tiling::Gather::to_rank0); });
+}
+
+void TiledModel::join_on_rank0(ResolveState& st) {
     // 4. Rank 0: the joined tree's key basins, and the pieces of each anchor's path from its pass down to its pit.
-    answer.clear();
-    if (root0) {
+    st.answer.clear();
+    if (tiles_.rank() == 0) {
         std::vector<std::int64_t> anchors;
         std::vector<Link> deferred;
         std::vector<ForestEdge> forest_edges;
-        for (const auto& m : all) {
+        for (const auto& m : st.all) {
             std::size_t at = 0;
             const auto a = take<std::int64_t>(m, at);
             const auto d = take<Link>(m, at);
             const auto e = take<ForestEdge>(m, at);
-            for (const EdgeRecord& r : take<EdgeRecord>(m, at)) edges.emplace(r.cell, std::pair{r.tree, r.next});
+            for (const EdgeRecord& r : take<EdgeRecord>(m, at)) st.edges.emplace(r.cell, std::pair{r.tree, r.next});
             anchors.insert(anchors.end(), a.begin(), a.end());
             deferred.insert(deferred.end(), d.begin(), d.end());
             forest_edges.insert(forest_edges.end(), e.begin(), e.end());
@@ -455,25 +480,28 @@ void TiledModel::resolve_pits(double* h) {
             if (k.basin < 0 || !std::binary_search(anchors.begin(), anchors.end(), k.basin)) continue;
             if (k.in < 0) throw std::logic_error("stream-power: an anchor basin's way out is not a link");
             pieces.push_back({k.in, k.across});
-            std::pair<std::int64_t, std::int64_t> end = edge_of(edges, k.in);
+            std::pair<std::int64_t, std::int64_t> end = edge_of(st.edges, k.in);
             std::size_t guard = 0;
             while (end.second >= 0) {
                 pieces.push_back({end.second, end.first});  // the exit's receiver now drains back to the exit
-                end = edge_of(edges, end.second);
-                if (++guard > edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
+                end = edge_of(st.edges, end.second);
+                if (++guard > st.edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
             }
             if (end.first != k.basin) throw std::logic_error("stream-power: a pass's path does not reach its pit");
         }
-        put(answer, keys);
-        put(answer, pieces);
+        put(st.answer, keys);
+        put(st.answer, pieces);
     }
-    joined([&] { return tiles_.share_from_rank0(answer); });
+    joined([&] { return tiles_.share_from_rank0(st.answer); });
+}
+
+void TiledModel::apply_joined(ResolveState& st, double* h) {
     // 5. Every rank: orient its closed basins, fill its lakes, reverse its pieces of the paths.
     std::size_t at = 0;
     std::unordered_map<std::int64_t, KeyExit> keys;
-    for (const KeyExit& k : take<KeyExit>(answer, at)) keys.emplace(k.basin, k);
-    const auto pieces = take<Piece>(answer, at);
-    const std::vector<BasinExit> closed = orient_tile(forest, keys);
+    for (const KeyExit& k : take<KeyExit>(st.answer, at)) keys.emplace(k.basin, k);
+    const auto pieces = take<Piece>(st.answer, at);
+    const std::vector<BasinExit> closed = orient_tile(st.forest, keys);
     if (settings_.depressions == Depressions::fill) {
         std::unordered_map<std::int64_t, double> level;
         level.reserve(closed.size() + keys.size());

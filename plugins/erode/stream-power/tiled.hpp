@@ -110,6 +110,13 @@ private:
     Hop hop(std::size_t l) const;
     std::string edge_hops() const;
     void resolve_pits(double* h);
+    // resolve_pits' five steps (tiled.cpp), over the state they pass on (ResolveState, defined there).
+    struct ResolveState;
+    void label_basins(ResolveState& st);
+    std::vector<Link> links_between_basins();
+    void settle_tile_lakes(ResolveState& st, std::vector<Link> links);
+    void join_on_rank0(ResolveState& st);
+    void apply_joined(ResolveState& st, double* h);
     void accumulate();
     /// Solve `v` down the rivers: f(l, v_receiver) sets v[l] for every cell but the roots, receivers first.
     void propagate(std::vector<double>& v, const std::function<void(std::size_t, double)>& f);
