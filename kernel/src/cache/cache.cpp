@@ -4,7 +4,6 @@
 #include <orogen/parallel.hpp>
 #include <orogen/plugin.hpp>
 
-#include <openssl/evp.h>
 #include <xxhash.h>
 
 #include <algorithm>
@@ -480,10 +479,7 @@ void write_payload(Writer& w, const Contents& c) {
 }
 
 std::vector<std::string> read_messages(std::span<const std::uint8_t> block, const Header& h) {
-    Digest d{};
-    unsigned int len = 0;
-    EVP_Digest(block.data(), block.size(), d.data(), &len, EVP_sha256(), nullptr);
-    if (d != h.message_hash) throw CorruptEntry("its messages do not match their SHA-256");
+    if (detail::sha256_of(block.data(), block.size()) != h.message_hash) throw CorruptEntry("its messages do not match their SHA-256");
     Reader r(block, 0);
     std::vector<std::string> out;
     const std::uint32_t n = r.u32();
@@ -538,13 +534,8 @@ std::string hex(const Digest& d) {
     return s;
 }
 
-Hasher::Hasher() : ctx_(EVP_MD_CTX_new()) {
-    if (!ctx_ || EVP_DigestInit_ex(static_cast<EVP_MD_CTX*>(ctx_), EVP_sha256(), nullptr) != 1)
-        throw Error("internal error: OpenSSL's SHA-256 is not available");
-}
-Hasher::~Hasher() { EVP_MD_CTX_free(static_cast<EVP_MD_CTX*>(ctx_)); }
 Hasher& Hasher::bytes(const void* data, std::size_t n) {
-    EVP_DigestUpdate(static_cast<EVP_MD_CTX*>(ctx_), data, n);
+    sha_.update(data, n);
     return *this;
 }
 Hasher& Hasher::u64(std::uint64_t v) { return bytes(&v, sizeof v); }
@@ -553,13 +544,6 @@ Hasher& Hasher::text(std::string_view s) {
     u64(s.size());
     return bytes(s.data(), s.size());
 }
-Digest Hasher::finish() {
-    Digest d{};
-    unsigned int len = 0;
-    EVP_DigestFinal_ex(static_cast<EVP_MD_CTX*>(ctx_), d.data(), &len);
-    return d;
-}
-
 namespace {
 std::size_t hash_blocks(std::size_t payload_bytes) { return std::max<std::size_t>(1, (payload_bytes + hash_block - 1) / hash_block); }
 
@@ -567,10 +551,7 @@ std::size_t hash_blocks(std::size_t payload_bytes) { return std::max<std::size_t
 Digest block_digest(std::span<const std::uint8_t> payload, std::size_t b) {
     const std::size_t begin = b * hash_block;
     const std::size_t n = std::min(hash_block, payload.size() - std::min(begin, payload.size()));
-    Digest d{};
-    unsigned int len = 0;
-    EVP_Digest(payload.data() + begin, n, d.data(), &len, EVP_sha256(), nullptr);
-    return d;
+    return detail::sha256_of(payload.data() + begin, n);
 }
 
 /// XXH3-128 of block `b` of the payload, in the first 16 bytes.
@@ -815,8 +796,8 @@ std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
     put<std::uint32_t>(h + 120, std::uint32_t(contents.messages.size()));
     put<std::uint32_t>(h + 124, std::uint32_t(contents.files.size() + contents.recorded.size()));
     put<std::uint64_t>(h + 128, message_bytes);
-    unsigned int len = 0;
-    EVP_Digest(buf.data() + header_size, message_bytes, h + 136, &len, EVP_sha256(), nullptr);
+    const Digest messages = detail::sha256_of(buf.data() + header_size, message_bytes);
+    std::memcpy(h + 136, messages.data(), messages.size());
     return std::move(buf);
 }
 
@@ -912,8 +893,8 @@ void reseal(std::vector<std::uint8_t>& entry, const Digest& key) {
     h = entry.data();
     put<std::uint64_t>(h + 128, message_bytes);
     put<std::uint32_t>(h + 120, message_bytes >= 4 ? get<std::uint32_t>(h + header_size) : 0);
-    unsigned int len = 0;
-    EVP_Digest(h + header_size, message_bytes, h + 136, &len, EVP_sha256(), nullptr);
+    const Digest messages = detail::sha256_of(h + header_size, message_bytes);
+    std::memcpy(h + 136, messages.data(), messages.size());
     const std::span<const std::uint8_t> payload(entry.data() + payload_offset, entry.size() - payload_offset);
     put<std::uint64_t>(h + 48, payload.size());
     const Digest sum = payload_checksum(payload);

@@ -17,6 +17,7 @@
 // modification time; when the folder outgrows its limit the oldest entries go.
 #pragma once
 
+#include "io/digest.hpp"
 #include "spec/plan.hpp"
 
 #include <orogen/values.hpp>
@@ -38,24 +39,20 @@ namespace orogen::cache {
 using Digest = std::array<std::uint8_t, 32>;
 std::string hex(const Digest& d);
 
-/// Incremental SHA-256 (OpenSSL underneath, which uses the CPU's SHA
-/// instructions where there are some). Fields are length-prefixed so that
-/// ("ab", "c") and ("a", "bc") hash differently.
+/// Typed fields into the kernel's one SHA-256 (io/digest.hpp: OpenSSL underneath, which uses the CPU's
+/// SHA instructions where there are some). Fields are length-prefixed so that ("ab", "c") and ("a", "bc")
+/// hash differently.
 class Hasher {
 public:
-    Hasher();
-    ~Hasher();
-    Hasher(const Hasher&) = delete;
-    Hasher& operator=(const Hasher&) = delete;
     Hasher& bytes(const void* data, std::size_t n);
     Hasher& u64(std::uint64_t v);
     Hasher& f64(double v);  ///< the bit pattern, so 0.1 and 0.1000000001 differ
     Hasher& text(std::string_view s);
     Hasher& digest(const Digest& d) { return bytes(d.data(), d.size()); }
-    Digest finish();
+    Digest finish() { return sha_.bytes(); }
 
 private:
-    void* ctx_;
+    detail::Sha256 sha_;
 };
 
 /// The identity of the loaded binary (executable or shared library) whose code holds `address`: its GNU

@@ -15,6 +15,8 @@
 #pragma once
 
 #include <cstddef>
+#include <array>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -22,6 +24,9 @@
 namespace orogen::detail {
 
 /// Incremental SHA-256 (OpenSSL's EVP, which uses the CPU's SHA instructions).
+/// SHA-256 of `count` bytes at once (32 bytes).
+std::array<std::uint8_t, 32> sha256_of(const void* bytes, std::size_t count);
+
 class Sha256 {
 public:
     Sha256();
@@ -31,6 +36,8 @@ public:
     void update(const void* bytes, std::size_t count);
     /// 64 lowercase hex digits; the object must not be used afterwards.
     std::string hex();
+    /// The 32 bytes of the digest; the object must not be used afterwards.
+    std::array<std::uint8_t, 32> bytes();
 
 private:
     struct Ctx;

@@ -62,6 +62,22 @@ void Sha256::update(const void* bytes, std::size_t count) {
         throw Error("internal error: OpenSSL's SHA-256 failed");
 }
 
+std::array<std::uint8_t, 32> Sha256::bytes() {
+    std::array<std::uint8_t, 32> d{};
+    unsigned int n = 0;
+    if (EVP_DigestFinal_ex(ctx_->md.get(), d.data(), &n) != 1 || n != d.size())
+        throw Error("internal error: OpenSSL's SHA-256 failed");
+    return d;
+}
+
+std::array<std::uint8_t, 32> sha256_of(const void* bytes, std::size_t count) {
+    std::array<std::uint8_t, 32> d{};
+    unsigned int n = 0;
+    if (EVP_Digest(bytes, count, d.data(), &n, EVP_sha256(), nullptr) != 1 || n != d.size())
+        throw Error("internal error: OpenSSL's SHA-256 failed");
+    return d;
+}
+
 std::string Sha256::hex() {
     unsigned char d[EVP_MAX_MD_SIZE];
     unsigned int n = 0;
