@@ -86,12 +86,13 @@ struct Settings {
     /// particles from drilling holes; material is conserved either way).
     double max_dig = 0.05;
 
-    /// Particles per chunk of the parallel terrain exchange (see settle() in sph.cpp); any value gives the
-    /// same bits, a serial loop's included. Not a node parameter: for the tests that check exactly that.
+    /// Particles per chunk of the parallel terrain exchange (see settle() in integrator.cpp); any value
+    /// gives the same bits, a serial loop's included. Not a node parameter: for the tests that check
+    /// exactly that.
     std::size_t settle_chunk = 16384;
     /// The largest share of the particles that may have changed cell since the last sort for the sort to
-    /// merge them into the others' order (merge_movers in sph.cpp) instead of radix-sorting all; either
-    /// gives the same permutation. Not a node parameter: for the tests (0: always the radix sort).
+    /// merge them into the others' order (merge_movers in neighbourhood.cpp) instead of radix-sorting
+    /// all; either gives the same permutation. Not a node parameter: for the tests (0: always the radix sort).
     double merge_movers_up_to = 0.125;
 };
 

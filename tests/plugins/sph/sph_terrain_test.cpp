@@ -158,7 +158,7 @@ TEST(SphDeterminism, SameBytesOnOneAndTwoThreads) {
 }
 
 // The terrain exchange runs in parallel over fixed chunks of particles, rows two
-// chunks share applied afterwards in particle order (settle() in sph.cpp): every
+// chunks share applied afterwards in particle order (settle() in integrator.cpp): every
 // vertex must receive its additions in the serial loop's order, so chunks of
 // 1000 particles (bands of rows each owns, a few rows shared) and of 3 (every
 // row shared by many) on 2 threads give the serial loop's bits: the double
