@@ -2,6 +2,7 @@
 #include "sph.hpp"
 
 #include <orogen/error.hpp>
+#include <orogen/io.hpp>  // human_bytes, physical_memory
 #include <orogen/plugin.hpp>
 
 #include <unistd.h>
@@ -16,21 +17,6 @@
 namespace {
 
 using namespace orogen;
-
-std::uint64_t physical_memory() {
-    const long pages = ::sysconf(_SC_PHYS_PAGES);
-    const long page = ::sysconf(_SC_PAGE_SIZE);
-    return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : (std::uint64_t(8) << 30);
-}
-
-std::string human_bytes(double b) {
-    const char* unit[] = {"bytes", "KB", "MB", "GB", "TB", "PB"};
-    int u = 0;
-    while (b >= 1024.0 && u < 5) b /= 1024.0, ++u;
-    char buf[64];
-    std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.1f %s", b, unit[u]);
-    return buf;
-}
 
 sph::Settings settings(const NodeContext& ctx) {
     sph::Settings s;
