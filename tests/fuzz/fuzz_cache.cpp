@@ -1,4 +1,4 @@
-// libFuzzer target: the node cache's entry decoder (kernel/src/cache/cache.cpp, docs/cache.md).
+// libFuzzer target: the node cache's entry decoder (kernel/src/cache/entry.cpp, docs/cache.md).
 //
 // Each input is decoded twice: as it is (so the header, size and checksum checks are exercised) and resealed
 // (cache::reseal sets the magic, version and key and recomputes the sizes and checksums, so mutations of the
