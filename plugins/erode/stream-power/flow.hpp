@@ -141,6 +141,8 @@ public:
     double cell() const { return cell_; }
 
     bool is_outlet(std::int64_t i) const { return outlet_[std::size_t(i)] != 0; }
+    /// 1 per outlet cell, 0 elsewhere.
+    const std::vector<std::uint8_t>& outlets() const { return outlet_; }
     const std::vector<std::int32_t>& receivers() const { return receiver_; }  ///< i itself for an outlet
     const std::vector<std::int32_t>& stack() const { return stack_; }  ///< receivers before donors
     const std::vector<double>& area() const { return area_; }  ///< m², after accumulate()

@@ -14,6 +14,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -94,6 +95,16 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.slope_exponent = ctx.real("n");
     s.diffusivity = ctx.real("diffusivity");
     s.channel_area = ctx.real("channel_area");
+    constexpr double rad = std::numbers::pi / 180.0;
+    s.rock.angle = ctx.real("landslide_angle") * rad;
+    s.rock.thickness = ctx.real("bed_thickness");
+    s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
+    // Azimuth clockwise from north; grid x runs east and y south.
+    s.rock.dip_east = std::sin(ctx.real("bed_dip_toward") * rad);
+    s.rock.dip_south = -std::cos(ctx.real("bed_dip_toward") * rad);
+    s.rock.angle_spread = ctx.real("bed_angle_spread") * rad;
+    s.rock.erodibility_contrast = ctx.real("bed_erodibility_contrast");
+    s.rock.seed = ctx.seed();
     s.open = *parse_sides(ctx.text("open"));
     s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
@@ -380,6 +391,18 @@ void check(CheckContext& ctx) {
         ctx.error("mfd_exponent", "mfd_exponent weights multiple flow directions; give routing=mfd as well");
     if (ctx.real("dt") > ctx.real("years"))
         ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
+    // The beds' parameters describe beds: without a thickness there are none, and a spread of landslide
+    // angles needs landslides.
+    if (!(ctx.real("bed_thickness") > 0.0))
+        for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast"})
+            if (ctx.given(p))
+                ctx.error(p, std::string(p) + " describes the rock's beds; give bed_thickness (m) as well");
+    if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
+        ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
+    if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
+        a > 0.0 && (a - spread < 5.0 || a + spread > 80.0))
+        ctx.error("bed_angle_spread", "the beds' landslide angles run landslide_angle ± bed_angle_spread, which must stay "
+                                      "within 5-80°; give a smaller spread");
     const std::string& layer = ctx.text("uplift_layer");
     const ValueInfo* hist = ctx.input(1);
     if (hist) {
@@ -523,6 +546,35 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("drainage area where rivers take over from hillslopes: incision is scaled by "
                           "1 - exp(-A/channel_area), so smaller catchments are shaped by creep (channel heads "
                           "at 1e3-1e5 m², Montgomery & Dietrich 1988); 0 = every cell is a river"),
+                Param::real("landslide_angle", 0.0)
+                    .min(0.0)
+                    .max(80.0)
+                    .unit("°")
+                    .help("threshold hillslope angle: after each step whatever stands steeper slides away, the "
+                          "rivers carrying the debris off (25-40° in ranges that erode fast, Montgomery & Brandon "
+                          "2002); hillslopes end planar at it, divides sharp. 0 = no landslides"),
+                Param::real("bed_thickness", 0.0)
+                    .min(0.0)
+                    .max(1e5)
+                    .unit("m")
+                    .help("rock in tilted beds of this thickness, each of its own strength (from the seed): strong "
+                          "beds stand steeper and erode slower. 0 = one rock"),
+                Param::real("bed_dip", 0.0).min(0.0).max(89.0).unit("°").help("the beds' dip (0 = flat-lying)"),
+                Param::real("bed_dip_toward", 0.0)
+                    .min(0.0)
+                    .max(360.0)
+                    .unit("°")
+                    .help("azimuth the beds dip towards, clockwise from north"),
+                Param::real("bed_angle_spread", 0.0)
+                    .min(0.0)
+                    .max(40.0)
+                    .unit("°")
+                    .help("landslide angles run landslide_angle ± this from the weakest bed to the strongest"),
+                Param::real("bed_erodibility_contrast", 1.0)
+                    .min(1.0)
+                    .max(1000.0)
+                    .help("erodibility of the weakest bed over the strongest's (1 = the same; shale against "
+                          "sandstone ~10, Sklar & Dietrich 2001)"),
                 Param::string("open", "nesw")
                     .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
                           "level. none: the lowest cell is the one outlet"),

@@ -1,6 +1,8 @@
 // stream_power.cpp — the implicit stream-power model (see stream_power.hpp).
 #include "stream_power.hpp"
 
+#include <orogen/solvers/threshold_slopes.hpp>
+
 #include <orogen/parallel.hpp>
 
 #include <algorithm>
@@ -132,11 +134,17 @@ std::int64_t Model::step(double dt) {
         diffusion_->step(h, dt);
         for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
     }
-    // 4. Implicit incision (and deposition).
+    // 4. Implicit incision (and deposition), in the rock each cell shows now.
+    rock_at(settings_.rock, h, uplifted_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
     if (settings_.deposition > 0.0)
         incise_with_deposition(dt);
     else
         incise(dt);
+    // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
+    if (settings_.rock.angle > 0.0)
+        threshold::limit_slopes(h, width_, height_, cell_,
+                                {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
+                                flow_.outlets().data());
     time_ += dt;
     return pits;
 }
@@ -166,12 +174,14 @@ void Model::incise(double dt) {
         const std::int32_t* __restrict const rv = rcv;
         const std::int32_t* __restrict const st = stack;
         double* __restrict const hh = h;
+        const double* __restrict const kf = rock_k_.empty() ? nullptr : rock_k_.data();
         const double c1 = kdt_l1, c2 = kdt_l2, ia0 = inv_a0, a00 = a0, mm = m, iac = inverse_channel_area(settings_);
         const std::int64_t w = W;
         auto factor = [=](std::int32_t i, std::int32_t r) {
             const double am = area_power(ar[i], tb, ia0, a00, mm, iac);
             const std::int64_t d = std::int64_t(r) - i;
-            return am * ((d == 1 || d == -1 || d == w || d == -w) ? c1 : c2);
+            const double f = am * ((d == 1 || d == -1 || d == w || d == -w) ? c1 : c2);
+            return kf ? f * kf[i] : f;
         };
         for (std::int64_t g = g0; g < g1; ++g) {
             const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];
@@ -302,8 +312,9 @@ void Model::incise_with_deposition(double dt) {
                     double F = 0.0, c = 0.0;
                     if (act[s]) {
                         const std::int64_t d = std::int64_t(r) - i;
-                        const double lin = area_pow(area[i]) *
-                                           ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
+                        double lin = area_pow(area[i]) *
+                                     ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
+                        if (!rock_k_.empty()) lin *= rock_k_[std::size_t(i)];  // the bed it cuts
                         if (ns == 1.0) {
                             F = lin;
                         } else if (ns > 1.0) {  // Newton: the tangent of x^n at x0

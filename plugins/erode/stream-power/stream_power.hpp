@@ -30,6 +30,7 @@
 #pragma once
 
 #include "flow.hpp"
+#include "rock.hpp"
 
 #include <orogen/solvers/diffusion.hpp>
 
@@ -65,6 +66,12 @@ struct Settings {
     /// shaped by creep (and, after the run, by landslides: erode:thermal) rather than by D8 lines one cell wide; above a few A_c the
     /// factor is 1 and the law is unchanged.
     double channel_area = 0.0;
+    /// The rock (rock.hpp): landslides at a threshold angle and beds of varying strength. With
+    /// rock.angle > 0, after each step's incision whatever stands steeper than its rock's landslide
+    /// angle slides away (threshold_slopes.hpp: the rivers carry the debris off, as in ranges that
+    /// erode fast; Burbank et al. 1996, Montgomery & Brandon 2002), so hillslopes end planar at the
+    /// threshold and the divides between them sharp.
+    Beds rock;
 };
 
 /// Uplift that varies in time as well as in space: a piecewise-constant rate
@@ -151,6 +158,7 @@ private:
     FlowRouter flow_;
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
+    std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     double time_ = 0.0, sediment_out_ = 0.0;
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_

@@ -1,6 +1,8 @@
 // tiled.cpp — the stream-power model on one rank's tile (see tiled.hpp).
 #include "tiled.hpp"
 
+#include <orogen/solvers/threshold_slopes.hpp>
+
 #include "basin_join.hpp"
 
 #include <algorithm>
@@ -717,7 +719,8 @@ std::int64_t TiledModel::step(double dt) {
         diffusion_->step(h_.data(), dt);
         if (sink >= 0) h_[std::size_t(sink)] = sink_h;
     }
-    // 4. Implicit incision, receivers first (Model::incise, the same arithmetic).
+    // 4. Implicit incision, receivers first (Model::incise, the same arithmetic), in the rock each cell shows.
+    rock_at(settings_.rock, h_.data(), uplifted_.data(), n, own_.width, own_.x0, own_.y0, cell_, rock_slopes_, rock_k_);
     const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
     const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
     const double c1 = K * dt / std::pow(cell_, ns), c2 = K * dt / std::pow(cell_ * kSqrt2, ns);
@@ -727,7 +730,8 @@ std::int64_t TiledModel::step(double dt) {
         const double hi = h_[l];
         if (hi <= hr) return;
         const int k = dir_[l];
-        const double F = area_power(area_[l], tab, inv_a0, a0, m, inv_ac) * ((k & 1) ? c2 : c1);
+        double F = area_power(area_[l], tab, inv_a0, a0, m, inv_ac) * ((k & 1) ? c2 : c1);
+        if (!rock_k_.empty()) F *= rock_k_[l];
         if (ns == 1.0) {
             const double wt = 1.0 / (1.0 + F);
             h_[l] = hr + (hi - hr) * wt;
@@ -735,6 +739,11 @@ std::int64_t TiledModel::step(double dt) {
             h_[l] = hr + incised_drop(hi - hr, F, ns);
         }
     });
+    // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
+    if (settings_.rock.angle > 0.0)
+        threshold::limit_slopes(tiles_, h_.data(), cell_,
+                                {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
+                                outlet_.data());
     return pits;
 }
 

@@ -142,6 +142,7 @@ private:
     int W_, H_;
     double cell_;
     Settings settings_;
+    std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     std::int64_t sink_ = -1;  // every side closed: the outlet (whole-grid index)
     std::vector<double> h_, uplift_, uplifted_;
     UpliftHistory history_;

@@ -123,6 +123,129 @@ TEST(StreamPower, AChannelAreaScalesIncisionByOneMinusExpOfAreaOverIt) {
     EXPECT_GT(steepest_ratio, 5.0) << "small catchments must be steeper than the plain law's";
 }
 
+TEST(Landslides, AfterEveryStepNoHillslopeStandsSteeperThanItsThreshold) {
+    // Fast uplift and no creep would steepen the hillslopes without end; landslides hold every vertex at
+    // most S_c·d above each neighbour (D8 distances), and the rivers still reach steady state below it.
+    const int w = 71, h = 53;
+    const double cell = 30.0, U = 2e-3;
+    Settings s;
+    s.erodibility = 2e-5;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.0;
+    s.channel_area = 3e4;
+    s.rock.angle = 32.0 * M_PI / 180.0;
+    Model model(w, h, cell, noise(w, h, 4, 10.0), std::vector<double>(std::size_t(w) * h, U), s);
+    Settings plain = s;
+    plain.rock.angle = 0.0;
+    Model unlimited(w, h, cell, noise(w, h, 4, 10.0), std::vector<double>(std::size_t(w) * h, U), plain);
+    model.run(2e6, 2e4);
+    unlimited.run(2e6, 2e4);
+    const double sc = std::tan(s.rock.angle);
+    auto steepest = [&](const std::vector<double>& z) {
+        double worst = 0.0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int nx = x + dx, ny = y + dy;
+                        if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                        const double d = cell * std::hypot(double(dx), double(dy));
+                        worst = std::max(worst, (z[std::size_t(y) * w + x] - z[std::size_t(ny) * w + nx]) / d);
+                    }
+        return worst;
+    };
+    EXPECT_LE(steepest(model.heights()), sc * (1.0 + 1e-12));
+    EXPECT_GT(steepest(unlimited.heights()), 1.5 * sc) << "without landslides the same run must be far steeper";
+    EXPECT_EQ(model.first_non_finite(), -1);
+}
+
+TEST(Beds, ABedDipsTowardsItsAzimuthAndKeepsItsStrength) {
+    Beds beds;
+    beds.thickness = 40.0;
+    beds.dip_slope = std::tan(30.0 * M_PI / 180.0);
+    beds.dip_east = std::sin(120.0 * M_PI / 180.0);  // dipping towards azimuth 120° (east-south-east)
+    beds.dip_south = -std::cos(120.0 * M_PI / 180.0);
+    beds.seed = 9;
+    int differ = 0;
+    for (int k = 0; k < 200; ++k) {
+        const double z = -500.0 + 7.3 * k, x = 13.0 * k, y = 5000.0 - 11.0 * k, along = 250.0;
+        // The same bed lies tan(dip)·along lower, `along` metres towards the dip.
+        EXPECT_EQ(beds.strength(z, x, y),
+                  beds.strength(z - beds.dip_slope * along, x + along * beds.dip_east, y + along * beds.dip_south));
+        const double s = beds.strength(z, x, y);
+        EXPECT_GE(s, 0.0);
+        EXPECT_LT(s, 1.0);
+        differ += beds.strength(z, x, y) != beds.strength(z + beds.thickness, x, y);  // the next bed up
+    }
+    EXPECT_GT(differ, 190) << "beds a thickness apart must (almost always) differ in strength";
+    beds.erodibility_contrast = 9.0;
+    EXPECT_DOUBLE_EQ(beds.erodibility_factor(0.0), 3.0);   // the weakest: √contrast times the average K
+    EXPECT_DOUBLE_EQ(beds.erodibility_factor(1.0), 1.0 / 3.0);
+    beds.angle = 35.0 * M_PI / 180.0;
+    beds.angle_spread = 10.0 * M_PI / 180.0;
+    EXPECT_NEAR(beds.landslide_slope(0.0), std::tan(25.0 * M_PI / 180.0), 1e-12);
+    EXPECT_NEAR(beds.landslide_slope(1.0), std::tan(45.0 * M_PI / 180.0), 1e-12);
+}
+
+TEST(Beds, StrongBedsStandSteeperThanWeakOnes) {
+    // Flat-lying beds 60 m thick under a rising block: after the run, hillslopes in strong rock are steeper
+    // than in weak rock (their landslide angle is higher, their rivers slower).
+    const int w = 81, h = 61;
+    const double cell = 30.0, U = 1e-3;
+    Settings s;
+    s.erodibility = 1e-5;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.01;
+    s.channel_area = 2e4;
+    s.rock.angle = 33.0 * M_PI / 180.0;
+    s.rock.angle_spread = 10.0 * M_PI / 180.0;
+    s.rock.erodibility_contrast = 4.0;
+    s.rock.thickness = 60.0;
+    s.rock.seed = 3;
+    Model model(w, h, cell, noise(w, h, 6, 10.0), std::vector<double>(std::size_t(w) * h, U), s);
+    model.run(3e6, 3e4);
+    const auto& z = model.heights();
+    const auto& up = model.uplifted();
+    double steep[2] = {0, 0};
+    int count[2] = {0, 0};
+    for (int y = 1; y + 1 < h; ++y)
+        for (int x = 1; x + 1 < w; ++x) {
+            const std::size_t i = std::size_t(y) * w + x;
+            const double strength = s.rock.strength(z[i] - up[i], x * cell, y * cell);
+            if (strength > 0.3 && strength < 0.7) continue;
+            const double gx = (z[i + 1] - z[i - 1]) / (2 * cell), gy = (z[i + w] - z[i - w]) / (2 * cell);
+            steep[strength >= 0.7] += std::hypot(gx, gy);
+            ++count[strength >= 0.7];
+        }
+    ASSERT_GT(count[0], 200);
+    ASSERT_GT(count[1], 200);
+    EXPECT_GT(steep[1] / count[1], 1.15 * steep[0] / count[0]) << "strong beds must hold steeper slopes";
+}
+
+TEST(Beds, LandslidesAndBedsGiveTheSameBitsOnOneAndTwoThreads) {
+    const int w = 97, h = 71;
+    std::vector<double> results[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        Settings s;
+        s.erodibility = 1e-5;
+        s.area_exponent = 0.5;
+        s.diffusivity = 0.05;
+        s.rock.angle = 30.0 * M_PI / 180.0;
+        s.rock.angle_spread = 8.0 * M_PI / 180.0;
+        s.rock.erodibility_contrast = 3.0;
+        s.rock.thickness = 25.0;
+        s.rock.dip_slope = 0.4;
+        s.rock.dip_east = 0.6;
+        s.rock.dip_south = 0.8;
+        s.rock.seed = 17;
+        Model model(w, h, 30.0, noise(w, h, 8, 50.0), std::vector<double>(std::size_t(w) * h, 1.5e-3), s);
+        model.run(6e5, 3e4);
+        results[t] = model.heights();
+    }
+    EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
+}
+
 TEST(StreamPower, TheRockUpliftIsCountedApartFromTheErosion) {
     // uplifted(): U·t on every cell but the outlets (held at base level), whatever the rivers did; the
     // node writes it as the layer 'uplifted' and the surface's own change, heights − start − uplifted,

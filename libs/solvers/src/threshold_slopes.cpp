@@ -1,0 +1,168 @@
+// threshold_slopes.cpp — the threshold-slope limit (threshold_slopes.hpp): sweeps of
+// h ← min(h, h(nb) + S_c·d) in four directions until a round changes nothing.
+#include <orogen/parallel.hpp>
+#include <orogen/solvers/threshold_slopes.hpp>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+namespace orogen::threshold {
+namespace {
+
+constexpr double kSqrt2 = 1.4142135623730951;
+
+/// A grid the sweeps update in its rectangle [x0, x1) × [y0, y1), reading every
+/// vertex of the grid (the rest: a tile's ghosts, which they never write).
+struct Sweeps {
+    double* g;
+    int gw, gh;
+    int x0, y0, x1, y1;
+    const std::uint8_t* fixed;  // gw × gh, or null
+    const double* slopes;  // gw × gh S_c per vertex (m/m), or null: `slope` everywhere
+    double slope, cell;  // S_c (m/m), the vertex spacing (m)
+
+    /// How far above a neighbour `cell` away vertex i may stand, straight (1) or diagonal (√2).
+    double step(std::size_t i) const { return (slopes ? slopes[i] : slope) * cell; }
+
+    /// Row r from row `from` (r ± 1): its three neighbours there. Returns the vertices lowered.
+    std::int64_t row_from(int r, int from) const {
+        std::int64_t lowered = 0;
+        const double* src = g + std::size_t(from) * std::size_t(gw);
+        double* dst = g + std::size_t(r) * std::size_t(gw);
+        const std::uint8_t* fx = fixed ? fixed + std::size_t(r) * std::size_t(gw) : nullptr;
+        const std::size_t base = std::size_t(r) * std::size_t(gw);
+        for (int c = x0; c < x1; ++c) {
+            const double straight = step(base + std::size_t(c)), diagonal = straight * kSqrt2;
+            double best = src[c] + straight;
+            if (c > 0) best = std::min(best, src[c - 1] + diagonal);
+            if (c + 1 < gw) best = std::min(best, src[c + 1] + diagonal);
+            if (best < dst[c] && (fx == nullptr || fx[c] == 0)) {
+                dst[c] = best;
+                ++lowered;
+            }
+        }
+        return lowered;
+    }
+
+    /// Down then up the rows: each row from the one just finished (serial over the rows; the
+    /// vertices of a row are independent of each other).
+    std::int64_t vertical() const {
+        std::int64_t lowered = 0;
+        for (int r = std::max(y0, 1); r < y1; ++r) lowered += row_from(r, r - 1);
+        for (int r = std::min(y1, gh - 1) - 1; r >= y0; --r) lowered += row_from(r, r + 1);
+        return lowered;
+    }
+
+    /// East then west along each row, the rows in parallel (each reads and writes only its own).
+    std::int64_t horizontal() const {
+        std::atomic<std::int64_t> lowered{0};
+        parallel_for(y0, y1, 64, [&](std::int64_t b, std::int64_t e) {
+            std::int64_t mine = 0;
+            for (std::int64_t r = b; r < e; ++r) {
+                const std::size_t base = std::size_t(r) * std::size_t(gw);
+                double* row = g + base;
+                const std::uint8_t* fx = fixed ? fixed + base : nullptr;
+                for (int c = std::max(x0, 1); c < x1; ++c)
+                    if (const double v = row[c - 1] + step(base + std::size_t(c));
+                        v < row[c] && (fx == nullptr || fx[c] == 0)) {
+                        row[c] = v;
+                        ++mine;
+                    }
+                for (int c = std::min(x1, gw - 1) - 1; c >= x0; --c)
+                    if (const double v = row[c + 1] + step(base + std::size_t(c));
+                        v < row[c] && (fx == nullptr || fx[c] == 0)) {
+                        row[c] = v;
+                        ++mine;
+                    }
+            }
+            lowered += mine;
+        });
+        return lowered.load();
+    }
+
+    /// One round: every vertex updated from all eight neighbours at least once.
+    std::int64_t round() const { return vertical() + horizontal(); }
+};
+
+void check_slope(double cell, const Slopes& slopes) {
+    if (!(cell > 0.0) || !std::isfinite(cell))
+        throw std::invalid_argument("threshold slopes: the cell size must be a positive number of metres");
+    if (!slopes.per_vertex && (!(slopes.uniform > 0.0) || !std::isfinite(slopes.uniform)))
+        throw std::invalid_argument("threshold slopes: the threshold slope must be a positive finite tangent");
+}
+
+/// After the sweeps: what each vertex lost, into `removed` and the result (a fixed order).
+void account(const double* before, const double* after, std::size_t count, double* removed, Result& result) {
+    for (std::size_t i = 0; i < count; ++i) {
+        const double drop = before[i] - after[i];
+        if (drop > 0.0) {
+            ++result.lowered;
+            result.removed += drop;
+            if (removed) removed[i] += drop;
+        }
+    }
+}
+
+}  // namespace
+
+Result limit_slopes(double* heights, int width, int height, double cell, const Slopes& slopes,
+                    const std::uint8_t* fixed, double* removed) {
+    check_slope(cell, slopes);
+    const std::size_t n = std::size_t(width) * std::size_t(height);
+    const std::vector<double> before(heights, heights + n);
+    const Sweeps s{heights, width, height, 0, 0, width, height, fixed, slopes.per_vertex, slopes.uniform, cell};
+    Result result;
+    do ++result.rounds;
+    while (s.round() > 0);
+    account(before.data(), heights, n, removed, result);
+    return result;
+}
+
+Result limit_slopes(Tiling& tiles, double* heights, double cell, const Slopes& slopes, const std::uint8_t* fixed,
+                    double* removed) {
+    check_slope(cell, slopes);
+    if (tiles.halo() < 1) throw std::logic_error("threshold slopes: a tiled limit needs a halo of at least 1");
+    const TileRect own = tiles.owned(), ghost = tiles.ghosted();
+    const std::size_t n = std::size_t(own.width) * std::size_t(own.height);
+    std::vector<double> g = tiles.ghosted_copy(heights);
+    // The ghosts' flags and slopes are never read: only owned vertices are lowered, by their own slope.
+    std::vector<std::uint8_t> gfixed;
+    if (fixed) gfixed = tiles.ghosted_copy(fixed);
+    std::vector<double> gslopes;
+    if (slopes.per_vertex) gslopes = tiles.ghosted_copy(slopes.per_vertex);
+    const Sweeps s{g.data(),
+                   ghost.width,
+                   ghost.height,
+                   own.x0 - ghost.x0,
+                   own.y0 - ghost.y0,
+                   own.x1() - ghost.x0,
+                   own.y1() - ghost.y0,
+                   fixed ? gfixed.data() : nullptr,
+                   slopes.per_vertex ? gslopes.data() : nullptr,
+                   slopes.uniform,
+                   cell};
+    double* grids[] = {g.data()};
+    Result result;
+    for (;;) {
+        tiles.exchange(std::span<double* const>(grids));
+        ++result.rounds;
+        const std::int64_t changed = tiles.reduce(s.round(), Tiling::Reduce::sum);
+        if (changed == 0) break;
+    }
+    // The tile's part of the ghosted grid back into `heights`, and what it lost.
+    std::vector<double> before(heights, heights + n);
+    for (int r = 0; r < own.height; ++r)
+        std::copy_n(g.data() + std::size_t(r + s.y0) * std::size_t(ghost.width) + std::size_t(s.x0),
+                    std::size_t(own.width), heights + std::size_t(r) * std::size_t(own.width));
+    Result mine;
+    account(before.data(), heights, n, removed, mine);
+    result.lowered = tiles.reduce(mine.lowered, Tiling::Reduce::sum);
+    result.removed = tiles.reduce(mine.removed, Tiling::Reduce::sum);
+    return result;
+}
+
+}  // namespace orogen::threshold

@@ -1,0 +1,53 @@
+// rock.hpp — rock of varying strength under a landscape: tilted beds.
+//
+// Real ranges are cut into rock whose strength changes from bed to bed:
+// sandstone over shale, limestone over marl, gneiss over schist. Strong beds
+// stand steeper and erode slower; weak ones fail at gentler angles and give
+// way to the rivers (Sklar & Dietrich 2001; Schmidt & Montgomery 1995 for
+// the hillslope angle; Forte et al. 2016 for the landscapes of alternating
+// beds). This is what spreads a range's slopes over many angles rather than
+// one, and cuts benches, hogbacks and strike valleys where the beds surface.
+//
+// The beds are planar, `thickness` metres thick, dipping at `dip` towards
+// azimuth `toward`; each has a strength s in [0, 1) drawn from the seed and its
+// index (counter-based: the same beds on any thread count and any tiling).
+// The rock a cell shows is the one at its rock height ζ = h − uplift received
+// (the height that rock had at the start: the beds rise with the uplift, and
+// erosion digs into them). Its landslide angle is angle + spread·(2s − 1) and
+// its erodibility K·contrast^(1/2 − s): the weakest bed erodes √contrast
+// times faster than the average, the strongest √contrast times slower.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace orogen::stream_power {
+
+struct Beds {
+    double thickness = 0.0;  ///< m (0: one rock everywhere)
+    double dip_slope = 0.0;  ///< tan of the dip angle
+    double dip_east = 0.0;  ///< unit vector, grid x (east), the beds dip towards
+    double dip_south = 1.0;  ///< ... and grid y (south)
+    double angle = 0.0;  ///< mean landslide angle, radians (0: no landslides)
+    double angle_spread = 0.0;  ///< radians: ± from the weakest bed to the strongest
+    double erodibility_contrast = 1.0;  ///< K of the weakest bed / K of the strongest (≥ 1)
+    std::uint64_t seed = 0;
+
+    bool layered() const { return thickness > 0.0; }
+    /// The strength in [0, 1) of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
+    /// corner, x east, y south); 0.5 when unlayered.
+    double strength(double zeta, double x, double y) const;
+    /// tan of the landslide angle of rock of strength s.
+    double landslide_slope(double s) const;
+    /// K's factor for rock of strength s.
+    double erodibility_factor(double s) const;
+};
+
+/// Each cell's landslide slope (tan) and erodibility factor, from its height and the uplift it received
+/// (both `count` values of a width-`width` block whose first cell is (x0, y0) of the grid, cells `cell`
+/// metres apart). `slopes` / `factors` are resized; either is left empty when it would be uniform.
+void rock_at(const Beds& beds, const double* heights, const double* uplifted, std::size_t count, int width, int x0,
+             int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors);
+
+}  // namespace orogen::stream_power
