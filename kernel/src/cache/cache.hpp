@@ -74,6 +74,10 @@ Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std
 Digest output_key(const Digest& node, std::string_view name);
 /// The key of an output of a node that always runs: what it produced decides, not how.
 Digest content_key(const Digest& node, std::string_view name, const Digest& content);
+/// The key of a value the caller bound to a run (run/runner.hpp BoundValues): its content (value_hash)
+/// alone, as for what an importer read; its name is not in it (the node that reads it is keyed by its
+/// own label and parameters).
+Digest bound_key(const Digest& content);
 
 /// The content hash of a payload (value_hash): SHA-256 over the SHA-256 of each 1 MiB block and the
 /// payload's length, so that every core hashes a part.

@@ -64,6 +64,12 @@ public:
 
     bool usable() const { return store_.usable(); }
 
+    /// Keyed by its content: a node that reads it is reused only for the same bits (and layers, and cell),
+    /// whatever it is called and wherever it came from. Hashing costs a pass over it, only with the cache on.
+    void bound(const std::string& name, const Value& v) override {
+        if (cache::storable(v.type())) value_keys_[name] = cache::bound_key(cache::value_hash(v));
+    }
+
     TurnAnswer at_turn(const NodeTurn& turn) override {
         const std::size_t i = turn.index;
         const PlannedNode& node = turn.node;

@@ -187,4 +187,10 @@ Digest content_key(const Digest& node, std::string_view name, const Digest& cont
     return h.finish();
 }
 
+Digest bound_key(const Digest& content) {
+    Hasher h;
+    h.text("orogen bound value").digest(content);
+    return h.finish();
+}
+
 }  // namespace orogen::cache

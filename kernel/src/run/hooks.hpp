@@ -18,7 +18,8 @@
 //   after_node    j finished well, before its outputs are checked
 //   on_result     j's outputs are checked and kept
 //   skipped       j did not run (at_turn answered for it)
-// and once, run_finished, after the last node (failed or not).
+// and once, bound, for each value the caller bound (run()'s `bound`) before
+// the first node, and run_finished, after the last node (failed or not).
 #pragma once
 
 #include "runner.hpp"
@@ -94,6 +95,8 @@ struct Outcome {
 class NodeHooks {
 public:
     virtual ~NodeHooks() = default;
+    /// A value the caller bound by name (runner.hpp BoundValues), before the first node's turn.
+    virtual void bound(const std::string& /*name*/, const Value&) {}
     virtual TurnAnswer at_turn(const NodeTurn&) { return {}; }
     /// The producer's values, if the hook has them without running it.
     virtual std::optional<Reuse> supply(const NodeTurn&) { return std::nullopt; }

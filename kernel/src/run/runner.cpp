@@ -63,6 +63,9 @@ public:
     // Outputs inside --out are staged and move into place with the rest at the end of the run; one the
     // checker allowed outside (--allow-outside-out) is written where it goes, by itself.
     fs::path output_path(const std::string& relative) override {
+        if (options_.out_dir.empty())  // writes_files() said no node of the plan writes files
+            throw Error("internal error: " + node_.node->qualified_name() + " writes " + relative +
+                        " but declares no output path parameter");
         if (for_entry_)
             throw Error("internal error: " + node_.node->qualified_name() +
                         " writes files, so it cannot be mapped over a series");
@@ -282,13 +285,18 @@ std::string wrong_output(const PlannedNode& node, const NodeOutputs& out) {
 /// tiled run's agreement) is a hook (hooks.hpp).
 class Evaluation {
 public:
-    Evaluation(RunShared& shared, std::vector<std::unique_ptr<NodeHooks>> hooks)
+    Evaluation(RunShared& shared, std::vector<std::unique_ptr<NodeHooks>> hooks, BoundValues bound)
         : shared_(shared), plan_(shared.plan), options_(shared.options), hooks_(std::move(hooks)) {
         for (std::size_t j = 0; j < plan_.nodes.size(); ++j) {
             const PlannedNode& n = plan_.nodes[j];
             if (n.value_name.empty()) continue;
             producer_[n.value_name] = {j, ""};
             for (const auto& side : n.node->side_outputs) producer_[n.value_name + "." + side.name] = {j, side.name};
+        }
+        // The caller's values are at hand from the start, held here alone, until their last reader.
+        for (auto& [name, v] : bound) {
+            for (auto& h : hooks_) h->bound(name, v);
+            keep(name, std::move(v));
         }
     }
 
@@ -435,12 +443,15 @@ void RunShared::warn(const std::string& line) const {
     else if (options.progress) options.progress->message(line, ProgressDisplay::Kind::warning);
 }
 
-RunResult run(const Plan& plan, const RunOptions& options) {
-    RunResult result;
-    const auto t0 = std::chrono::steady_clock::now();
-    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+namespace {
 
+/// The output folder made, debris of killed runs removed and a staging folder of this run's made; false
+/// (result's exit code and error set) if that failed. In a tiled run rank 0 cleans up before the other
+/// ranks make theirs (it would see their fresh folders as debris), and every rank stages in rank 0's folder:
+/// every rank writes its files there, and rank 0 moves them into place with its own, the manifest (which
+/// lists and hashes them all) last, or removes them all.
+bool prepare_outputs(const RunOptions& options, RunResult& result, std::optional<Staging>& staging,
+                     fs::path& staging_folder) {
     std::error_code ec;
     fs::create_directories(options.out_dir, ec);
     if (ec || !fs::is_directory(options.out_dir, ec)) {
@@ -450,18 +461,12 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     }
     // In a tiled run every rank learns of a failure on any (and only the first failing rank reports it).
     if (options.tiled) agree_across_ranks(*options.tiled, result);
-    if (result.exit_code != 0) return result;
-    // Debris of earlier runs that were killed, then a staging folder of our own. In a tiled run rank 0
-    // cleans up before the other ranks make theirs (it would see their fresh folders as debris).
+    if (result.exit_code != 0) return false;
     const bool rank0 = !options.tiled || options.tiled->rank() == 0;
     if (rank0) result.notes = clean_debris(options.out_dir);
     if (options.tiled) options.tiled->agree(0);
     if (options.on_note)
         for (const auto& note : result.notes) options.on_note(note);
-    // A tiled run stages in rank 0's folder alone: every rank writes its files there, and rank 0 moves them
-    // into place with its own, the manifest (which lists and hashes them all) last, or removes them all.
-    std::optional<Staging> staging;
-    fs::path staging_folder;
     try {
         if (rank0) {
             staging.emplace(options.out_dir);
@@ -472,19 +477,84 @@ RunResult run(const Plan& plan, const RunOptions& options) {
         result.error = std::string("orogen: error: ") + e.what() + "\n";
     }
     if (options.tiled) agree_across_ranks(*options.tiled, result);
-    if (result.exit_code != 0) return result;
+    if (result.exit_code != 0) return false;
     if (options.tiled) {
         std::string folder = staging_folder.string();
         options.tiled->broadcast(folder);
         staging_folder = folder;
     }
+    return true;
+}
+
+/// All or nothing: the staged files, then the manifest (staged with the rest), moved into place; listed in
+/// result.outputs. A failure sets result's exit code and error.
+void commit_outputs(const RunShared& shared, Staging& staging) {
+    const Plan& plan = shared.plan;
+    const RunOptions& options = shared.options;
+    RunResult& result = shared.result;
+    try {
+        const std::vector<fs::path> staged = staging.files();
+        write_manifest(plan, options, staging, staged, shared.outside, shared.kept);
+        staging.commit("manifest.json");
+        std::vector<fs::path> all = staged;
+        all.insert(all.end(), shared.kept.begin(), shared.kept.end());
+        std::sort(all.begin(), all.end());
+        for (const auto& f : all) result.outputs.push_back(options.out_dir / f);
+        for (const auto& f : shared.outside) result.outputs.push_back(f);
+        result.outputs.push_back(options.out_dir / "manifest.json");
+    } catch (const std::exception& e) {
+        result.exit_code = 1;
+        result.error = std::string("orogen: error: ") + e.what() + "\n";
+    }
+}
+
+}  // namespace
+
+ValueInfo describe_bound(const Value& value) {
+    ValueInfo info;
+    info.type = value.type();
+    if (value.type() == ValueType::heightmap) {
+        const Heightmap& hm = *value.heightmap();
+        info.width = hm.width();
+        info.height = hm.height();
+        info.cell = hm.cell();
+        for (auto& name : hm.layer_names()) info.layers.insert(std::move(name));
+    } else if (value.type() == ValueType::image) {
+        info.width = value.image()->width;
+        info.height = value.image()->height;
+    } else if (value.type() == ValueType::series) {
+        info.element = value.series()->element;
+        info.count = value.series()->size();
+        info.empty = info.count == 0;
+    }
+    return info;
+}
+
+bool writes_files(const Plan& plan) {
+    for (const PlannedNode& n : plan.nodes)
+        for (const Param& p : n.node->params)
+            if (p.type == ParamType::path && p.path_role == PathRole::output) return true;
+    return false;
+}
+
+RunResult run(const Plan& plan, const RunOptions& options, BoundValues bound) {
+    RunResult result;
+    const auto t0 = std::chrono::steady_clock::now();
+    const int threads = options.threads > 0 ? options.threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+
+    const bool writes = !options.out_dir.empty();  // else no folder, no staging, no manifest (RunOptions::out_dir)
+    const bool rank0 = !options.tiled || options.tiled->rank() == 0;
+    std::optional<Staging> staging;
+    fs::path staging_folder;
+    if (writes && !prepare_outputs(options, result, staging, staging_folder)) return result;
     std::vector<fs::path> outside;  // outputs written outside --out (allowed with --allow-outside-out)
 
     RunShared shared{plan, options, staging ? &*staging : nullptr, staging_folder, outside, result, {}};
     std::vector<std::unique_ptr<NodeHooks>> hooks;  // in the order they are called at each point
     for (auto make : {cache_hooks, progress_hooks, tiled_hooks})
         if (auto h = make(shared)) hooks.push_back(std::move(h));
-    Evaluation evaluation(shared, std::move(hooks));
+    Evaluation evaluation(shared, std::move(hooks), std::move(bound));
     try {
         evaluation.run_all();
     } catch (const NodeFailed& f) {
@@ -496,26 +566,12 @@ RunResult run(const Plan& plan, const RunOptions& options) {
     result.total_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (result.exit_code == 0 && options.cancel && options.cancel->load())  // stopped after the last node
         cancelled(result, "orogen: error: " + cancel_reason(options) + " before the outputs were moved into place\n");
-    if (result.exit_code == 0 && !rank0) {
+    if (result.exit_code == 0 && writes && !rank0) {
         // Another rank of a tiled run: its files are in rank 0's staging folder; rank 0 commits them (and says
         // whether that worked).
         agree_across_ranks(*options.tiled, result);
-    } else if (result.exit_code == 0) {
-        // All or nothing: the manifest is staged with the rest and moves into place last.
-        try {
-            const std::vector<fs::path> staged = staging->files();
-            write_manifest(plan, options, *staging, staged, outside, shared.kept);
-            staging->commit("manifest.json");
-            std::vector<fs::path> all = staged;
-            all.insert(all.end(), shared.kept.begin(), shared.kept.end());
-            std::sort(all.begin(), all.end());
-            for (const auto& f : all) result.outputs.push_back(options.out_dir / f);
-            for (const auto& f : outside) result.outputs.push_back(f);
-            result.outputs.push_back(options.out_dir / "manifest.json");
-        } catch (const std::exception& e) {
-            result.exit_code = 1;
-            result.error = std::string("orogen: error: ") + e.what() + "\n";
-        }
+    } else if (result.exit_code == 0 && writes) {
+        commit_outputs(shared, *staging);
         if (options.tiled) agree_across_ranks(*options.tiled, result);
     }
     return result;  // on failure `staging` goes out of scope and takes every staged file with it

@@ -27,6 +27,9 @@ struct PluginRecord {
 };
 
 struct RunOptions {
+    /// Where the outputs and manifest.json go. Empty: the run writes no files at all (no folder, no
+    /// staging, no manifest), for a plan of which writes_files() is false (the Python module's node());
+    /// a node that asks for an output path then fails.
     std::filesystem::path out_dir = "out";
     int threads = 0;  ///< 0: all cores
     ProgressDisplay* progress = nullptr;
@@ -73,7 +76,22 @@ struct RunResult {
 /// The seed a node gets: a hash of the spec's seed and the node's label.
 std::uint64_t node_seed(std::uint64_t spec_seed, const std::string& label);
 
-RunResult run(const Plan& plan, const RunOptions& options);
+/// Values the caller hands to a run by name, made outside any spec (the Python module's node() inputs: a
+/// numpy array copied into a heightmap, a value from an earlier run). The spec reads `name` as if an
+/// earlier line had made it; the checker learns what each is from CheckOptions::bound (describe_bound()).
+/// No file, no importer: the value itself reaches the node. With the cache, a bound value is keyed by its
+/// content (cache::bound_key over cache::value_hash), as a file an importer reads is.
+using BoundValues = std::map<std::string, Value, std::less<>>;
+
+/// What the checker knows of a bound value: its type, and a heightmap's size, cell and layers.
+ValueInfo describe_bound(const Value& value);
+
+/// True if a node of `plan` declares an output path (it may write files): such a plan needs an out_dir.
+bool writes_files(const Plan& plan);
+
+/// Runs `plan`. `bound` is taken over: a value whose only holder was the caller's map is the node's to
+/// change in place when no later node reads it (NodeContext::take_heightmap: no copy).
+RunResult run(const Plan& plan, const RunOptions& options, BoundValues bound = {});
 
 /// The timing table printed after a run.
 std::string format_timings(const RunResult& result);

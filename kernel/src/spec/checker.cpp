@@ -314,6 +314,7 @@ private:
         for (const auto& st : parsed_.statements)
             if (!st.name.empty()) defined_anywhere_.emplace(st.name, st.name_where);
         nested_key_.assign(parsed_.statements.size(), "");
+        for (const auto& [name, info] : options_.bound) values_[name] = info;  // made before the first line
     }
 
     void check_statement(std::size_t si) {
@@ -324,6 +325,9 @@ private:
             if (auto it = defined_at_.find(st.name); it != defined_at_.end())
                 diags_.error(st.name_where, "'" + st.name + "' is already defined on line " +
                                                 std::to_string(it->second.line) + "; give this value another name");
+        if (!st.name.empty() && options_.bound.count(st.name))
+            diags_.error(st.name_where, "'" + st.name + "' is a value the caller hands to the run (an input of "
+                                        "orogen.node()); give this value another name");
         const NodeDescriptor* node = registry_.find(call.qualified());
         if (!node) {
             report_unknown_node(st, label);

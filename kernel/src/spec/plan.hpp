@@ -54,6 +54,10 @@ struct CheckOptions {
     bool allow_outside_out = false;
     /// A tiled run: the ranks on this machine over all ranks (CheckContext::memory_share of a tiled node).
     double tiled_memory_share = 1.0;
+    /// Values the host binds by name before the run (the Python module's node() inputs; run()'s `bound`):
+    /// the spec reads `name` as if an earlier line had made a value like this (describe_bound() gives it).
+    /// A line that defines one of these names is an error.
+    std::map<std::string, ValueInfo, std::less<>> bound;
 };
 
 /// Check `parsed` against `registry`. Errors go to `diags`; the plan is only
