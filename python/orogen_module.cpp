@@ -3,7 +3,8 @@
 //
 //   run(spec, seed=None, set={}, threads=None, out=None, progress=False) -> {name: value}
 //   nodes() -> [{"name", "kind", "summary"}];  help(name) -> {...}
-// (orogen.node() is Python, in orogen/__init__.py, over run() and _write_input().)
+//   _run_node(spec, inputs, threads) -> {name: value}: orogen.node() (orogen/__init__.py) runs the spec it
+//   writes with its inputs bound by name (runner.hpp BoundValues): no file, one copy of an array at most.
 //
 // Bad input (a spec error, a parameter out of range, a file refused at check time) raises ValueError with
 // the CLI's message; a failed run RuntimeError naming the node; Ctrl-C stops the node as on the command
@@ -17,17 +18,17 @@
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
 
-#ifdef OROGEN_PYTHON_EXR
-#include <orogen/exr/exr.hpp>
-#endif
-
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
+#include <cstring>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <future>
 #include <sstream>
@@ -200,19 +201,27 @@ std::string error_count(const spec::Diagnostics& diags, const std::string& name)
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
 
-/// A folder for a run without `out`: its files are written there and removed with it.
+/// A folder for a run without `out` whose nodes write files: they are written there and removed with it.
+/// Made only if the plan writes files (make()): a run that writes none touches no folder at all.
 struct ScratchFolder {
     fs::path path;
+    bool made = false;
     ScratchFolder() {
         static std::atomic<int> counter{0};
-        path = fs::temp_directory_path() /
+        // $TMPDIR as std::filesystem::temp_directory_path() reads it, without its check that the folder
+        // exists: the checker wants the path even for a run that will not make it.
+        const char* tmp = std::getenv("TMPDIR");
+        path = fs::path(tmp && *tmp ? tmp : "/tmp") /
             ("orogen-python-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
+    }
+    void make() {
         fs::remove_all(path);
         fs::create_directories(path);
+        made = true;
     }
     ~ScratchFolder() {
         std::error_code ec;
-        fs::remove_all(path, ec);
+        if (made) fs::remove_all(path, ec);
     }
     ScratchFolder(const ScratchFolder&) = delete;
     ScratchFolder& operator=(const ScratchFolder&) = delete;
@@ -226,84 +235,48 @@ std::string path_text(const py::handle& v, const char* what) {
                          std::string(py::str(py::type::of(v).attr("__name__"))));
 }
 
-py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed, const py::dict& overrides,
-                  std::optional<int> threads, const py::object& out_arg, bool progress) {
-    const std::string spec = path_text(spec_arg, "spec");
-    std::optional<std::string> out;
-    if (!out_arg.is_none()) out = path_text(out_arg, "out");
-    // A path, or the spec's text itself.
+/// `spec` (a path, or the text itself): its name for messages, its text, and the path input paths are
+/// relative to.
+struct SpecText {
     std::string name, text;
-    fs::path spec_path;
+    fs::path path;
+};
+
+SpecText read_spec(const std::string& spec) {
+    SpecText r;
     std::error_code ec;
     const bool is_text = spec.find('\n') != std::string::npos;
     if (!is_text && fs::is_regular_file(spec, ec)) {
         try {
             const auto bytes = read_file(spec);
-            text.assign(bytes.begin(), bytes.end());
+            r.text.assign(bytes.begin(), bytes.end());
         } catch (const std::exception& e) { throw py::value_error(std::string("orogen: error: ") + e.what()); }
-        name = spec;
-        spec_path = spec;
+        r.name = spec;
+        r.path = spec;
     } else if (!is_text && !spec.empty() && spec.rfind("orogen", 0) != 0) {
         throw py::value_error("orogen: error: cannot read spec " + spec + ": " +
                               (fs::exists(spec, ec) ? "it is not a regular file" : "no such file") +
                               " (give a path to a .orogen file, or the spec's text)");
     } else {
-        text = spec;
-        name = "<spec>";
-        spec_path = fs::current_path() / name;  // input paths are relative to the current folder
+        r.text = spec;
+        r.name = "<spec>";
+        r.path = fs::current_path() / r.name;  // input paths are relative to the current folder
     }
-    if (threads && (*threads < 1 || *threads > 1024))
-        throw py::value_error("threads must be a number from 1 to 1024, got " + std::to_string(*threads));
+    return r;
+}
 
-    CheckOptions check_options;
-    for (const auto& [k, v] : overrides)
-        check_options.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
-    check_options.seed = seed;
-    std::optional<ScratchFolder> scratch;
-    if (!out) scratch.emplace();
-    const fs::path out_dir = out ? fs::path(*out) : scratch->path;
-    check_options.out_dir = out_dir;
-
-    PluginSet& set = plugins();
-    auto source = std::make_shared<spec::Source>(name, std::move(text));
-    spec::Diagnostics diags;
-    const spec::Spec parsed = spec::parse(source, diags);
-    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, name));
-    Plan plan = check(parsed, set.registry(), spec_path, check_options, diags);
-    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, name));
-    // The checker's warnings are about files ("this spec writes no files"): moot when nothing is written.
-    if (!diags.all().empty() && out && PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1) != 0)
-        throw py::error_already_set();  // warnings turned into errors
-
-    // Every named value (and side value) is wanted back: held past the last node. (A call written where an
-    // input goes is not named: its value is released after its reader, as in the CLI.)
-    for (const PlannedNode& n : plan.nodes) {
-        if (n.value_name.empty() || n.in_place) continue;
-        plan.last_use[n.value_name] = plan.nodes.size();
-        for (const auto& side : n.node->side_outputs) plan.last_use[n.value_name + "." + side.name] = plan.nodes.size();
-    }
-
-    ProgressDisplay display(stderr, ::isatty(STDERR_FILENO) != 0, !progress);
-    RunOptions options;
-    options.out_dir = out_dir;
-    options.threads = threads.value_or(0);
-    options.progress = &display;
-    options.plugins = set.plugins();
-    options.cancel = &g_cancel;
-    options.cancel_signal = &g_signal;
-    options.cache = std::nullopt;  // every node runs: a cached node's values would not be at hand
+/// `plan` run on a thread of its own, the GIL released; this thread wakes every 50 ms for Python's signals,
+/// so Ctrl-C asks the node to stop (as SIGINT does on the command line). Raises what the run raised.
+RunResult run_released(const Plan& plan, const RunOptions& options, BoundValues bound) {
     g_cancel = false;
     g_signal = 0;
-
-    // The run on a thread of its own, the GIL released; this thread wakes every 50 ms for Python's signals,
-    // so Ctrl-C asks the node to stop (as SIGINT does on the command line).
     RunResult result;
     std::exception_ptr failure;
     std::promise<void> done;
     std::future<void> finished = done.get_future();
     std::thread worker([&] {
         try {
-            result = run(plan, options);
+            result = run(plan, options, std::move(bound));
         } catch (...) { failure = std::current_exception(); }
         done.set_value();
     });
@@ -329,6 +302,63 @@ py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed,
     if (failure) std::rethrow_exception(failure);
     if (result.exit_code == 2) throw py::value_error(result.error);
     if (result.exit_code != 0) throw std::runtime_error(result.error);
+    return result;
+}
+
+/// run() and node(): `bound` are values the spec reads by name without making them (node()'s inputs).
+py::dict run_spec_bound(const py::object& spec_arg, std::optional<std::uint64_t> seed, const py::dict& overrides,
+                        std::optional<int> threads, const py::object& out_arg, bool progress, BoundValues bound) {
+    const std::string spec = path_text(spec_arg, "spec");
+    std::optional<std::string> out;
+    if (!out_arg.is_none()) out = path_text(out_arg, "out");
+    SpecText text = read_spec(spec);
+    if (threads && (*threads < 1 || *threads > 1024))
+        throw py::value_error("threads must be a number from 1 to 1024, got " + std::to_string(*threads));
+
+    CheckOptions check_options;
+    for (const auto& [k, v] : overrides)
+        check_options.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
+    check_options.seed = seed;
+    for (const auto& [name, v] : bound) check_options.bound[name] = describe_bound(v);
+    ScratchFolder scratch;  // made below only if a node writes files
+    check_options.out_dir = out ? fs::path(*out) : scratch.path;
+
+    PluginSet& set = plugins();
+    auto source = std::make_shared<spec::Source>(text.name, std::move(text.text));
+    spec::Diagnostics diags;
+    const spec::Spec parsed = spec::parse(source, diags);
+    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, text.name));
+    Plan plan = check(parsed, set.registry(), text.path, check_options, diags);
+    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, text.name));
+    // The checker's warnings are about files ("this spec writes no files"): moot when nothing is written.
+    if (!diags.all().empty() && out && PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1) != 0)
+        throw py::error_already_set();  // warnings turned into errors
+
+    // Every named value (and side value) is wanted back: held past the last node. (A call written where an
+    // input goes is not named: its value is released after its reader, as in the CLI.)
+    for (const PlannedNode& n : plan.nodes) {
+        if (n.value_name.empty() || n.in_place) continue;
+        plan.last_use[n.value_name] = plan.nodes.size();
+        for (const auto& side : n.node->side_outputs) plan.last_use[n.value_name + "." + side.name] = plan.nodes.size();
+    }
+
+    ProgressDisplay display(stderr, ::isatty(STDERR_FILENO) != 0, !progress);
+    RunOptions options;
+    if (out) {
+        options.out_dir = *out;
+    } else if (writes_files(plan)) {  // else out_dir stays empty: no folder, no manifest, nothing written
+        scratch.make();
+        options.out_dir = scratch.path;
+    } else {
+        options.out_dir.clear();
+    }
+    options.threads = threads.value_or(0);
+    options.progress = &display;
+    options.plugins = set.plugins();
+    options.cancel = &g_cancel;
+    options.cancel_signal = &g_signal;
+    options.cache = std::nullopt;  // every node runs: a cached node's values would not be at hand
+    const RunResult result = run_released(plan, options, std::move(bound));
 
     py::dict values;
     for (const auto& [key, v] : result.values) {
@@ -336,6 +366,65 @@ py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed,
         values[py::str(key)] = to_python(v);
     }
     return values;
+}
+
+py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed, const py::dict& overrides,
+                  std::optional<int> threads, const py::object& out_arg, bool progress) {
+    return run_spec_bound(spec_arg, seed, overrides, threads, out_arg, progress, {});
+}
+
+/// A 2-D float32 numpy array of any layout (C or Fortran order, a slice with strides) copied once into a
+/// heightmap's own storage, row 0 the north edge; a NaN or infinity is a ValueError naming input `i` and
+/// the first bad sample (column, row), as a spec's importer refuses it. The kernel's heightmap owns its
+/// std::vector, so it cannot borrow numpy's memory: this copy is the one node() makes.
+std::shared_ptr<Heightmap> heightmap_of_array(const py::array& a, double cell, int i) {
+    const std::string which = "input " + std::to_string(i);
+    if (a.ndim() != 2 || !a.dtype().is(py::dtype::of<float>()))
+        throw py::value_error(which + " must be a 2-D float32 array");  // node() said so in its own words first
+    const auto rows = a.shape(0), cols = a.shape(1);
+    std::vector<float> heights(std::size_t(rows) * std::size_t(cols));
+    const auto* base = static_cast<const char*>(a.data());
+    if (a.flags() & py::array::c_style) {
+        std::memcpy(heights.data(), base, heights.size() * sizeof(float));
+    } else {
+        const auto row_step = a.strides(0), col_step = a.strides(1);
+        for (py::ssize_t r = 0; r < rows; ++r)
+            for (py::ssize_t c = 0; c < cols; ++c)
+                std::memcpy(&heights[std::size_t(r * cols + c)], base + r * row_step + c * col_step, sizeof(float));
+    }
+    // One pass, branch-free, to find whether any sample is bad; the first one named only then.
+    bool finite = true;
+    for (const float v : heights) finite &= std::isfinite(v);
+    if (!finite) {
+        const auto at = std::size_t(
+            std::find_if(heights.begin(), heights.end(), [](float v) { return !std::isfinite(v); }) - heights.begin());
+        const float v = heights[at];
+        throw py::value_error(which + ": sample (" + std::to_string(at % std::size_t(cols)) + ", " +
+                              std::to_string(at / std::size_t(cols)) + ") is " +
+                              (std::isnan(v) ? "nan"
+                                   : v > 0   ? "inf"
+                                             : "-inf") +
+                              "; heights and layers must be finite numbers");
+    }
+    return std::make_shared<Heightmap>(int(cols), int(rows), cell, std::move(heights));
+}
+
+/// orogen.node()'s run: `inputs` a list of (name, value, cell), each value an orogen.Heightmap (bound as
+/// it is: no copy; a node that changes it works on a copy, as any node whose input is read elsewhere) or a
+/// 2-D float32 array (copied once into a heightmap the run alone holds: a node that changes it does so in
+/// place).
+py::dict run_node(const std::string& spec, const py::list& inputs, std::optional<int> threads) {
+    BoundValues bound;
+    int i = 0;
+    for (const auto& item : inputs) {
+        const auto entry = item.cast<py::tuple>();
+        const auto name = entry[0].cast<std::string>();
+        const py::object value = entry[1];
+        ++i;
+        if (py::isinstance<PyHeightmap>(value)) bound[name] = Value(value.cast<const PyHeightmap&>().hm);
+        else bound[name] = Value(heightmap_of_array(value.cast<py::array>(), entry[2].cast<double>(), i));
+    }
+    return run_spec_bound(py::str(spec), std::nullopt, py::dict(), threads, py::none(), false, std::move(bound));
 }
 
 // ------------------------------------------------------------ nodes, help
@@ -421,26 +510,6 @@ py::dict help(const std::string& name) {
     return d;
 }
 
-#ifdef OROGEN_PYTHON_EXR
-/// node()'s way in: heights and layers (2-D float32 C-contiguous arrays of one shape, checked by the caller)
-/// as an uncompressed OpenEXR file import:exr reads back bit for bit.
-void write_input(const std::string& path, const std::string& channel,
-                 const py::array_t<float, py::array::c_style>& height, const py::dict& layers, double cell) {
-    const int h = int(height.shape(0)), w = int(height.shape(1));
-    std::vector<py::array_t<float, py::array::c_style>> keep;
-    std::vector<exr::Plane> planes{{channel, height.data()}};
-    for (const auto& [k, v] : layers) {
-        keep.push_back(v.cast<py::array_t<float, py::array::c_style>>());
-        planes.push_back({k.cast<std::string>(), keep.back().data()});
-    }
-    exr::WriteOptions o;
-    o.compression = exr::Compression::none;
-    o.cell = cell;
-    py::gil_scoped_release release;
-    exr::write(path, w, h, planes, o);
-}
-#endif
-
 }  // namespace
 
 PYBIND11_MODULE(_orogen, m) {
@@ -501,8 +570,6 @@ PYBIND11_MODULE(_orogen, m) {
           "Run a spec (a path, or the text itself) and return every named value: {name: value}.");
     m.def("nodes", &nodes, "The nodes the loaded plugins provide: [{'name', 'kind', 'summary'}].");
     m.def("help", &help, py::arg("name"), "A node's description, inputs and parameters (type, default, range, unit).");
-#ifdef OROGEN_PYTHON_EXR
-    m.def("_write_input", &write_input, py::arg("path"), py::arg("channel"), py::arg("height"), py::arg("layers"),
-          py::arg("cell"));
-#endif
+    m.def("_run_node", &run_node, py::arg("spec"), py::arg("inputs"), py::arg("threads") = py::none(),
+          "orogen.node()'s run: the spec with its inputs [(name, Heightmap or float32 array, cell)] bound by name.");
 }

@@ -9,17 +9,11 @@
 See docs/python.md.
 """
 import math as _math
-import os as _os
-import shutil as _shutil
-import tempfile as _tempfile
 
 from . import _orogen
 from ._orogen import Heightmap, Series, help, nodes, run
 
 __all__ = ["Heightmap", "Series", "help", "node", "nodes", "run"]
-
-_HEIGHT_CHANNEL = "orogen:height"  # not a layer name any node uses
-
 
 def _literal(value, where):
     """A Python value as the spec writes it."""
@@ -43,6 +37,7 @@ def _literal(value, where):
 
 
 def _grid_of(array, i):
+    """A numpy input checked (its samples are checked for NaN and infinity as they are copied in)."""
     import numpy as np
 
     if not isinstance(array, np.ndarray):
@@ -53,12 +48,7 @@ def _grid_of(array, i):
         raise ValueError(f"input {i} is {array.dtype}; orogen heightmaps are float32: pass a.astype(np.float32)")
     if array.shape[0] < 2 or array.shape[1] < 2:
         raise ValueError(f"input {i} is {array.shape[1]}x{array.shape[0]}; a heightmap needs at least 2 vertices a side")
-    bad = ~np.isfinite(array)
-    if bad.any():
-        row, col = (int(v) for v in np.argwhere(bad)[0])
-        raise ValueError(f"input {i}: sample ({col}, {row}) is {array[row, col]}; heights and layers must be finite "
-                         "numbers")
-    return np.ascontiguousarray(array)
+    return array
 
 
 def node(name, *inputs, cell=None, grid=None, spec_seed=0, label="result", threads=None, **params):
@@ -69,42 +59,47 @@ def node(name, *inputs, cell=None, grid=None, spec_seed=0, label="result", threa
     the spec checker checks them, with its messages (ValueError). A node without inputs (a generator) runs on
     a grid of `grid=(width, height)` vertices (default: the first input's size, else 513 x 513). The node's
     seed comes from `spec_seed` and `label`, as it would in a spec whose seed line is `spec_seed` and where
-    the node is named `label`, so node() gives the same bits as that spec. The inputs cross through an
-    uncompressed OpenEXR file in a scratch folder (a copy, bit for bit, layers included).
+    the node is named `label`, so node() gives the same bits as that spec.
+
+    The inputs are handed to the node in memory, by name: no file is written, not even a temporary one. An
+    orogen.Heightmap crosses as it is, layers and all, without a copy (a node that changes its input works
+    on a copy of it, as in a spec where another node reads that value too). A numpy array is copied once,
+    into the node's heightmap (orogen's heightmaps own their memory and cannot borrow numpy's); any layout
+    is read directly, C or Fortran order or a strided slice, so that copy is the only one; a node that
+    changes its input then works on that copy in place.
     """
-    if not hasattr(_orogen, "_write_input"):
-        raise RuntimeError("this orogen was built without export:exr, which node() needs for its inputs")
     if cell is not None and not (isinstance(cell, (int, float)) and _math.isfinite(cell) and cell > 0):
         raise ValueError(f"cell must be a number of metres above 0, got {cell!r}")
     if not isinstance(label, str) or not label.isidentifier():
         raise ValueError(f"label must be a name as a spec writes one (letters, digits, _), got {label!r}")
-    scratch = _tempfile.mkdtemp(prefix="orogen-node-")
-    try:
-        lines = [f"orogen 1", f"seed {int(spec_seed)}"]
-        calls = []
-        size = None
-        for i, value in enumerate(inputs, start=1):
-            if isinstance(value, Heightmap):
-                height, layers, spacing = value.height, value.layers, value.cell
-            else:
-                height, layers, spacing = _grid_of(value, i), {}, (1.0 if cell is None else float(cell))
-            if size is None:
-                size = (height.shape[1], height.shape[0], spacing)
-            path = _os.path.join(scratch, f"in{i}.exr")
-            _orogen._write_input(path, _HEIGHT_CHANNEL, height, layers, spacing)
-            calls.append(f'input{i} = import:exr(path="{path}", channel="{_HEIGHT_CHANNEL}", layers=all)')
-        if grid is not None:
-            if not (isinstance(grid, (tuple, list)) and len(grid) == 2 and all(isinstance(v, int) for v in grid)):
-                raise ValueError(f"grid must be (width, height) in vertices, got {grid!r}")
-            size = (grid[0], grid[1], size[2] if size else (1.0 if cell is None else float(cell)))
+    lines = [f"orogen 1", f"seed {int(spec_seed)}"]
+    notes, bound = [], []
+    size = None
+    for i, value in enumerate(inputs, start=1):
+        if isinstance(value, Heightmap):
+            rows, cols, spacing = value.shape[0], value.shape[1], value.cell
+            what = "an orogen.Heightmap"
+        else:
+            array = _grid_of(value, i)
+            rows, cols, spacing = array.shape[0], array.shape[1], (1.0 if cell is None else float(cell))
+            value = array
+            what = "a float32 array"
         if size is None:
-            size = (513, 513, 1.0 if cell is None else float(cell))
-        lines.append(f"grid {int(size[0])}x{int(size[1])} cell={float(size[2])!r}")
-        lines += calls
-        args = [f"input{i}" for i in range(1, len(inputs) + 1)]
-        args += [f"{k}={_literal(v, k)}" for k, v in params.items()]
-        lines.append(f"{label} = {name}({', '.join(args)})")
-        values = run("\n".join(lines) + "\n", threads=threads)
-        return values.get(label)
-    finally:
-        _shutil.rmtree(scratch, ignore_errors=True)
+            size = (cols, rows, spacing)
+        bound.append((f"input{i}", value, spacing))
+        # One line per input, where a spec would make it: the node's line, and the checker's line:col in a
+        # message, stay where they were when inputs were imported from files.
+        notes.append(f"# input{i}: {what}, {cols}x{rows}, cell {spacing!r} m, handed to the run in memory")
+    if grid is not None:
+        if not (isinstance(grid, (tuple, list)) and len(grid) == 2 and all(isinstance(v, int) for v in grid)):
+            raise ValueError(f"grid must be (width, height) in vertices, got {grid!r}")
+        size = (grid[0], grid[1], size[2] if size else (1.0 if cell is None else float(cell)))
+    if size is None:
+        size = (513, 513, 1.0 if cell is None else float(cell))
+    lines.append(f"grid {int(size[0])}x{int(size[1])} cell={float(size[2])!r}")
+    lines += notes
+    args = [f"input{i}" for i in range(1, len(inputs) + 1)]
+    args += [f"{k}={_literal(v, k)}" for k, v in params.items()]
+    lines.append(f"{label} = {name}({', '.join(args)})")
+    values = _orogen._run_node("\n".join(lines) + "\n", bound, threads=threads)
+    return values.get(label)

@@ -305,3 +305,62 @@ def test_plates_and_particles_come_back_frame_by_frame():
     assert not position.flags.writeable
     assert all(a.shape[0] == position.shape[0] for a in last["attributes"].values())
     assert [f["step"] for f in frames] == sorted(f["step"] for f in frames)
+
+
+def test_node_writes_no_file_not_even_a_temporary_one(tmp_path, monkeypatch):
+    # $TMPDIR (and Python's own tempfile folder) a regular file: a temporary file or folder anywhere under it
+    # could not be made, so a call that made one would fail. The inputs are handed over in memory.
+    not_a_folder = tmp_path / "not-a-folder"
+    not_a_folder.write_text("")
+    monkeypatch.setenv("TMPDIR", str(not_a_folder))
+    monkeypatch.setattr(tempfile, "tempdir", str(not_a_folder))
+    cwd = tmp_path / "cwd"
+    cwd.mkdir()
+    monkeypatch.chdir(cwd)
+    a = (np.arange(33 * 33, dtype=np.float32).reshape(33, 33) % 7) * 3
+    t = orogen.node("erode:thermal", a, iterations=3)
+    h = orogen.node("erode:hydraulic", t, iterations=2)
+    g = orogen.node("generate:fault", grid=(17, 17), iterations=3)
+    assert t.shape == h.shape == (33, 33) and g.shape == (17, 17)
+    assert not np.array_equal(t.height, a)
+    # run() too, when no node of the spec writes a file.
+    assert orogen.run("orogen 1\ngrid 17\nb = generate:fault(iterations=5)\n")["b"].shape == (17, 17)
+    assert list(cwd.iterdir()) == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cwd", "not-a-folder"]
+    assert not_a_folder.read_text() == ""
+
+
+def test_a_heightmaps_layers_reach_the_node_intact_and_the_value_is_not_changed():
+    values = orogen.run(NODE_SPEC + "h = erode:hydraulic(t, iterations=3)\nu = erode:thermal(h, talus=30, iterations=5)\n")
+    h = values["h"]
+    height, layers = h.height.copy(), {k: v.copy() for k, v in h.layers.items()}
+    assert {"eroded", "sediment", "water"} <= set(layers)
+    u = orogen.node("erode:thermal", h, spec_seed=4, label="u", talus=30, iterations=5)
+    want = values["u"]
+    assert sorted(u.layers) == sorted(want.layers) and set(layers) <= set(u.layers)
+    assert np.array_equal(bits(u.height), bits(want.height))
+    for name in want.layers:
+        assert np.array_equal(bits(u.layers[name]), bits(want.layers[name])), name
+    # The node changed a copy: the earlier value, which Python still holds, is as it was.
+    assert np.array_equal(bits(h.height), bits(height))
+    for name, layer in layers.items():
+        assert np.array_equal(bits(h.layers[name]), bits(layer)), name
+    with pytest.raises(ValueError, match="'input1' is a value the caller hands to the run"):
+        orogen.node("erode:thermal", h, label="input1")
+
+
+def test_node_reads_fortran_order_and_strided_arrays_and_leaves_them_as_they_were():
+    values = orogen.run(NODE_SPEC)
+    c = np.array(values["b"].height)
+    fortran = np.asfortranarray(c)
+    wide = np.full((49 * 2, 65 * 3), 7.0, dtype=np.float32)
+    wide[::2, ::3] = c
+    strided = wide[::2, ::3]
+    assert not fortran.flags.c_contiguous and not strided.flags.c_contiguous and not strided.flags.f_contiguous
+    for a in (fortran, strided, c):
+        t = orogen.node("erode:thermal", a, cell=10, talus=30, iterations=40)
+        assert np.array_equal(bits(t.height), bits(values["t"].height))
+        assert np.array_equal(bits(a), bits(values["b"].height))  # the caller's array untouched
+    wide[4, 9] = np.inf  # sample (3, 2) of the strided view
+    with pytest.raises(ValueError, match=r"input 1: sample \(3, 2\) is inf; heights and layers must be finite"):
+        orogen.node("erode:thermal", strided)
