@@ -162,7 +162,8 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
 
 INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
                          testing::Values(Preset{"himalaya", "himalaya_baspa_30m"}, Preset{"rif", "morocco_rif_27m"},
-                                         Preset{"raukumara", "nz_raukumara_30m"}),
+                                         Preset{"raukumara", "nz_raukumara_30m"},
+                                         Preset{"kahurangi", "nz_kahurangi_30m"}),
                          [](const auto& info) { return std::string(info.param.pipeline); });
 
 }  // namespace
