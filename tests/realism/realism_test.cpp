@@ -46,11 +46,11 @@ const Band kBands[] = {
 
 constexpr int kSide = 1025;  ///< the shipped pipelines' grid
 
-/// The float32 heights export:raw wrote (kSide² of them), or false (and a test failure naming the size).
-bool read_terrain(const fs::path& path, std::vector<float>& heights) {
+/// The float32 heights export:raw wrote (side² of them), or false (and a test failure naming the size).
+bool read_terrain(const fs::path& path, std::vector<float>& heights, int side = kSide) {
     const std::string raw = slurp(path);
-    EXPECT_EQ(raw.size(), std::size_t(kSide) * kSide * sizeof(float)) << path;
-    if (raw.size() != std::size_t(kSide) * kSide * sizeof(float)) return false;
+    EXPECT_EQ(raw.size(), std::size_t(side) * side * sizeof(float)) << path;
+    if (raw.size() != std::size_t(side) * side * sizeof(float)) return false;
     heights.resize(raw.size() / sizeof(float));
     std::memcpy(heights.data(), raw.data(), raw.size());
     return true;
@@ -118,19 +118,25 @@ std::optional<Reference> read_reference(const fs::path& dems, const std::string&
 }
 
 struct Preset {
-    const char* pipeline;   ///< pipelines/<name>.orogen
-    const char* namesake;   ///< the reference DEM it is named after
+    const char* pipeline;  ///< pipelines/<name>.orogen
+    const char* namesake;  ///< the reference DEM it is named after
+    int side = kSide;      ///< the pipeline's grid, vertices a side
+    double cell = 30.0;    ///< its cell size, m
+    /// The references it is told apart from, at about its cell size (slope figures depend on it).
+    std::vector<const char*> references = {"himalaya_baspa_30m", "morocco_rif_27m", "nz_kahurangi_30m",
+                                           "nz_raukumara_30m"};
 };
 
 class RangePreset : public testing::TestWithParam<Preset> {};
 
 TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
     // The distance `orogen analyze --against` prints: RMS over every figure of the difference in units of
-    // the four 27–30 m references' spread (libs/analysis compare.hpp).
+    // the references' spread (libs/analysis compare.hpp): the four 27–30 m ones, or the 50–90 m ones for
+    // a preset at 90 m.
     const fs::path dems = fs::path(OROGEN_SOURCE_DIR) / ".." / "shared" / "realism" / "dems";
     if (!fs::exists(dems / "himalaya_baspa_30m.f32")) GTEST_SKIP() << "no reference DEMs at " << dems;
     std::vector<Reference> refs;
-    for (const char* name : {"himalaya_baspa_30m", "morocco_rif_27m", "nz_kahurangi_30m", "nz_raukumara_30m"}) {
+    for (const char* name : GetParam().references) {
         auto r = read_reference(dems, name);
         ASSERT_TRUE(r) << name;
         refs.push_back(std::move(*r));
@@ -147,8 +153,8 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
                                    " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     std::vector<float> h;
-    ASSERT_TRUE(read_terrain(dir / "terrain.r32", h));
-    const auto mine = orogen::analysis::measure({h.data(), kSide, kSide, 30.0});
+    ASSERT_TRUE(read_terrain(dir / "terrain.r32", h, GetParam().side));
+    const auto mine = orogen::analysis::measure({h.data(), GetParam().side, GetParam().side, GetParam().cell});
     std::string nearest;
     double best = 1e300;
     for (std::size_t i = 0; i < refs.size(); ++i) {
@@ -163,7 +169,10 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
 INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
                          testing::Values(Preset{"himalaya", "himalaya_baspa_30m"}, Preset{"rif", "morocco_rif_27m"},
                                          Preset{"raukumara", "nz_raukumara_30m"},
-                                         Preset{"kahurangi", "nz_kahurangi_30m"}),
+                                         Preset{"kahurangi", "nz_kahurangi_30m"},
+                                         Preset{"montblanc", "alps_montblanc_93m", 769, 90.0,
+                                                {"alps_montblanc_93m", "andes_peru_lima_90m", "rockies_frontrange_90m",
+                                                 "india_shillong_50m"}}),
                          [](const auto& info) { return std::string(info.param.pipeline); });
 
 }  // namespace

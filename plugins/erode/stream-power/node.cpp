@@ -105,6 +105,16 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.rock.angle_spread = ctx.real("bed_angle_spread") * rad;
     s.rock.erodibility_contrast = ctx.real("bed_erodibility_contrast");
     s.rock.seed = ctx.seed();
+    if (ctx.flag("glaciers")) {
+        s.glaciers.ela = ctx.real("ela");
+        s.glaciers.balance_gradient = ctx.real("ice_balance_gradient");
+        s.glaciers.max_balance = ctx.real("ice_max_balance");
+        s.glaciers.erodibility = ctx.real("ice_erodibility");
+        s.glaciers.flux_exponent = ctx.real("ice_flux_exponent");
+        s.glaciers.half_width = ctx.real("glacier_half_width");
+        s.glaciers.wall_slope = std::tan(ctx.real("trough_wall_angle") * rad);
+        s.glaciers.glacier_flux = ctx.real("glacier_min_flux");
+    }
     s.open = *parse_sides(ctx.text("open"));
     s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
@@ -285,6 +295,11 @@ void write_layers(NodeContext& ctx, Heightmap& hm, Engine& engine, std::int64_t 
         eroded.data[i] += float(double(out[i]) - double(before[i]) - rock_uplift[i]);
         uplifted.data[i] += float(rock_uplift[i]);
     }
+    if (ctx.flag("glaciers") && engine.whole) {  // glaciers never tile: the whole grid's model
+        const std::vector<double>& ice = engine.whole->ice_flux();
+        GridView q = hm.layer("ice_flux", 0.0f);
+        for (std::size_t i = 0; i < n && i < ice.size(); ++i) q.data[i] = float(ice[i]);
+    }
     if (ctx.flag("chi")) {
         const std::vector<double> chi = engine.chi();
         GridView c = hm.layer("chi", 0.0f);
@@ -449,6 +464,13 @@ void check(CheckContext& ctx) {
     check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));
     for (const char* l : {"drainage", "flow_direction", "eroded", "uplifted"}) ctx.output().layers.insert(l);
     if (ctx.flag("chi")) ctx.output().layers.insert("chi");
+    if (ctx.flag("glaciers")) ctx.output().layers.insert("ice_flux");
+    if (ctx.flag("glaciers") && ctx.real("deposition") > 0.0)
+        ctx.error("glaciers", "glaciers erode detachment-limited for now; give deposition=0 or glaciers=false");
+    if (!ctx.flag("glaciers"))
+        for (const char* p : {"ela", "ice_balance_gradient", "ice_max_balance", "ice_erodibility", "ice_flux_exponent",
+                              "glacier_half_width", "glacier_min_flux", "trough_wall_angle"})
+            if (ctx.given(p)) ctx.error(p, std::string(p) + " describes glaciers; give glaciers=true as well");
 }
 
 }  // namespace
@@ -471,9 +493,13 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "uplift_smoothing metres; with a second input (a heightmap series such as plates.timelapse), the height "
             "change between its frames over the years they map to (the first frame year 0, the last "
             "uplift_history_years, default the run's years), spread the same way. deposition=G > 0 lets G Qs/A of "
-            "the sediment flux Qs settle on its way down (Yuan et al. 2019; solved exactly on the receiver tree). The same "
+            "the sediment flux Qs settle on its way down (Yuan et al. 2019; solved exactly on the receiver tree). "
+            "landslide_angle > 0 holds every slope below that threshold after each step (the debris leaves with the "
+            "rivers); bed_* cut the rock into tilted beds of varying strength (landslide angle and erodibility); "
+            "glaciers=true routes ice from above the ELA down the valleys, eroding K_g Q^m_g S^n and carving "
+            "U-shaped troughs. The same "
             "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
-            "uplift_history; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where it "
+            "glaciers; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
             "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; added to "
             "an earlier eroder's), uplifted (the rock uplift it received, m; eroded + uplifted is the net change) and, "
@@ -575,6 +601,48 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(1000.0)
                     .help("erodibility of the weakest bed over the strongest's (1 = the same; shale against "
                           "sandstone ~10, Sklar & Dietrich 2001)"),
+                Param::boolean("glaciers", false)
+                    .help("valley glaciers: ice gathers above the ELA, flows down the valleys, erodes "
+                          "ice_erodibility*Q^ice_flux_exponent*S^n and carves U-shaped troughs (docs/landscape.md); "
+                          "adds the layer ice_flux"),
+                Param::real("ela", 2500.0)
+                    .min(-1000.0)
+                    .max(9000.0)
+                    .unit("m")
+                    .help("glaciers: the equilibrium-line altitude, above which snow outlasts the summer (Alps "
+                          "today ~2900 m, in the last glacial maximum ~1500 m lower)"),
+                Param::real("ice_balance_gradient", 0.007)
+                    .min(0.0, true)
+                    .max(0.1)
+                    .unit("1/yr")
+                    .help("glaciers: metres of ice a year gained per metre above the ELA (0.005-0.01 in the Alps)"),
+                Param::real("ice_max_balance", 2.0)
+                    .min(0.0, true)
+                    .max(20.0)
+                    .unit("m/yr")
+                    .help("glaciers: the most ice a year any height gains"),
+                Param::real("ice_erodibility", 2e-6)
+                    .min(0.0)
+                    .max(1.0)
+                    .help("glaciers: K_g of E = K_g*Q^m_g*S^n, Q the ice flux in m³/yr"),
+                Param::real("ice_flux_exponent", 0.5).min(0.1).max(1.5).help("glaciers: m_g of the glacial erosion law"),
+                Param::real("glacier_half_width", 400.0)
+                    .min(0.0)
+                    .max(1e4)
+                    .unit("m")
+                    .help("glaciers: half the width of a glacier carrying 1e6 m³/yr (width grows as Q^0.4, Bahr "
+                          "1997); its trough is carved that far on each side"),
+                Param::real("glacier_min_flux", 2e5)
+                    .min(0.0)
+                    .max(1e12)
+                    .unit("m³/yr")
+                    .help("glaciers: the ice flux from which ice slides, erodes and carves a trough; thinner ice "
+                          "(snow on the slopes and peaks) erodes nothing, so horns and aretes stand above"),
+                Param::real("trough_wall_angle", 40.0)
+                    .min(1.0)
+                    .max(80.0)
+                    .unit("°")
+                    .help("glaciers: the slope of a trough's walls at the glacier's margin"),
                 Param::string("open", "nesw")
                     .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
                           "level. none: the lowest cell is the one outlet"),
@@ -605,6 +673,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 stream_power::Settings s;
                 if (std::get<std::string>(p.at("routing")) == "mfd") s.mfd_exponent = 1.0;
                 s.deposition = std::get<double>(p.at("deposition"));
+                if (std::get<bool>(p.at("glaciers"))) s.glaciers.balance_gradient = 1.0;
                 return stream_power::untiled_because(s);
             },
     });

@@ -134,12 +134,15 @@ std::int64_t Model::step(double dt) {
         diffusion_->step(h, dt);
         for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
     }
-    // 4. Implicit incision (and deposition), in the rock each cell shows now.
+    // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
     rock_at(settings_.rock, h, uplifted_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
+    if (settings_.glaciers.any()) glacial_factors(dt);
     if (settings_.deposition > 0.0)
         incise_with_deposition(dt);
     else
         incise(dt);
+    if (settings_.glaciers.any())
+        carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
     // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
     if (settings_.rock.angle > 0.0)
         threshold::limit_slopes(h, width_, height_, cell_,
@@ -147,6 +150,18 @@ std::int64_t Model::step(double dt) {
                                 flow_.outlets().data());
     time_ += dt;
     return pits;
+}
+
+void Model::glacial_factors(double dt) {
+    const Glaciers& g = settings_.glaciers;
+    const std::size_t n = h_.size();
+    stream_power::ice_flux(g, h_.data(), flow_.stack().data(), flow_.receivers().data(), n, cell_, ice_);
+    ice_f_.assign(n, 0.0);
+    const double ns = settings_.slope_exponent;
+    for (std::size_t i = 0; i < n; ++i)
+        if (ice_[i] >= g.glacier_flux && flow_.receivers()[i] != std::int32_t(i))  // a glacier, not at an outlet or pit
+            ice_f_[i] = g.erodibility * dt * std::pow(ice_[i], g.flux_exponent) /
+                        std::pow(flow_.distance(std::int64_t(i)), ns);
 }
 
 void Model::incise(double dt) {
@@ -175,13 +190,15 @@ void Model::incise(double dt) {
         const std::int32_t* __restrict const st = stack;
         double* __restrict const hh = h;
         const double* __restrict const kf = rock_k_.empty() ? nullptr : rock_k_.data();
+        const double* __restrict const gf = ice_f_.empty() ? nullptr : ice_f_.data();
         const double c1 = kdt_l1, c2 = kdt_l2, ia0 = inv_a0, a00 = a0, mm = m, iac = inverse_channel_area(settings_);
         const std::int64_t w = W;
         auto factor = [=](std::int32_t i, std::int32_t r) {
             const double am = area_power(ar[i], tb, ia0, a00, mm, iac);
             const std::int64_t d = std::int64_t(r) - i;
             const double f = am * ((d == 1 || d == -1 || d == w || d == -w) ? c1 : c2);
-            return kf ? f * kf[i] : f;
+            const double fk = kf ? f * kf[i] : f;
+            return gf ? fk + gf[i] : fk;
         };
         for (std::int64_t g = g0; g < g1; ++g) {
             const std::int64_t b = chunks[std::size_t(g)], e = chunks[std::size_t(g + 1)];

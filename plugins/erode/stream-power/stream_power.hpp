@@ -30,6 +30,7 @@
 #pragma once
 
 #include "flow.hpp"
+#include "glaciers.hpp"
 #include "rock.hpp"
 
 #include <orogen/solvers/diffusion.hpp>
@@ -72,6 +73,10 @@ struct Settings {
     /// erode fast; Burbank et al. 1996, Montgomery & Brandon 2002), so hillslopes end planar at the
     /// threshold and the divides between them sharp.
     Beds rock;
+    /// Valley glaciers (glaciers.hpp): with glaciers.any(), ice gathers above the ELA, flows down the
+    /// flow graph, erodes K_g·Q^m_g·S^n in the same implicit sweep as the rivers and carves U-shaped
+    /// troughs. Detachment-limited only (deposition = 0), and not tiled.
+    Glaciers glaciers;
 };
 
 /// Uplift that varies in time as well as in space: a piecewise-constant rate
@@ -131,6 +136,8 @@ public:
     /// With deposition: the most up-and-down passes an outlet basin needed in the last step.
     int deposition_passes() const { return deposition_passes_; }
 
+    /// Glaciers: each cell's ice flux in the last step (m³/yr); empty without glaciers.
+    const std::vector<double>& ice_flux() const { return ice_; }
     /// Route and accumulate over the current heights without eroding (for the output layers).
     void route_only();
 
@@ -147,6 +154,7 @@ public:
 
 private:
     void incise(double dt);
+    void glacial_factors(double dt);  // ice_ and ice_f_ over this step's flow graph
     void incise_with_deposition(double dt);
     void add_history_uplift(double t0, double t1);
     void accumulate(const double* routed);  // D8 or multiple-flow area over the routed heights
@@ -159,6 +167,7 @@ private:
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
+    std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     double time_ = 0.0, sediment_out_ = 0.0;
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_

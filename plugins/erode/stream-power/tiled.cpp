@@ -91,6 +91,7 @@ int direction_to(std::int64_t from, std::int64_t to, int W) {
 std::string untiled_because(const Settings& s) {
     if (s.mfd_exponent > 0.0) return "routing=mfd is not tiled yet";
     if (s.deposition > 0.0) return "deposition > 0 is not tiled yet";
+    if (s.glaciers.any()) return "glaciers are not tiled yet";
     return "";
 }
 

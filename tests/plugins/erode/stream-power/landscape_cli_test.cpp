@@ -127,6 +127,35 @@ TEST(LandscapeCli, DepositionAndUpliftHistoryAreCheckedBeforeTheRun) {
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
 
+TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
+    TempDir dir;
+    const auto spec = dir.write("rock.orogen",
+                                "orogen 1\n"
+                                "grid 65 cell=30\n"
+                                "base = generate:shape(kind=pyramid, height=300)\n"
+                                "a = erode:stream-power(base, bed_dip=20)\n"
+                                "b = erode:stream-power(base, bed_thickness=50, bed_angle_spread=10)\n"
+                                "c = erode:stream-power(base, landslide_angle=30, bed_thickness=50, bed_angle_spread=28)\n"
+                                "d = erode:stream-power(base, ela=2000)\n"
+                                "e = erode:stream-power(base, glaciers=true, deposition=1)\n"
+                                "f = erode:stream-power(base, landslide_angle=85)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want : {
+             "rock.orogen:4:38: error: erode:stream-power: bed_dip describes the rock's beds; give bed_thickness (m) "
+             "as well",
+             "rock.orogen:5:65: error: erode:stream-power: bed_angle_spread spreads the landslide angle; give "
+             "landslide_angle as well",
+             "rock.orogen:6:85: error: erode:stream-power: the beds' landslide angles run landslide_angle ± "
+             "bed_angle_spread, which must stay within 5-80°; give a smaller spread",
+             "rock.orogen:7:34: error: erode:stream-power: ela describes glaciers; give glaciers=true as well",
+             "rock.orogen:8:39: error: erode:stream-power: glaciers erode detachment-limited for now; give "
+             "deposition=0 or glaciers=false",
+             "rock.orogen:9:46: error: 'landslide_angle' of erode:stream-power is 85, out of range [0, 80] °",
+         })
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+}
+
 TEST(LandscapeCli, UpliftFromThePlatesHistoryWithDepositionGivesTheSameBytesOnOneAndTwoThreads) {
     TempDir dir;
     const auto spec = dir.write("h.orogen",

@@ -246,6 +246,133 @@ TEST(Beds, LandslidesAndBedsGiveTheSameBitsOnOneAndTwoThreads) {
     EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
 }
 
+TEST(Glaciers, IceGathersAboveTheElaAndMeltsBelowIt) {
+    // A straight valley of 40 cells, cell 0 the outlet, rising 25 m a cell: each cell adds
+    // b(z)·cell² to the ice it receives and the flux never goes below zero.
+    const int n = 40;
+    const double cell = 100.0;
+    Glaciers g;
+    g.ela = 600.0;
+    g.balance_gradient = 0.01;
+    g.max_balance = 2.0;
+    std::vector<double> z(n);
+    std::vector<std::int32_t> stack(n), receiver(n);
+    for (int i = 0; i < n; ++i) z[i] = 25.0 * i, stack[i] = i, receiver[i] = std::max(0, i - 1);
+    std::vector<double> q;
+    ice_flux(g, z.data(), stack.data(), receiver.data(), n, cell, q);
+    double expected = 0.0;
+    for (int i = n - 1; i >= 0; --i) {
+        expected = std::max(0.0, expected + std::min(0.01 * (z[i] - 600.0), 2.0) * cell * cell);
+        EXPECT_DOUBLE_EQ(q[i], expected) << i;
+    }
+    EXPECT_GT(q[24], 0.0) << "ice flows below the ELA (cell 24, 600 m) until ablation eats it";
+    EXPECT_EQ(q[0], 0.0);
+    EXPECT_DOUBLE_EQ(q[39], 2.0 * cell * cell) << "the top gains at most b_max";
+}
+
+TEST(Glaciers, AGlacierTurnsAVShapedValleyIntoAParabolicTrough) {
+    // A V-shaped valley running south (walls at 35°, floor falling 5 % a cell); a glacier of 4e6 m³/yr
+    // down its axis. Across the valley, within the glacier's half-width, the walls end on the parabola
+    // h_c + tan θ_w/(2R)·p²; beyond it and on the floor nothing changes.
+    const int w = 61, h = 30, axis = 30;
+    const double cell = 50.0, wall = std::tan(35.0 * M_PI / 180.0);
+    Glaciers g;
+    g.half_width = 400.0;
+    g.wall_slope = std::tan(40.0 * M_PI / 180.0);
+    std::vector<double> z(std::size_t(w) * h), q(z.size(), 0.0);
+    std::vector<std::int32_t> receiver(z.size());
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * w + x;
+            z[i] = 2000.0 - 0.05 * cell * y + wall * cell * std::abs(x - axis);
+            receiver[i] = y + 1 < h ? std::int32_t(i + w) : std::int32_t(i);
+        }
+    for (int y = 0; y < h; ++y) q[std::size_t(y) * w + axis] = 4e6;
+    const auto before = z;
+    const double removed = carve_troughs(g, z.data(), q, receiver.data(), w, h, cell);
+    const double R = g.half_width_for(4e6), a = g.wall_slope / (2.0 * R);
+    EXPECT_NEAR(R, 400.0 * std::pow(4.0, 0.4), 1e-9);
+    double expected_removed = 0.0;
+    for (int y = 0; y + 1 < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * w + x;
+            const double p = cell * std::abs(x - axis);
+            const double floor = before[std::size_t(y) * w + axis];
+            const double want = p <= R ? std::min(before[i], floor + a * p * p) : before[i];
+            EXPECT_NEAR(z[i], want, 1e-9) << x << "," << y;
+            expected_removed += before[i] - want;
+        }
+    EXPECT_NEAR(removed, expected_removed * cell * cell, 1e-3);
+    // The trough is wider than the V at the same depth: 100 m above the floor the V is 2·100/tan 35° wide.
+    const int y = 10;
+    int v_width = 0, u_width = 0;
+    for (int x = 0; x < w; ++x) {
+        const double floor = before[std::size_t(y) * w + axis];
+        v_width += before[std::size_t(y) * w + x] < floor + 100.0;
+        u_width += z[std::size_t(y) * w + x] < floor + 100.0;
+    }
+    EXPECT_GE(u_width, 2 * v_width) << "a U is at least twice as wide as the V it was";
+}
+
+TEST(Glaciers, WithTheElaAboveTheSummitsTheRunIsTheRiversAlone) {
+    const int w = 65, h = 49;
+    Settings s;
+    s.erodibility = 1e-5;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.02;
+    Settings iced = s;
+    iced.glaciers.ela = 1e5;
+    iced.glaciers.balance_gradient = 0.01;
+    iced.glaciers.erodibility = 1e-4;
+    Model rivers(w, h, 50.0, noise(w, h, 2, 100.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+    Model glaciers(w, h, 50.0, noise(w, h, 2, 100.0), std::vector<double>(std::size_t(w) * h, 1e-3), iced);
+    rivers.run(2e5, 2e4);
+    glaciers.run(2e5, 2e4);
+    EXPECT_EQ(0, std::memcmp(rivers.heights().data(), glaciers.heights().data(), rivers.heights().size() * 8));
+}
+
+TEST(Glaciers, GlaciatedValleysEndDeeperAndWiderAndTheBitsHoldOnTwoThreads) {
+    // A rising block with valleys: 300 kyr with glaciers (ELA 600 m) against rivers alone. Above the ELA
+    // the glaciated valleys are cut deeper (lower mean height) and their floors are wider.
+    const int w = 81, h = 61;
+    const double cell = 60.0;
+    std::vector<double> start(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            start[std::size_t(y) * w + x] =
+                1200.0 * std::sin(M_PI * y / (h - 1)) + 150.0 * std::abs(std::sin(0.25 * x)) + 5.0 * random::uniform(4, x, y);
+    Settings s;
+    s.erodibility = 5e-6;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.05;
+    s.open = {true, false, true, false};
+    Settings iced = s;
+    iced.glaciers.ela = 600.0;
+    iced.glaciers.balance_gradient = 0.007;
+    iced.glaciers.erodibility = 2e-6;
+    iced.glaciers.glacier_flux = 1e5;
+    Model rivers(w, h, cell, start, std::vector<double>(start.size(), 5e-4), s);
+    rivers.run(3e5, 2e4);
+    std::vector<double> runs[2];
+    std::size_t ice_cells = 0;
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        Model glaciers(w, h, cell, start, std::vector<double>(start.size(), 5e-4), iced);
+        glaciers.run(3e5, 2e4);
+        runs[t] = glaciers.heights();
+        ice_cells = std::size_t(std::count_if(glaciers.ice_flux().begin(), glaciers.ice_flux().end(),
+                                              [](double q) { return q > 0.0; }));
+    }
+    EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), runs[0].size() * 8)) << "1 and 2 threads";
+    ASSERT_GT(ice_cells, std::size_t(200));
+    double sum_r = 0.0, sum_g = 0.0;
+    int cells = 0;
+    for (std::size_t i = 0; i < start.size(); ++i)
+        if (rivers.heights()[i] > 600.0) sum_r += rivers.heights()[i], sum_g += runs[0][i], ++cells;
+    ASSERT_GT(cells, 500);
+    EXPECT_LT(sum_g / cells, sum_r / cells - 20.0) << "the glaciers must lower the high ground by tens of metres";
+}
+
 TEST(StreamPower, TheRockUpliftIsCountedApartFromTheErosion) {
     // uplifted(): U·t on every cell but the outlets (held at base level), whatever the rivers did; the
     // node writes it as the layer 'uplifted' and the surface's own change, heights − start − uplifted,
