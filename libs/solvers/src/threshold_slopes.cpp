@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <span>
+#include <utility>
 #include <stdexcept>
 #include <vector>
 
@@ -28,18 +29,22 @@ struct Sweeps {
     /// How far above a neighbour `cell` away vertex i may stand, straight (1) or diagonal (√2).
     double step(std::size_t i) const { return (slopes ? slopes[i] : slope) * cell; }
 
-    /// Row r from row `from` (r ± 1): its three neighbours there. Returns the vertices lowered.
-    std::int64_t row_from(int r, int from) const {
+    /// Row r of the columns [a, b) from row `from` (r ± 1): its three neighbours there, those in the
+    /// columns just outside [a, b) read from `west` and `east` (a copy of those columns, by row, or null
+    /// where the grid ends). Returns the vertices lowered.
+    std::int64_t row_from(int r, int from, int a, int b, const double* west, const double* east) const {
         std::int64_t lowered = 0;
         const double* src = g + std::size_t(from) * std::size_t(gw);
-        double* dst = g + std::size_t(r) * std::size_t(gw);
-        const std::uint8_t* fx = fixed ? fixed + std::size_t(r) * std::size_t(gw) : nullptr;
         const std::size_t base = std::size_t(r) * std::size_t(gw);
-        for (int c = x0; c < x1; ++c) {
+        double* dst = g + base;
+        const std::uint8_t* fx = fixed ? fixed + base : nullptr;
+        for (int c = a; c < b; ++c) {
             const double straight = step(base + std::size_t(c)), diagonal = straight * kSqrt2;
             double best = src[c] + straight;
-            if (c > 0) best = std::min(best, src[c - 1] + diagonal);
-            if (c + 1 < gw) best = std::min(best, src[c + 1] + diagonal);
+            if (c > a) best = std::min(best, src[c - 1] + diagonal);
+            else if (west) best = std::min(best, west[from] + diagonal);
+            if (c + 1 < b) best = std::min(best, src[c + 1] + diagonal);
+            else if (east) best = std::min(best, east[from] + diagonal);
             if (best < dst[c] && (fx == nullptr || fx[c] == 0)) {
                 dst[c] = best;
                 ++lowered;
@@ -48,14 +53,45 @@ struct Sweeps {
         return lowered;
     }
 
-    /// Down then up the rows: each row from the one just finished (serial over the rows; the
-    /// vertices of a row are independent of each other).
-    std::int64_t vertical() const {
-        std::int64_t lowered = 0;
-        for (int r = std::max(y0, 1); r < y1; ++r) lowered += row_from(r, r - 1);
-        for (int r = std::min(y1, gh - 1) - 1; r >= y0; --r) lowered += row_from(r, r + 1);
-        return lowered;
+    /// Down (or up) the rows, each from the one just finished, in strips of columns side by side: a
+    /// strip reads its neighbours' edge columns as they were when the sweep began (values only fall, so
+    /// a stale one lowers less, never wrongly; a round that changes nothing read none stale), so the
+    /// strips run in parallel and never touch each other's memory.
+    std::int64_t vertical_pass(bool down) const {
+        constexpr int kStrip = 256;
+        const int strips = (x1 - x0 + kStrip - 1) / kStrip;
+        // First every strip's edge columns, before any strip moves: then no thread reads what another writes.
+        std::vector<double> edges(std::size_t(strips) * 2 * std::size_t(gh));
+        auto edge = [&](int s, int side) {
+            return edges.data() + (std::size_t(s) * 2 + std::size_t(side)) * std::size_t(gh);
+        };
+        auto strip = [&](int s) { return std::pair{x0 + s * kStrip, std::min(x1, x0 + (s + 1) * kStrip)}; };
+        for (int s = 0; s < strips; ++s) {
+            const auto [a, b] = strip(s);
+            for (int r = 0; r < gh; ++r) {
+                const std::size_t row = std::size_t(r) * std::size_t(gw);
+                if (a > 0) edge(s, 0)[r] = g[row + std::size_t(a - 1)];
+                if (b < gw) edge(s, 1)[r] = g[row + std::size_t(b)];
+            }
+        }
+        std::atomic<std::int64_t> lowered{0};
+        parallel_for(0, strips, 1, [&](std::int64_t s0, std::int64_t s1) {
+            for (std::int64_t s = s0; s < s1; ++s) {
+                const auto [a, b] = strip(int(s));
+                const double* w = a > 0 ? edge(int(s), 0) : nullptr;
+                const double* e = b < gw ? edge(int(s), 1) : nullptr;
+                std::int64_t mine = 0;
+                if (down)
+                    for (int r = std::max(y0, 1); r < y1; ++r) mine += row_from(r, r - 1, a, b, w, e);
+                else
+                    for (int r = std::min(y1, gh - 1) - 1; r >= y0; --r) mine += row_from(r, r + 1, a, b, w, e);
+                lowered += mine;
+            }
+        });
+        return lowered.load();
     }
+
+    std::int64_t vertical() const { return vertical_pass(true) + vertical_pass(false); }
 
     /// East then west along each row, the rows in parallel (each reads and writes only its own).
     std::int64_t horizontal() const {

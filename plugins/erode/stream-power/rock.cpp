@@ -10,12 +10,16 @@
 
 namespace orogen::stream_power {
 
-double Beds::strength(double zeta, double x, double y) const {
-    if (!layered()) return 0.5;
+int Beds::bed_class(double zeta, double x, double y) const {
+    if (!layered()) return kStrengths / 2;
     // The bed's base rises towards the dip's opposite: q is the height above a bed surface through the origin.
     const double q = zeta + dip_slope * (x * dip_east + y * dip_south);
     const auto bed = static_cast<std::int64_t>(std::floor(q / thickness));
-    return random::uniform(seed, std::uint64_t(bed));
+    return int(random::below(kStrengths, seed, std::uint64_t(bed)));
+}
+
+double Beds::strength(double zeta, double x, double y) const {
+    return (bed_class(zeta, x, y) + 0.5) / double(kStrengths);
 }
 
 double Beds::landslide_slope(double s) const {
@@ -32,18 +36,21 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, st
     slopes.resize(vary_slope ? count : 0);
     factors.resize(vary_k ? count : 0);
     if (!vary_slope && !vary_k) return;
+    // A bed's strength is one of kStrengths classes: the slopes and factors come from a table (a tan and
+    // a pow per class, not per cell and step).
+    constexpr int kStrengths = Beds::kStrengths;
+    double slope_of[kStrengths], factor_of[kStrengths];
+    for (int k = 0; k < kStrengths; ++k) {
+        const double s = (k + 0.5) / double(kStrengths);
+        slope_of[k] = beds.landslide_slope(s);
+        factor_of[k] = beds.erodibility_factor(s);
+    }
     parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e; ++i) {
             const double x = double(x0 + int(i % width)) * cell, y = double(y0 + int(i / width)) * cell;
-            const double s = beds.strength(heights[i] - uplifted[i], x, y);
-            if (vary_slope) {
-                static const double jit = std::getenv("OROGEN_JIT") ? std::atof(std::getenv("OROGEN_JIT")) : 0.0;
-                const double u = random::uniform(beds.seed ^ 0x5bd1e995u, std::uint64_t(x0 + int(i % width)),
-                                                 std::uint64_t(y0 + int(i / width)));
-                slopes[std::size_t(i)] =
-                    std::tan(std::atan(beds.landslide_slope(s)) + jit * 3.14159265358979 / 180.0 * (2.0 * u - 1.0));
-            }
-            if (vary_k) factors[std::size_t(i)] = beds.erodibility_factor(s);
+            const int k = beds.bed_class(heights[i] - uplifted[i], x, y);
+            if (vary_slope) slopes[std::size_t(i)] = slope_of[k];
+            if (vary_k) factors[std::size_t(i)] = factor_of[k];
         }
     });
 }

@@ -9,8 +9,9 @@
 // one, and cuts benches, hogbacks and strike valleys where the beds surface.
 //
 // The beds are planar, `thickness` metres thick, dipping at `dip` towards
-// azimuth `toward`; each has a strength s in [0, 1) drawn from the seed and its
-// index (counter-based: the same beds on any thread count and any tiling).
+// azimuth `toward`; each has a strength s in (0, 1), one of 256 classes drawn
+// from the seed and its index (counter-based: the same beds on any thread
+// count and any tiling).
 // The rock a cell shows is the one at its rock height ζ = h − uplift received
 // (the height that rock had at the start: the beds rise with the uplift, and
 // erosion digs into them). Its landslide angle is angle + spread·(2s − 1) and
@@ -34,9 +35,14 @@ struct Beds {
     double erodibility_contrast = 1.0;  ///< K of the weakest bed / K of the strongest (≥ 1)
     std::uint64_t seed = 0;
 
+    /// A bed's strength is one of this many classes, s = (k + 1/2)/kStrengths.
+    static constexpr int kStrengths = 256;
+
     bool layered() const { return thickness > 0.0; }
-    /// The strength in [0, 1) of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
-    /// corner, x east, y south); 0.5 when unlayered.
+    /// The strength class k of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
+    /// corner, x east, y south), from the seed and the bed's index; kStrengths/2 when unlayered.
+    int bed_class(double zeta, double x, double y) const;
+    /// Its strength, (k + 1/2)/kStrengths in (0, 1).
     double strength(double zeta, double x, double y) const;
     /// tan of the landslide angle of rock of strength s.
     double landslide_slope(double s) const;

@@ -158,10 +158,12 @@ void Model::glacial_factors(double dt) {
     stream_power::ice_flux(g, h_.data(), flow_.stack().data(), flow_.receivers().data(), n, cell_, ice_);
     ice_f_.assign(n, 0.0);
     const double ns = settings_.slope_exponent;
-    for (std::size_t i = 0; i < n; ++i)
-        if (ice_[i] >= g.glacier_flux && flow_.receivers()[i] != std::int32_t(i))  // a glacier, not at an outlet or pit
-            ice_f_[i] = g.erodibility * dt * std::pow(ice_[i], g.flux_exponent) /
-                        std::pow(flow_.distance(std::int64_t(i)), ns);
+    parallel_for(0, std::int64_t(n), 1 << 14, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i)
+            if (ice_[std::size_t(i)] >= g.glacier_flux && flow_.receivers()[std::size_t(i)] != std::int32_t(i))
+                ice_f_[std::size_t(i)] = g.erodibility * dt * std::pow(ice_[std::size_t(i)], g.flux_exponent) /
+                                         std::pow(flow_.distance(i), ns);  // a glacier, not at an outlet or pit
+    });
 }
 
 void Model::incise(double dt) {

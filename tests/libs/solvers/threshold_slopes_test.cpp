@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -139,17 +140,20 @@ TEST(ThresholdSlopes, RoughReliefEndsAtTheThresholdWithoutPitsAndNothingRaised) 
 TEST(ThresholdSlopes, TheSameBitsAsAJacobiIterationAndOnOneAndTwoThreads) {
     // The update is monotone, so every order of updates ends at the one greatest fixed point, bit for bit:
     // the sweeps, Jacobi's all-at-once iteration, and the sweeps on any number of threads.
-    const int w = 97, h = 64;
-    const double cell = 25.0;
-    const auto start = rough(w, h, 11, 600.0);
-    std::vector<double> slope(start.size());
-    for (std::size_t i = 0; i < slope.size(); ++i) slope[i] = 0.4 + 0.6 * random::uniform(5, i);
-    const auto reference = jacobi(start, w, h, cell, slope);
-    for (int threads : {1, 2}) {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
-        auto v = start;
-        threshold::limit_slopes(v.data(), w, h, cell, {0.0, slope.data()});
-        EXPECT_EQ(0, std::memcmp(v.data(), reference.data(), v.size() * sizeof(double))) << threads << " threads";
+    // 601 columns: the vertical sweeps run in strips of 256 columns, which meet at two seams.
+    for (const auto [w, h] : {std::pair{97, 64}, std::pair{601, 47}}) {
+        const double cell = 25.0;
+        const auto start = rough(w, h, 11, 600.0);
+        std::vector<double> slope(start.size());
+        for (std::size_t i = 0; i < slope.size(); ++i) slope[i] = 0.4 + 0.6 * random::uniform(5, i);
+        const auto reference = jacobi(start, w, h, cell, slope);
+        for (int threads : {1, 2}) {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+            auto v = start;
+            threshold::limit_slopes(v.data(), w, h, cell, {0.0, slope.data()});
+            EXPECT_EQ(0, std::memcmp(v.data(), reference.data(), v.size() * sizeof(double)))
+                << w << " x " << h << ", " << threads << " threads";
+        }
     }
 }
 
