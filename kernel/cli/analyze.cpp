@@ -74,7 +74,7 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
             const auto n = got ? parse_number(v) : std::nullopt;
             if (!n || *n <= 0.0 || *n > 1e6)
                 return "--cell needs the distance between samples in metres, a number above 0" +
-                       (got ? ", got '" + v + "'" : std::string());
+                    (got ? ", got '" + v + "'" : std::string());
             a.cell = *n;
         } else if (is("--heights")) {
             const bool got = value("--heights", v);
@@ -83,7 +83,7 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
             const auto high = got && colon != std::string::npos ? parse_number(v.substr(colon + 1)) : std::nullopt;
             if (!low || !high || !(*high > *low))
                 return "--heights needs LOW:HIGH, the heights in metres of a PNG's black and white (LOW < HIGH)" +
-                       (got ? ", got '" + v + "'" : std::string());
+                    (got ? ", got '" + v + "'" : std::string());
             a.heights = std::pair{*low, *high};
         } else if (is("--threads")) {
             const bool got = value("--threads", v);
@@ -102,8 +102,9 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
         }
     }
     if (a.files.empty())
-        return a.against.empty() ? "analyze needs at least one terrain file"
-                                 : "analyze needs a terrain to measure before --against (the files after it are references)";
+        return a.against.empty()
+            ? "analyze needs at least one terrain file"
+            : "analyze needs a terrain to measure before --against (the files after it are references)";
     if (references && a.against.empty()) return "--against needs at least one reference DEM after it";
     if (a.files.size() + a.against.size() > 16)
         return "analyze compares at most 16 files at once, got " + std::to_string(a.files.size() + a.against.size());
@@ -134,8 +135,10 @@ ComposedSpec compose_analyze_spec(const AnalyzeArgs& args) {
             fs::path raw = file;
             raw.replace_extension(".f32");
             if (!fs::exists(raw, ec)) {
-                spec.problem = file.string() + ": a .json file is read as the description of a .f32 grid beside it, "
-                                               "but there is no " + raw.string() + "; give the terrain file itself";
+                spec.problem = file.string() +
+                    ": a .json file is read as the description of a .f32 grid beside it, "
+                    "but there is no " +
+                    raw.string() + "; give the terrain file itself";
                 return spec;
             }
             file = raw;
@@ -147,12 +150,13 @@ ComposedSpec compose_analyze_spec(const AnalyzeArgs& args) {
         std::string node;
         if (ext == ".png") {
             if (!args.cell || !args.heights) {
-                spec.problem = file.string() + ": a PNG holds neither the cell size nor heights in metres; give --cell "
-                                               "METRES and --heights LOW:HIGH (the heights of black and white)";
+                spec.problem = file.string() +
+                    ": a PNG holds neither the cell size nor heights in metres; give --cell "
+                    "METRES and --heights LOW:HIGH (the heights of black and white)";
                 return spec;
             }
             node = "import:png(path=" + path + cell + ", low=" + number(args.heights->first) +
-                   ", high=" + number(args.heights->second) + ")";
+                ", high=" + number(args.heights->second) + ")";
         } else if (ext == ".r16" || ext == ".r32") {
             node = "import:raw(path=" + path + cell + ")";
         } else if (ext == ".exr") {

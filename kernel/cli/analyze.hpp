@@ -11,12 +11,12 @@
 namespace orogen::cli {
 
 struct AnalyzeArgs {
-    std::vector<std::string> files;    ///< terrains to measure
+    std::vector<std::string> files;  ///< terrains to measure
     std::vector<std::string> against;  ///< references (real DEMs)
-    std::string out = "analysis";      ///< --out
-    std::optional<double> cell;        ///< --cell M: the cell size of every file (m)
+    std::string out = "analysis";  ///< --out
+    std::optional<double> cell;  ///< --cell M: the cell size of every file (m)
     std::optional<std::pair<double, double>> heights;  ///< --heights LOW:HIGH, metres of a PNG's black and white
-    bool render = true;                ///< --no-render: no pictures
+    bool render = true;  ///< --no-render: no pictures
     bool quiet = false;
     int threads = 0;
 };

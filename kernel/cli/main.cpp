@@ -99,7 +99,7 @@ struct Args {
     bool allow_outside_out = false;
     std::vector<std::string> overrides;
     std::optional<std::string> cache_dir;  ///< --cache DIR
-    bool no_cache = false;                 ///< --no-cache
+    bool no_cache = false;  ///< --no-cache
     std::uint64_t cache_size = cache::Settings{}.max_bytes;
     std::optional<std::pair<int, int>> tiles;  ///< --tiles RxC
     std::string tiles_text;
@@ -141,13 +141,16 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
         } else if (is("--seed")) {
             auto v = value("--seed");
             auto n = v ? parse_u64(*v) : std::nullopt;
-            if (!n) return usage_error("--seed needs a whole number from 0 to 2^64-1" + (v ? ", got '" + *v + "'" : std::string()));
+            if (!n)
+                return usage_error("--seed needs a whole number from 0 to 2^64-1" +
+                                   (v ? ", got '" + *v + "'" : std::string()));
             a.seed = n;
         } else if (is("--threads")) {
             auto v = value("--threads");
             auto n = v ? parse_u64(*v) : std::nullopt;
             if (!n || *n < 1 || *n > 1024)
-                return usage_error("--threads needs a number from 1 to 1024" + (v ? ", got '" + *v + "'" : std::string()));
+                return usage_error("--threads needs a number from 1 to 1024" +
+                                   (v ? ", got '" + *v + "'" : std::string()));
             a.threads = int(*n);
         } else if (is("--set")) {
             auto v = value("--set");
@@ -156,7 +159,9 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
         } else if (is("--cache-size")) {
             auto v = value("--cache-size");
             auto n = v ? cache::parse_size(*v) : std::nullopt;
-            if (!n) return usage_error("--cache-size needs a size such as 2G, 500M or 1073741824" + (v ? ", got '" + *v + "'" : std::string()));
+            if (!n)
+                return usage_error("--cache-size needs a size such as 2G, 500M or 1073741824" +
+                                   (v ? ", got '" + *v + "'" : std::string()));
             a.cache_size = *n;
         } else if (is("--cache")) {
             auto v = value("--cache");
@@ -176,10 +181,11 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
             a.quiet = true;
         } else if (arg.size() > 1 && arg[0] == '-') {
             static const std::vector<std::string> options = {
-                "--out", "--seed", "--threads", "--set", "--cache-size", "--cache", "--no-cache", "--tiles",
-                "--allow-outside-out", "--quiet"};
+                "--out",      "--seed",  "--threads",           "--set",  "--cache-size", "--cache",
+                "--no-cache", "--tiles", "--allow-outside-out", "--quiet"};
             const std::string guess = spec::closest(arg.substr(0, arg.find('=')), options);
-            return usage_error("unknown option '" + arg + "'" + (guess.empty() ? "" : "; did you mean '" + guess + "'?"));
+            return usage_error("unknown option '" + arg + "'" +
+                               (guess.empty() ? "" : "; did you mean '" + guess + "'?"));
         } else {
             a.positional.push_back(arg);
         }
@@ -200,8 +206,9 @@ std::optional<cache::Settings> cache_settings(const Args& args) {
     if (const char* off = std::getenv("OROGEN_NO_CACHE"); off && *off && std::string(off) != "0") return std::nullopt;
     s.folder = cache::default_folder();
     if (s.folder.empty()) {
-        std::fprintf(stderr, "orogen: warning: neither XDG_CACHE_HOME nor HOME is set, so there is no cache folder; "
-                             "running without the cache (give one with --cache DIR)\n");
+        std::fprintf(stderr,
+                     "orogen: warning: neither XDG_CACHE_HOME nor HOME is set, so there is no cache folder; "
+                     "running without the cache (give one with --cache DIR)\n");
         return std::nullopt;
     }
     return s;
@@ -225,8 +232,9 @@ int cmd_cache(const Args& args) {
     if (args.no_cache) return usage_error("--no-cache means no cache folder; give the folder with --cache DIR");
     const fs::path folder = args.cache_dir ? fs::path(*args.cache_dir) : cache::default_folder();
     if (folder.empty()) {
-        std::fprintf(stderr, "orogen: error: neither XDG_CACHE_HOME nor HOME is set, so there is no default cache "
-                             "folder; give one with --cache DIR\n");
+        std::fprintf(stderr,
+                     "orogen: error: neither XDG_CACHE_HOME nor HOME is set, so there is no default cache "
+                     "folder; give one with --cache DIR\n");
         return exit_bad_input;
     }
     if (args.positional[0] == "clear") {
@@ -238,9 +246,11 @@ int cmd_cache(const Args& args) {
     }
     const cache::FolderFacts f = cache::folder_facts(folder);
     std::printf("cache folder: %s%s\n", folder.c_str(), f.exists ? "" : " (does not exist yet: nothing kept)");
-    std::printf("entries:      %llu (%s)\n", static_cast<unsigned long long>(f.entries), human_bytes(double(f.bytes)).c_str());
+    std::printf("entries:      %llu (%s)\n", static_cast<unsigned long long>(f.entries),
+                human_bytes(double(f.bytes)).c_str());
     std::printf("limit:        %s%s\n", human_bytes(double(args.cache_size)).c_str(),
-                args.cache_size == cache::Settings{}.max_bytes ? " (the default; a run's --cache-size sets its own)" : " (--cache-size)");
+                args.cache_size == cache::Settings{}.max_bytes ? " (the default; a run's --cache-size sets its own)"
+                                                               : " (--cache-size)");
     if (f.entries > 0) {
         std::printf("oldest:       %s (least recently used)\n", utc_time(f.oldest_ns).c_str());
         std::printf("newest:       %s (most recently used)\n", utc_time(f.newest_ns).c_str());
@@ -278,15 +288,17 @@ std::vector<std::string> summarise_outputs(const std::vector<fs::path>& outputs)
     for (const auto& pattern : order) {
         const auto& files = groups[pattern];
         if (files.size() <= kListed) lines.insert(lines.end(), files.begin(), files.end());
-        else lines.push_back(files.front() + " ... " + fs::path(files.back()).filename().string() + " (" +
-                             std::to_string(files.size()) + " files)");
+        else
+            lines.push_back(files.front() + " ... " + fs::path(files.back()).filename().string() + " (" +
+                            std::to_string(files.size()) + " files)");
     }
     return lines;
 }
 
 /// The tiles of a run under mpirun: --tiles or automatic.
 TileSplit tiled_split(const Plan& plan, const Args& args) {
-    const auto [rows, cols] = args.tiles ? *args.tiles : automatic_tiles(g_mpi->size, plan.grid.width, plan.grid.height);
+    const auto [rows, cols] =
+        args.tiles ? *args.tiles : automatic_tiles(g_mpi->size, plan.grid.width, plan.grid.height);
     return split_grid(plan.grid.width, plan.grid.height, rows, cols);
 }
 
@@ -298,13 +310,13 @@ std::string tiles_problem(const Args& args, int ranks) {
     if (tiles == ranks) return "";
     if (tiles < ranks)
         return "--tiles " + args.tiles_text + " makes " + std::to_string(tiles) + " tile" + (tiles == 1 ? "" : "s") +
-               " for " + std::to_string(ranks) + " ranks (more ranks than tiles): give --tiles with " +
-               std::to_string(ranks) + " tiles, or start " + std::to_string(tiles) + " rank" + (tiles == 1 ? "" : "s") +
-               " (mpirun -n " + std::to_string(tiles) + ")";
+            " for " + std::to_string(ranks) + " ranks (more ranks than tiles): give --tiles with " +
+            std::to_string(ranks) + " tiles, or start " + std::to_string(tiles) + " rank" + (tiles == 1 ? "" : "s") +
+            " (mpirun -n " + std::to_string(tiles) + ")";
     return "--tiles " + args.tiles_text + " makes " + std::to_string(tiles) + " tiles for " + std::to_string(ranks) +
-           " rank" + (ranks == 1 ? "" : "s") + ", and each rank holds one tile: give --tiles with " +
-           std::to_string(ranks) + " tiles, or start " + std::to_string(tiles) + " ranks (mpirun -n " +
-           std::to_string(tiles) + ")";
+        " rank" + (ranks == 1 ? "" : "s") + ", and each rank holds one tile: give --tiles with " +
+        std::to_string(ranks) + " tiles, or start " + std::to_string(tiles) + " ranks (mpirun -n " +
+        std::to_string(tiles) + ")";
 }
 
 /// Read, parse and check a spec. Prints diagnostics; returns nullopt on error.
@@ -340,7 +352,8 @@ std::optional<Plan> check_spec_text(const std::string& path, std::string text, c
     spec::Spec parsed = spec::parse(source, diags);
     if (diags.has_errors()) {  // syntax first: semantic errors on a broken tree would be noise
         std::fputs(diags.format().c_str(), stderr);
-        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s", path.c_str());
+        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
+                     path.c_str());
         return std::nullopt;
     }
     CheckOptions options;
@@ -352,8 +365,8 @@ std::optional<Plan> check_spec_text(const std::string& path, std::string text, c
         // Tiled: each heightmap of a tiled node is one tile, and the ranks on this machine share its memory.
         const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
         const int on_this_machine = std::clamp(local ? std::atoi(local) : g_mpi->size, 1, g_mpi->size);
-        options.heightmap_memory_limit = heightmap_memory_limit() / std::uint64_t(on_this_machine) *
-                                         std::uint64_t(g_mpi->size);
+        options.heightmap_memory_limit =
+            heightmap_memory_limit() / std::uint64_t(on_this_machine) * std::uint64_t(g_mpi->size);
         options.tiled_memory_share = double(on_this_machine) / double(g_mpi->size);
     }
     Plan plan = check(parsed, plugins.registry(), path, options, diags);
@@ -368,7 +381,8 @@ std::optional<Plan> check_spec_text(const std::string& path, std::string text, c
     if (g_mpi && g_mpi->rank != 0) return diags.has_errors() ? std::nullopt : std::optional<Plan>(std::move(plan));
     if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
     if (diags.has_errors()) {
-        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s", path.c_str());
+        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
+                     path.c_str());
         return std::nullopt;
     }
     return plan;
@@ -416,7 +430,8 @@ int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugi
     options.on_note = [](const std::string& note) { std::fprintf(stderr, "orogen: %s\n", note.c_str()); };
     // A tiled run keeps no cache: its values are tiles, which the cache's keys do not describe (docs/cache.md).
     options.cache = g_mpi ? std::nullopt : cache_settings(args);
-    for (const auto* n : plugins.registry().nodes()) {  // which plugin (name, version) makes each node: part of its cache key
+    for (const auto* n :
+         plugins.registry().nodes()) {  // which plugin (name, version) makes each node: part of its cache key
         const std::string file = plugins.registry().provider(n->qualified_name());
         for (const auto& p : options.plugins)
             if (p.file == file) options.node_plugins[n->qualified_name()] = p;
@@ -430,8 +445,8 @@ int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugi
     if (!args.quiet && speaks && summary) {
         if (g_mpi) {
             const TileSplit& split = tiled->split();
-            std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size, g_mpi->size == 1 ? "" : "s",
-                        split.grid_width, split.grid_height, split.rows, split.cols);
+            std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size,
+                        g_mpi->size == 1 ? "" : "s", split.grid_width, split.grid_height, split.rows, split.cols);
             for (const PlannedNode& node : plan->nodes)
                 if (node.node->tile_halo >= 0 && !TiledRun::runs_tiled(node))
                     std::printf("  '%s' (%s) ran on rank 0 over the whole grid: %s\n", node.label.c_str(),
@@ -449,7 +464,8 @@ int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugi
 /// the analyze:terrain node wrote is printed.
 int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
     cli::AnalyzeArgs a;
-    if (const std::string problem = cli::parse_analyze_args(argc, argv, a); !problem.empty()) return usage_error(problem);
+    if (const std::string problem = cli::parse_analyze_args(argc, argv, a); !problem.empty())
+        return usage_error(problem);
     const cli::ComposedSpec composed = cli::compose_analyze_spec(a);
     if (!composed.problem.empty()) {
         std::fprintf(stderr, "orogen: error: %s\n", composed.problem.c_str());
@@ -464,8 +480,9 @@ int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
     // The spec's file name only names it in messages: its paths are absolute.
     auto plan = check_spec_text("orogen-analyze.orogen", composed.text, plugins, args);
     if (!plan) {
-        std::fprintf(stderr, "(orogen analyze ran the spec above, composed from its command line: a node's cell= is "
-                             "--cell, low= and high= are --heights)\n");
+        std::fprintf(stderr,
+                     "(orogen analyze ran the spec above, composed from its command line: a node's cell= is "
+                     "--cell, low= and high= are --heights)\n");
         return exit_bad_input;
     }
     const int rc = run_plan(plan, args, plugins, false);
@@ -486,9 +503,11 @@ int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
 int cmd_list(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() > 1) return usage_error("list takes at most one kind");
     const std::string kind = args.positional.empty() ? "" : args.positional[0];
-    static const std::vector<std::string> kinds = {"generate", "erode", "tectonics", "render", "export", "import", "analyze"};
+    static const std::vector<std::string> kinds = {"generate", "erode",  "tectonics", "render",
+                                                   "export",   "import", "analyze"};
     if (!kind.empty() && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) {
-        std::string msg = "unknown kind '" + kind + "' (kinds: generate, erode, tectonics, render, export, import, analyze)";
+        std::string msg =
+            "unknown kind '" + kind + "' (kinds: generate, erode, tectonics, render, export, import, analyze)";
         const std::string guess = spec::closest(kind, kinds);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
@@ -509,12 +528,12 @@ std::string value_text(const ParamValue& v, const Param& p) {
             using T = std::decay_t<decltype(x)>;
             if constexpr (std::is_same_v<T, std::monostate>) s << "(required)";
             else if constexpr (std::is_same_v<T, bool>) s << (x ? "true" : "false");
-            else if constexpr (std::is_same_v<T, std::string>)
-                s << (p.type == ParamType::choice ? x : "\"" + x + "\"");
+            else if constexpr (std::is_same_v<T, std::string>) s << (p.type == ParamType::choice ? x : "\"" + x + "\"");
             else if constexpr (std::is_same_v<T, Point2>) s << "(" << x.x << ", " << x.y << ")";
             else if constexpr (std::is_same_v<T, std::vector<Point2>>) {
                 s << "[";
-                for (std::size_t i = 0; i < x.size(); ++i) s << (i ? ", " : "") << "(" << x[i].x << ", " << x[i].y << ")";
+                for (std::size_t i = 0; i < x.size(); ++i)
+                    s << (i ? ", " : "") << "(" << x[i].x << ", " << x[i].y << ")";
                 s << "]";
             } else s << x;
         },
@@ -545,8 +564,9 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
     std::printf("\ninputs:%s\n", n->inputs.empty() ? " none" : "");
     for (std::size_t i = 0; i < n->inputs.size(); ++i) {
         const auto& in = n->inputs[i];
-        const std::string type = in.many == Many::either ? describe_type(in.type, false) + " or " + describe_type(in.type, true)
-                                                          : describe_type(in.type, in.many == Many::series);
+        const std::string type = in.many == Many::either
+            ? describe_type(in.type, false) + " or " + describe_type(in.type, true)
+            : describe_type(in.type, in.many == Many::series);
         std::printf("  %zu. %-14s %s%s%s\n", i + 1, in.name.c_str(), type.c_str(),
                     in.need == Need::optional ? ", optional" : "", in.help.empty() ? "" : (" — " + in.help).c_str());
     }
@@ -565,11 +585,12 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
         std::string range;
         if (p.minimum || p.maximum) {
             range = std::string(p.minimum ? (p.minimum_exclusive ? "(" : "[") : "(") +
-                    (p.minimum ? value_text(*p.minimum, p) : "-inf") + ", " +
-                    (p.maximum ? value_text(*p.maximum, p) : "inf") + (p.maximum ? (p.maximum_exclusive ? ")" : "]") : ")");
+                (p.minimum ? value_text(*p.minimum, p) : "-inf") + ", " +
+                (p.maximum ? value_text(*p.maximum, p) : "inf") + (p.maximum ? (p.maximum_exclusive ? ")" : "]") : ")");
         }
-        std::printf("  %-16s %-12s default %-12s%s%s\n", p.name.c_str(), type.c_str(), value_text(p.default_value, p).c_str(),
-                    range.empty() ? "" : ("  range " + range).c_str(), p.unit_text.empty() ? "" : ("  unit " + p.unit_text).c_str());
+        std::printf("  %-16s %-12s default %-12s%s%s\n", p.name.c_str(), type.c_str(),
+                    value_text(p.default_value, p).c_str(), range.empty() ? "" : ("  range " + range).c_str(),
+                    p.unit_text.empty() ? "" : ("  unit " + p.unit_text).c_str());
         if (p.type == ParamType::choice) {
             std::string options;
             for (const auto& c : p.choices) options += (options.empty() ? "" : ", ") + c;
@@ -641,8 +662,9 @@ int main(int argc, char** argv) {
             return exit_bad_input;
         }
     } else if (args.tiles) {
-        return usage_error("--tiles splits a run under mpirun (mpirun -n N orogen run SPEC --tiles RxC); "
-                           "this orogen was not started by mpirun");
+        return usage_error(
+            "--tiles splits a run under mpirun (mpirun -n N orogen run SPEC --tiles RxC); "
+            "this orogen was not started by mpirun");
     }
 
     if (args.command == "cache") {  // no plugins needed

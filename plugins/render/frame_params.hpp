@@ -29,10 +29,11 @@ inline void check_frame_memory(CheckContext& ctx, double bytes_per_pixel) {
     const double need = w * h * bytes_per_pixel;
     const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (need > memory / 2)
-        ctx.error("width", "a " + std::to_string(std::int64_t(w)) + " × " + std::to_string(std::int64_t(h)) +
-                               " frame needs about " + std::to_string(std::int64_t(std::ceil(need / 1e6))) +
-                               " MB, more than half of this machine's " + std::to_string(std::int64_t(memory / 1e6)) +
-                               " MB of memory; use a smaller width and height");
+        ctx.error("width",
+                  "a " + std::to_string(std::int64_t(w)) + " × " + std::to_string(std::int64_t(h)) +
+                      " frame needs about " + std::to_string(std::int64_t(std::ceil(need / 1e6))) +
+                      " MB, more than half of this machine's " + std::to_string(std::int64_t(memory / 1e6)) +
+                      " MB of memory; use a smaller width and height");
 }
 
 }  // namespace orogen::render

@@ -16,8 +16,8 @@ namespace orogen {
 /// A mutable view of `width` × `height` float samples, `cell` metres apart.
 struct GridView {
     float* data = nullptr;
-    int width = 0;      ///< samples per row (vertices, not tiles)
-    int height = 0;     ///< rows
+    int width = 0;  ///< samples per row (vertices, not tiles)
+    int height = 0;  ///< rows
     double cell = 1.0;  ///< distance between neighbouring samples, metres
 
     std::size_t size() const { return std::size_t(width) * std::size_t(height); }

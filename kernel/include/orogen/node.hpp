@@ -47,7 +47,7 @@ using ParamValue = std::variant<std::monostate, std::int64_t, double, bool, std:
 
 /// What a path parameter names.
 enum class PathRole {
-    input,   ///< an existing file to read; must exist at check time
+    input,  ///< an existing file to read; must exist at check time
     output,  ///< a file to write, relative to the output folder
 };
 
@@ -79,15 +79,32 @@ struct Param {
     static Param path(std::string name, PathRole role, std::vector<std::string> extensions = {},
                       std::optional<std::string> def = std::nullopt);
 
-    Param& min(double v, bool exclusive = false) & { minimum = v; minimum_exclusive = exclusive; return *this; }
-    Param& max(double v, bool exclusive = false) & { maximum = v; maximum_exclusive = exclusive; return *this; }
-    Param& unit(std::string u) & { unit_text = std::move(u); return *this; }
-    Param& help(std::string h) & { help_text = std::move(h); return *this; }
+    Param& min(double v, bool exclusive = false) & {
+        minimum = v;
+        minimum_exclusive = exclusive;
+        return *this;
+    }
+    Param& max(double v, bool exclusive = false) & {
+        maximum = v;
+        maximum_exclusive = exclusive;
+        return *this;
+    }
+    Param& unit(std::string u) & {
+        unit_text = std::move(u);
+        return *this;
+    }
+    Param& help(std::string h) & {
+        help_text = std::move(h);
+        return *this;
+    }
     Param&& min(double v, bool exclusive = false) && { return std::move(min(v, exclusive)); }
     Param&& max(double v, bool exclusive = false) && { return std::move(max(v, exclusive)); }
     Param&& unit(std::string u) && { return std::move(unit(std::move(u))); }
     Param&& help(std::string h) && { return std::move(help(std::move(h))); }
-    Param&& at_most(std::size_t n) && { max_points = n; return std::move(*this); }
+    Param&& at_most(std::size_t n) && {
+        max_points = n;
+        return std::move(*this);
+    }
 
     bool required() const { return std::holds_alternative<std::monostate>(default_value); }
 };
@@ -136,7 +153,7 @@ std::string describe_type(ValueType type, bool series);
 struct ValueInfo {
     ValueType type = ValueType::none;
     int width = 0, height = 0;  ///< heightmap/image size, 0 if unknown
-    double cell = 0.0;          ///< heightmap cell size in metres, 0 if unknown
+    double cell = 0.0;  ///< heightmap cell size in metres, 0 if unknown
     std::set<std::string, std::less<>> layers;  ///< heightmap layers known to exist
     bool layers_known = true;  ///< false if an input may carry layers nobody declared (imports)
     /// For a series: the type of its entries (the fields above then describe an entry).
@@ -150,7 +167,7 @@ struct ValueInfo {
 /// The default grid from the spec's `grid` statement.
 struct GridSpec {
     int width = 513, height = 513;  ///< vertices
-    double cell = 1.0;              ///< metres
+    double cell = 1.0;  ///< metres
 };
 
 /// Handed to a node's check hook after the kernel has type-checked every
@@ -182,7 +199,10 @@ public:
     virtual ValueInfo& output() = 0;
     /// What side value `name` will hold, to refine (e.g. mark a time-lapse that records nothing
     /// as empty); nullptr if the node declares no such side output.
-    virtual ValueInfo* side_output(std::string_view name) { (void)name; return nullptr; }
+    virtual ValueInfo* side_output(std::string_view name) {
+        (void)name;
+        return nullptr;
+    }
 
     /// True if heightmap input `i` has layer `name` (or may have it: its layers
     /// are not known before the run). Otherwise reports at `param`
@@ -280,8 +300,8 @@ enum class CachePolicy {
 };
 
 struct NodeDescriptor {
-    std::string kind;     ///< generate | erode | tectonics | render | export | import | analyze
-    std::string name;     ///< kebab-case, unique within the kind
+    std::string kind;  ///< generate | erode | tectonics | render | export | import | analyze
+    std::string name;  ///< kebab-case, unique within the kind
     std::string summary;  ///< one line, for `orogen list`
     std::string description;  ///< longer text for `orogen help` (optional)
     std::vector<InputSpec> inputs;

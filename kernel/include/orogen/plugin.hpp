@@ -72,8 +72,8 @@ extern "C" {
 /// What a plugin returns from `orogen_plugin_info`.
 struct OrogenPluginInfo {
     std::uint32_t api_version;  ///< OROGEN_PLUGIN_API_VERSION at build time
-    const char* plugin_name;    ///< kebab-case
-    const char* plugin_version; ///< the plugin's own version, free form ("1.2.0")
+    const char* plugin_name;  ///< kebab-case
+    const char* plugin_version;  ///< the plugin's own version, free form ("1.2.0")
     void (*register_nodes)(orogen::Registry& registry);
 };
 
@@ -83,9 +83,9 @@ typedef OrogenPluginInfo (*OrogenPluginInfoFn)(void);
 
 #define OROGEN_PLUGIN_ENTRY_SYMBOL "orogen_plugin_info"
 
-#define OROGEN_PLUGIN(NAME, VERSION, REGISTRY)                                          \
-    static void orogen_register_nodes_(orogen::Registry& REGISTRY);                     \
+#define OROGEN_PLUGIN(NAME, VERSION, REGISTRY)                                                    \
+    static void orogen_register_nodes_(orogen::Registry& REGISTRY);                               \
     extern "C" __attribute__((visibility("default"))) OrogenPluginInfo orogen_plugin_info(void) { \
-        return {OROGEN_PLUGIN_API_VERSION, NAME, VERSION, &orogen_register_nodes_};      \
-    }                                                                                    \
+        return {OROGEN_PLUGIN_API_VERSION, NAME, VERSION, &orogen_register_nodes_};               \
+    }                                                                                             \
     static void orogen_register_nodes_(orogen::Registry& REGISTRY)

@@ -40,7 +40,7 @@ class Heightmap;  // values.hpp
 
 /// A rectangle of vertices in global grid coordinates.
 struct TileRect {
-    int x0 = 0, y0 = 0;         ///< first column and row
+    int x0 = 0, y0 = 0;  ///< first column and row
     int width = 0, height = 0;  ///< vertices
     int x1() const { return x0 + width; }
     int y1() const { return y0 + height; }

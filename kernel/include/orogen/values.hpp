@@ -88,7 +88,7 @@ struct Image {
     int height = 0;
     Format format = Format::rgba8;
     std::vector<std::uint8_t> rgba8;  ///< width*height*4 bytes, sRGB
-    std::vector<float> rgba32f;       ///< width*height*4 floats, linear
+    std::vector<float> rgba32f;  ///< width*height*4 floats, linear
 };
 
 // ---------------------------------------------------------------- particles
@@ -123,8 +123,8 @@ struct ParticleSeries {
 struct PlateState {
     int id = 0;
     std::vector<Point2> polygon;
-    Point2 velocity;          ///< m per simulation second
-    double density = 1.0;     ///< relative; denser plates subduct
+    Point2 velocity;  ///< m per simulation second
+    double density = 1.0;  ///< relative; denser plates subduct
 };
 
 struct PlateSnapshot {
@@ -148,7 +148,7 @@ struct CollisionEvent {
 
 /// A plate simulation's history.
 struct PlateHistory {
-    double width = 0.0;   ///< extent of the simulated area, metres
+    double width = 0.0;  ///< extent of the simulated area, metres
     double height = 0.0;
     std::vector<PlateSnapshot> snapshots;
     std::vector<CollisionEvent> collisions;
@@ -205,7 +205,7 @@ private:
 /// value (shared_ptrs to its inputs, its parameters).
 struct Series {
     ValueType element = ValueType::none;  ///< type of every entry (never series)
-    std::vector<double> times;            ///< one per entry, in the producer's clock (seconds, or years)
+    std::vector<double> times;  ///< one per entry, in the producer's clock (seconds, or years)
     /// Makes entry i (0 ≤ i < size()). May be called more than once, in any
     /// order, from one thread at a time; must be deterministic.
     std::function<Value(std::size_t)> make;

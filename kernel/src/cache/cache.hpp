@@ -98,9 +98,9 @@ struct Contents {
     /// Files the node wrote that are too large to be worth a copy in the cache (docs/cache.md): only their
     /// path, size and SHA-256 are kept. A re-run finds them in --out or runs the node again.
     struct Recorded {
-        std::string path;     ///< relative to the output folder
+        std::string path;  ///< relative to the output folder
         std::uint64_t bytes = 0;
-        std::string sha256;   ///< 64 lowercase hex digits
+        std::string sha256;  ///< 64 lowercase hex digits
         bool operator==(const Recorded&) const = default;
     };
     std::vector<Recorded> recorded;
@@ -134,9 +134,9 @@ struct OtherVersion : std::runtime_error {
 
 /// Header facts read without touching the payload.
 struct EntryInfo {
-    std::uint64_t bytes = 0;     ///< whole file
+    std::uint64_t bytes = 0;  ///< whole file
     std::uint32_t messages = 0;  ///< messages the node printed
-    std::uint32_t files = 0;     ///< files it wrote (kept or recorded)
+    std::uint32_t files = 0;  ///< files it wrote (kept or recorded)
     std::vector<std::string> texts;  ///< the messages (read and checked with the header: no payload needed)
 };
 
@@ -152,11 +152,11 @@ std::optional<std::uint64_t> parse_size(std::string_view text);
 
 /// What a cache folder holds (`orogen cache info`).
 struct FolderFacts {
-    bool exists = false;            ///< false: no such folder (nothing kept yet)
-    std::uint64_t entries = 0;      ///< `<key>.orc` files
-    std::uint64_t bytes = 0;        ///< their size
-    std::int64_t oldest_ns = 0;     ///< least recently used entry's modification time (ns since 1970), if any
-    std::int64_t newest_ns = 0;     ///< most recently used
+    bool exists = false;  ///< false: no such folder (nothing kept yet)
+    std::uint64_t entries = 0;  ///< `<key>.orc` files
+    std::uint64_t bytes = 0;  ///< their size
+    std::int64_t oldest_ns = 0;  ///< least recently used entry's modification time (ns since 1970), if any
+    std::int64_t newest_ns = 0;  ///< most recently used
     std::uint64_t temporaries = 0;  ///< half-written entries of runs in progress or killed
     std::uint64_t temporary_bytes = 0;
 };
@@ -165,7 +165,7 @@ FolderFacts folder_facts(const std::filesystem::path& folder);
 
 struct Cleared {
     std::uint64_t entries = 0, bytes = 0;  ///< removed
-    std::vector<std::string> failures;     ///< "file: why", one per entry that could not be removed
+    std::vector<std::string> failures;  ///< "file: why", one per entry that could not be removed
 };
 /// Remove every entry of `folder` and the temporaries of killed runs (older than an hour; a run in progress
 /// keeps its own). Nothing else in the folder is touched, so pointing --cache at a wrong folder loses no

@@ -138,16 +138,16 @@ public:
     void run_finished() override {
         int reused = 0;
         for (const auto& t : shared_.result.timings) reused += t.cached ? 1 : 0;
-        shared_.result.cache_summary = "cache: " + std::to_string(reused) + " of " + std::to_string(plan_.nodes.size()) +
-                                       " nodes reused from " + store_.folder().string() + " (" +
-                                       human_bytes(double(store_.total_bytes())) + " of " +
-                                       human_bytes(double(shared_.options.cache->max_bytes)) + ")";
+        shared_.result.cache_summary = "cache: " + std::to_string(reused) + " of " +
+            std::to_string(plan_.nodes.size()) + " nodes reused from " + store_.folder().string() + " (" +
+            human_bytes(double(store_.total_bytes())) + " of " + human_bytes(double(shared_.options.cache->max_bytes)) +
+            ")";
     }
 
 private:
     struct State {
         std::optional<cache::Digest> key;  ///< nullopt: not cached (a series' producer unknown...)
-        bool rerun = false;                ///< always runs; its outputs are keyed by their contents
+        bool rerun = false;  ///< always runs; its outputs are keyed by their contents
         TurnAnswer::Kind answered = TurnAnswer::Kind::run;
         std::vector<fs::path> files_before;  ///< the staging folder's files before it ran (sorted)
         std::size_t outside_before = 0;
@@ -171,8 +171,8 @@ private:
             if (it == value_keys_.end() || !it->second) return;  // made by a node whose result has no key
             inputs.push_back(it->second);
         }
-        s.key = cache::node_key(plan_, node, inputs, plugin->second.name, plugin->second.version, plugin->second.identity,
-                                node_seed(plan_.seed, node.label));
+        s.key = cache::node_key(plan_, node, inputs, plugin->second.name, plugin->second.version,
+                                plugin->second.identity, node_seed(plan_.seed, node.label));
         if (s.rerun || node.value_name.empty()) return;
         value_keys_[node.value_name] = cache::output_key(*s.key, "");
         for (const auto& side : node.node->side_outputs)
@@ -201,7 +201,8 @@ private:
             int written = 0;
             for (const auto& [relative, bytes] : contents->files) {
                 const fs::path rel(relative);
-                if (rel.empty() || rel.is_absolute() || std::any_of(rel.begin(), rel.end(), [](const fs::path& p) { return p == ".."; }))
+                if (rel.empty() || rel.is_absolute() ||
+                    std::any_of(rel.begin(), rel.end(), [](const fs::path& p) { return p == ".."; }))
                     throw Error("a cached file has a bad path: " + relative);
                 if (already_in_place(rel, bytes)) {  // nothing to stage or move: it is listed as it is
                     shared_.kept.push_back(rel);
@@ -233,7 +234,8 @@ private:
         if (!place.inside) return false;
         const fs::path target = shared_.options.out_dir / place.relative;
         std::error_code ec;
-        if (!fs::is_regular_file(fs::symlink_status(target, ec)) || fs::file_size(target, ec) != size || ec) return false;
+        if (!fs::is_regular_file(fs::symlink_status(target, ec)) || fs::file_size(target, ec) != size || ec)
+            return false;
         std::string hex = detail::remembered_sha256(target);
         if (hex.empty()) {
             hex = sha256_file(target);
@@ -256,7 +258,8 @@ private:
         std::size_t at = 0;
         while (at < bytes.size()) {
             const std::size_t n = std::min(buf.size(), bytes.size() - at);
-            if (!in.read(buf.data(), std::streamsize(n)) || std::memcmp(buf.data(), bytes.data() + at, n) != 0) return false;
+            if (!in.read(buf.data(), std::streamsize(n)) || std::memcmp(buf.data(), bytes.data() + at, n) != 0)
+                return false;
             at += n;
         }
         return true;
@@ -274,7 +277,8 @@ private:
             c.messages = said;
             store_.save(*s.key, c);
         } catch (const std::exception& e) {
-            shared_.warn("orogen: warning: could not keep the result of '" + node.label + "' in the cache (" + e.what() + ")");
+            shared_.warn("orogen: warning: could not keep the result of '" + node.label + "' in the cache (" +
+                         e.what() + ")");
         }
     }
 
@@ -322,9 +326,8 @@ private:
 std::unique_ptr<NodeHooks> cache_hooks(RunShared& shared) {
     // Rank 0 of a tiled run keeps no cache either: its nodes' values are tiles elsewhere.
     if (!shared.options.cache || !shared.staging || shared.options.tiled) return nullptr;
-    auto hooks = std::make_unique<CacheHooks>(shared, cache::Store(*shared.options.cache, [&shared](const std::string& line) {
-                                                  shared.warn(line);
-                                              }));
+    auto hooks = std::make_unique<CacheHooks>(
+        shared, cache::Store(*shared.options.cache, [&shared](const std::string& line) { shared.warn(line); }));
     if (!hooks->usable()) return nullptr;
     return hooks;
 }

@@ -45,7 +45,8 @@ void check_version(const Header& h) {
 }
 
 std::vector<std::string> read_messages(std::span<const std::uint8_t> block, const Header& h) {
-    if (detail::sha256_of(block.data(), block.size()) != h.message_hash) throw CorruptEntry("its messages do not match their SHA-256");
+    if (detail::sha256_of(block.data(), block.size()) != h.message_hash)
+        throw CorruptEntry("its messages do not match their SHA-256");
     Reader r(block, 0);
     std::vector<std::string> out;
     const std::uint32_t n = r.u32();
@@ -75,7 +76,9 @@ void write_payload(Writer& w, const Contents& c) {
     }
 }
 
-std::size_t hash_blocks(std::size_t payload_bytes) { return std::max<std::size_t>(1, (payload_bytes + hash_block - 1) / hash_block); }
+std::size_t hash_blocks(std::size_t payload_bytes) {
+    return std::max<std::size_t>(1, (payload_bytes + hash_block - 1) / hash_block);
+}
 
 /// SHA-256 of block `b` of the payload.
 Digest block_digest(std::span<const std::uint8_t> payload, std::size_t b) {
@@ -116,9 +119,9 @@ Digest combine_blocks(std::size_t payload_bytes, const std::vector<Digest>& dige
 /// Run `jobs` (each costs about `bytes`) on every core the run may use, largest first, each thread taking the
 /// next job as it finishes one: a 16 MiB copy and sixteen 1 MiB hash blocks share two cores evenly.
 void run_jobs(std::vector<Deferred::Copy>& jobs) {
-    std::stable_sort(jobs.begin(), jobs.end(), [](const Deferred::Copy& a, const Deferred::Copy& b) { return a.bytes > b.bytes; });
-    const std::size_t workers = std::min<std::size_t>(
-        jobs.size(), std::size_t(std::max(1, thread_count())));
+    std::stable_sort(jobs.begin(), jobs.end(),
+                     [](const Deferred::Copy& a, const Deferred::Copy& b) { return a.bytes > b.bytes; });
+    const std::size_t workers = std::min<std::size_t>(jobs.size(), std::size_t(std::max(1, thread_count())));
     std::atomic<std::size_t> next{0};
     parallel_for(0, std::int64_t(workers), 1, [&](std::int64_t w0, std::int64_t w1) {
         for (std::int64_t w = w0; w != w1; ++w)
@@ -189,8 +192,9 @@ void parse_payload(std::span<const std::uint8_t> entry, std::size_t offset, Cont
     }
     const auto check_path = [](const std::string& path) {
         const fs::path rel(path);
-        if (rel.empty() || rel.is_absolute() ||
-            std::any_of(rel.begin(), rel.end(), [](const fs::path& part) { return part.empty() || part == ".." || part == "."; }))
+        if (rel.empty() || rel.is_absolute() || std::any_of(rel.begin(), rel.end(), [](const fs::path& part) {
+                return part.empty() || part == ".." || part == ".";
+            }))
             throw CorruptEntry("a kept file has a bad path ('" + path + "')");
     };
     const std::uint32_t files = r.count32(16);  // a path's length and an array's count at least
@@ -239,7 +243,6 @@ Contents decode(std::span<const std::uint8_t> entry, const Digest& key) {
         throw;  // sealed as written, yet not valid: written by something other than this orogen
     }
 
-
     std::vector<Digest> digests(hash_blocks(payload.size()));
     std::vector<Deferred::Copy> jobs = std::move(deferred.copies);
     jobs.reserve(jobs.size() + digests.size());
@@ -247,7 +250,8 @@ Contents decode(std::span<const std::uint8_t> entry, const Digest& key) {
         jobs.push_back({std::min(hash_block, payload.size() - std::min(b * hash_block, payload.size())),
                         [&digests, payload, b] { digests[b] = block_checksum(payload, b); }});
     run_jobs(jobs);
-    if (combine_checksums(payload.size(), digests) != h.payload_hash) throw CorruptEntry("its payload does not match its checksum");
+    if (combine_checksums(payload.size(), digests) != h.payload_hash)
+        throw CorruptEntry("its payload does not match its checksum");
     for (auto& assemble : deferred.after) assemble();
     return c;
 }

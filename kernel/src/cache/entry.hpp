@@ -14,8 +14,10 @@
 namespace orogen::cache {
 
 inline constexpr char magic[8] = {'O', 'R', 'G', 'N', 'C', 'A', 'C', 'H'};
-inline constexpr std::uint32_t format_version = 3;  // 2: the payload sealed by XXH3-128 instead of SHA-256; 3: recorded files
-inline constexpr std::size_t header_size = 192;  // a multiple of 64, so arrays aligned in the payload are aligned in the file
+inline constexpr std::uint32_t format_version =
+    3;  // 2: the payload sealed by XXH3-128 instead of SHA-256; 3: recorded files
+inline constexpr std::size_t header_size =
+    192;  // a multiple of 64, so arrays aligned in the payload are aligned in the file
 inline constexpr std::size_t max_message_bytes = std::size_t(1) << 20;
 inline constexpr std::size_t hash_block = std::size_t(1) << 20;  // bytes per block of the payload hash and checksum
 

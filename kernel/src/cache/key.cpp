@@ -44,7 +44,11 @@ Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std
                 std::string_view plugin_name, std::string_view plugin_version, std::string_view plugin_identity,
                 std::uint64_t seed) {
     Hasher h;
-    h.text("orogen node key").u64(format_version).text(OROGEN_VERSION).u64(OROGEN_PLUGIN_API_VERSION).text(kernel_identity());
+    h.text("orogen node key")
+        .u64(format_version)
+        .text(OROGEN_VERSION)
+        .u64(OROGEN_PLUGIN_API_VERSION)
+        .text(kernel_identity());
     h.text(node.node->qualified_name()).text(plugin_name).text(plugin_version).text(plugin_identity);
     h.u64(seed);
     h.u64(std::uint64_t(plan.grid.width)).u64(std::uint64_t(plan.grid.height)).f64(plan.grid.cell);
@@ -80,7 +84,7 @@ namespace {
 struct FoundBinary {
     const void* address = nullptr;
     bool found = false;
-    std::string file;      ///< "" for the main program
+    std::string file;  ///< "" for the main program
     std::string build_id;  ///< hex, "" if it has none
 };
 
@@ -94,7 +98,8 @@ std::string build_id_in(const std::uint8_t* notes, std::size_t size, std::size_t
         std::memcpy(&n, notes + at, sizeof n);
         const std::size_t name_at = at + sizeof n, desc_at = name_at + up(n.n_namesz);
         if (desc_at > size || n.n_descsz > size - desc_at) break;
-        if (n.n_type == NT_GNU_BUILD_ID && n.n_namesz == 4 && std::memcmp(notes + name_at, "GNU", 4) == 0 && n.n_descsz > 0) {
+        if (n.n_type == NT_GNU_BUILD_ID && n.n_namesz == 4 && std::memcmp(notes + name_at, "GNU", 4) == 0 &&
+            n.n_descsz > 0) {
             static const char* digits = "0123456789abcdef";
             std::string hexid;
             for (std::size_t i = 0; i < n.n_descsz; ++i) {
@@ -123,8 +128,8 @@ int find_binary(dl_phdr_info* info, std::size_t, void* data) {
     for (int i = 0; i < info->dlpi_phnum && want->build_id.empty(); ++i) {
         const auto& ph = info->dlpi_phdr[i];
         if (ph.p_type == PT_NOTE)
-            want->build_id = build_id_in(reinterpret_cast<const std::uint8_t*>(info->dlpi_addr + ph.p_vaddr), ph.p_memsz,
-                                         std::size_t(ph.p_align));
+            want->build_id = build_id_in(reinterpret_cast<const std::uint8_t*>(info->dlpi_addr + ph.p_vaddr),
+                                         ph.p_memsz, std::size_t(ph.p_align));
     }
     return 1;
 }
@@ -169,7 +174,7 @@ const std::string& kernel_identity() {
         const std::string id = binary_identity(reinterpret_cast<const void*>(&kernel_identity));
         // Without one, a kernel rebuilt with other code must not find this one's entries: this process's own.
         return id.empty() ? "process:" + std::to_string(::getpid()) + "-" +
-                                std::to_string(std::chrono::steady_clock::now().time_since_epoch().count())
+                std::to_string(std::chrono::steady_clock::now().time_since_epoch().count())
                           : id;
     }();
     return identity;

@@ -104,7 +104,8 @@ Value read_value(Reader& r) {
             const int width = r.i32(), height = r.i32();
             const double cell = r.f64();
             if (width < 0 || height < 0) throw CorruptEntry("a heightmap of negative size");
-            if (!std::isfinite(cell) || cell <= 0) throw CorruptEntry("a heightmap whose cell size is not a positive number");
+            if (!std::isfinite(cell) || cell <= 0)
+                throw CorruptEntry("a heightmap whose cell size is not a positive number");
             const std::size_t size = std::size_t(width) * std::size_t(height);
             // Heights first, then each layer: fresh vectors filled from the mapping (deferred: on every core, beside
             // the checksum), then adopted by the Heightmap, so no byte of it is written twice.
@@ -112,7 +113,8 @@ Value read_value(Reader& r) {
             const auto heights = r.array_span<float>();
             if (heights.size() != size) throw CorruptEntry("a heightmap's size does not match its heights");
             const std::uint32_t layers = r.count32(16);  // each: a name's length and an array's count at least
-            auto arrays = std::make_shared<std::vector<std::pair<std::string, std::vector<float>>>>(std::size_t(layers) + 1);
+            auto arrays =
+                std::make_shared<std::vector<std::pair<std::string, std::vector<float>>>>(std::size_t(layers) + 1);
             r.copy_into((*arrays)[0].second, heights);
             for (std::uint32_t i = 1; i <= layers; ++i) {
                 std::string name = r.str();
@@ -125,7 +127,8 @@ Value read_value(Reader& r) {
             }
             auto assemble = [hm, arrays, width, height, cell] {
                 *hm = Heightmap(width, height, cell, std::move((*arrays)[0].second));
-                for (std::size_t i = 1; i < arrays->size(); ++i) hm->set_layer((*arrays)[i].first, std::move((*arrays)[i].second));
+                for (std::size_t i = 1; i < arrays->size(); ++i)
+                    hm->set_layer((*arrays)[i].first, std::move((*arrays)[i].second));
                 arrays->clear();
             };
             if (r.deferred()) r.deferred()->after.push_back(std::move(assemble));
@@ -162,7 +165,8 @@ Value read_value(Reader& r) {
                 for (std::uint32_t i = 0; i < n; ++i) {
                     std::string name = r.str();
                     const std::int32_t components = r.i32();
-                    if (components < 1) throw CorruptEntry("a particle attribute of " + std::to_string(components) + " components");
+                    if (components < 1)
+                        throw CorruptEntry("a particle attribute of " + std::to_string(components) + " components");
                     const auto data = r.array_span<float>();
                     // Every attribute has `components` floats for each of the frame's particles.
                     if (data.size() % std::size_t(components) != 0 ||
@@ -210,8 +214,7 @@ Value read_value(Reader& r) {
             }
             return Value(std::move(ph));
         }
-        default:
-            throw CorruptEntry("a value of unknown type " + std::to_string(int(type)));
+        default: throw CorruptEntry("a value of unknown type " + std::to_string(int(type)));
     }
 }
 
@@ -240,7 +243,7 @@ std::size_t estimate(const Value& v) {
 
 bool storable(ValueType type) {
     return type == ValueType::heightmap || type == ValueType::image || type == ValueType::particles ||
-           type == ValueType::plates;
+        type == ValueType::plates;
 }
 
 Digest value_hash(const Value& value) {

@@ -135,7 +135,8 @@ public:
     std::span<const T> array_span() {
         const std::uint64_t n = u64();
         pos_ = (pos_ + array_alignment - 1) / array_alignment * array_alignment;
-        if (pos_ > bytes_.size() || n > (bytes_.size() - pos_) / sizeof(T)) throw CorruptEntry("an array runs past the payload");
+        if (pos_ > bytes_.size() || n > (bytes_.size() - pos_) / sizeof(T))
+            throw CorruptEntry("an array runs past the payload");
         std::span<const T> s(reinterpret_cast<const T*>(bytes_.data() + pos_), n);  // 64-byte aligned (mmap'd)
         pos_ += n * sizeof(T);
         return s;
@@ -150,8 +151,7 @@ public:
     void copy_into(std::vector<T>& out, std::span<const T> s) {
         if (deferred_ && s.size_bytes() >= defer_bytes)
             deferred_->copies.push_back({s.size_bytes(), [&out, s] { fill(out, s); }});
-        else
-            fill(out, s);
+        else fill(out, s);
     }
     /// A count that must be followed by at least `min_bytes_each` bytes per element (so a damaged count
     /// cannot make us allocate gigabytes).
@@ -162,7 +162,8 @@ public:
 
 private:
     std::uint64_t bounded(std::uint64_t n, std::size_t min_bytes_each) const {
-        if (n > (bytes_.size() - pos_) / std::max<std::size_t>(min_bytes_each, 1)) throw CorruptEntry("a count runs past the payload");
+        if (n > (bytes_.size() - pos_) / std::max<std::size_t>(min_bytes_each, 1))
+            throw CorruptEntry("a count runs past the payload");
         return n;
     }
     std::span<const std::uint8_t> bytes_;

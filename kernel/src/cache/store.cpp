@@ -28,7 +28,7 @@ public:
     explicit Mapping(const fs::path& path) {
         fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
         if (fd_ < 0) throw std::system_error(errno, std::generic_category());
-        struct stat st{};
+        struct stat st {};
         if (::fstat(fd_, &st) != 0) throw std::system_error(errno, std::generic_category());
         if (!S_ISREG(st.st_mode)) throw CorruptEntry("not a regular file");
         size_ = std::size_t(st.st_size);
@@ -72,7 +72,7 @@ std::optional<std::uint64_t> parse_size(std::string_view text) {
     if (end == s.c_str() || errno == ERANGE || !std::isfinite(number) || number < 0) return std::nullopt;
     std::string unit(end);
     for (auto& ch : unit) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (!unit.empty() && unit.back() == 'b') unit.pop_back();   // "GB", "GiB" -> "g", "gi"
+    if (!unit.empty() && unit.back() == 'b') unit.pop_back();  // "GB", "GiB" -> "g", "gi"
     if (!unit.empty() && unit.back() == 'i') unit.pop_back();
     double scale = 1;
     if (unit.empty()) scale = 1;
@@ -122,7 +122,7 @@ std::optional<EntryInfo> Store::probe(const Digest& key, const std::string& what
         if (n <= 0) break;
         got += n;
     }
-    struct stat st{};
+    struct stat st {};
     const bool stat_ok = ::fstat(fd, &st) == 0;
     ::close(fd);
     try {
@@ -188,8 +188,8 @@ bool Store::save(const Digest& key, const Contents& contents) {
     if (bytes.size() > settings_.max_bytes) return false;  // would evict everything else and itself
     static std::atomic<unsigned> counter{0};
     const fs::path final_path = path(key);
-    const fs::path tmp = settings_.folder / (".tmp-" + hex(key).substr(0, 16) + "-" + std::to_string(::getpid()) + "-" +
-                                             std::to_string(counter++));
+    const fs::path tmp = settings_.folder /
+        (".tmp-" + hex(key).substr(0, 16) + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
     std::string why;
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) why = errno_text(errno);
@@ -232,7 +232,7 @@ std::vector<FileFact> list_entries(const fs::path& folder, bool remove_stale_tem
     const auto now = std::chrono::system_clock::now();
     for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
         const std::string name = it->path().filename().string();
-        struct stat st{};
+        struct stat st {};
         if (::lstat(it->path().c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
         const std::int64_t mtime = std::int64_t(st.st_mtim.tv_sec) * 1'000'000'000 + st.st_mtim.tv_nsec;
         if (name.rfind(".tmp-", 0) == 0) {  // a killed run's half entry: gone after an hour
@@ -251,7 +251,8 @@ namespace {
 void check_listable(const fs::path& folder) {
     std::error_code ec;
     const auto st = fs::status(folder, ec);
-    if (!fs::is_directory(st)) throw BadInput(folder.string() + " is not a folder; give the cache folder with --cache DIR");
+    if (!fs::is_directory(st))
+        throw BadInput(folder.string() + " is not a folder; give the cache folder with --cache DIR");
     fs::directory_iterator it(folder, ec);
     if (ec) throw BadInput("cannot list the cache folder " + folder.string() + " (" + ec.message() + ")");
 }
@@ -270,8 +271,9 @@ FolderFacts folder_facts(const fs::path& folder) {
         f.bytes += e.bytes;
     }
     for (fs::directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
-        struct stat st{};
-        if (it->path().filename().string().rfind(".tmp-", 0) == 0 && ::lstat(it->path().c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+        struct stat st {};
+        if (it->path().filename().string().rfind(".tmp-", 0) == 0 && ::lstat(it->path().c_str(), &st) == 0 &&
+            S_ISREG(st.st_mode)) {
             ++f.temporaries;
             f.temporary_bytes += std::uint64_t(st.st_size);
         }

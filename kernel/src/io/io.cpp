@@ -24,8 +24,8 @@ std::string errno_text(int err) { return std::strerror(err); }
 /// "out/.cut.png.4711.3.tmp": hidden, beside the target (same file system, so rename is atomic).
 fs::path temporary_name(const fs::path& target) {
     static std::atomic<unsigned> counter{0};
-    const auto name = "." + target.filename().string() + "." + std::to_string(::getpid()) + "." +
-                      std::to_string(counter++) + ".tmp";
+    const auto name =
+        "." + target.filename().string() + "." + std::to_string(::getpid()) + "." + std::to_string(counter++) + ".tmp";
     return target.parent_path() / name;
 }
 
@@ -123,12 +123,9 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)), temporary_
 }
 
 AtomicFile::AtomicFile(AtomicFile&& other) noexcept
-    : target_(std::move(other.target_)),
-      temporary_(std::move(other.temporary_)),
-      hashing_(std::move(other.hashing_)),
+    : target_(std::move(other.target_)), temporary_(std::move(other.temporary_)), hashing_(std::move(other.hashing_)),
       stream_(std::move(other.stream_)),  // now on its own filebuf again
-      digest_(std::move(other.digest_)),
-      committed_(other.committed_) {
+      digest_(std::move(other.digest_)), committed_(other.committed_) {
     if (hashing_) install_hashing();
     other.committed_ = true;  // the moved-from object owns nothing
 }
@@ -154,7 +151,8 @@ void AtomicFile::flush_checked() {
         const bool ok = bool(s);
         s.close();
         if (!ok || s.fail())
-            throw Error("cannot write " + target_.string() + ": writing failed (disk full?); the existing file, if any, is unchanged");
+            throw Error("cannot write " + target_.string() +
+                        ": writing failed (disk full?); the existing file, if any, is unchanged");
     }
     std::error_code ec;
     const auto size = fs::file_size(temporary_, ec);
@@ -202,17 +200,18 @@ namespace {
 std::string kind_problem(mode_t mode) {
     if (S_ISDIR(mode)) return "is a folder; give a file";
     const char* kind = S_ISFIFO(mode) ? "a FIFO (named pipe)"
-                       : S_ISCHR(mode) ? "a character device"
-                       : S_ISBLK(mode) ? "a block device"
-                       : S_ISSOCK(mode) ? "a socket"
-                                        : "not a regular file";
+        : S_ISCHR(mode)               ? "a character device"
+        : S_ISBLK(mode)               ? "a block device"
+        : S_ISSOCK(mode)              ? "a socket"
+                                      : "not a regular file";
     return std::string("is ") + kind + ", not a regular file; give a file (orogen reads only regular files)";
 }
 }  // namespace
 
 std::string regular_file_problem(const fs::path& path) {
     struct stat st {};
-    if (::stat(path.c_str(), &st) != 0) return errno == ENOENT ? "does not exist" : "cannot be read (" + errno_text(errno) + ")";
+    if (::stat(path.c_str(), &st) != 0)
+        return errno == ENOENT ? "does not exist" : "cannot be read (" + errno_text(errno) + ")";
     if (S_ISREG(st.st_mode)) return "";
     return kind_problem(st.st_mode);
 }
@@ -266,9 +265,9 @@ std::string heightmap_memory_problem(double width, double height, std::uint64_t 
     if (bytes <= double(limit)) return "";
     const auto side = std::uint64_t(std::sqrt(double(limit) / 4.0));
     return "needs " + human_bytes(bytes) + " for one heightmap (4 bytes a vertex), more than the " +
-           human_bytes(double(limit)) + " allowed here (a quarter of this machine's " +
-           human_bytes(double(physical_memory())) + " of memory); use at most about " + std::to_string(side) + "x" +
-           std::to_string(side);
+        human_bytes(double(limit)) + " allowed here (a quarter of this machine's " +
+        human_bytes(double(physical_memory())) + " of memory); use at most about " + std::to_string(side) + "x" +
+        std::to_string(side);
 }
 
 std::string human_bytes(double bytes) {

@@ -119,13 +119,12 @@ void prepare_folders(const fs::path& out_dir, const std::vector<fs::path>& files
             throw Error("cannot write " + target.string() +
                         ": a symbolic link now leads it out of the output folder; the previous outputs are unchanged");
         if (fs::is_directory(fs::symlink_status(target, ec)))
-            throw Error("cannot write " + target.string() + ": a folder has that name; the previous outputs are unchanged");
+            throw Error("cannot write " + target.string() +
+                        ": a folder has that name; the previous outputs are unchanged");
     }
 }
 
-std::string plural(std::size_t n, const char* word) {
-    return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
-}
+std::string plural(std::size_t n, const char* word) { return std::to_string(n) + " " + word + (n == 1 ? "" : "s"); }
 
 }  // namespace
 
@@ -148,13 +147,15 @@ OutputPlace place_output(const fs::path& out_dir, const std::string& path) {
 std::string outside_out_message(const fs::path& out_dir, const std::string& path, const OutputPlace& place) {
     std::string why;
     switch (place.escape) {
-        case OutputPlace::Escape::absolute: why = "is an absolute path, outside the output folder " + out_dir.string(); break;
+        case OutputPlace::Escape::absolute:
+            why = "is an absolute path, outside the output folder " + out_dir.string();
+            break;
         case OutputPlace::Escape::dot_dot:
             why = "leads out of the output folder " + out_dir.string() + " (to " + place.resolved.string() + ")";
             break;
         default:
             why = "leads out of the output folder " + out_dir.string() + " through a symbolic link (to " +
-                  place.resolved.string() + ")";
+                place.resolved.string() + ")";
     }
     return "'" + path + "' " + why + "; give a path inside --out, or pass --allow-outside-out to write there";
 }
@@ -266,7 +267,8 @@ std::vector<std::string> clean_debris(const fs::path& out_dir) {
          !ec && it != end && ++seen < 100000; it.increment(ec)) {
         const std::string name = it->path().filename().string();
         if (it->is_directory(ec)) {
-            if (name.rfind(staging_prefix, 0) == 0 || it.depth() >= 8 || it->is_symlink(ec)) it.disable_recursion_pending();
+            if (name.rfind(staging_prefix, 0) == 0 || it.depth() >= 8 || it->is_symlink(ec))
+                it.disable_recursion_pending();
             continue;
         }
         std::smatch m;

@@ -23,7 +23,7 @@ namespace orogen {
 struct OutputPlace {
     std::filesystem::path resolved;  ///< absolute, `..` and existing symbolic links resolved
     std::filesystem::path relative;  ///< relative to the output folder (only if inside)
-    bool inside = false;             ///< strictly inside the output folder
+    bool inside = false;  ///< strictly inside the output folder
     enum class Escape { none, absolute, dot_dot, symlink } escape = Escape::none;
 };
 
@@ -31,7 +31,8 @@ struct OutputPlace {
 OutputPlace place_output(const std::filesystem::path& out_dir, const std::string& path);
 
 /// The one-line reason an output path is refused, naming the path and the flag that allows it.
-std::string outside_out_message(const std::filesystem::path& out_dir, const std::string& path, const OutputPlace& place);
+std::string outside_out_message(const std::filesystem::path& out_dir, const std::string& path,
+                                const OutputPlace& place);
 
 /// Prefix of every staging folder's name.
 inline constexpr const char* staging_prefix = ".orogen-staging-";

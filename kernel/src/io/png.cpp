@@ -85,11 +85,13 @@ int decode(const std::uint8_t* bytes, std::size_t size, bool header_only, ErrorS
             std::uint16_t* dst = out + std::size_t(y) * w;
             if (pass > 0) {  // interlaced: feed back the row we have so far
                 if (bit_depth == 16) std::memcpy(row, dst, std::size_t(w) * 2);
-                else for (png_uint_32 x = 0; x < w; ++x) row[x] = png_byte(dst[x]);
+                else
+                    for (png_uint_32 x = 0; x < w; ++x) row[x] = png_byte(dst[x]);
             }
             png_read_row(png, row, nullptr);
             if (bit_depth == 16) std::memcpy(dst, row, std::size_t(w) * 2);
-            else for (png_uint_32 x = 0; x < w; ++x) dst[x] = row[x];
+            else
+                for (png_uint_32 x = 0; x < w; ++x) dst[x] = row[x];
         }
     }
     png_read_end(png, nullptr);
@@ -111,12 +113,14 @@ std::string chunk_problem(const std::vector<std::uint8_t>& bytes, std::uint64_t&
     while (true) {
         if (bytes.size() - at < 12)
             return "truncated PNG (the file ends at byte " + std::to_string(bytes.size()) +
-                   ", before its end marker IEND); it was cut short: copy it again";
+                ", before its end marker IEND); it was cut short: copy it again";
         const std::uint64_t length = be32(&bytes[at]);
-        if (length > 0x7fffffffu) return "damaged PNG (a chunk at byte " + std::to_string(at) + " declares an impossible length)";
+        if (length > 0x7fffffffu)
+            return "damaged PNG (a chunk at byte " + std::to_string(at) + " declares an impossible length)";
         if (bytes.size() - at - 12 < length)
-            return "truncated PNG (the file ends at byte " + std::to_string(bytes.size()) + ", inside a chunk that declares " +
-                   std::to_string(length) + " bytes; the end marker IEND is missing); it was cut short: copy it again";
+            return "truncated PNG (the file ends at byte " + std::to_string(bytes.size()) +
+                ", inside a chunk that declares " + std::to_string(length) +
+                " bytes; the end marker IEND is missing); it was cut short: copy it again";
         if (std::memcmp(&bytes[at + 4], "IDAT", 4) == 0) idat_bytes += length;
         if (std::memcmp(&bytes[at + 4], "IEND", 4) == 0) return "";
         at += 12 + std::size_t(length);
@@ -136,8 +140,8 @@ GrayImage read_png(const std::vector<std::uint8_t>& bytes, const std::filesystem
         throw BadInput("cannot read " + path.string() + ": damaged PNG (" + err.message + ")");
     if (wrong_format) {
         const char* what = colour_type == PNG_COLOR_TYPE_PALETTE ? "a palette (indexed colour) image"
-                           : (colour_type & PNG_COLOR_MASK_ALPHA) ? "an RGBA colour image"
-                                                                  : "an RGB colour image";
+            : (colour_type & PNG_COLOR_MASK_ALPHA)               ? "an RGBA colour image"
+                                                                 : "an RGB colour image";
         throw BadInput("cannot read " + path.string() + ": it is " + what +
                        ", but a heightmap must be a grayscale PNG (8 or 16 bits); convert it, e.g. "
                        "`convert in.png -colorspace gray -depth 16 out.png`");
@@ -228,16 +232,18 @@ std::vector<std::uint8_t> filter_rows(const std::uint8_t* raw, int height, std::
 
 void encode(std::ostream& file, int width, int height, int bits, int colour_type, int channels, const std::uint8_t* raw,
             int level) {
-    if (width <= 0 || height <= 0) throw Error("internal error: PNG size " + std::to_string(width) + "x" + std::to_string(height));
+    if (width <= 0 || height <= 0)
+        throw Error("internal error: PNG size " + std::to_string(width) + "x" + std::to_string(height));
     if (level < 0 || level > 12) throw BadInput("PNG compression level must be 0 to 12, got " + std::to_string(level));
     const int bpp = channels * bits / 8;
     const std::size_t row_bytes = std::size_t(width) * std::size_t(bpp);
     const std::vector<std::uint8_t> filtered = filter_rows(raw, height, row_bytes, bpp);
     std::unique_ptr<libdeflate_compressor, decltype(&libdeflate_free_compressor)> z(libdeflate_alloc_compressor(level),
-                                                                                      libdeflate_free_compressor);
+                                                                                    libdeflate_free_compressor);
     if (!z) throw Error("PNG encoding failed: out of memory for the compressor");
     std::vector<std::uint8_t> idat(libdeflate_zlib_compress_bound(z.get(), filtered.size()));
-    const std::size_t packed = libdeflate_zlib_compress(z.get(), filtered.data(), filtered.size(), idat.data(), idat.size());
+    const std::size_t packed =
+        libdeflate_zlib_compress(z.get(), filtered.data(), filtered.size(), idat.data(), idat.size());
     if (packed == 0) throw Error("PNG encoding failed: the compressed image did not fit its bound");
 
     static constexpr std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
@@ -252,7 +258,8 @@ void encode(std::ostream& file, int width, int height, int bits, int colour_type
     ihdr[12] = 0;  // not interlaced
     write_chunk(file, "IHDR", ihdr, sizeof ihdr);
     constexpr std::size_t piece = std::size_t(1) << 20;  // IDAT chunks of 1 MiB, as readers stream them
-    for (std::size_t at = 0; at < packed; at += piece) write_chunk(file, "IDAT", idat.data() + at, std::min(piece, packed - at));
+    for (std::size_t at = 0; at < packed; at += piece)
+        write_chunk(file, "IDAT", idat.data() + at, std::min(piece, packed - at));
     write_chunk(file, "IEND", nullptr, 0);
     if (!file) throw Error("PNG encoding failed: write failed (disk full?)");
 }

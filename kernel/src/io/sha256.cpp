@@ -129,8 +129,8 @@ std::string file_identity(const std::filesystem::path& file) {
     Identity id;
     if (!identify(file, key, id)) return "";
     return std::to_string(key.first) + ":" + std::to_string(key.second) + ":" + std::to_string(id.size) + ":" +
-           std::to_string(id.mtime_s) + "." + std::to_string(id.mtime_ns) + ":" + std::to_string(id.ctime_s) + "." +
-           std::to_string(id.ctime_ns);
+        std::to_string(id.mtime_s) + "." + std::to_string(id.mtime_ns) + ":" + std::to_string(id.ctime_s) + "." +
+        std::to_string(id.ctime_ns);
 }
 
 void adopt_sha256(const std::filesystem::path& file, const std::string& hex, const std::string& identity) {

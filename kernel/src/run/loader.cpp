@@ -51,8 +51,9 @@ void PluginSet::load(const fs::path& file) {
         return;
     }
     if (!lib.has(OROGEN_PLUGIN_ENTRY_SYMBOL)) {
-        impl_->problems.push_back(name + ": not an orogen plugin: it has no entry point '" OROGEN_PLUGIN_ENTRY_SYMBOL
-                                         "' (define one with OROGEN_PLUGIN(...)); skipped");
+        impl_->problems.push_back(name +
+                                  ": not an orogen plugin: it has no entry point '" OROGEN_PLUGIN_ENTRY_SYMBOL
+                                  "' (define one with OROGEN_PLUGIN(...)); skipped");
         return;
     }
     OrogenPluginInfo info{};

@@ -88,7 +88,8 @@ Param Param::points(std::string name, std::optional<std::vector<Point2>> def) {
     return p;
 }
 
-Param Param::path(std::string name, PathRole role, std::vector<std::string> extensions, std::optional<std::string> def) {
+Param Param::path(std::string name, PathRole role, std::vector<std::string> extensions,
+                  std::optional<std::string> def) {
     Param p;
     p.name = std::move(name);
     p.type = ParamType::path;

@@ -30,8 +30,8 @@ namespace {
 // run concurrently on the same number of threads and sub-ranges of the same kind (at least `grain` long).
 void parallel_for_threads(std::int64_t begin, std::int64_t end, std::int64_t grain,
                           const std::function<void(std::int64_t, std::int64_t)>& body) {
-    const int threads = std::max(1, int(tbb::global_control::active_value(
-                                        tbb::global_control::max_allowed_parallelism)));
+    const int threads =
+        std::max(1, int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
     // sub-ranges of at least `grain`, about 16 a thread (TSan makes every atomic step costly)
     grain = std::max(grain, (end - begin + 16 * threads - 1) / (16 * threads));
     std::atomic<std::int64_t> next{begin};
@@ -93,8 +93,6 @@ double parallel_sum(std::int64_t begin, std::int64_t end, std::int64_t block,
     return sum;
 }
 
-int thread_count() {
-    return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-}
+int thread_count() { return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)); }
 
 }  // namespace orogen

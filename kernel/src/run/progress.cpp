@@ -37,8 +37,8 @@ void ProgressDisplay::update(double fraction) {
     const double elapsed = std::chrono::duration<double>(clock_type::now() - started_).count();
     if (decile > last_decile_ && decile < 10 && elapsed > 1.0) {
         last_decile_ = decile;
-        std::fprintf(out_, "[%d/%d] %s (%s) %d%% %.1f s\n", index_, total_, label_.c_str(), node_.c_str(),
-                     decile * 10, elapsed);
+        std::fprintf(out_, "[%d/%d] %s (%s) %d%% %.1f s\n", index_, total_, label_.c_str(), node_.c_str(), decile * 10,
+                     elapsed);
         std::fflush(out_);
     }
 }

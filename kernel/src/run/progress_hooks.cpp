@@ -21,7 +21,8 @@ public:
     }
 
     void after_node(const NodeTurn& turn) override {
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started_[turn.index]).count();
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - started_[turn.index]).count();
         if (shared_.options.progress) shared_.options.progress->finish(seconds);
         turn.timing.seconds += seconds;
     }
@@ -30,8 +31,9 @@ public:
         ProgressDisplay* progress = shared_.options.progress;
         if (!progress) return;
         for (const auto& line : reuse.said)  // replayed as the node said them: "label: ..." or "label: warning: ..."
-            progress->message(line, line.find(": warning: ") != std::string::npos ? ProgressDisplay::Kind::warning
-                                                                                 : ProgressDisplay::Kind::info);
+            progress->message(line,
+                              line.find(": warning: ") != std::string::npos ? ProgressDisplay::Kind::warning
+                                                                            : ProgressDisplay::Kind::info);
         progress->skipped(int(turn.index) + 1, total(), turn.node.label, turn.node.node->qualified_name(), reuse.why);
     }
 

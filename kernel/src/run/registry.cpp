@@ -38,7 +38,8 @@ void Registry::add(NodeDescriptor node) {
     };
     static const char* kinds[] = {"generate", "erode", "tectonics", "render", "export", "import", "analyze"};
     if (std::find(std::begin(kinds), std::end(kinds), node.kind) == std::end(kinds))
-        return refuse("unknown kind '" + node.kind + "' (use generate, erode, tectonics, render, export, import or analyze)");
+        return refuse("unknown kind '" + node.kind +
+                      "' (use generate, erode, tectonics, render, export, import or analyze)");
     if (!is_kebab(node.name)) return refuse("the name must be kebab-case (lowercase letters, digits, '-')");
     if (!node.run) return refuse("it has no run function");
     for (const auto& p : node.params) {
@@ -64,9 +65,8 @@ const NodeDescriptor* Registry::find(std::string_view qualified_name) const {
 std::vector<const NodeDescriptor*> Registry::nodes() const {
     std::vector<const NodeDescriptor*> out;
     for (const auto& [_, e] : impl_->nodes) out.push_back(&e.node);
-    std::sort(out.begin(), out.end(), [](auto* a, auto* b) {
-        return std::tie(a->kind, a->name) < std::tie(b->kind, b->name);
-    });
+    std::sort(out.begin(), out.end(),
+              [](auto* a, auto* b) { return std::tie(a->kind, a->name) < std::tie(b->kind, b->name); });
     return out;
 }
 

@@ -34,8 +34,8 @@ class Context : public NodeContext {
 public:
     Context(const Plan& plan, const PlannedNode& node, std::vector<Value> inputs, const RunOptions& options,
             const fs::path& staging, std::vector<fs::path>& outside, bool for_entry = false)
-        : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), staging_(staging),
-          outside_(outside), seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
+        : plan_(plan), node_(node), inputs_(std::move(inputs)), options_(options), staging_(staging), outside_(outside),
+          seed_(node_seed(plan.seed, node.label)), for_entry_(for_entry) {}
 
     const std::string& label() const override { return node_.label; }
     std::uint64_t seed() const override { return seed_; }
@@ -82,7 +82,8 @@ public:
                                 " is a file, not a folder; move it away or write elsewhere");
             }
             if (fs::is_directory(target, ec))
-                throw Error("cannot write " + target.string() + ": a folder has that name; move it away or write elsewhere");
+                throw Error("cannot write " + target.string() +
+                            ": a folder has that name; move it away or write elsewhere");
         }
         fs::create_directories(full.parent_path(), ec);
         if (ec)
@@ -102,7 +103,9 @@ public:
     void check_cancelled() override {
         if (options_.cancel && options_.cancel->load()) throw Cancelled();
     }
-    void info(std::string_view message) override { say(node_.label + ": " + std::string(message), ProgressDisplay::Kind::info); }
+    void info(std::string_view message) override {
+        say(node_.label + ": " + std::string(message), ProgressDisplay::Kind::info);
+    }
     void warn(std::string_view message) override {
         say(node_.label + ": warning: " + std::string(message), ProgressDisplay::Kind::warning);
     }
@@ -155,9 +158,7 @@ std::shared_ptr<Series> map_over_series(const Plan& plan, const PlannedNode& nod
                 throw Error("internal error: it returned a " + std::string(to_string(v.type())) + " but declares a " +
                             std::string(to_string(node.node->output)));
             return v;
-        } catch (const Cancelled&) {
-            throw;
-        } catch (const Error& e) {
+        } catch (const Cancelled&) { throw; } catch (const Error& e) {
             throw Error("entry " + std::to_string(j) + " of '" + node.label + "' (" + node.node->qualified_name() +
                             ", line " + std::to_string(node.where.line) + "): " + e.what(),
                         e.kind());
@@ -191,7 +192,8 @@ void write_manifest(const Plan& plan, const RunOptions& options, const Staging& 
     j.key("plugins").begin_array();
     for (const auto& p : options.plugins) {
         j.begin_object();
-        j.key("name").value(p.name).key("version").value(p.version).key("file").value(fs::path(p.file).filename().string());
+        j.key("name").value(p.name).key("version").value(p.version).key("file").value(
+            fs::path(p.file).filename().string());
         j.end_object();
     }
     j.end_array();
@@ -224,8 +226,9 @@ void write_manifest(const Plan& plan, const RunOptions& options, const Staging& 
     j.end_array();
     j.end_object();
     const std::string& text = j.str();
-    write_file_atomically(staging.folder() / "manifest.json",
-                          std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    write_file_atomically(
+        staging.folder() / "manifest.json",
+        std::span<const std::uint8_t>(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
 std::string cancel_reason(const RunOptions& options) {
@@ -238,9 +241,10 @@ void cancelled(RunResult& result, std::string message) {
     result.error = std::move(message);
 }
 
-
 /// The worst exit code of all ranks on every rank (only the lowest failing rank keeps its message).
-void agree_across_ranks(TiledRun& tiled, RunResult& result) { agree_across_ranks(tiled, result.exit_code, result.error); }
+void agree_across_ranks(TiledRun& tiled, RunResult& result) {
+    agree_across_ranks(tiled, result.exit_code, result.error);
+}
 
 /// How node `node` stopped, from the exception in flight (called inside a catch).
 Outcome outcome_of_exception(const PlannedNode& node, const RunOptions& options) {
@@ -259,9 +263,7 @@ Outcome outcome_of_exception(const PlannedNode& node, const RunOptions& options)
         outcome.error = node_error(node, e.what());
     } catch (const std::bad_alloc&) {
         outcome.error = node_error(node, "out of memory; try a smaller grid");
-    } catch (const std::exception& e) {
-        outcome.error = node_error(node, e.what());
-    } catch (...) {
+    } catch (const std::exception& e) { outcome.error = node_error(node, e.what()); } catch (...) {
         outcome.error = node_error(node, "unknown exception");
     }
     return outcome;
@@ -270,12 +272,13 @@ Outcome outcome_of_exception(const PlannedNode& node, const RunOptions& options)
 /// "internal error: ..." if node returned a value other than the one it declares, else "".
 std::string wrong_output(const PlannedNode& node, const NodeOutputs& out) {
     const bool series_out = node.node->output_series || node.mapped_input >= 0;
-    const ValueType returned_entry = out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
+    const ValueType returned_entry =
+        out.main.type() == ValueType::series ? out.main.series()->element : out.main.type();
     if ((out.main.type() == ValueType::series) == series_out && returned_entry == node.node->output) return "";
     return "internal error: it returned a " +
-           (returned_entry == ValueType::none ? std::string("nothing")
-                                              : describe_type(returned_entry, out.main.type() == ValueType::series)) +
-           " but declares a " + describe_type(node.node->output, series_out);
+        (returned_entry == ValueType::none ? std::string("nothing")
+                                           : describe_type(returned_entry, out.main.type() == ValueType::series)) +
+        " but declares a " + describe_type(node.node->output, series_out);
 }
 
 /// Runs a plan's nodes in spec order. Evaluation is by demand: a node runs at its turn unless a hook says it
@@ -306,7 +309,8 @@ public:
             current_ = i;
             const PlannedNode& node = plan_.nodes[i];
             rows_.push_back(shared_.result.timings.size());
-            shared_.result.timings.push_back({node.label, node.node->qualified_name(), node.where.line, 0.0, false, false});
+            shared_.result.timings.push_back(
+                {node.label, node.node->qualified_name(), node.where.line, 0.0, false, false});
             const NodeTurn turn = this->turn(i);
             TurnAnswer answer;
             for (auto& h : hooks_) {
@@ -401,17 +405,15 @@ private:
             else if (node.mapped_input >= 0)  // entries are made when a later node pulls them
                 out = NodeOutputs(map_over_series(plan_, node, mapped_inputs, std::size_t(node.mapped_input), options_,
                                                   shared_.staging_folder, shared_.outside));
-            else
-                out = node.node->run(*ctx);
-        } catch (...) {
-            outcome = outcome_of_exception(node, options_);
-        }
+            else out = node.node->run(*ctx);
+        } catch (...) { outcome = outcome_of_exception(node, options_); }
         for (auto& h : hooks_) h->settle(turn, outcome);
         if (outcome.exit_code != 0) throw NodeFailed{outcome.exit_code, outcome.error};
         for (auto& h : hooks_) h->after_node(turn);
         turn.timing.cached = turn.timing.read = false;
         if (runs_here)
-            if (const std::string wrong = wrong_output(node, out); !wrong.empty()) throw NodeFailed{1, node_error(node, wrong)};
+            if (const std::string wrong = wrong_output(node, out); !wrong.empty())
+                throw NodeFailed{1, node_error(node, wrong)};
         if (!node.value_name.empty()) {
             keep(node.value_name, out.main);
             for (const auto& [side, v] : out.side) keep(node.value_name + "." + side, v);
@@ -457,7 +459,7 @@ bool prepare_outputs(const RunOptions& options, RunResult& result, std::optional
     if (ec || !fs::is_directory(options.out_dir, ec)) {
         result.exit_code = 1;
         result.error = "orogen: error: cannot create the output folder " + options.out_dir.string() + " (" +
-                       (ec ? ec.message() : std::string("a file of that name exists")) + "); pick another with --out\n";
+            (ec ? ec.message() : std::string("a file of that name exists")) + "); pick another with --out\n";
     }
     // In a tiled run every rank learns of a failure on any (and only the first failing rank reports it).
     if (options.tiled) agree_across_ranks(*options.tiled, result);
@@ -581,7 +583,8 @@ std::string format_timings(const RunResult& result) {
     // Columns as wide as their longest entry (at least the usual 16 and 26), so a long label or
     // kind:name (a mapped node's "frames[12]", a plugin's long name) does not push its row askew.
     std::size_t label_w = 16, node_w = 26;
-    for (const auto& t : result.timings) label_w = std::max(label_w, t.label.size()), node_w = std::max(node_w, t.node.size());
+    for (const auto& t : result.timings)
+        label_w = std::max(label_w, t.label.size()), node_w = std::max(node_w, t.node.size());
     const int lw = int(label_w), nw = int(node_w);
     std::ostringstream out;
     std::vector<char> line(label_w + node_w + 64);
@@ -589,8 +592,9 @@ std::string format_timings(const RunResult& result) {
                   "share");
     out << line.data();
     for (const auto& t : result.timings) {
-        std::snprintf(line.data(), line.size(), "%-*s %-*s %5d %10.3f %5.1f%%%s\n", lw, t.label.c_str(), nw, t.node.c_str(),
-                      t.line, t.seconds, result.total_seconds > 0 ? 100.0 * t.seconds / result.total_seconds : 0.0,
+        std::snprintf(line.data(), line.size(), "%-*s %-*s %5d %10.3f %5.1f%%%s\n", lw, t.label.c_str(), nw,
+                      t.node.c_str(), t.line, t.seconds,
+                      result.total_seconds > 0 ? 100.0 * t.seconds / result.total_seconds : 0.0,
                       t.cached ? (t.read ? "  cached, read" : "  cached") : "");
         out << line.data();
     }

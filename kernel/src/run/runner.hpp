@@ -55,15 +55,15 @@ struct NodeTiming {
     int line = 0;
     double seconds = 0.0;
     bool cached = false;  ///< it did not run: its result came from the cache (or nothing that ran needed it)
-    bool read = false;    ///< cached, and its values were read from the cache for a node that ran
+    bool read = false;  ///< cached, and its values were read from the cache for a node that ran
 };
 
 struct RunResult {
-    int exit_code = 0;        ///< 0 ok, 1 failed run, 2 bad input, 130 cancelled
-    std::string error;        ///< formatted diagnostic when exit_code != 0 ("" on a rank that only saw another fail)
+    int exit_code = 0;  ///< 0 ok, 1 failed run, 2 bad input, 130 cancelled
+    std::string error;  ///< formatted diagnostic when exit_code != 0 ("" on a rank that only saw another fail)
     std::vector<NodeTiming> timings;
     std::vector<std::filesystem::path> outputs;  ///< files written (staged ones sorted), the manifest last
-    std::vector<std::string> notes;              ///< debris of killed runs removed before this one, one line each
+    std::vector<std::string> notes;  ///< debris of killed runs removed before this one, one line each
     double total_seconds = 0.0;
     /// "cache: 9 of 14 nodes reused from DIR (312 MiB of 2 GiB)"; empty without the cache.
     std::string cache_summary;

@@ -12,8 +12,9 @@ namespace orogen {
 Param timelapse_param() {
     return Param::integer("timelapse_every", 0)
         .min(0)
-        .help("record the heightmap every this many steps into the side value NAME.timelapse (a series "
-              "render:terrain maps over and export:video encodes); 0 = no time-lapse");
+        .help(
+            "record the heightmap every this many steps into the side value NAME.timelapse (a series "
+            "render:terrain maps over and export:video encodes); 0 = no time-lapse");
 }
 
 SideOutput timelapse_output() {
@@ -42,13 +43,14 @@ void check_timelapse(CheckContext& ctx, std::int64_t steps) {
     const double bytes = frames * w * h * 4.0 * 2.0;  // heights + water
     const double memory = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
     if (bytes > memory / 2)
-        ctx.error("timelapse_every", "a time-lapse of " + std::to_string(std::int64_t(frames)) + " snapshots of " +
-                                         std::to_string(int(w)) + "×" + std::to_string(int(h)) + " needs " +
-                                         human_bytes(bytes) + ", more than half of this machine's " +
-                                         human_bytes(memory) + "; record less often");
+        ctx.error("timelapse_every",
+                  "a time-lapse of " + std::to_string(std::int64_t(frames)) + " snapshots of " +
+                      std::to_string(int(w)) + "×" + std::to_string(int(h)) + " needs " + human_bytes(bytes) +
+                      ", more than half of this machine's " + human_bytes(memory) + "; record less often");
 }
 
-Timelapse::Timelapse(std::int64_t every, double seconds_per_step) : every_(every), seconds_per_step_(seconds_per_step) {}
+Timelapse::Timelapse(std::int64_t every, double seconds_per_step)
+    : every_(every), seconds_per_step_(seconds_per_step) {}
 
 Timelapse::Timelapse(std::int64_t every, double seconds_per_step, Tiling& tiles)
     : every_(every), tiles_(&tiles), seconds_per_step_(seconds_per_step) {}

@@ -56,16 +56,18 @@ std::optional<ParamValue> convert(const Param& p, const Literal& l, const std::s
         return std::nullopt;
     };
     auto non_finite_word = [&]() {
-        return l.kind == Literal::Kind::word && (lower(l.text) == "nan" || lower(l.text) == "inf" ||
-                                                 lower(l.text) == "infinity");
+        return l.kind == Literal::Kind::word &&
+            (lower(l.text) == "nan" || lower(l.text) == "inf" || lower(l.text) == "infinity");
     };
     auto number = [&](const Literal& n, bool integer) -> std::optional<double> {
         if (n.kind != Literal::Kind::number) {
-            if (n.kind == Literal::Kind::word && (lower(n.text) == "nan" || lower(n.text) == "inf" || lower(n.text) == "infinity")) {
+            if (n.kind == Literal::Kind::word &&
+                (lower(n.text) == "nan" || lower(n.text) == "inf" || lower(n.text) == "infinity")) {
                 diags.error(n.where, who + " must be a finite number, got " + n.text);
                 return std::nullopt;
             }
-            diags.error(n.where, who + " must be " + (integer ? "an integer" : "a number") + ", got " + spec::describe(n));
+            diags.error(n.where,
+                        who + " must be " + (integer ? "an integer" : "a number") + ", got " + spec::describe(n));
             return std::nullopt;
         }
         if (!std::isfinite(n.number)) {
@@ -77,8 +79,9 @@ std::optional<ParamValue> convert(const Param& p, const Literal& l, const std::s
             return std::nullopt;
         }
         if (!in_range(p, n.number)) {
-            diags.error(n.where, who + " is " + n.text + ", out of range " + range_text(p) +
-                                     (p.unit_text.empty() ? "" : " " + p.unit_text));
+            diags.error(n.where,
+                        who + " is " + n.text + ", out of range " + range_text(p) +
+                            (p.unit_text.empty() ? "" : " " + p.unit_text));
             return std::nullopt;
         }
         return n.number;
@@ -157,8 +160,9 @@ std::optional<ParamValue> convert(const Param& p, const Literal& l, const std::s
                 return wrong("a point (x, y) or a list of points [(x, y), ...]");
             }
             if (pts.size() > p.max_points) {
-                diags.error(l.where, who + " takes at most " + std::to_string(p.max_points) + " points, got " +
-                                         std::to_string(pts.size()));
+                diags.error(l.where,
+                            who + " takes at most " + std::to_string(p.max_points) + " points, got " +
+                                std::to_string(pts.size()));
                 return std::nullopt;
             }
             return ParamValue(std::move(pts));
@@ -193,7 +197,8 @@ public:
         if (invalid_.count(name)) throw InvalidParamRead{};
         auto it = node_.params.find(name);
         if (it == node_.params.end())
-            throw Error("internal error: " + node_.node->qualified_name() + " has no parameter '" + std::string(name) + "'");
+            throw Error("internal error: " + node_.node->qualified_name() + " has no parameter '" + std::string(name) +
+                        "'");
         return it->second;
     }
     fs::path resolved_path(std::string_view name) const override {
@@ -284,8 +289,9 @@ private:
         if (!parsed_.version) {
             diags_.error(file_start_, "a spec starts with its format version: add `orogen 1` as the first line");
         } else if (*parsed_.version != 1) {
-            diags_.error(parsed_.version_where, "format version " + std::to_string(*parsed_.version) +
-                                                    " is not supported; this orogen reads `orogen 1`");
+            diags_.error(parsed_.version_where,
+                         "format version " + std::to_string(*parsed_.version) +
+                             " is not supported; this orogen reads `orogen 1`");
         }
         plan_.seed = options_.seed ? *options_.seed : parsed_.seed.value_or(0);
         plan_.grid.width = parsed_.grid_width;
@@ -296,8 +302,9 @@ private:
         if (const std::string problem =
                 heightmap_memory_problem(plan_.grid.width, plan_.grid.height, options_.heightmap_memory_limit);
             !problem.empty())
-            diags_.error(parsed_.has_grid ? parsed_.grid_where : file_start_,
-                         "grid " + std::to_string(plan_.grid.width) + "x" + std::to_string(plan_.grid.height) + " " + problem);
+            diags_.error(
+                parsed_.has_grid ? parsed_.grid_where : file_start_,
+                "grid " + std::to_string(plan_.grid.width) + "x" + std::to_string(plan_.grid.height) + " " + problem);
     }
 
     /// Each --set parsed as its own little source, so its errors point into the override.
@@ -323,11 +330,14 @@ private:
         const std::string label = label_of(si);
         if (!st.name.empty())
             if (auto it = defined_at_.find(st.name); it != defined_at_.end())
-                diags_.error(st.name_where, "'" + st.name + "' is already defined on line " +
-                                                std::to_string(it->second.line) + "; give this value another name");
+                diags_.error(st.name_where,
+                             "'" + st.name + "' is already defined on line " + std::to_string(it->second.line) +
+                                 "; give this value another name");
         if (!st.name.empty() && options_.bound.count(st.name))
-            diags_.error(st.name_where, "'" + st.name + "' is a value the caller hands to the run (an input of "
-                                        "orogen.node()); give this value another name");
+            diags_.error(st.name_where,
+                         "'" + st.name +
+                             "' is a value the caller hands to the run (an input of "
+                             "orogen.node()); give this value another name");
         const NodeDescriptor* node = registry_.find(call.qualified());
         if (!node) {
             report_unknown_node(st, label);
@@ -382,20 +392,21 @@ private:
         nc.planned.inputs.assign(node->inputs.size(), "");
         if (call.inputs.size() > node->inputs.size()) {
             const auto& extra = call.inputs[node->inputs.size()];
-            diags_.error(extra.where, call.qualified() + " takes " +
-                                          (node->inputs.empty() ? std::string("no inputs")
-                                                                : "at most " + std::to_string(node->inputs.size()) +
-                                                                      (node->inputs.size() == 1 ? " input" : " inputs")) +
-                                          ", but '" + extra.full() + "' is input " + std::to_string(node->inputs.size() + 1));
+            diags_.error(extra.where,
+                         call.qualified() + " takes " +
+                             (node->inputs.empty() ? std::string("no inputs")
+                                                   : "at most " + std::to_string(node->inputs.size()) +
+                                      (node->inputs.size() == 1 ? " input" : " inputs")) +
+                             ", but '" + extra.full() + "' is input " + std::to_string(node->inputs.size() + 1));
             nc.inputs_ok = false;
         }
         for (std::size_t i = 0; i < call.inputs.size() && i < node->inputs.size(); ++i) check_input(nc, i);
         for (std::size_t i = call.inputs.size(); i < node->inputs.size(); ++i) {
             if (node->inputs[i].need != Need::required) continue;
-            diags_.error(call.where, call.qualified() + " needs input " + std::to_string(i + 1) + " ('" +
-                                         node->inputs[i].name + "', a " +
-                                         describe_type(node->inputs[i].type, node->inputs[i].many == Many::series) +
-                                         "): " + call.qualified() + "(NAME, ...)");
+            diags_.error(call.where,
+                         call.qualified() + " needs input " + std::to_string(i + 1) + " ('" + node->inputs[i].name +
+                             "', a " + describe_type(node->inputs[i].type, node->inputs[i].many == Many::series) +
+                             "): " + call.qualified() + "(NAME, ...)");
             nc.inputs_ok = false;
         }
     }
@@ -409,9 +420,10 @@ private:
         for (const auto& [k, _] : values_)
             if (k.find(':') == std::string::npos) names.push_back(k);  // not the labels of calls in place
         std::string msg = "'" + in.full() + "' is not defined";
-        if (auto later = defined_anywhere_.find(in.name); later != defined_anywhere_.end() && defined_at_.count(in.name) == 0) {
+        if (auto later = defined_anywhere_.find(in.name);
+            later != defined_anywhere_.end() && defined_at_.count(in.name) == 0) {
             msg += " yet: it is defined later, on line " + std::to_string(later->second.line) +
-                   "; move that line above this one (a node reads only values made before it)";
+                "; move that line above this one (a node reads only values made before it)";
         } else if (defined_at_.count(in.name) == 0) {
             const std::string guess = spec::closest(in.full(), names);
             msg += guess.empty() ? "; define it with `" + in.name + " = kind:node(...)` on an earlier line"
@@ -432,7 +444,8 @@ private:
             nc.inputs_ok = false;
             return;
         }
-        if (poisoned_.count(in.statement >= 0 ? key : in.name)) {  // its node is unknown: that error was reported already
+        if (poisoned_.count(in.statement >= 0 ? key
+                                              : in.name)) {  // its node is unknown: that error was reported already
             nc.inputs_ok = false;
             return;
         }
@@ -446,15 +459,15 @@ private:
         const bool have_series = have.type == ValueType::series;
         const ValueType have_entry = have_series ? have.element : have.type;
         const bool maps = want.many == Many::one && have_series && node->output != ValueType::none &&
-                          !node->output_series && nc.planned.mapped_input < 0;
+            !node->output_series && nc.planned.mapped_input < 0;
         // An input declared ValueType::none takes any value; the node's check hook says which it accepts.
         const bool fits = (want.type == ValueType::none || have_entry == want.type) &&
-                          (want.many == Many::either || (want.many == Many::series) == have_series || maps);
+            (want.many == Many::either || (want.many == Many::series) == have_series || maps);
         if (!fits) {
-            std::string msg = call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name + "') must be a " +
-                              describe_type(want.type, want.many == Many::series) +
-                              (want.many == Many::either ? " or a " + describe_type(want.type, true) : "") + ", but '" +
-                              in.full() + "' is a " + describe_type(have_entry, have_series);
+            std::string msg = call.qualified() + " input " + std::to_string(i + 1) + " ('" + want.name +
+                "') must be a " + describe_type(want.type, want.many == Many::series) +
+                (want.many == Many::either ? " or a " + describe_type(want.type, true) : "") + ", but '" + in.full() +
+                "' is a " + describe_type(have_entry, have_series);
             if ((want.type == ValueType::none || have_entry == want.type) && want.many == Many::one && have_series)
                 msg += node->output == ValueType::none ? " (a node that only writes files is not mapped over a series)"
                                                        : " (a node is mapped over one series input at a time)";
@@ -487,7 +500,8 @@ private:
             if (!p) {
                 std::string msg = call.qualified() + " has no parameter '" + arg.key + "'";
                 const std::string guess = spec::closest(arg.key, param_names);
-                msg += guess.empty() ? "; `orogen help " + call.qualified() + "` lists them" : "; did you mean '" + guess + "'?";
+                msg += guess.empty() ? "; `orogen help " + call.qualified() + "` lists them"
+                                     : "; did you mean '" + guess + "'?";
                 diags_.error(arg.key_where, msg);
                 continue;
             }
@@ -522,8 +536,9 @@ private:
             auto it = nc.literals.find(p.name);
             if (it == nc.literals.end()) {
                 if (p.required()) {
-                    diags_.error(call.where, call.qualified() + " needs parameter '" + p.name + "'" +
-                                                 (p.help_text.empty() ? "" : " (" + p.help_text + ")"));
+                    diags_.error(call.where,
+                                 call.qualified() + " needs parameter '" + p.name + "'" +
+                                     (p.help_text.empty() ? "" : " (" + p.help_text + ")"));
                     nc.invalid.insert(p.name);
                 } else {
                     nc.planned.params[p.name] = p.default_value;
@@ -549,8 +564,8 @@ private:
             if (it == nc.planned.params.end() || !std::holds_alternative<std::string>(it->second)) continue;
             const std::string& value = std::get<std::string>(it->second);
             const Location where = nc.param_where.count(p.name) ? nc.param_where[p.name] : nc.st.call.where;
-            const bool ok = p.path_role == PathRole::input ? input_path_ok(value, where)
-                                                           : output_path_ok(nc, p, value, where);
+            const bool ok =
+                p.path_role == PathRole::input ? input_path_ok(value, where) : output_path_ok(nc, p, value, where);
             if (!ok) nc.invalid.insert(p.name);
         }
     }
@@ -559,10 +574,11 @@ private:
         const fs::path resolved = fs::path(value).is_absolute() ? fs::path(value) : plan_.spec_folder / value;
         std::error_code ec;
         if (!fs::exists(resolved, ec)) {
-            diags_.error(where, "no such file: " + value +
-                                    (fs::path(value).is_absolute()
-                                         ? std::string()
-                                         : " (looked for " + resolved.string() + "; input paths are relative to the spec's folder)"));
+            diags_.error(where,
+                         "no such file: " + value +
+                             (fs::path(value).is_absolute() ? std::string()
+                                                            : " (looked for " + resolved.string() +
+                                      "; input paths are relative to the spec's folder)"));
             return false;
         }
         if (const std::string problem = regular_file_problem(resolved); !problem.empty()) {
@@ -595,14 +611,16 @@ private:
         if (out.is_absolute()) {
             std::error_code ec;
             if (!fs::is_directory(out.parent_path(), ec)) {
-                diags_.error(where, "cannot write " + value + ": folder " + out.parent_path().string() + " does not exist");
+                diags_.error(where,
+                             "cannot write " + value + ": folder " + out.parent_path().string() + " does not exist");
                 return false;
             }
         }
         const std::string key = place.resolved.string();
         if (auto prev = output_files_.find(key); prev != output_files_.end()) {
-            diags_.error(where, "'" + value + "' is already written by the node on line " +
-                                    std::to_string(prev->second.line) + "; give each output its own path");
+            diags_.error(where,
+                         "'" + value + "' is already written by the node on line " + std::to_string(prev->second.line) +
+                             "; give each output its own path");
             return false;
         }
         output_files_.emplace(key, where);
@@ -664,9 +682,7 @@ private:
             nc.node->check(ctx);
         } catch (const InvalidParamRead&) {
             // stopped at a parameter whose error is already reported
-        } catch (const std::exception& e) {
-            diags_.error(call.where, call.qualified() + ": " + e.what());
-        }
+        } catch (const std::exception& e) { diags_.error(call.where, call.qualified() + ": " + e.what()); }
         out = ctx.take_output();
         sides = ctx.take_sides();
     }
@@ -719,15 +735,15 @@ private:
     const Location file_start_;
     Plan plan_;
     std::vector<PendingOverride> overrides_;
-    std::map<std::string, ValueInfo, std::less<>> values_;       // value key → info
-    std::map<std::string, Location, std::less<>> defined_at_;    // value name → statement
+    std::map<std::string, ValueInfo, std::less<>> values_;  // value key → info
+    std::map<std::string, Location, std::less<>> defined_at_;  // value name → statement
     std::map<std::string, Location, std::less<>> output_files_;  // output path → where
     std::map<std::string, int, std::less<>> unnamed_count_;
     std::set<std::string, std::less<>> poisoned_;  // names whose node is unknown
     std::vector<std::string> all_nodes_;
     std::map<std::string, Location, std::less<>> defined_anywhere_;  // for "'x' is defined later, on line N"
     std::vector<std::string> nested_key_;  // value key of each call written where an input goes (its label)
-    std::vector<std::string> labels_;      // every node's label, for --set's "did you mean"
+    std::vector<std::string> labels_;  // every node's label, for --set's "did you mean"
 };
 
 }  // namespace

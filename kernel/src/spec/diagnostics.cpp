@@ -34,9 +34,9 @@ void Diagnostics::note(const Location& where, std::string message) {
 
 std::string format(const Diagnostic& d) {
     std::ostringstream out;
-    const char* sev = d.severity == Diagnostic::Severity::error     ? "error"
-                      : d.severity == Diagnostic::Severity::warning ? "warning"
-                                                                    : "note";
+    const char* sev = d.severity == Diagnostic::Severity::error ? "error"
+        : d.severity == Diagnostic::Severity::warning           ? "warning"
+                                                                : "note";
     if (!d.where.source) {
         out << "orogen: " << sev << ": " << d.message << "\n";
         return out.str();
@@ -44,7 +44,8 @@ std::string format(const Diagnostic& d) {
     out << d.where.source->name << ":" << d.where.line << ":" << d.where.column << ": " << sev << ": " << d.message
         << "\n";
     const std::string_view text = d.where.source->line(d.where.line);
-    bool printable = d.where.length > 0;  // length 0: a place with no text worth showing  // a binary file's "line" is noise: say where, do not echo it
+    bool printable = d.where.length >
+        0;  // length 0: a place with no text worth showing  // a binary file's "line" is noise: say where, do not echo it
     for (unsigned char c : text) printable = printable && (c >= 0x20 || c == '\t') && c != 0x7f;
     if (printable) {
         out << "  " << text << "\n  ";

@@ -70,8 +70,9 @@ private:
             if ((b < 0x20 && b != '\n' && b != '\t' && b != '\r') || b == 0x7f) {
                 char hex[8];
                 std::snprintf(hex, sizeof hex, "0x%02x", b);
-                diags_.error(Location{source_, 1, 1, 0}, "this is not a text spec: byte " + std::to_string(k) +
-                                                             " is " + hex + ", a control character; is it a binary file?");
+                diags_.error(Location{source_, 1, 1, 0},
+                             "this is not a text spec: byte " + std::to_string(k) + " is " + hex +
+                                 ", a control character; is it a binary file?");
                 Token bad;
                 bad.kind = Tok::bad;
                 bad.where = Location{source_, 1, 1, 1};

@@ -61,8 +61,9 @@ public:
         if (peek().kind == Tok::colon) {
             ++p_;
             if (peek().kind != Tok::word) {
-                error(peek(), "expected the node's name after '" + name.text +
-                                  ":' (an unnamed node is set by its label, e.g. --set export:png#2.bits=8)");
+                error(peek(),
+                      "expected the node's name after '" + name.text +
+                          ":' (an unnamed node is set by its label, e.g. --set export:png#2.bits=8)");
                 return std::nullopt;
             }
             o.target += ":" + peek().text;
@@ -79,8 +80,9 @@ public:
             }
             o.target_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - name.where.column;
         }
-        if (!expect(Tok::dot, "'.' between the value name and the parameter (NAME.PARAM=VALUE; an unnamed node by "
-                              "its label, e.g. export:png#2.bits=8)"))
+        if (!expect(Tok::dot,
+                    "'.' between the value name and the parameter (NAME.PARAM=VALUE; an unnamed node by "
+                    "its label, e.g. export:png#2.bits=8)"))
             return std::nullopt;
         const Token& param = peek();
         if (param.kind != Tok::word) {
@@ -137,8 +139,7 @@ private:
             else if (t_[i].kind == Tok::rparen && --depth == 0) break;
             else if (t_[i].kind == Tok::eof) return false;
         }
-        for (++i; i < t_.size() && t_[i].kind == Tok::newline; ++i) {
-        }
+        for (++i; i < t_.size() && t_[i].kind == Tok::newline; ++i) {}
         return i < t_.size() && (t_[i].kind == Tok::comma || t_[i].kind == Tok::rparen);
     }
     void skip_newlines() {
@@ -170,8 +171,9 @@ private:
     void statement(Spec& spec) {
         const Token& first = peek();
         if (first.kind != Tok::word) {
-            error(first, "expected a statement (orogen, seed, grid, NAME = kind:node(...), or kind:node(...)), found " +
-                             what(first));
+            error(first,
+                  "expected a statement (orogen, seed, grid, NAME = kind:node(...), or kind:node(...)), found " +
+                      what(first));
             return;
         }
         if (peek(1).kind == Tok::equals) {  // NAME = call
@@ -241,8 +243,9 @@ private:
             error(first, "a node is called as kind:node(...), e.g. generate:" + first.text + "(...)");
             return;
         }
-        error(first, "unknown statement '" + first.text +
-                         "'; expected orogen, seed, grid, NAME = kind:node(...), or kind:node(...)");
+        error(first,
+              "unknown statement '" + first.text +
+                  "'; expected orogen, seed, grid, NAME = kind:node(...), or kind:node(...)");
     }
 
     void grid(Spec& spec) {
@@ -272,7 +275,8 @@ private:
             // Either side may be any number the lexer accepted (1e27, or HUGE_VAL from 400 digits): clamp before
             // converting, since a double outside long's range is undefined behaviour (found by fuzz_spec).
             const auto side = [](double v) { return std::to_string(long(std::clamp(v, -1e18, 1e18))); };
-            diags_.error(spec.grid_where, "the grid needs at least 2 vertices a side, got " + side(width) + "x" + side(height));
+            diags_.error(spec.grid_where,
+                         "the grid needs at least 2 vertices a side, got " + side(width) + "x" + side(height));
             return;
         }
         spec.grid_width = width > 2e9 ? 2000000000 : int(width);
@@ -316,14 +320,16 @@ private:
         call.where = kind.where;
         call.where.length = node.where.column + node.where.length - kind.where.column;
         const Token& open = peek();
-        if (!expect(Tok::lparen, "'(' after " + call.qualified() + " (a call with no arguments is written " +
-                                     call.qualified() + "())"))
+        if (!expect(
+                Tok::lparen,
+                "'(' after " + call.qualified() + " (a call with no arguments is written " + call.qualified() + "())"))
             return std::nullopt;
         // Inside ( ) newlines do not end a statement, so a missing ')' shows up lines later:
         // then point at the '(' that was never closed.
         // (A kind:node(...) on a later line followed by ',' or ')' is an input made in place, not the next statement.)
         auto unclosed = [&](const Token& at) {
-            if (at.kind == Tok::eof || (at.where.line > open.where.line && starts_statement(p_) && !call_in_place(p_))) {
+            if (at.kind == Tok::eof ||
+                (at.where.line > open.where.line && starts_statement(p_) && !call_in_place(p_))) {
                 diags_.error(open.where, "this '(' of the call to " + call.qualified() + " is never closed; add ')'");
                 return true;
             }
@@ -349,8 +355,9 @@ private:
                 auto value = literal();
                 if (!value) return std::nullopt;
                 if (value->kind == Literal::Kind::word && peek().kind == Tok::dot) {
-                    diags_.error(value->where, "a value with a '.' in it is a string: write it in quotes, " + a.text + "=\"" +
-                                            value->text + "." + (peek(1).kind == Tok::word ? peek(1).text : "") + "\"");
+                    diags_.error(value->where,
+                                 "a value with a '.' in it is a string: write it in quotes, " + a.text + "=\"" +
+                                     value->text + "." + (peek(1).kind == Tok::word ? peek(1).text : "") + "\"");
                     return std::nullopt;
                 }
                 call.params.push_back(Argument{a.text, a.where, std::move(*value)});
@@ -363,8 +370,9 @@ private:
                 Input in{a.text, "", a.where};
                 if (peek(1).kind == Tok::colon) {  // a call where a value goes: hoisted before this statement
                     if (nesting_ >= kMaxNesting) {  // (a bound on the recursion, whatever the input)
-                        error(a, "calls are nested more than " + std::to_string(kMaxNesting) +
-                                     " deep here; name some of the values on lines of their own");
+                        error(a,
+                              "calls are nested more than " + std::to_string(kMaxNesting) +
+                                  " deep here; name some of the values on lines of their own");
                         return std::nullopt;
                     }
                     ++nesting_;
@@ -372,9 +380,10 @@ private:
                     --nesting_;
                     if (!inner) return std::nullopt;
                     if (peek().kind == Tok::dot) {
-                        error(peek(), "to use a side value of " + inner->qualified() + ", name the value first: NAME = " +
-                                          inner->qualified() + "(...) on a line of its own, then NAME." +
-                                          (peek(1).kind == Tok::word ? peek(1).text : "SIDE"));
+                        error(peek(),
+                              "to use a side value of " + inner->qualified() + ", name the value first: NAME = " +
+                                  inner->qualified() + "(...) on a line of its own, then NAME." +
+                                  (peek(1).kind == Tok::word ? peek(1).text : "SIDE"));
                         return std::nullopt;
                     }
                     in.name = inner->qualified() + "(...)";
@@ -484,7 +493,9 @@ private:
                 }
             }
             default:
-                error(t, "expected a value (a number, \"string\", true/false, a word, (x, y) or [list]), found " + what(t));
+                error(
+                    t,
+                    "expected a value (a number, \"string\", true/false, a word, (x, y) or [list]), found " + what(t));
                 return std::nullopt;
         }
     }

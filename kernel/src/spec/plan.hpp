@@ -17,14 +17,14 @@ namespace orogen {
 
 struct PlannedNode {
     const NodeDescriptor* node = nullptr;
-    std::string label;       ///< value name, or kind:node for unnamed calls
+    std::string label;  ///< value name, or kind:node for unnamed calls
     std::string value_name;  ///< "" if unnamed; a call written where an input goes: its label
-    bool in_place = false;   ///< a call written where an input goes (unnamed, but its value is read)
-    spec::Location where;    ///< the call
+    bool in_place = false;  ///< a call written where an input goes (unnamed, but its value is read)
+    spec::Location where;  ///< the call
     std::vector<std::string> inputs;  ///< value keys ("base", "sim.particles"), "" for an optional input not given
     std::map<std::string, ParamValue, std::less<>> params;  ///< every declared parameter, defaults filled in
-    std::set<std::string, std::less<>> given;               ///< parameters set in the spec or by --set
-    std::vector<std::string> output_files;                   ///< output path parameters' values
+    std::set<std::string, std::less<>> given;  ///< parameters set in the spec or by --set
+    std::vector<std::string> output_files;  ///< output path parameters' values
     /// The input (Many::one) that was given a series: the node is mapped over
     /// its entries and outputs a series (-1: runs once, as usual).
     int mapped_input = -1;
@@ -46,7 +46,7 @@ struct Plan {
 
 struct CheckOptions {
     std::vector<std::string> overrides;  ///< "NAME.PARAM=VALUE"
-    std::optional<std::uint64_t> seed;   ///< --seed, overrides the spec's
+    std::optional<std::uint64_t> seed;  ///< --seed, overrides the spec's
     /// Memory a single heightmap may take before the grid is refused, bytes (0: a quarter of physical memory).
     std::uint64_t heightmap_memory_limit = 0;
     /// --out: every output path must resolve inside it, unless allow_outside_out (--allow-outside-out).

@@ -28,13 +28,29 @@
 
 namespace orogen::spec {
 
-enum class Tok { word, number, string, lparen, rparen, lbracket, rbracket, comma, equals, colon, dot, hash, newline, eof, bad };
+enum class Tok {
+    word,
+    number,
+    string,
+    lparen,
+    rparen,
+    lbracket,
+    rbracket,
+    comma,
+    equals,
+    colon,
+    dot,
+    hash,
+    newline,
+    eof,
+    bad
+};
 
 struct Token {
     Tok kind = Tok::eof;
-    std::string text;     ///< as written (strings: the decoded value)
+    std::string text;  ///< as written (strings: the decoded value)
     double number = 0.0;  ///< for numbers
-    bool integer = false; ///< a number written without '.', exponent
+    bool integer = false;  ///< a number written without '.', exponent
     Location where;
 };
 
@@ -75,7 +91,7 @@ struct Argument {
 
 struct Call {
     std::string kind, node;  ///< "generate", "diamond-square"
-    Location where;          ///< spans kind:node
+    Location where;  ///< spans kind:node
     std::vector<Input> inputs;
     std::vector<Argument> params;
     std::string qualified() const { return kind + ":" + node; }
@@ -111,7 +127,7 @@ Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags);
 /// it: kind:node, kind:node#2, ...
 struct Override {
     std::string target;  ///< NAME, or the label kind:node[#N]
-    std::string param;   ///< PARAM
+    std::string param;  ///< PARAM
     Location target_where, param_where;
     Literal value;
 };

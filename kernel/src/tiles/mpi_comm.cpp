@@ -97,9 +97,11 @@ void sendrecv(const void* send_data, std::size_t send_bytes, int to, void* recv_
             const std::size_t n = std::min(kPiece, bytes - done);
             requests.emplace_back();
             if (sending)
-                check(MPI_Isend(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()), "MPI_Isend");
+                check(MPI_Isend(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()),
+                      "MPI_Isend");
             else
-                check(MPI_Irecv(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()), "MPI_Irecv");
+                check(MPI_Irecv(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()),
+                      "MPI_Irecv");
             done += n;
         } while (done < bytes);
     };
@@ -149,8 +151,9 @@ namespace {
 }  // namespace
 
 Session::Session(int&, char**&) {
-    throw Error("started by mpirun, but this orogen was built without MPI: install Open MPI "
-                "(apt-get install openmpi-bin libopenmpi-dev), configure again and rebuild, or run without mpirun");
+    throw Error(
+        "started by mpirun, but this orogen was built without MPI: install Open MPI "
+        "(apt-get install openmpi-bin libopenmpi-dev), configure again and rebuild, or run without mpirun");
 }
 Session::~Session() = default;
 void max_all(int*, int) {}

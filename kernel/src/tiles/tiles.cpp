@@ -49,8 +49,8 @@ std::vector<double> Tiling::gather_rows(std::span<const double> mine, int per_ro
     if (n && mine.size() != n)
         throw Error("internal error: gather_rows got " + std::to_string(mine.size()) + " values for " +
                     std::to_string(n));
-    const auto all = gather(std::string_view(reinterpret_cast<const char*>(mine.data()), n * sizeof(double)),
-                            Gather::to_every_rank);
+    const auto all =
+        gather(std::string_view(reinterpret_cast<const char*>(mine.data()), n * sizeof(double)), Gather::to_every_rank);
     std::vector<double> rows(std::size_t(grid_height()) * std::size_t(per_row));
     std::size_t at = 0;
     for (const std::string& part : all) {
@@ -65,13 +65,8 @@ std::vector<double> Tiling::gather_rows(std::span<const double> mine, int per_ro
 // ------------------------------------------------------------------ a grid eroder's tiled loop
 
 TiledFields::TiledFields(Tiling& tiles, double cell)
-    : tiles_(tiles),
-      cell_(cell),
-      own_(tiles.owned()),
-      ghosted_(tiles.ghosted()),
-      ox_(own_.x0 - ghosted_.x0),
-      oy_(own_.y0 - ghosted_.y0),
-      waited_before_(tiles.seconds_waiting()) {}
+    : tiles_(tiles), cell_(cell), own_(tiles.owned()), ghosted_(tiles.ghosted()), ox_(own_.x0 - ghosted_.x0),
+      oy_(own_.y0 - ghosted_.y0), waited_before_(tiles.seconds_waiting()) {}
 
 GridView TiledFields::grow(const float* tile) {
     grids_.push_back(std::make_unique<std::vector<float>>(tiles_.ghosted_copy(tile)));
@@ -154,7 +149,8 @@ std::optional<std::pair<int, int>> parse_tiles(std::string_view text) {
     const auto x = text.find_first_of("xX");
     if (x == std::string_view::npos || x == 0 || x + 1 == text.size()) return std::nullopt;
     auto number = [](std::string_view t) -> std::optional<int> {
-        if (t.empty() || t.size() > 6 || t.find_first_not_of("0123456789") != std::string_view::npos) return std::nullopt;
+        if (t.empty() || t.size() > 6 || t.find_first_not_of("0123456789") != std::string_view::npos)
+            return std::nullopt;
         const int v = std::stoi(std::string(t));
         return v >= 1 ? std::optional<int>(v) : std::nullopt;
     };
@@ -183,11 +179,12 @@ std::pair<int, int> automatic_tiles(int ranks, int width, int height) {
 
 void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptions& options, spec::Diagnostics& diags) {
     const std::string how = (options.tiles_given ? "--tiles " : "the automatic split ") + std::to_string(split.rows) +
-                            "x" + std::to_string(split.cols);
+        "x" + std::to_string(split.cols);
     const std::string grid = std::to_string(split.grid_width) + "x" + std::to_string(split.grid_height);
     if (split.cols > split.grid_width || split.rows > split.grid_height) {
         diags.error(spec::Location{plan.source, 1, 1, 1},
-                    how + " cuts the " + grid + " grid into more " + (split.cols > split.grid_width ? "columns" : "rows") +
+                    how + " cuts the " + grid + " grid into more " +
+                        (split.cols > split.grid_width ? "columns" : "rows") +
                         " than it has vertices; use fewer ranks or --tiles with fewer " +
                         (split.cols > split.grid_width ? "columns" : "rows"));
         return;
@@ -198,10 +195,11 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
             const std::string problem =
                 heightmap_memory_problem(split.grid_width, split.grid_height, options.whole_grid_limit);
             if (!problem.empty())
-                diags.error(node.where, who + " runs on rank 0 over the whole " + grid + " grid (" +
-                                            TiledRun::untiled_reason(node) + "), which " + problem +
-                                            "; remove it from this spec (run it on the result, in a smaller spec), "
-                                            "change what keeps it from tiling or use a smaller grid");
+                diags.error(node.where,
+                            who + " runs on rank 0 over the whole " + grid + " grid (" +
+                                TiledRun::untiled_reason(node) + "), which " + problem +
+                                "; remove it from this spec (run it on the result, in a smaller spec), "
+                                "change what keeps it from tiling or use a smaller grid");
             continue;
         }
         const int halo = node.node->tile_halo;
@@ -218,8 +216,9 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
                             " (--tiles), fewer ranks or a larger grid");
         if (auto it = node.params.find(timelapse_param().name); it != node.params.end() && !node.node->tiled_timelapse)
             if (const auto* every = std::get_if<std::int64_t>(&it->second); every && *every > 0)
-                diags.error(node.where, who + ": time-lapses are not recorded in a tiled run yet; set " +
-                                            timelapse_param().name + "=0 or run without mpirun");
+                diags.error(node.where,
+                            who + ": time-lapses are not recorded in a tiled run yet; set " + timelapse_param().name +
+                                "=0 or run without mpirun");
     }
 }
 
@@ -344,12 +343,8 @@ void NodeTiling::carry(Toward toward, std::span<double> values, int per_line,
     const int rank = this->rank(), c = rank % split.cols, r = rank / split.cols;
     int from = -1, to = -1;  // upstream and downstream neighbours
     switch (toward) {
-        case Toward::east:
-            from = c > 0 ? rank - 1 : -1, to = c + 1 < split.cols ? rank + 1 : -1;
-            break;
-        case Toward::west:
-            from = c + 1 < split.cols ? rank + 1 : -1, to = c > 0 ? rank - 1 : -1;
-            break;
+        case Toward::east: from = c > 0 ? rank - 1 : -1, to = c + 1 < split.cols ? rank + 1 : -1; break;
+        case Toward::west: from = c + 1 < split.cols ? rank + 1 : -1, to = c > 0 ? rank - 1 : -1; break;
         case Toward::south:
             from = r > 0 ? rank - split.cols : -1, to = r + 1 < split.rows ? rank + split.cols : -1;
             break;
@@ -451,7 +446,8 @@ std::vector<float> NodeTiling::fetch_samples(const float* mine, AxisSamples colu
         }
         k = 0;
         for (int j = take.r0; j < take.r1; ++j)
-            for (int i = take.c0; i < take.c1; ++i) out[std::size_t(j) * std::size_t(ncols) + std::size_t(i)] = take_buffer[k++];
+            for (int i = take.c0; i < take.c1; ++i)
+                out[std::size_t(j) * std::size_t(ncols) + std::size_t(i)] = take_buffer[k++];
     }
     return out;
 }

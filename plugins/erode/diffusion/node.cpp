@@ -52,8 +52,8 @@ NodeOutputs run(NodeContext& ctx) {
     // In a tiled run (mpirun) the heightmap is this rank's tile and the solver sweeps across the tiles
     // (diffusion.hpp): the same bits as one process, the tile's share of the memory.
     Tiling* tiles = ctx.tiling();
-    diffusion::Solver solver = tiles ? diffusion::Solver(*tiles, hm->cell(), s)
-                                     : diffusion::Solver(hm->width(), hm->height(), hm->cell(), s);
+    diffusion::Solver solver =
+        tiles ? diffusion::Solver(*tiles, hm->cell(), s) : diffusion::Solver(hm->width(), hm->height(), hm->cell(), s);
     // A sample's index in the whole grid, for the messages.
     auto sample = [&](std::size_t k) {
         if (!tiles) return std::int64_t(k);
@@ -109,9 +109,10 @@ NodeOutputs run(NodeContext& ctx) {
 void check(CheckContext& ctx) {
     diffusion::FixedSides f;
     if (!parse_sides(ctx.text("fixed"), f))
-        ctx.error("fixed", "'" + ctx.text("fixed") +
-                               "' is not a set of sides; write the letters of the fixed sides (n, e, s, w), e.g. "
-                               "\"ns\", or all or none");
+        ctx.error("fixed",
+                  "'" + ctx.text("fixed") +
+                      "' is not a set of sides; write the letters of the fixed sides (n, e, s, w), e.g. "
+                      "\"ns\", or all or none");
     if (ctx.real("dt") > ctx.real("years"))
         ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
     check_timelapse(ctx, std::int64_t(std::ceil(ctx.real("years") / ctx.real("dt"))));

@@ -329,12 +329,8 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
 }
 
 Rule make_rule(const Settings& settings, const float* hardness, double cell) {
-    return Rule{float(settings.rain),
-                float(settings.solubility),
-                float(1.0 - settings.evaporation),
-                float(settings.capacity),
-                settings.hardness,
-                hardness,
+    return Rule{float(settings.rain),     float(settings.solubility), float(1.0 - settings.evaporation),
+                float(settings.capacity), settings.hardness,          hardness,
                 float(1.0 / cell)};
 }
 
@@ -403,8 +399,8 @@ void steepness_hardness(ConstGridView height, GridView out) {
 
 void step(const ConstState& in, const State& out, const Settings& settings, const float* hardness) {
     const int w = in.height.width, h = in.height.height;
-    for (ConstGridView v : {in.water, in.sediment, ConstGridView(out.height), ConstGridView(out.water),
-                            ConstGridView(out.sediment)})
+    for (ConstGridView v :
+         {in.water, in.sediment, ConstGridView(out.height), ConstGridView(out.water), ConstGridView(out.sediment)})
         if (v.width != w || v.height != h) throw Error("hydraulic::step: state grids differ in size");
     if (settings.hardness == Hardness::layer && hardness == nullptr)
         throw Error("hydraulic::step: hardness layer mode needs a hardness layer");

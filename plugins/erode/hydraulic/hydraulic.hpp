@@ -30,22 +30,22 @@ namespace orogen::hydraulic {
 
 enum class Hardness {
     steepness,  ///< the thesis's (1 − |n_y|)³: steep ground dissolves, flat ground does not
-    constant,   ///< softness 1 everywhere
-    layer,      ///< softness 1 − clamp(layer, 0, 1)
+    constant,  ///< softness 1 everywhere
+    layer,  ///< softness 1 − clamp(layer, 0, 1)
 };
 
 struct Settings {
-    double rain = 0.01;        ///< metres of water added to every cell per step (Olsen's Kr)
+    double rain = 0.01;  ///< metres of water added to every cell per step (Olsen's Kr)
     double solubility = 0.01;  ///< metres of terrain dissolved per metre of water per step (Ks)
     double evaporation = 0.5;  ///< fraction of water evaporating per step (Ke), 0..1
-    double capacity = 0.05;    ///< metres of sediment a metre of water holds (Kc)
+    double capacity = 0.05;  ///< metres of sediment a metre of water holds (Kc)
     Hardness hardness = Hardness::steepness;
 };
 
 /// The state the automaton evolves. All views the same size.
 struct State {
-    GridView height;    ///< terrain, m
-    GridView water;     ///< water column, m
+    GridView height;  ///< terrain, m
+    GridView water;  ///< water column, m
     GridView sediment;  ///< dissolved material, m of terrain
 };
 struct ConstState {

@@ -68,7 +68,10 @@ std::shared_ptr<Series> run_tiled(NodeContext& ctx, Tiling& tiles, Heightmap& hm
     Timelapse lapse(ctx.integer("timelapse_every"), 1.0, tiles);  // time = step count
     lapse.record(0, a.height, a.water.data, ox, oy);
     fields.sweeps(
-        iterations, kStepsPerSweep, [&] { return std::array{a.height, a.water, a.sediment}; },
+        iterations, kStepsPerSweep,
+        [&] {
+            return std::array{a.height, a.water, a.sediment};
+        },
         [&](std::int64_t first, int k) {
             for (std::int64_t i = first + 1; i <= first + k; ++i) {
                 hydraulic::step({a.height, a.water, a.sediment}, b, s, hard);
@@ -159,7 +162,8 @@ NodeOutputs run(NodeContext& ctx) {
     for (const char* l : {"flux_west", "flux_east", "flux_north", "flux_south"}) hm->remove_layer(l);
     GridView flow = hm->layer("flow", 0.0f);
     hydraulic::outflow({hm->view(), water, sediment}, s, layer, flow);
-    if (s.hardness == hydraulic::Hardness::steepness) hydraulic::steepness_hardness(hm->view(), hm->layer("hardness", 0.0f));
+    if (s.hardness == hydraulic::Hardness::steepness)
+        hydraulic::steepness_hardness(hm->view(), hm->layer("hardness", 0.0f));
     lapse.finish(iterations, *hm);
     NodeOutputs out(hm);
     if (lapse.enabled()) out.side["timelapse"] = Value(lapse.series());

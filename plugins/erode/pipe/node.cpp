@@ -45,7 +45,7 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
     const TileRect own = fields.owned();
     const int ox = fields.ox(), oy = fields.oy();
     // 0 height, 1 water, 2 sediment, 3-6 fluxes, 7 flow (speed).
-    const char* names[] = {"", "water", "sediment", kFluxLayers[0], kFluxLayers[1], kFluxLayers[2], kFluxLayers[3],
+    const char* names[] = {"",    "water", "sediment", kFluxLayers[0], kFluxLayers[1], kFluxLayers[2], kFluxLayers[3],
                            "flow"};
     GridView held[8];
     held[0] = fields.grow(hm->heights().data());
@@ -93,8 +93,8 @@ NodeOutputs run_tiled(NodeContext& ctx, Tiling& tiles, std::shared_ptr<Heightmap
             << solver.substeps() << " sub-steps: " << total << " s, halo exchange " << ex << " s ("
             << (total > 0 ? 100.0 * ex / total : 0.0) << " %), reductions " << red << " s ("
             << (total > 0 ? 100.0 * red / total : 0.0) << " %), of which waiting for the other ranks "
-            << tiles.seconds_waiting() - waited_before << " s; CPU " << cpu << " s, of which halo exchange and reductions "
-            << cpu_other << " s";
+            << tiles.seconds_waiting() - waited_before << " s; CPU " << cpu
+            << " s, of which halo exchange and reductions " << cpu_other << " s";
         ctx.info(msg.str());
         if (tiles.rank() == 0) ctx.info(suspended_line(solver));
     }
@@ -141,14 +141,15 @@ NodeOutputs run(NodeContext& ctx) {
         const auto& m = *ctx.input(1).heightmap();
         if (m.width() != hm->width() || m.height() != hm->height()) {
             std::ostringstream msg;
-            msg << "the rain mask is " << m.width() << "x" << m.height() << " but the terrain is " << hm->width()
-                << "x" << hm->height() << "; give a mask of the terrain's size";
+            msg << "the rain mask is " << m.width() << "x" << m.height() << " but the terrain is " << hm->width() << "x"
+                << hm->height() << "; give a mask of the terrain's size";
             throw BadInput(msg.str());
         }
         mask = m.heights();
     }
     for (float& v : mask)
-        if (!(v >= 0.0f)) throw BadInput("rain_mask: the mask holds a negative or NaN value; rain factors must be >= 0");
+        if (!(v >= 0.0f))
+            throw BadInput("rain_mask: the mask holds a negative or NaN value; rain factors must be >= 0");
 
     // State: continue from water/sediment/flux layers when the input has them.
     // `flow` is this model's speed only in a pipe state (one with the flux
@@ -207,8 +208,7 @@ void check(CheckContext& ctx) {
         if (mask) ctx.error("rain_mask", "give the rain mask either as a layer name or as a second input, not both");
         ctx.require_layer(0, "rain_mask", mask_layer);
     }
-    if (mask && in && mask->width > 0 && in->width > 0 &&
-        (mask->width != in->width || mask->height != in->height)) {
+    if (mask && in && mask->width > 0 && in->width > 0 && (mask->width != in->width || mask->height != in->height)) {
         std::ostringstream msg;
         msg << "the rain mask is " << mask->width << "x" << mask->height << " but the terrain is " << in->width << "x"
             << in->height << "; give a mask of the terrain's size";
@@ -233,10 +233,12 @@ OROGEN_PLUGIN("erode-pipe", "0.1.0", registry) {
             "thin films do not scour like rivers, ramped down in water shallower than erosion_depth); the terrain "
             "erodes where the water carries less than that (never below its lowest neighbour) and receives "
             "deposits where it carries more (never above its highest); creep diffuses the terrain a little; "
-            "sediment moves with the water (semi-Lagrangian, at most one cell per sub-step); water evaporates. Each step of dt seconds is split into sub-steps under "
+            "sediment moves with the water (semi-Lagrangian, at most one cell per sub-step); water evaporates. Each "
+            "step of dt seconds is split into sub-steps under "
             "a CFL limit, so any dt runs without blowing up. Walls are closed unless boundary=open. Terrain + "
             "sediment (and, without rain and evaporation, water) is conserved. State layers: water (m), "
-            "sediment (m), flow (speed carrying sediment, m/s), flux_west/east/north/south (m^3/s), eroded (net change, m); an "
+            "sediment (m), flow (speed carrying sediment, m/s), flux_west/east/north/south (m^3/s), eroded (net "
+            "change, m); an "
             "input that carries them continues the simulation.",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to erode"},
                    {"rain_mask", ValueType::heightmap, Need::optional,

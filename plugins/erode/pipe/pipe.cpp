@@ -25,19 +25,19 @@ namespace {
 
 /// Constants of one sub-step, in float for the row loops.
 struct Sub {
-    float dt;         ///< s
-    float rain_dt;    ///< m of rain this sub-step (before the mask)
+    float dt;  ///< s
+    float rain_dt;  ///< m of rain this sub-step (before the mask)
     float flux_gain;  ///< dt·g·A/l: m³/s of flux per metre of surface drop
-    float area;       ///< l², m²
-    float inv_area;   ///< 1/l²
-    float l, inv_l;   ///< cell size, m
+    float area;  ///< l², m²
+    float inv_area;  ///< 1/l²
+    float l, inv_l;  ///< cell size, m
     float capacity, min_slope;
     float take, drop;  ///< 1 − e^(−Ks·dt), 1 − e^(−Kd·dt)
-    float keep;        ///< e^(−Ke·dt)
-    float speed_cap;   ///< m/s: capacity uses min(|v|, c)
+    float keep;  ///< e^(−Ke·dt)
+    float speed_cap;  ///< m/s: capacity uses min(|v|, c)
     float inv_erosion_depth;  ///< 1/m
     float gravity;  ///< m/s²
-    float kappa;    ///< creep·dt/l², dimensionless, at most 0.2 (stable)
+    float kappa;  ///< creep·dt/l², dimensionless, at most 0.2 (stable)
     bool open;
 };
 
@@ -52,12 +52,12 @@ inline float flow_speed(float u, float v, float d, float gravity) {
 /// The arrays of one sub-step.
 struct Arrays {
     const float* b;  ///< terrain now
-    float* b_next;   ///< terrain after erosion/deposition
-    float* d;        ///< water (updated in place by pass 2: no one reads a neighbour's depth there)
-    float* s;        ///< sediment (stored; pass 3 writes it)
-    float* s1;       ///< sediment after erosion/deposition, before transport
-    float* u;        ///< velocity east, m/s
-    float* v;        ///< velocity south, m/s
+    float* b_next;  ///< terrain after erosion/deposition
+    float* d;  ///< water (updated in place by pass 2: no one reads a neighbour's depth there)
+    float* s;  ///< sediment (stored; pass 3 writes it)
+    float* s1;  ///< sediment after erosion/deposition, before transport
+    float* u;  ///< velocity east, m/s
+    float* v;  ///< velocity south, m/s
     float *fw, *fe, *fn, *fs;  ///< outflow fluxes, m³/s (pass 1 updates each cell's own in place)
     const float* mask;
     int w, h;
@@ -73,8 +73,9 @@ inline float rain_factor(const Arrays& a, std::size_t i) { return a.mask ? a.mas
 
 /// Pass 1 for one cell. The flags say which neighbours exist; the interior
 /// loop passes constants so the compiler drops the tests and vectorises.
-[[gnu::always_inline]] inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
-                      float mw, float me, float mn, float ms, float mc) {
+[[gnu::always_inline]] inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw,
+                                             bool he, bool hn, bool hs, float mw, float me, float mn, float ms,
+                                             float mc) {
     const float* __restrict b = a.b;
     const float* __restrict d = a.d;
     const float d1 = d[i] + k.rain_dt * mc;
@@ -131,8 +132,9 @@ void flux_row(const Arrays& a, const Sub& k, int y) {
 }
 
 /// Pass 2 for one cell; returns its speed, adds to the row sums.
-[[gnu::always_inline]] inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw, bool he, bool hn, bool hs,
-                       float gx_scale, float gy_scale, float mc, bool rescale, double scale) {
+[[gnu::always_inline]] inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw,
+                                              bool he, bool hn, bool hs, float gx_scale, float gy_scale, float mc,
+                                              bool rescale, double scale) {
     const float* __restrict b = a.b;
     const float d1 = a.d[i] + k.rain_dt * mc;
     const float from_w = hw ? a.fe[i - 1] : 0.0f;
@@ -296,7 +298,8 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
 /// [sum_x0, sum_x0 + sum_w) (in a tiled run only the maxima and the
 /// finiteness check are used: Solver::Impl::tile_reductions makes the sums).
 RowSums water_row(const Arrays& a, const Sub& k, int y, bool rescale, double scale) {
-    if (a.mask) return rescale ? water_row_impl<true, true>(a, k, y, scale) : water_row_impl<true, false>(a, k, y, scale);
+    if (a.mask)
+        return rescale ? water_row_impl<true, true>(a, k, y, scale) : water_row_impl<true, false>(a, k, y, scale);
     return rescale ? water_row_impl<false, true>(a, k, y, scale) : water_row_impl<false, false>(a, k, y, scale);
 }
 
@@ -375,8 +378,7 @@ struct Solver::Impl {
     void exchange();
     /// Sums and maxima of a tiled sub-step over the owned cells, combined
     /// across ranks exactly as a single process combines its rows.
-    void tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
-                         float& vm, float& dm);
+    void tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite, float& vm, float& dm);
 };
 
 double process_cpu_seconds() {
@@ -419,15 +421,15 @@ void Solver::Impl::exchange() {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = process_cpu_seconds();
     const double cell = st.height.cell;
-    const GridView grids[] = {{b_cur, w, h, cell}, st.water, st.sediment, st.flux_west, st.flux_east,
-                              st.flux_north, st.flux_south};
+    const GridView grids[] = {{b_cur, w, h, cell}, st.water,      st.sediment,  st.flux_west,
+                              st.flux_east,        st.flux_north, st.flux_south};
     tiles->exchange(grids);
     exchanging += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     cpu_exchanging += process_cpu_seconds() - c0;
 }
 
-void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite,
-                                   float& vm, float& dm) {
+void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& total_new, bool& finite, float& vm,
+                                   float& dm) {
     const auto t0 = std::chrono::steady_clock::now();
     const double c0 = process_cpu_seconds();
     const std::size_t W = std::size_t(w);
@@ -478,8 +480,7 @@ void Solver::Impl::tile_reductions(const Arrays& a, double& total_s1, double& to
     cpu_reducing += process_cpu_seconds() - c0;
 }
 
-Solver::Solver(const State& state, const Settings& settings, const float* rain_mask, Tiling* tiling)
-    : impl_(new Impl) {
+Solver::Solver(const State& state, const Settings& settings, const float* rain_mask, Tiling* tiling) : impl_(new Impl) {
     Impl& m = *impl_;
     m.st = state;
     m.cfg = settings;
@@ -544,7 +545,9 @@ Solver::Solver(const State& state, const Settings& settings, const float* rain_m
         vd[0] = std::max(vd[0], m.row_vmax[std::size_t(y)]);
         vd[1] = std::max(vd[1], m.row_dmax[std::size_t(y)]);
     }
-    if (tiling) tiling->reduce(std::span<float>(vd), Tiling::Reduce::max);  // the whole grid's (a maximum is exact in any order)
+    if (tiling)
+        tiling->reduce(std::span<float>(vd),
+                       Tiling::Reduce::max);  // the whole grid's (a maximum is exact in any order)
     m.vmax = double(vd[0]);
     m.dmax = double(vd[1]);
 }
@@ -599,8 +602,22 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     const bool tiled = tiles != nullptr;
     if (tiled) exchange();
 
-    Arrays ar{b_cur, b_next, st.water.data, st.sediment.data, s1.data(), u.data(), v.data(), st.flux_west.data,
-              st.flux_east.data, st.flux_north.data, st.flux_south.data, mask, W, H, ox, ow};
+    Arrays ar{b_cur,
+              b_next,
+              st.water.data,
+              st.sediment.data,
+              s1.data(),
+              u.data(),
+              v.data(),
+              st.flux_west.data,
+              st.flux_east.data,
+              st.flux_north.data,
+              st.flux_south.data,
+              mask,
+              W,
+              H,
+              ox,
+              ow};
     // Chunks of rows: few and large, since each chunk leaves its edge rows
     // to the clean-up passes below.
     const std::int64_t grain = std::max<std::int64_t>(16, H / 16);
@@ -672,8 +689,8 @@ void Solver::Impl::substep(double dt, std::int64_t step, std::int64_t sub) {
     }
     if (!finite || !std::isfinite(total_new) || !std::isfinite(vm)) {
         std::ostringstream msg;
-        msg << "non-finite terrain, water or sediment at step " << step << " (sub-step " << sub << ", dt "
-            << dt << " s); the simulation became unstable";
+        msg << "non-finite terrain, water or sediment at step " << step << " (sub-step " << sub << ", dt " << dt
+            << " s); the simulation became unstable";
         throw Error(msg.str());
     }
     vmax = vm;

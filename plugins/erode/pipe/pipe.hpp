@@ -54,36 +54,37 @@ namespace orogen::pipe {
 
 enum class Boundary {
     closed,  ///< walls: no water or sediment leaves the grid
-    open,    ///< water flows off the edges as if onto dry ground at the edge's height
+    open,  ///< water flows off the edges as if onto dry ground at the edge's height
 };
 
 struct Settings {
-    double rain = 0.001;        ///< m/s of water on every cell (times the mask, if any)
+    double rain = 0.001;  ///< m/s of water on every cell (times the mask, if any)
     double evaporation = 0.01;  ///< 1/s: fraction of water evaporating per second (exponential)
-    double capacity = 1.0;      ///< Kc, s: sediment capacity per unit tilt and speed (m per m/s)
-    double dissolve = 0.5;      ///< Ks, 1/s: rate of taking up the capacity deficit
-    double deposit = 1.0;       ///< Kd, 1/s: rate of dropping the capacity excess
-    double gravity = 9.81;      ///< m/s²
-    double pipe_area = 1.0;     ///< A, m²: cross-section of each virtual pipe
-    double min_slope = 0.05;    ///< lower bound of sin α in the capacity, so flat water still carries
+    double capacity = 1.0;  ///< Kc, s: sediment capacity per unit tilt and speed (m per m/s)
+    double dissolve = 0.5;  ///< Ks, 1/s: rate of taking up the capacity deficit
+    double deposit = 1.0;  ///< Kd, 1/s: rate of dropping the capacity excess
+    double gravity = 9.81;  ///< m/s²
+    double pipe_area = 1.0;  ///< A, m²: cross-section of each virtual pipe
+    double min_slope = 0.05;  ///< lower bound of sin α in the capacity, so flat water still carries
     /// m: water shallower than this carries in proportion to its depth (0 = Mei's
     /// original capacity, independent of depth).
     double erosion_depth = 0.05;
     /// m²/s: creep, a linear diffusion of the terrain that damps grid-scale
     /// ripples (0 = none, Mei's original). Limited to κ = creep·dt/l² ≤ 0.2 per sub-step.
     double creep = 0.0;
-    double cfl = 0.5;           ///< Courant number of the sub-steps (≤ 0.7 for the pipe model)
+    double cfl = 0.5;  ///< Courant number of the sub-steps (≤ 0.7 for the pipe model)
     Boundary boundary = Boundary::closed;
 };
 
 /// The simulation state; the caller owns the memory (e.g. heightmap layers),
 /// so a later run can continue from it.
 struct State {
-    GridView height;    ///< terrain b, m
-    GridView water;     ///< water depth d, m
+    GridView height;  ///< terrain b, m
+    GridView water;  ///< water depth d, m
     GridView sediment;  ///< suspended sediment s, m of terrain
     GridView flux_west, flux_east, flux_north, flux_south;  ///< outflow through each pipe, m³/s
-    GridView speed;     ///< carrying speed min(|v|, √(g·d)) of the last sub-step, m/s (also read at start: the first sub-step's CFL)
+    GridView
+        speed;  ///< carrying speed min(|v|, √(g·d)) of the last sub-step, m/s (also read at start: the first sub-step's CFL)
 };
 
 /// Vertices of the neighbouring tiles one sub-step reads, in a tiled run:

@@ -15,7 +15,7 @@ namespace orogen::sph {
 
 namespace {
 
-constexpr std::int64_t kGrain = 512;     // particles per parallel task (integration)
+constexpr std::int64_t kGrain = 512;  // particles per parallel task (integration)
 constexpr std::int64_t kCellGrain = 64;  // cells per parallel task (density, forces)
 
 /// Candidate buffers per thread, kept across tasks and sub-steps (density_pass uses the first 3,
@@ -43,10 +43,8 @@ FluidConstants FluidConstants::from(const Settings& settings, float h) {
 }
 
 Simulation::Impl::Impl(ConstGridView terrain_in, const Settings& settings, std::size_t capacity)
-    : s(settings),
-      kernel(CubicSpline::with_support(float(4.0 * settings.radius))),
-      fluid(FluidConstants::from(settings, kernel.h)),
-      terrain(terrain_in, settings.radius) {
+    : s(settings), kernel(CubicSpline::with_support(float(4.0 * settings.radius))),
+      fluid(FluidConstants::from(settings, kernel.h)), terrain(terrain_in, settings.radius) {
     walls.tabulate(kernel, fluid.volume);
     p.reserve(capacity);
     cells.reserve(capacity, kernel.h);
@@ -132,7 +130,7 @@ void Simulation::Impl::force_pass() {
                 const std::size_t mp = padded(run_total(run, nr));
                 float* f[8];
                 for (int a = 0; a < 8; ++a) f[a] = room(buf[a], mp + kSlack);
-                const float* const from[8] = {soa[0].data(), soa[1].data(), soa[2].data(), soa[3].data(),
+                const float* const from[8] = {soa[0].data(), soa[1].data(), soa[2].data(),  soa[3].data(),
                                               soa[4].data(), soa[5].data(), p.pterm.data(), p.density.data()};
                 float* const to[8] = {f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
                 std::size_t k = gather8(from, to, run, nr);
@@ -167,13 +165,13 @@ void Simulation::Impl::force_pass() {
 
 /// integrate()'s constants for one sub-step.
 struct Simulation::Impl::StepConstants {
-    double ddt;              // s
-    double e;                // restitution
-    double fric;             // the tangential velocity's factor over the sub-step while in contact
-    double dissolve_frac;    // share of the capacity's deficit dissolved (times acidity·Δt)
-    double deposit_frac;     // share of the excess over capacity dropped
+    double ddt;  // s
+    double e;  // restitution
+    double fric;  // the tangential velocity's factor over the sub-step while in contact
+    double dissolve_frac;  // share of the capacity's deficit dissolved (times acidity·Δt)
+    double deposit_frac;  // share of the excess over capacity dropped
     double particle_volume;  // m³
-    double max_take;         // m³: max_dig over a tile
+    double max_take;  // m³: max_dig over a tile
 };
 
 /// The m³ of terrain particle i in contact takes up this sub-step (< 0: drops), from its tangential velocity
@@ -184,7 +182,8 @@ struct Simulation::Impl::StepConstants {
     const double sin_slope = std::sqrt(std::max(0.0, 1.0 - ny * ny));
     const double cap = s.capacity * k.particle_volume * speed * std::max(sin_slope, s.min_slope);
     const double sed = p.sediment[i];
-    if (sed < cap) return std::min(std::min(1.0, double(p.acidity[i]) * k.ddt) * k.dissolve_frac * (cap - sed), k.max_take);
+    if (sed < cap)
+        return std::min(std::min(1.0, double(p.acidity[i]) * k.ddt) * k.dissolve_frac * (cap - sed), k.max_take);
     return -k.deposit_frac * (sed - cap);
 }
 
@@ -286,8 +285,13 @@ struct Simulation::Impl::StepConstants {
 bool Simulation::Impl::integrate(float dt) {
     const double ddt = dt;
     const double cell = terrain.cell();
-    const StepConstants k{ddt, s.restitution, std::exp(-s.friction * ddt), 1.0, std::min(1.0, s.deposit * ddt),
-                          double(fluid.volume), s.max_dig * cell * cell};
+    const StepConstants k{ddt,
+                          s.restitution,
+                          std::exp(-s.friction * ddt),
+                          1.0,
+                          std::min(1.0, s.deposit * ddt),
+                          double(fluid.volume),
+                          s.max_dig * cell * cell};
     const std::size_t n = p.n;
     const std::int64_t blocks = (std::int64_t(n) + kGrain - 1) / kGrain;
     std::vector<std::uint8_t> block_bad(std::size_t(std::max<std::int64_t>(blocks, 1)), 0);
@@ -305,7 +309,6 @@ bool Simulation::Impl::integrate(float dt) {
     return true;
 }
 
-
 /// Apply the exchanges to the terrain, remove particles that left or reached
 /// the sea. Every terrain vertex receives its additions in particle order,
 /// as a serial loop would, on any thread count: the particles are cut into
@@ -318,7 +321,7 @@ bool Simulation::Impl::integrate(float dt) {
 /// A queued exchange (16 bytes; queued only where a particle's tile reaches a shared row, so a few
 /// per cent of the particles at 16384 a chunk, at most two entries per particle).
 struct Simulation::Impl::Deferred {
-    float x, z;     // m, where the exchange happens; x NaN: a particle that left over an open edge
+    float x, z;  // m, where the exchange happens; x NaN: a particle that left over an open edge
     double volume;  // m³ added to the terrain there (< 0: taken); or the sediment that left with it
 };
 

@@ -17,10 +17,10 @@ namespace orogen::sph {
 
 /// The fluid's constants, derived from Settings (float: the SPH loops run in single precision).
 struct FluidConstants {
-    float mass = 0, volume = 0;      ///< of a particle: kg, m³ (a cube of the spacing 2r)
-    float rho0 = 0, B = 0, c0 = 0;   ///< rest density kg/m³, Tait's stiffness Pa, sound speed m/s
-    float visc_eps = 0;              ///< 0.01 (h/2)², m²: keeps Π finite at r → 0
-    float alpha_c_hs = 0;            ///< α c0 h/2, m²/s: Monaghan's viscosity coefficient
+    float mass = 0, volume = 0;  ///< of a particle: kg, m³ (a cube of the spacing 2r)
+    float rho0 = 0, B = 0, c0 = 0;  ///< rest density kg/m³, Tait's stiffness Pa, sound speed m/s
+    float visc_eps = 0;  ///< 0.01 (h/2)², m²: keeps Π finite at r → 0
+    float alpha_c_hs = 0;  ///< α c0 h/2, m²/s: Monaghan's viscosity coefficient
 
     static FluidConstants from(const Settings& s, float h);
 };

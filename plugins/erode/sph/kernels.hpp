@@ -37,8 +37,8 @@ constexpr float kFar = 1e15f;
 /// shape = 6q²(q − 1) + 1 for q ≤ 1/2 and 2(1 − q)³ beyond. The constants are derived from h once.
 struct CubicSpline {
     float h = 0, h2 = 0, inv_h = 0;  ///< support m, m², 1/m
-    float w_norm = 0;                ///< 8/(π h³), 1/m³
-    float grad_norm = 0;             ///< 48/(π h³), 1/m³: dW/dq = grad_norm · shape'(q) with shape' below
+    float w_norm = 0;  ///< 8/(π h³), 1/m³
+    float grad_norm = 0;  ///< 48/(π h³), 1/m³: dW/dq = grad_norm · shape'(q) with shape' below
 
     static CubicSpline with_support(float h) {
         CubicSpline k;

@@ -157,9 +157,9 @@ std::size_t Neighbourhood::key_particles(const Particles& p, std::size_t m, std:
                 const Vec3& q = p.pos[i];
                 const float cx = cell_of(q.x), cy = cell_of(q.y), cz = cell_of(q.z);
                 key[k] = std::uint64_t(int(cz) - min_cz_) * stride_z_ + std::uint64_t(int(cy) - min_cy_) * stride_y_ +
-                         std::uint64_t(int(cx) - min_cx_);
+                    std::uint64_t(int(cx) - min_cx_);
                 const bool mv = i >= keyed_ || cx != cell_of(p.soa[0][i]) || cy != cell_of(p.soa[1][i]) ||
-                                cz != cell_of(p.soa[2][i]);
+                    cz != cell_of(p.soa[2][i]);
                 moved_[k] = mv;
                 c += mv;
             }
@@ -362,7 +362,8 @@ void Neighbourhood::permute(std::vector<T>& v, const std::uint32_t* p, std::size
         for (std::int64_t k = b; k < e; ++k) std::memcpy(tmp + std::size_t(k) * sizeof(T), &v[p[k]], sizeof(T));
     });
     parallel_for(0, std::int64_t(m), 8192, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t k = b; k < e; ++k) std::memcpy(&v[std::size_t(k)], tmp + std::size_t(k) * sizeof(T), sizeof(T));
+        for (std::int64_t k = b; k < e; ++k)
+            std::memcpy(&v[std::size_t(k)], tmp + std::size_t(k) * sizeof(T), sizeof(T));
     });
 }
 

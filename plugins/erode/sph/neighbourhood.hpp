@@ -57,10 +57,9 @@ public:
                 for (int dy = -1; dy <= 1; ++dy, ++row) {
                     // The box's padding keeps every key of the row within it: no wrap-around.
                     const std::uint64_t mid = k + std::uint64_t(std::int64_t(dz)) * m_.stride_z_ +
-                                              std::uint64_t(std::int64_t(dy)) * m_.stride_y_;
+                        std::uint64_t(std::int64_t(dy)) * m_.stride_y_;
                     const std::uint64_t* lo = started_ ? at_[row] : first;
-                    if (!started_ || (last - lo > 8 && lo[8] < mid - 1))
-                        lo = std::lower_bound(lo, last, mid - 1);
+                    if (!started_ || (last - lo > 8 && lo[8] < mid - 1)) lo = std::lower_bound(lo, last, mid - 1);
                     else
                         while (lo != last && *lo < mid - 1) ++lo;
                     at_[row] = lo;
@@ -82,7 +81,7 @@ public:
     };
 
 private:
-    static constexpr std::size_t kListBlock = 16384;   // entries per parallel block of the list steps
+    static constexpr std::size_t kListBlock = 16384;  // entries per parallel block of the list steps
     static constexpr std::size_t kMoverBlock = 16384;  // entries per parallel block of merge_movers
 
     /// Cell coordinate (in units of h) of a position in m, clamped so keys fit in 63 bits.
@@ -92,10 +91,10 @@ private:
     std::size_t list_live(const Particles& p);
     std::uint64_t bound_cells(const Particles& p, std::size_t m);
     std::size_t key_particles(const Particles& p, std::size_t m, std::uint64_t* key);
-    void radix_sort(std::uint64_t*& key, std::uint64_t*& tkey, std::uint32_t*& idx, std::uint32_t*& tidx,
-                    std::size_t m, int bits);
-    void merge_movers(std::uint64_t* key, std::uint64_t* tkey, std::uint32_t* idx, std::uint32_t* tidx,
-                      std::size_t m, const std::vector<std::size_t>& mv_first);
+    void radix_sort(std::uint64_t*& key, std::uint64_t*& tkey, std::uint32_t*& idx, std::uint32_t*& tidx, std::size_t m,
+                    int bits);
+    void merge_movers(std::uint64_t* key, std::uint64_t* tkey, std::uint32_t* idx, std::uint32_t* tidx, std::size_t m,
+                      const std::vector<std::size_t>& mv_first);
     void list_cells(const std::uint64_t* key, std::size_t m);
     void permute_particles(Particles& p, const std::uint32_t* idx, std::size_t m, bool keep_fields);
     template <typename T>
@@ -108,17 +107,17 @@ private:
     std::vector<std::uint64_t> sort_keys_;
     std::vector<std::uint32_t> perm_, perm_tmp_;
     std::vector<std::uint8_t> moved_;  // per sorted entry: changed cell since the last sort (merge_movers)
-    std::int64_t merged_sorts_ = 0;    // sorts done by merge_movers
-    std::size_t keyed_ = 0;            // particles [0, keyed) have a cell from the last sort (in soa)
-    std::vector<std::size_t> block_first_;                              // the list steps' per-block places
-    std::vector<std::uint32_t> radix_offset_;                           // radix_sort's histograms
+    std::int64_t merged_sorts_ = 0;  // sorts done by merge_movers
+    std::size_t keyed_ = 0;  // particles [0, keyed) have a cell from the last sort (in soa)
+    std::vector<std::size_t> block_first_;  // the list steps' per-block places
+    std::vector<std::uint32_t> radix_offset_;  // radix_sort's histograms
     std::vector<std::pair<std::uint64_t, std::uint32_t>> mover_list_;  // merge_movers' movers
     // `ncell` occupied cells, each with its key and its first particle (cell_start[ncell] = the particles).
     std::vector<std::uint64_t> cell_key_;
     std::vector<std::uint32_t> cell_start_;
     std::size_t ncell_ = 0;
     std::uint64_t stride_y_ = 1, stride_z_ = 1;  // key steps of one cell in y and z (x: 1)
-    int min_cx_ = 0, min_cy_ = 0, min_cz_ = 0;    // the padded box's first cell
+    int min_cx_ = 0, min_cy_ = 0, min_cz_ = 0;  // the padded box's first cell
 };
 
 /// Particles in the runs, and that count rounded up to whole kLanes.

@@ -108,10 +108,10 @@ void check(CheckContext& ctx) {
     const double need = double(particles) * double(sph::Simulation::bytes_per_particle());
     const double limit = double(physical_memory()) / 4.0;
     if (need > limit) {
-        ctx.error("particles", std::to_string(particles) + " particles need " + human_bytes(need) +
-                                   " of memory, more than the " + human_bytes(limit) +
-                                   " allowed here (a quarter of this machine's memory); use at most about " +
-                                   std::to_string(std::uint64_t(limit / double(sph::Simulation::bytes_per_particle()))));
+        ctx.error("particles",
+                  std::to_string(particles) + " particles need " + human_bytes(need) + " of memory, more than the " +
+                      human_bytes(limit) + " allowed here (a quarter of this machine's memory); use at most about " +
+                      std::to_string(std::uint64_t(limit / double(sph::Simulation::bytes_per_particle()))));
     }
     if (ctx.integer("rain") == 0 && ctx.param("springs") == ParamValue(std::vector<Point2>{}))
         ctx.error("rain", "no water: rain=0 and no springs; give rain > 0 or springs=[(x, y), ...]");
@@ -128,7 +128,8 @@ OROGEN_PLUGIN("erode-sph", "0.1.0", registry) {
         .description =
             "The thesis's SPH eroder with a real fluid: weakly compressible SPH (Tait equation of state, "
             "Monaghan's artificial viscosity, CFL-limited sub-steps), a cell list with the particles sorted by "
-            "cell every sub-step and vectorized neighbour sums, terrain contact by a Möller–Trumbore test of each particle's motion against "
+            "cell every sub-step and vectorized neighbour sums, terrain contact by a Möller–Trumbore test of each "
+            "particle's motion against "
             "the two triangles of the tile beneath it and an impulse along the normal interpolated from the "
             "tile's vertex normals (no particle ever ends below the surface). Rain spawns `rain` particles per "
             "step rain_height m above random points; springs spawn spring_rate per step at grid-relative points. "
@@ -145,42 +146,72 @@ OROGEN_PLUGIN("erode-sph", "0.1.0", registry) {
         .params =
             {
                 Param::integer("steps", 200).min(0).max(100'000'000).help("number of time steps"),
-                Param::real("dt", 0.05).min(0.0, true).max(3600.0).unit("s").help(
-                    "time step; split internally into CFL-limited sub-steps"),
-                Param::integer("particles", 100'000).min(1).max(2'000'000'000).help(
-                    "most particles alive at once (memory is reserved for them)"),
+                Param::real("dt", 0.05)
+                    .min(0.0, true)
+                    .max(3600.0)
+                    .unit("s")
+                    .help("time step; split internally into CFL-limited sub-steps"),
+                Param::integer("particles", 100'000)
+                    .min(1)
+                    .max(2'000'000'000)
+                    .help("most particles alive at once (memory is reserved for them)"),
                 Param::integer("rain", 100).min(0).max(100'000'000).help("rain particles spawned per step"),
-                Param::real("rain_height", 2.0).min(0.0, true).max(1e5).unit("m").help(
-                    "height above the terrain at which rain spawns"),
-                Param::points("springs", std::vector<Point2>{}).min(0).max(1).help(
-                    "point sources, grid-relative (0..1, 0..1); [] none"),
+                Param::real("rain_height", 2.0)
+                    .min(0.0, true)
+                    .max(1e5)
+                    .unit("m")
+                    .help("height above the terrain at which rain spawns"),
+                Param::points("springs", std::vector<Point2>{})
+                    .min(0)
+                    .max(1)
+                    .help("point sources, grid-relative (0..1, 0..1); [] none"),
                 Param::integer("spring_rate", 10).min(0).max(1'000'000).help("particles per step per spring"),
-                Param::real("radius", 0.5).min(0.0, true).max(1e4).unit("m").help(
-                    "particle radius: spacing 2·radius, kernel support 4·radius"),
-                Param::integer("lifespan", 500).min(1).max(2'000'000'000).help(
-                    "steps a particle lives before it evaporates and leaves its sediment"),
-                Param::real("acidity", 2.0).min(0.0).max(1e6).unit("1/s").help(
-                    "rate at which a touching particle dissolves the deficit below its capacity"),
-                Param::real("capacity", 0.5).min(0.0).unit("s/m").help(
-                    "sediment capacity: m³ of terrain per m³ of water per m/s of speed along the slope"),
+                Param::real("radius", 0.5)
+                    .min(0.0, true)
+                    .max(1e4)
+                    .unit("m")
+                    .help("particle radius: spacing 2·radius, kernel support 4·radius"),
+                Param::integer("lifespan", 500)
+                    .min(1)
+                    .max(2'000'000'000)
+                    .help("steps a particle lives before it evaporates and leaves its sediment"),
+                Param::real("acidity", 2.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("1/s")
+                    .help("rate at which a touching particle dissolves the deficit below its capacity"),
+                Param::real("capacity", 0.5)
+                    .min(0.0)
+                    .unit("s/m")
+                    .help("sediment capacity: m³ of terrain per m³ of water per m/s of speed along the slope"),
                 Param::real("deposit", 1.0).min(0.0).unit("1/s").help("rate of dropping the excess over capacity"),
                 Param::real("min_slope", 0.05).min(0.0).max(1.0).help("lower bound of sin(slope) in the capacity"),
-                Param::real("max_dig", 0.05).min(0.0).unit("m").help(
-                    "most a particle lowers a vertex in one sub-step (no drilled holes)"),
-                Param::real("friction", 1.0).min(0.0).unit("1/s").help(
-                    "decay rate of the speed along the terrain while touching it"),
+                Param::real("max_dig", 0.05)
+                    .min(0.0)
+                    .unit("m")
+                    .help("most a particle lowers a vertex in one sub-step (no drilled holes)"),
+                Param::real("friction", 1.0)
+                    .min(0.0)
+                    .unit("1/s")
+                    .help("decay rate of the speed along the terrain while touching it"),
                 Param::real("viscosity", 0.05).min(0.0).max(10.0).help("Monaghan's artificial viscosity alpha"),
-                Param::real("sound_speed", 20.0).min(0.0, true).max(1e5).unit("m/s").help(
-                    "numerical speed of sound c0: density varies by about (v/c0)²; sub-steps shrink as it grows"),
+                Param::real("sound_speed", 20.0)
+                    .min(0.0, true)
+                    .max(1e5)
+                    .unit("m/s")
+                    .help("numerical speed of sound c0: density varies by about (v/c0)²; sub-steps shrink as it grows"),
                 Param::real("density", 1000.0).min(0.0, true).unit("kg/m³").help("rest density of water"),
                 Param::real("gravity", 9.81).min(0.0).max(1000.0).unit("m/s²").help("gravity"),
                 Param::real("cfl", 0.4).min(0.0, true).max(1.0).help("Courant number of the sub-steps"),
-                Param::choice("boundary", {"closed", "open"}, "closed").help(
-                    "closed: the map's edges are walls; open: particles leave over them (counted)"),
-                Param::real("sea_level", -1e30).unit("m").help(
-                    "particles below this height are removed, leaving their sediment"),
-                Param::integer("record_every", 10).min(0).max(100'000'000).help(
-                    "steps between particle frames in .particles (0 = none)"),
+                Param::choice("boundary", {"closed", "open"}, "closed")
+                    .help("closed: the map's edges are walls; open: particles leave over them (counted)"),
+                Param::real("sea_level", -1e30)
+                    .unit("m")
+                    .help("particles below this height are removed, leaving their sediment"),
+                Param::integer("record_every", 10)
+                    .min(0)
+                    .max(100'000'000)
+                    .help("steps between particle frames in .particles (0 = none)"),
             },
         .adds_layers = {"eroded", "deposited", "water"},
         .check = check,

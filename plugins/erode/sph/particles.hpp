@@ -24,7 +24,7 @@ inline bool finite3(const Vec3& v) { return std::isfinite(v.x) && std::isfinite(
 struct Particles {
     std::size_t cap = 0, n = 0, live = 0;
     std::vector<Vec3> pos, vel, acc;
-    std::vector<float> density, pterm;       // pterm = p/ρ²
+    std::vector<float> density, pterm;  // pterm = p/ρ²
     std::vector<double> sediment, exchange;  // m³ carried; m³ taken up this sub-step (<0 = dropped)
     std::vector<float> acidity;
     std::vector<std::int32_t> age, lifespan;

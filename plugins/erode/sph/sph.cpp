@@ -62,8 +62,10 @@ void Simulation::rain(std::int64_t count, double height, std::uint64_t seed, std
                       std::int32_t lifespan) {
     Impl& m = *impl_;
     for (std::int64_t k = 0; k < count; ++k) {
-        const double x = random::uniform(seed, 0x5241494Eu, std::uint64_t(step), std::uint64_t(k), 0) * m.terrain.extent_x();
-        const double z = random::uniform(seed, 0x5241494Eu, std::uint64_t(step), std::uint64_t(k), 1) * m.terrain.extent_z();
+        const double x =
+            random::uniform(seed, 0x5241494Eu, std::uint64_t(step), std::uint64_t(k), 0) * m.terrain.extent_x();
+        const double z =
+            random::uniform(seed, 0x5241494Eu, std::uint64_t(step), std::uint64_t(k), 1) * m.terrain.extent_z();
         add(Vec3{float(x), float(m.terrain.surface(x, z) + height), float(z)}, Vec3{}, acidity, lifespan);
     }
 }
@@ -74,14 +76,13 @@ void Simulation::spring(double x, double z, std::int64_t count, std::uint64_t se
     const double spacing = 2.0 * m.s.radius;
     for (std::int64_t k = 0; k < count; ++k) {
         const double a = 2.0 * std::numbers::pi *
-                         random::uniform(seed, 0x535052u, std::uint64_t(which), std::uint64_t(step), std::uint64_t(k), 0);
+            random::uniform(seed, 0x535052u, std::uint64_t(which), std::uint64_t(step), std::uint64_t(k), 0);
         const double rr = 2.0 * spacing *
-                          std::sqrt(random::uniform(seed, 0x535052u, std::uint64_t(which), std::uint64_t(step),
-                                                    std::uint64_t(k), 1));
+            std::sqrt(random::uniform(seed, 0x535052u, std::uint64_t(which), std::uint64_t(step), std::uint64_t(k), 1));
         const double px = std::clamp(x + rr * std::cos(a), 0.0, m.terrain.extent_x());
         const double pz = std::clamp(z + rr * std::sin(a), 0.0, m.terrain.extent_z());
-        const double lift = spacing * (1.0 + random::uniform(seed, 0x535052u, std::uint64_t(which),
-                                                             std::uint64_t(step), std::uint64_t(k), 2));
+        const double lift = spacing *
+            (1.0 + random::uniform(seed, 0x535052u, std::uint64_t(which), std::uint64_t(step), std::uint64_t(k), 2));
         add(Vec3{float(px), float(m.terrain.surface(px, pz) + lift), float(pz)}, Vec3{}, acidity, lifespan);
     }
 }

@@ -62,25 +62,25 @@ namespace orogen::sph {
 
 enum class Boundary {
     closed,  ///< the map's edges are walls
-    open,    ///< particles that cross an edge leave (with their sediment) and are counted
+    open,  ///< particles that cross an edge leave (with their sediment) and are counted
 };
 
 struct Settings {
-    double radius = 0.5;             ///< particle radius r, m; spacing 2r, kernel support h = 4r
-    double rest_density = 1000.0;    ///< ρ0, kg/m³
-    double sound_speed = 20.0;       ///< c0, m/s; δρ/ρ ≈ (v/c0)²
-    double viscosity = 0.05;         ///< Monaghan's α (dimensionless)
-    double gravity = 9.81;           ///< m/s²
-    double cfl = 0.4;                ///< Courant number of the sub-steps
-    double friction = 1.0;           ///< 1/s: tangential velocity decay while touching the terrain
-    double restitution = 0.0;        ///< fraction of the inward normal velocity reflected at contact
+    double radius = 0.5;  ///< particle radius r, m; spacing 2r, kernel support h = 4r
+    double rest_density = 1000.0;  ///< ρ0, kg/m³
+    double sound_speed = 20.0;  ///< c0, m/s; δρ/ρ ≈ (v/c0)²
+    double viscosity = 0.05;  ///< Monaghan's α (dimensionless)
+    double gravity = 9.81;  ///< m/s²
+    double cfl = 0.4;  ///< Courant number of the sub-steps
+    double friction = 1.0;  ///< 1/s: tangential velocity decay while touching the terrain
+    double restitution = 0.0;  ///< fraction of the inward normal velocity reflected at contact
     Boundary boundary = Boundary::closed;
     double sea_level = -std::numeric_limits<double>::infinity();  ///< m: particles below it are removed
 
     // Erosion (capacity Kc in s/m: m³ of terrain per m³ of water per m/s of speed along the slope).
     bool erode = true;
     double capacity = 0.5;
-    double deposit = 1.0;     ///< 1/s: rate of dropping the excess over capacity
+    double deposit = 1.0;  ///< 1/s: rate of dropping the excess over capacity
     double min_slope = 0.05;  ///< lower bound of sin α in the capacity
     /// m: no vertex is lowered by more than this in one sub-step (keeps single
     /// particles from drilling holes; material is conserved either way).
@@ -104,9 +104,9 @@ struct Vec3 {
 struct Counts {
     std::int64_t spawned = 0;
     std::int64_t evaporated = 0;  ///< reached their lifespan
-    std::int64_t left = 0;        ///< crossed an open edge
-    std::int64_t sea = 0;         ///< fell below the sea level
-    std::int64_t refused = 0;     ///< not spawned: the particle budget was full
+    std::int64_t left = 0;  ///< crossed an open edge
+    std::int64_t sea = 0;  ///< fell below the sea level
+    std::int64_t refused = 0;  ///< not spawned: the particle budget was full
 };
 
 class Simulation {

@@ -11,19 +11,11 @@
 namespace orogen::sph {
 
 TerrainBoundary::TerrainBoundary(ConstGridView terrain, double radius)
-    : w_(terrain.width),
-      hgt_(terrain.height),
-      cell_(terrain.cell),
-      inv_cell_(1.0 / terrain.cell),
-      extent_x_((terrain.width - 1) * terrain.cell),
-      extent_z_((terrain.height - 1) * terrain.cell),
-      radius_(radius),
-      terrain_(terrain.data, terrain.data + terrain.size()),
-      water_sum_(terrain.size(), 0.0),
-      vnormal_(3 * terrain.size()),
-      dirty_lo_(std::size_t(terrain.height), 0),
-      dirty_hi_(std::size_t(terrain.height), terrain.width - 1),
-      any_dirty_(true) {
+    : w_(terrain.width), hgt_(terrain.height), cell_(terrain.cell), inv_cell_(1.0 / terrain.cell),
+      extent_x_((terrain.width - 1) * terrain.cell), extent_z_((terrain.height - 1) * terrain.cell), radius_(radius),
+      terrain_(terrain.data, terrain.data + terrain.size()), water_sum_(terrain.size(), 0.0),
+      vnormal_(3 * terrain.size()), dirty_lo_(std::size_t(terrain.height), 0),
+      dirty_hi_(std::size_t(terrain.height), terrain.width - 1), any_dirty_(true) {
     refresh_normals();  // all of them
 }
 

@@ -100,7 +100,8 @@ public:
         const double tv[3] = {o[0] - p0[0], o[1] - p0[1], o[2] - p0[2]};
         const double u = (tv[0] * pv[0] + tv[1] * pv[1] + tv[2] * pv[2]) * inv;
         if (u < 0.0 || u > 1.0) return -1.0;
-        const double qv[3] = {tv[1] * e1[2] - tv[2] * e1[1], tv[2] * e1[0] - tv[0] * e1[2], tv[0] * e1[1] - tv[1] * e1[0]};
+        const double qv[3] = {tv[1] * e1[2] - tv[2] * e1[1], tv[2] * e1[0] - tv[0] * e1[2],
+                              tv[0] * e1[1] - tv[1] * e1[0]};
         const double v = (d[0] * qv[0] + d[1] * qv[1] + d[2] * qv[2]) * inv;
         if (v < 0.0 || u + v > 1.0) return -1.0;
         const double t = (e2[0] * qv[0] + e2[1] * qv[1] + e2[2] * qv[2]) * inv;

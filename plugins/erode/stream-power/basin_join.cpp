@@ -43,7 +43,7 @@ TileForest contract_tile(std::vector<Link> links, const std::function<bool(std::
     std::vector<std::int32_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0);
     std::vector<std::uint8_t> only_closed(f.closed);  // per root
-    std::vector<std::size_t> later;                   // deferred, in the total order
+    std::vector<std::size_t> later;  // deferred, in the total order
     for (std::size_t e = 0; e < links.size(); ++e) {
         const std::int32_t ra = find_root(parent, ends[2 * e]), rb = find_root(parent, ends[2 * e + 1]);
         if (ra == rb) continue;
@@ -83,7 +83,7 @@ TileForest contract_tile(std::vector<Link> links, const std::function<bool(std::
             for (std::int64_t a = f.adjacent_start[std::size_t(v)]; a < f.adjacent_start[std::size_t(v) + 1]; ++a) {
                 const std::int32_t t = f.adjacent[std::size_t(a)];
                 const std::int32_t u = f.taken_ends[2 * std::size_t(t)] == v ? f.taken_ends[2 * std::size_t(t) + 1]
-                                                                               : f.taken_ends[2 * std::size_t(t)];
+                                                                             : f.taken_ends[2 * std::size_t(t)];
                 if (f.anchor[std::size_t(u)] >= 0) continue;
                 f.anchor[std::size_t(u)] = std::int32_t(r);
                 up[std::size_t(u)] = v;
@@ -101,7 +101,8 @@ TileForest contract_tile(std::vector<Link> links, const std::function<bool(std::
         std::unordered_set<std::uint64_t> pairs;
         for (const std::size_t e : later) {
             const std::int32_t x = f.anchor[std::size_t(ends[2 * e])], y = f.anchor[std::size_t(ends[2 * e + 1])];
-            const std::uint64_t key = (std::uint64_t(std::uint32_t(std::min(x, y))) << 32) | std::uint32_t(std::max(x, y));
+            const std::uint64_t key =
+                (std::uint64_t(std::uint32_t(std::min(x, y))) << 32) | std::uint32_t(std::max(x, y));
             if (!pairs.insert(key).second) continue;
             f.deferred.push_back(links[e]);
             terminal[std::size_t(ends[2 * e])] = terminal[std::size_t(ends[2 * e + 1])] = 1;
@@ -132,7 +133,8 @@ TileForest contract_tile(std::vector<Link> links, const std::function<bool(std::
         highest[v] = p_key ? pass : std::max(pass, highest[p]);
         first[v] = p_key ? up_link[v] : first[p];
         if (terminal[v] || branches[v] >= 2)
-            f.edges.push_back({f.basin[v], f.basin[std::size_t(up_key[v])], highest[v], f.taken[std::size_t(first[v])]});
+            f.edges.push_back(
+                {f.basin[v], f.basin[std::size_t(up_key[v])], highest[v], f.taken[std::size_t(first[v])]});
     }
     return f;
 }
@@ -236,7 +238,8 @@ std::vector<BasinExit> orient_tile(const TileForest& f, const std::unordered_map
             const auto x = std::size_t(queue[q]);
             for (std::int64_t a = f.adjacent_start[x]; a < f.adjacent_start[x + 1]; ++a) {
                 const auto t = std::size_t(f.adjacent[std::size_t(a)]);
-                const auto u = std::size_t(f.taken_ends[2 * t] == std::int32_t(x) ? f.taken_ends[2 * t + 1] : f.taken_ends[2 * t]);
+                const auto u =
+                    std::size_t(f.taken_ends[2 * t] == std::int32_t(x) ? f.taken_ends[2 * t + 1] : f.taken_ends[2 * t]);
                 if (seen[u]) continue;
                 seen[u] = 1;
                 const Link& l = f.taken[t];

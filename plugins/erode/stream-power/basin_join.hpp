@@ -42,24 +42,24 @@ namespace orogen::stream_power {
 /// The way between two key basins of a tile's forest: `lower` hangs below `upper` (upper is nearer its anchor).
 struct ForestEdge {
     std::int64_t lower, upper;  ///< basins (pits' whole-grid cells; −1 the sea)
-    double pass;                ///< the highest pass on the way, m
-    Link first;                 ///< the way's link at `upper`'s end (upper's cell is i if upper == a, else j)
+    double pass;  ///< the highest pass on the way, m
+    Link first;  ///< the way's link at `upper`'s end (upper's cell is i if upper == a, else j)
 };
 
 /// What one tile settles of its basins, and what it leaves to rank 0.
 struct TileForest {
     std::vector<std::int64_t> anchors;  ///< the components' anchors (basin ids)
-    std::vector<Link> deferred;         ///< for rank 0: links between components, the lowest per pair, in the total order
-    std::vector<ForestEdge> edges;      ///< for rank 0: the forest reduced to its key basins
+    std::vector<Link> deferred;  ///< for rank 0: links between components, the lowest per pair, in the total order
+    std::vector<ForestEdge> edges;  ///< for rank 0: the forest reduced to its key basins
     // The forest itself (for orient_tile): nodes are indices.
-    std::vector<std::int64_t> basin;         ///< node → basin
+    std::vector<std::int64_t> basin;  ///< node → basin
     std::unordered_map<std::int64_t, std::int32_t> node;  ///< basin → node
-    std::vector<std::int32_t> anchor;        ///< node → its component's anchor node
-    std::vector<std::uint8_t> closed;        ///< node → closed on this tile
-    std::vector<Link> taken;                 ///< the forest's links
-    std::vector<std::int32_t> taken_ends;    ///< their two nodes each (a's, then b's)
+    std::vector<std::int32_t> anchor;  ///< node → its component's anchor node
+    std::vector<std::uint8_t> closed;  ///< node → closed on this tile
+    std::vector<Link> taken;  ///< the forest's links
+    std::vector<std::int32_t> taken_ends;  ///< their two nodes each (a's, then b's)
     std::vector<std::int64_t> adjacent_start;  ///< node → first entry in `adjacent` (+ end)
-    std::vector<std::int32_t> adjacent;        ///< indices into `taken`
+    std::vector<std::int32_t> adjacent;  ///< indices into `taken`
 };
 
 /// `links`: the tile's lowest link per pair of basins (a < b, −1 the sea);
@@ -69,9 +69,10 @@ TileForest contract_tile(std::vector<Link> links, const std::function<bool(std::
 /// Rank 0's answer for a key basin: its lake level and how it drains.
 struct KeyExit {
     std::int64_t basin;
-    double level;              ///< m; −inf for the sea
-    std::int64_t parent;       ///< the basin it drains into; −2 for the sea
-    std::int64_t in, across;   ///< the cells of its way out (in its basin, across); −1 when the way is a forest edge it hangs by (its tile walks it)
+    double level;  ///< m; −inf for the sea
+    std::int64_t parent;  ///< the basin it drains into; −2 for the sea
+    std::int64_t in,
+        across;  ///< the cells of its way out (in its basin, across); −1 when the way is a forest edge it hangs by (its tile walks it)
 };
 
 /// Rank 0: every tile's deferred links, forest edges and anchors joined into
@@ -83,7 +84,7 @@ std::vector<KeyExit> join_tiles(std::vector<Link> deferred, const std::vector<Fo
 /// A closed basin's lake level and way out.
 struct BasinExit {
     std::int64_t basin;
-    double level;             ///< m
+    double level;  ///< m
     std::int64_t in, across;  ///< its pass cell (in the basin) and the cell across, which it now drains to
 };
 

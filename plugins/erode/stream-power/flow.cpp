@@ -35,7 +35,8 @@ BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
     std::int32_t joined = 0;
     for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
-        const std::int32_t ra = find_root(parent, std::int32_t(links[e].a)), rb = find_root(parent, std::int32_t(links[e].b));
+        const std::int32_t ra = find_root(parent, std::int32_t(links[e].a)),
+                           rb = find_root(parent, std::int32_t(links[e].b));
         if (ra == rb) continue;
         parent[std::size_t(ra)] = rb;
         ++joined;
@@ -61,7 +62,8 @@ BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
             t.order.push_back(u);
         }
     }
-    if (std::int32_t(t.order.size()) != nodes) throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
+    if (std::int32_t(t.order.size()) != nodes)
+        throw std::logic_error("FlowRouter: a pit basin has no way to an outlet");
     return t;
 }
 
@@ -74,11 +76,12 @@ FlowRouter::FlowRouter(int width, int height, double cell, OpenSides open, std::
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x) {
             const bool o = (y == 0 && open.north) || (y == height - 1 && open.south) || (x == 0 && open.west) ||
-                           (x == width - 1 && open.east);
+                (x == width - 1 && open.east);
             outlet_[std::size_t(y) * std::size_t(width) + std::size_t(x)] = o ? 1 : 0;
         }
     if (!open.any()) {
-        if (outlet_cell < 0 || std::size_t(outlet_cell) >= size_) throw std::invalid_argument("FlowRouter: outlet outside the grid");
+        if (outlet_cell < 0 || std::size_t(outlet_cell) >= size_)
+            throw std::invalid_argument("FlowRouter: outlet outside the grid");
         outlet_[std::size_t(outlet_cell)] = 1;
     }
     receiver_.resize(size_);
@@ -109,24 +112,38 @@ int FlowRouter::direction(std::int64_t i) const {
 /// branches or integer lanes, which the compiler turns into vector blends (the
 /// comparisons are unpredictable on rough ground). Same arithmetic as the
 /// scalar form, (h_i − h_k)·(1/distance) with ties to the lower k.
-void inner_row_directions(const double* __restrict c, const double* __restrict up, const double* __restrict dn,
-                          int W, double* __restrict dir_out) {
+void inner_row_directions(const double* __restrict c, const double* __restrict up, const double* __restrict dn, int W,
+                          double* __restrict dir_out) {
     const double d = 1.0 / kSqrt2;
     for (int x = 1; x < W - 1; ++x) {
         const double hi = c[x];
         double best = 0.0, dir = -1.0, s;
-        s = (hi - c[x + 1]) * 1.0;  dir = s > best ? 0.0 : dir; best = s > best ? s : best;
-        s = (hi - dn[x + 1]) * d;   dir = s > best ? 1.0 : dir; best = s > best ? s : best;
-        s = (hi - dn[x]) * 1.0;     dir = s > best ? 2.0 : dir; best = s > best ? s : best;
-        s = (hi - dn[x - 1]) * d;   dir = s > best ? 3.0 : dir; best = s > best ? s : best;
-        s = (hi - c[x - 1]) * 1.0;  dir = s > best ? 4.0 : dir; best = s > best ? s : best;
-        s = (hi - up[x - 1]) * d;   dir = s > best ? 5.0 : dir; best = s > best ? s : best;
-        s = (hi - up[x]) * 1.0;     dir = s > best ? 6.0 : dir; best = s > best ? s : best;
-        s = (hi - up[x + 1]) * d;   dir = s > best ? 7.0 : dir;
+        s = (hi - c[x + 1]) * 1.0;
+        dir = s > best ? 0.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - dn[x + 1]) * d;
+        dir = s > best ? 1.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - dn[x]) * 1.0;
+        dir = s > best ? 2.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - dn[x - 1]) * d;
+        dir = s > best ? 3.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - c[x - 1]) * 1.0;
+        dir = s > best ? 4.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - up[x - 1]) * d;
+        dir = s > best ? 5.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - up[x]) * 1.0;
+        dir = s > best ? 6.0 : dir;
+        best = s > best ? s : best;
+        s = (hi - up[x + 1]) * d;
+        dir = s > best ? 7.0 : dir;
         dir_out[x] = dir;
     }
 }
-
 
 void FlowRouter::receivers_from(const double* h) {
     // Receivers and donor bits in one pass over rows: first the directions of
@@ -173,8 +190,7 @@ void FlowRouter::receivers_from(const double* h) {
                 const std::int64_t ty = y + kDy[dir];
                 if (ty <= y0 || ty >= y1 - 1)
                     std::atomic_ref<std::uint8_t>(donors_[std::size_t(to)]).fetch_or(bit, std::memory_order_relaxed);
-                else
-                    donors_[std::size_t(to)] = std::uint8_t(donors_[std::size_t(to)] | bit);
+                else donors_[std::size_t(to)] = std::uint8_t(donors_[std::size_t(to)] | bit);
             }
         }
     });
@@ -223,7 +239,8 @@ void FlowRouter::build_stack(bool label_basins) {
     for (std::int64_t g = 0; g < groups; ++g)
         offset[std::size_t(g + 1)] = offset[std::size_t(g)] + std::int64_t(walk_buffers_[std::size_t(g)].size());
     const std::size_t pos = std::size_t(offset[std::size_t(groups)]);
-    if (pos != size_) throw std::logic_error("FlowRouter: the receivers hold a loop");  // cannot happen: drops are strict
+    if (pos != size_)
+        throw std::logic_error("FlowRouter: the receivers hold a loop");  // cannot happen: drops are strict
     parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
         for (std::int64_t g = g0; g < g1; ++g) {
             const auto& buf = walk_buffers_[std::size_t(g)];
@@ -318,10 +335,8 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
                         const std::int32_t nj = node[std::size_t(basin_[std::size_t(j)])];
                         if (nj == ni || (nj != 0 && j < i)) continue;
                         const double pass = std::max(h[i], h[j]), low = std::min(h[i], h[j]);
-                        if (ni < nj)
-                            out.push_back({pass, low, ni, nj, i, j});
-                        else
-                            out.push_back({pass, low, nj, ni, j, i});
+                        if (ni < nj) out.push_back({pass, low, ni, nj, i, j});
+                        else out.push_back({pass, low, nj, ni, j, i});
                     }
                 }
             }
@@ -449,9 +464,8 @@ void FlowRouter::patch_stack() {
 void FlowRouter::accumulate() {
     const double a0 = cell_ * cell_;
     // Cells, not m²: every cell starts with 1 (a sequential fill, not one in stack order)...
-    parallel_for(0, std::int64_t(size_), 1 << 16, [&](std::int64_t b, std::int64_t e) {
-        std::fill(area_.begin() + b, area_.begin() + e, 1.0);
-    });
+    parallel_for(0, std::int64_t(size_), 1 << 16,
+                 [&](std::int64_t b, std::int64_t e) { std::fill(area_.begin() + b, area_.begin() + e, 1.0); });
     // ... and passes its total to its receiver, donors first (reverse stack order).
     // Whole numbers below 2^53 add exactly in any order, so a tiled run that adds
     // its tiles' partial counts gets these bits (floating-point m² would round).

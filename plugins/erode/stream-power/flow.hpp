@@ -43,7 +43,7 @@ struct OpenSides {
 };
 
 enum class Depressions {
-    fill,   ///< route across and fill each lake to its spill level
+    fill,  ///< route across and fill each lake to its spill level
     route,  ///< route across, leave the heights
 };
 
@@ -75,9 +75,10 @@ int steepest(double hi, unsigned inside, At at) {
 
 /// A link of the basin graph: the lowest pass between two basins.
 struct Link {
-    double pass;        ///< max(h_i, h_j): the water level at which the two basins join, m
-    double low;         ///< min(h_i, h_j), m: among equal passes the one from the lowest cell goes first
-    std::int64_t a, b;  ///< basin graph nodes, a < b (0 = the sea: every outlet basin; a tile's links: pits' cells, −1 the sea)
+    double pass;  ///< max(h_i, h_j): the water level at which the two basins join, m
+    double low;  ///< min(h_i, h_j), m: among equal passes the one from the lowest cell goes first
+    std::int64_t a,
+        b;  ///< basin graph nodes, a < b (0 = the sea: every outlet basin; a tile's links: pits' cells, −1 the sea)
     std::int64_t i, j;  ///< the two cells (i in a's basin, j in b's; whole-grid indices)
 };
 
@@ -100,9 +101,10 @@ inline bool pair_then_order(const Link& l, const Link& r) {
 
 /// The minimum spanning tree of the basin graph oriented from the sea (node 0).
 struct BasinTree {
-    std::vector<double> level;          ///< per node: the highest pass on its way to the sea, m
-    std::vector<std::int32_t> out_link; ///< per node: the link (index into the sorted links) it leaves by; −1 for the sea
-    std::vector<std::int32_t> order;    ///< nodes from the sea outwards (each after the node it spills into)
+    std::vector<double> level;  ///< per node: the highest pass on its way to the sea, m
+    std::vector<std::int32_t>
+        out_link;  ///< per node: the link (index into the sorted links) it leaves by; −1 for the sea
+    std::vector<std::int32_t> order;  ///< nodes from the sea outwards (each after the node it spills into)
 };
 
 /// Union-find: the root of v's set (path halving).
@@ -169,26 +171,26 @@ private:
     std::size_t size_;
     double cell_;
     OpenSides open_;
-    std::vector<std::uint8_t> outlet_;   // 1 where a cell is an outlet (open side or the declared sink)
+    std::vector<std::uint8_t> outlet_;  // 1 where a cell is an outlet (open side or the declared sink)
     std::vector<std::int32_t> receiver_;
-    std::vector<std::uint8_t> donors_;   // bit k: neighbour k sends its water here
+    std::vector<std::uint8_t> donors_;  // bit k: neighbour k sends its water here
     std::vector<std::int32_t> stack_;
     std::vector<std::int32_t> next_stack_;  // patch_stack's output, swapped with stack_
     struct Resolved {
-        std::int32_t basin;   // the pit basin (index into roots_)
+        std::int32_t basin;  // the pit basin (index into roots_)
         std::int32_t inside;  // its pass cell
         std::int32_t across;  // the cell its water now goes to
     };
     std::vector<Resolved> resolved_;  // resolve_pits, in resolution order
-    std::vector<std::int32_t> basin_;    // index of the basin's root in roots_ (during pit resolution)
-    std::vector<std::int32_t> roots_;    // outlets and pits, index order
+    std::vector<std::int32_t> basin_;  // index of the basin's root in roots_ (during pit resolution)
+    std::vector<std::int32_t> roots_;  // outlets and pits, index order
     std::vector<std::int64_t> basin_start_;  // first stack position of each basin (+ end)
-    std::vector<std::int64_t> chunks_;       // see chunks()
+    std::vector<std::int64_t> chunks_;  // see chunks()
     static constexpr std::int64_t kChunks = 64;
     std::vector<double> area_;
-    std::vector<std::uint8_t> lower_;      // accumulate_multiple: bit k = neighbour k is strictly lower
-    std::vector<std::uint8_t> pending_;    // accumulate_multiple: donors not yet added
-    std::vector<std::int32_t> order_;      // accumulate_multiple: the topological order
+    std::vector<std::uint8_t> lower_;  // accumulate_multiple: bit k = neighbour k is strictly lower
+    std::vector<std::uint8_t> pending_;  // accumulate_multiple: donors not yet added
+    std::vector<std::int32_t> order_;  // accumulate_multiple: the topological order
     std::vector<std::vector<std::int32_t>> walk_buffers_;  // build_stack: one stack piece per group of roots
     std::int64_t pits_ = 0;
     std::int64_t graph_pits_ = 0;

@@ -116,7 +116,8 @@ stream_power::Settings settings_of(NodeContext& ctx) {
         s.glaciers.glacier_flux = ctx.real("glacier_min_flux");
     }
     s.open = *parse_sides(ctx.text("open"));
-    s.depressions = ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
+    s.depressions =
+        ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
     s.deposition = ctx.real("deposition");
     return s;
@@ -179,8 +180,8 @@ std::vector<double> steady_uplift(const UpliftInputs& in) {
     const double fastest = in.fastest(uplift, 0.0);
     if (fastest * 1e3 > kMaxUpliftMmYr) {
         std::ostringstream msg;
-        msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives "
-            << fastest * 1e3 << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
+        msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives " << fastest * 1e3
+            << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
             << " mm/yr); give a longer uplift_layer_years";
         throw BadInput(msg.str());
     }
@@ -234,9 +235,10 @@ stream_power::UpliftHistory uplift_history(const UpliftInputs& in) {
         if (series) {
             f = series->at(k).heightmap();
             if (!f || f->width() != W || f->height() != H)
-                throw BadInput("uplift_history: frame " + std::to_string(k) + " is " +
-                               (f ? std::to_string(f->width()) + " x " + std::to_string(f->height()) : "not a heightmap") +
-                               ", the terrain " + std::to_string(W) + " x " + std::to_string(H));
+                throw BadInput(
+                    "uplift_history: frame " + std::to_string(k) + " is " +
+                    (f ? std::to_string(f->width()) + " x " + std::to_string(f->height()) : "not a heightmap") +
+                    ", the terrain " + std::to_string(W) + " x " + std::to_string(H));
         }
         return tiles ? tiles->scatter_from_rank0(f.get()) : f;
     };
@@ -324,7 +326,8 @@ NodeOutputs run(NodeContext& ctx) {
     Engine engine;
     std::vector<double> h(hm->heights().begin(), hm->heights().end());
     if (tiles)
-        engine.tiled = std::make_unique<stream_power::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
+        engine.tiled =
+            std::make_unique<stream_power::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
     else
         engine.whole = std::make_unique<stream_power::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
                                                              std::move(uplift), s);
@@ -381,8 +384,8 @@ NodeOutputs run(NodeContext& ctx) {
     if (s.deposition > 0.0) msg << "; " << sediment_out * 1e-9 << " km³ of sediment left by the outlets";
     if (tiles)
         msg << "; rank " << tiles->rank() << " of " << tiles->ranks() << ", up to " << rounds
-            << " round(s) a step down rivers crossing tiles; " << seconds << " s in the node, of which joining the tiles "
-            << engine.tiled->seconds_joining() << " s ("
+            << " round(s) a step down rivers crossing tiles; " << seconds
+            << " s in the node, of which joining the tiles " << engine.tiled->seconds_joining() << " s ("
             << 100.0 * engine.tiled->seconds_joining() / std::max(1e-9, seconds) << " %)";
     ctx.info(msg.str());
     lapse.finish(last, *hm);
@@ -393,15 +396,18 @@ NodeOutputs run(NodeContext& ctx) {
 
 void check(CheckContext& ctx) {
     if (!parse_sides(ctx.text("open")))
-        ctx.error("open", "'" + ctx.text("open") +
-                              "' is not a set of sides; write the letters of the open sides (n, e, s, w), e.g. "
-                              "\"nesw\", or all or none (every side closed: the lowest cell is the outlet)");
+        ctx.error("open",
+                  "'" + ctx.text("open") +
+                      "' is not a set of sides; write the letters of the open sides (n, e, s, w), e.g. "
+                      "\"nesw\", or all or none (every side closed: the lowest cell is the outlet)");
     if (!parse_base_level(ctx.text("base_level")))
-        ctx.error("base_level", "'" + ctx.text("base_level") +
-                                    "' is not a height; give edge (outlets keep their heights) or metres, e.g. \"0\"");
+        ctx.error("base_level",
+                  "'" + ctx.text("base_level") +
+                      "' is not a height; give edge (outlets keep their heights) or metres, e.g. \"0\"");
     if (ctx.text("routing") == "mfd" && ctx.text("depressions") == "route")
-        ctx.error("routing", "multiple flow directions need filled lakes (water crossing an unfilled lake would "
-                             "flow back into it); use depressions=fill or routing=d8");
+        ctx.error("routing",
+                  "multiple flow directions need filled lakes (water crossing an unfilled lake would "
+                  "flow back into it); use depressions=fill or routing=d8");
     if (ctx.text("routing") != "mfd" && ctx.given("mfd_exponent"))
         ctx.error("mfd_exponent", "mfd_exponent weights multiple flow directions; give routing=mfd as well");
     if (ctx.real("dt") > ctx.real("years"))
@@ -416,24 +422,28 @@ void check(CheckContext& ctx) {
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
         a > 0.0 && (a - spread < 5.0 || a + spread > 80.0))
-        ctx.error("bed_angle_spread", "the beds' landslide angles run landslide_angle ± bed_angle_spread, which must stay "
-                                      "within 5-80°; give a smaller spread");
+        ctx.error("bed_angle_spread",
+                  "the beds' landslide angles run landslide_angle ± bed_angle_spread, which must stay "
+                  "within 5-80°; give a smaller spread");
     const std::string& layer = ctx.text("uplift_layer");
     const ValueInfo* hist = ctx.input(1);
     if (hist) {
         if (!layer.empty())
-            ctx.error("uplift_layer", "give uplift_layer or an uplift_history input, not both (the plates' 'uplift' "
-                                      "layer is the sum of their history's height changes: it would count twice)");
+            ctx.error("uplift_layer",
+                      "give uplift_layer or an uplift_history input, not both (the plates' 'uplift' "
+                      "layer is the sum of their history's height changes: it would count twice)");
         if (hist->empty)
-            ctx.error("", "input 2 (uplift_history) records no frames: give its node timelapse_every=K (e.g. "
-                          "tectonics:plates(..., timelapse_every=50)) so that it hands on its heights over time");
+            ctx.error("",
+                      "input 2 (uplift_history) records no frames: give its node timelapse_every=K (e.g. "
+                      "tectonics:plates(..., timelapse_every=50)) so that it hands on its heights over time");
         else if (hist->count == 1)
             ctx.error("", "input 2 (uplift_history) has 1 frame; a rate needs at least two (the start and the end)");
         const ValueInfo* in = ctx.input(0);
         if (in && in->width > 0 && hist->width > 0 && (in->width != hist->width || in->height != hist->height))
-            ctx.error("", "input 2 (uplift_history) is " + std::to_string(hist->width) + " x " +
-                              std::to_string(hist->height) + ", the terrain " + std::to_string(in->width) + " x " +
-                              std::to_string(in->height) + "; record the history on the terrain's grid");
+            ctx.error("",
+                      "input 2 (uplift_history) is " + std::to_string(hist->width) + " x " +
+                          std::to_string(hist->height) + ", the terrain " + std::to_string(in->width) + " x " +
+                          std::to_string(in->height) + "; record the history on the terrain's grid");
     } else if (ctx.given("uplift_history_years")) {
         ctx.error("uplift_history_years",
                   "uplift_history_years spreads an uplift history; give one as input 2, e.g. plates.timelapse");
@@ -443,16 +453,17 @@ void check(CheckContext& ctx) {
     else if (ctx.given("uplift_layer_years"))
         ctx.error("uplift_layer_years", "uplift_layer_years scales an uplift layer; name one with uplift_layer");
     else if (ctx.given("uplift_smoothing") && !hist)
-        ctx.error("uplift_smoothing", "uplift_smoothing spreads an uplift layer or history; name a layer with "
-                                      "uplift_layer or give a history as input 2");
+        ctx.error("uplift_smoothing",
+                  "uplift_smoothing spreads an uplift layer or history; name a layer with "
+                  "uplift_layer or give a history as input 2");
     // Memory: the model holds about kBytesPerCell bytes per cell beside the heightmap.
     const ValueInfo* in = ctx.input(0);
     const std::int64_t w = in && in->width > 0 ? in->width : ctx.grid().width;
     const std::int64_t hgt = in && in->height > 0 ? in->height : ctx.grid().height;
     // In a tiled run each rank holds its tile's model only (memory_share: this machine's share of the grid).
     const double need = ctx.memory_share() * double(w) * double(hgt) *
-                        double(stream_power::kBytesPerCell +
-                               (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0));
+        double(stream_power::kBytesPerCell +
+               (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0));
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (have > 0 && need > 0.5 * have) {
         std::ostringstream msg;
@@ -499,9 +510,11 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "glaciers=true routes ice from above the ELA down the valleys, eroding K_g Q^m_g S^n and carving "
             "U-shaped troughs. The same "
             "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
-            "glaciers; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where it "
+            "glaciers; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where "
+            "it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
-            "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; added to "
+            "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; "
+            "added to "
             "an earlier eroder's), uplifted (the rock uplift it received, m; eroded + uplifted is the net change) and, "
             "with chi=true, chi (m).",
         .inputs = {{"terrain", ValueType::heightmap, Need::required, "heightmap to evolve"},
@@ -514,21 +527,19 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
         .params =
             {
                 Param::real("years", 1e6).min(0.0, true).max(1e9).unit("yr").help("simulated time"),
-                Param::real("dt", 1e4)
-                    .min(0.0, true)
-                    .max(1e8)
-                    .unit("yr")
-                    .help("time step (any size is stable; 1e3-1e5 resolve the transient)"),
+                Param::real("dt", 1e4).min(0.0, true).max(1e8).unit("yr").help(
+                    "time step (any size is stable; 1e3-1e5 resolve the transient)"),
                 Param::real("erodibility", 2e-5)
                     .min(0.0, true)
                     .max(1e-2)
                     .unit("m^(1-2m)/yr")
                     .help("K: 1e-7 (hard rock, dry) to 1e-4 (soft rock, wet) for m ~ 0.5, n = 1 "
                           "(Stock & Montgomery 1999)"),
-                Param::real("m", 0.45).min(0.1).max(1.5).help("area exponent (0.3-0.6 with n = 1; m/n is the concavity, "
-                                                              "0.35-0.6 in real rivers)"),
+                Param::real("m", 0.45).min(0.1).max(1.5).help(
+                    "area exponent (0.3-0.6 with n = 1; m/n is the concavity, "
+                    "0.35-0.6 in real rivers)"),
                 Param::real("n", 1.0).min(0.5).max(4.0).help("slope exponent (2/3-2 measured, Whipple & Tucker 1999; "
-                                                               "up to 4, Lague 2014)"),
+                                                             "up to 4, Lague 2014)"),
                 Param::real("uplift", 1.0)
                     .min(0.0)
                     .max(kMaxUpliftMmYr)
@@ -552,8 +563,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(1e9)
                     .unit("yr")
                     .help("with an uplift_history input: the years its frames span, from the start of the run "
-                          "(the first frame is year 0, the last this; 0 = the run's years); no history uplift after")
-                    ,
+                          "(the first frame is year 0, the last this; 0 = the run's years); no history uplift after"),
                 Param::real("deposition", 0.0)
                     .min(0.0)
                     .max(10.0)
@@ -625,7 +635,10 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .min(0.0)
                     .max(1.0)
                     .help("glaciers: K_g of E = K_g*Q^m_g*S^n, Q the ice flux in m³/yr"),
-                Param::real("ice_flux_exponent", 0.5).min(0.1).max(1.5).help("glaciers: m_g of the glacial erosion law"),
+                Param::real("ice_flux_exponent", 0.5)
+                    .min(0.1)
+                    .max(1.5)
+                    .help("glaciers: m_g of the glacial erosion law"),
                 Param::real("glacier_half_width", 400.0)
                     .min(0.0)
                     .max(1e4)

@@ -29,13 +29,8 @@ std::int64_t lowest_cell(const std::vector<double>& heights) {
 
 Model::Model(int width, int height, double cell, std::vector<double> heights, std::vector<double> uplift,
              const Settings& settings)
-    : width_(width),
-      height_(height),
-      cell_(cell),
-      settings_(settings),
-      h_(std::move(heights)),
-      uplift_(std::move(uplift)),
-      flow_(width, height, cell, settings.open, settings.open.any() ? 0 : lowest_cell(h_)) {
+    : width_(width), height_(height), cell_(cell), settings_(settings), h_(std::move(heights)),
+      uplift_(std::move(uplift)), flow_(width, height, cell, settings.open, settings.open.any() ? 0 : lowest_cell(h_)) {
     if (h_.size() != flow_.size()) throw std::invalid_argument("stream_power::Model: heights are not width × height");
     if (settings.mfd_exponent > 0.0 && settings.depressions != Depressions::fill)
         throw std::invalid_argument("stream_power::Model: multiple flow directions need Depressions::fill");
@@ -49,7 +44,8 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
 
 std::vector<double> area_power_table(double cell, double m, double inv_ac) {
     std::vector<double> t(static_cast<std::size_t>(kPowTable));
-    for (std::int64_t c = 0; c < kPowTable; ++c) t[std::size_t(c)] = channel_area_power(double(c) * (cell * cell), m, inv_ac);
+    for (std::int64_t c = 0; c < kPowTable; ++c)
+        t[std::size_t(c)] = channel_area_power(double(c) * (cell * cell), m, inv_ac);
     return t;
 }
 
@@ -76,15 +72,16 @@ void Model::set_uplift_history(UpliftHistory history) {
 void Model::add_history_uplift(double t0, double t1) {
     double* h = h_.data();
     const std::int64_t n = std::int64_t(h_.size());
-    for_history_intervals(history_, history_k_, history_rate_, h_.size(), t0, t1, [&](const double* rate, double overlap) {
-        parallel_for(0, n, 1 << 15, [&](std::int64_t b, std::int64_t e) {
-            for (std::int64_t i = b; i < e; ++i)
-                if (!flow_.is_outlet(i)) {
-                    h[i] += rate[i] * overlap;
-                    uplifted_[std::size_t(i)] += rate[i] * overlap;
-                }
-        });
-    });
+    for_history_intervals(history_, history_k_, history_rate_, h_.size(), t0, t1,
+                          [&](const double* rate, double overlap) {
+                              parallel_for(0, n, 1 << 15, [&](std::int64_t b, std::int64_t e) {
+                                  for (std::int64_t i = b; i < e; ++i)
+                                      if (!flow_.is_outlet(i)) {
+                                          h[i] += rate[i] * overlap;
+                                          uplifted_[std::size_t(i)] += rate[i] * overlap;
+                                      }
+                              });
+                          });
 }
 
 void Model::route_only() {
@@ -94,10 +91,8 @@ void Model::route_only() {
 }
 
 void Model::accumulate(const double* routed) {
-    if (settings_.mfd_exponent > 0.0)
-        flow_.accumulate_multiple(routed, settings_.mfd_exponent);
-    else
-        flow_.accumulate();
+    if (settings_.mfd_exponent > 0.0) flow_.accumulate_multiple(routed, settings_.mfd_exponent);
+    else flow_.accumulate();
 }
 
 std::int64_t Model::step(double dt) {
@@ -137,17 +132,16 @@ std::int64_t Model::step(double dt) {
     // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
     rock_at(settings_.rock, h, uplifted_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
     if (settings_.glaciers.any()) glacial_factors(dt);
-    if (settings_.deposition > 0.0)
-        incise_with_deposition(dt);
-    else
-        incise(dt);
+    if (settings_.deposition > 0.0) incise_with_deposition(dt);
+    else incise(dt);
     if (settings_.glaciers.any())
         carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
     // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
     if (settings_.rock.angle > 0.0)
-        threshold::limit_slopes(h, width_, height_, cell_,
-                                {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
-                                flow_.outlets().data());
+        threshold::limit_slopes(
+            h, width_, height_, cell_,
+            {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
+            flow_.outlets().data());
     time_ += dt;
     return pits;
 }
@@ -162,7 +156,7 @@ void Model::glacial_factors(double dt) {
         for (std::int64_t i = b; i < e; ++i)
             if (ice_[std::size_t(i)] >= g.glacier_flux && flow_.receivers()[std::size_t(i)] != std::int32_t(i))
                 ice_f_[std::size_t(i)] = g.erodibility * dt * std::pow(ice_[std::size_t(i)], g.flux_exponent) /
-                                         std::pow(flow_.distance(i), ns);  // a glacier, not at an outlet or pit
+                    std::pow(flow_.distance(i), ns);  // a glacier, not at an outlet or pit
     });
 }
 
@@ -266,7 +260,7 @@ void Model::incise_with_deposition(double dt) {
     if (dep_hs_.size() != n) {
         for (auto* v : {&dep_hs_, &dep_tree_, &dep_x_}) v->assign(n, 0.0);
         dep_pos_.assign(n, 0);
-        dep_p_.assign(2 * n, 0.0);   // p, q pairs
+        dep_p_.assign(2 * n, 0.0);  // p, q pairs
         dep_sa_.assign(2 * n, 0.0);  // Σα, Σβ pairs
         dep_active_.assign(n, 0);
     }
@@ -291,7 +285,7 @@ void Model::incise_with_deposition(double dt) {
         // Scratch indexed by stack position, so that the passes read and write it in order; only
         // the receiver's sums (and its position) are reached by a jump.
         double* hs = dep_hs_.data();
-        auto* pq = reinterpret_cast<double(*)[2]>(dep_p_.data());   // p, q
+        auto* pq = reinterpret_cast<double(*)[2]>(dep_p_.data());  // p, q
         auto* sum = reinterpret_cast<double(*)[2]>(dep_sa_.data());  // Σα, Σβ of the donors
         double* tree = dep_tree_.data();
         double* xp = dep_x_.data();
@@ -331,8 +325,7 @@ void Model::incise_with_deposition(double dt) {
                     double F = 0.0, c = 0.0;
                     if (act[s]) {
                         const std::int64_t d = std::int64_t(r) - i;
-                        double lin = area_pow(area[i]) *
-                                     ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
+                        double lin = area_pow(area[i]) * ((d == 1 || d == -1 || d == W || d == -W) ? kdt_l1 : kdt_l2);
                         if (!rock_k_.empty()) lin *= rock_k_[std::size_t(i)];  // the bed it cuts
                         if (ns == 1.0) {
                             F = lin;
@@ -397,7 +390,8 @@ void Model::incise_with_deposition(double dt) {
 }
 
 void Model::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {
-    if (!(years > 0.0) || !(dt > 0.0)) throw std::invalid_argument("stream_power::Model::run: years and dt must be > 0");
+    if (!(years > 0.0) || !(dt > 0.0))
+        throw std::invalid_argument("stream_power::Model::run: years and dt must be > 0");
     const auto steps = std::int64_t(std::ceil(years / dt * (1.0 - 1e-12)));
     for (std::int64_t s = 1; s <= steps; ++s) {
         const double this_dt = s < steps ? dt : years - dt * double(steps - 1);

@@ -49,7 +49,7 @@ struct Settings {
     double erodibility = 2e-5;  ///< K, m^(1−2m)/yr (n = 1)
     double area_exponent = 0.45;  ///< m
     double slope_exponent = 1.0;  ///< n
-    double diffusivity = 0.0;     ///< D, m²/yr (0: no hillslope diffusion)
+    double diffusivity = 0.0;  ///< D, m²/yr (0: no hillslope diffusion)
     OpenSides open;
     Depressions depressions = Depressions::fill;
     /// > 0: drainage area by multiple flow directions (Freeman 1991), water split among the lower
@@ -106,7 +106,8 @@ void for_history_intervals(const UpliftHistory& history, std::size_t& rate_k, st
         if (!(overlap > 0.0)) continue;
         if (rate_k != k) {
             rate = history.rate(k);
-            if (rate.size() != n) throw std::invalid_argument("stream_power: an uplift history rate is not the grid's size");
+            if (rate.size() != n)
+                throw std::invalid_argument("stream_power: an uplift history rate is not the grid's size");
             rate_k = k;
         }
         add(rate.data(), overlap);

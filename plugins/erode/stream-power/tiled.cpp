@@ -97,15 +97,8 @@ std::string untiled_because(const Settings& s) {
 
 TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, std::vector<double> uplift,
                        const Settings& settings)
-    : tiles_(tiles),
-      own_(tiles.owned()),
-      grown_(tiles.ghosted()),
-      W_(tiles.grid_width()),
-      H_(tiles.grid_height()),
-      cell_(cell),
-      settings_(settings),
-      h_(std::move(heights)),
-      uplift_(std::move(uplift)) {
+    : tiles_(tiles), own_(tiles.owned()), grown_(tiles.ghosted()), W_(tiles.grid_width()), H_(tiles.grid_height()),
+      cell_(cell), settings_(settings), h_(std::move(heights)), uplift_(std::move(uplift)) {
     const std::size_t n = std::size_t(own_.width) * std::size_t(own_.height);
     if (h_.size() != n) throw std::invalid_argument("stream_power::TiledModel: heights are not the tile's size");
     if (!uplift_.empty() && uplift_.size() != n)
@@ -149,7 +142,8 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
                 edge_.push_back(std::int32_t(std::int64_t(y) * own_.width + x));
     pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
     uplifted_.assign(n, 0.0);
-    if (settings.diffusivity > 0.0) diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, hillslope_settings(settings));
+    if (settings.diffusivity > 0.0)
+        diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, hillslope_settings(settings));
 }
 
 std::int64_t TiledModel::global(std::size_t l) const {
@@ -236,10 +230,8 @@ void TiledModel::build_trees() {
     for (std::size_t l = 0; l < n; ++l) {
         const int k = dir_[l];
         const std::int64_t r = k < 0 ? -1 : owned_neighbour(l, k);
-        if (r < 0)
-            trees_.push_back(std::int32_t(l));
-        else
-            donors_[std::size_t(r)] |= std::uint8_t(1u << ((k + 4) & 7));
+        if (r < 0) trees_.push_back(std::int32_t(l));
+        else donors_[std::size_t(r)] |= std::uint8_t(1u << ((k + 4) & 7));
     }
     tree_start_.assign(trees_.size() + 1, 0);
     std::size_t pos = 0;
@@ -356,7 +348,8 @@ void TiledModel::label_basins(ResolveState& st) {
                     break;
                 }
                 path.push_back(at.first);
-                if (path.size() > st.edges.size()) throw std::logic_error("stream-power: the tiles' rivers hold a loop");
+                if (path.size() > st.edges.size())
+                    throw std::logic_error("stream-power: the tiles' rivers hold a loop");
                 at = edge_of(st.edges, at.second);
             }
             if (basin < 0) basin = at.first;
@@ -419,10 +412,8 @@ std::vector<Link> TiledModel::links_between_basins() {
                 if (pit_j && j < i) continue;
                 const double pass = std::max(grown_h_[gl], grown_h_[gj]), low = std::min(grown_h_[gl], grown_h_[gj]);
                 const std::int64_t bj = pit_j ? lj : -1;  // the sea comes first, then pits by index
-                if (bj < li)
-                    tree_links.push_back({pass, low, bj, li, j, i});
-                else
-                    tree_links.push_back({pass, low, li, bj, i, j});
+                if (bj < li) tree_links.push_back({pass, low, bj, li, j, i});
+                else tree_links.push_back({pass, low, li, bj, i, j});
             }
         }
         if (tree_links.size() > 1) lowest_per_pair(tree_links);
@@ -437,9 +428,8 @@ void TiledModel::settle_tile_lakes(ResolveState& st, std::vector<Link> links) {
     // cell on its edge have all their links among the tile's (basin_join.hpp).
     std::unordered_set<std::int64_t> on_edge;
     for (const std::int32_t l : edge_) on_edge.insert(label_[std::size_t(l)]);
-    st.forest = contract_tile(std::move(links), [&](std::int64_t basin) {
-        return local_of(basin) >= 0 && on_edge.count(basin) == 0;
-    });
+    st.forest = contract_tile(std::move(links),
+                              [&](std::int64_t basin) { return local_of(basin) >= 0 && on_edge.count(basin) == 0; });
     // Rank 0 gets the rest, with the ends of the local trees of the cells it may cut paths from.
     std::vector<EdgeRecord> hops;
     auto hop_of = [&](std::int64_t cell) {
@@ -631,15 +621,12 @@ void TiledModel::propagate(std::vector<double>& v, const std::function<void(std:
     };
     std::vector<std::size_t> waiting;
     for (std::size_t t = 0; t < trees_.size(); ++t) {
-        if (dir_[std::size_t(trees_[t])] < 0)
-            solve_tree(t, 0.0);
-        else
-            waiting.push_back(t);
+        if (dir_[std::size_t(trees_[t])] < 0) solve_tree(t, 0.0);
+        else waiting.push_back(t);
     }
     rounds_ = 1;
-    double left = tiles_.ranks() > 1
-                      ? joined([&] { return tiles_.reduce(double(waiting.size()), Tiling::Reduce::sum); })
-                      : 0.0;
+    double left =
+        tiles_.ranks() > 1 ? joined([&] { return tiles_.reduce(double(waiting.size()), Tiling::Reduce::sum); }) : 0.0;
     if (left > 0.0) {
         grown_v_.assign(grown_h_.size(), 0.0);
         grown_done_.assign(grown_h_.size(), 0.0);
@@ -658,10 +645,8 @@ void TiledModel::propagate(std::vector<double>& v, const std::function<void(std:
             const auto l = std::size_t(trees_[t]);
             const int k = dir_[l];
             const auto r = std::size_t(std::int64_t(grown_index(l)) + std::int64_t(kDy[k]) * gw + kDx[k]);
-            if (grown_done_[r] != 0.0)
-                solve_tree(t, grown_v_[r]);
-            else
-                still.push_back(t);
+            if (grown_done_[r] != 0.0) solve_tree(t, grown_v_[r]);
+            else still.push_back(t);
         }
         waiting.swap(still);
         const double now = joined([&] { return tiles_.reduce(double(waiting.size()), Tiling::Reduce::sum); });
@@ -671,7 +656,8 @@ void TiledModel::propagate(std::vector<double>& v, const std::function<void(std:
 }
 
 void TiledModel::run(double years, double dt, const std::function<void(std::int64_t, std::int64_t)>& on_step) {
-    if (!(years > 0.0) || !(dt > 0.0)) throw std::invalid_argument("stream_power::TiledModel::run: years and dt must be > 0");
+    if (!(years > 0.0) || !(dt > 0.0))
+        throw std::invalid_argument("stream_power::TiledModel::run: years and dt must be > 0");
     const auto steps = std::int64_t(std::ceil(years / dt * (1.0 - 1e-12)));
     for (std::int64_t s = 1; s <= steps; ++s) {
         step(s < steps ? dt : years - dt * double(steps - 1));
@@ -701,13 +687,14 @@ std::int64_t TiledModel::step(double dt) {
                 uplifted_[l] += uplift_[l] * dt;
             }
     if (history_.rate)
-        for_history_intervals(history_, history_k_, history_rate_, n, time_, time_ + dt, [&](const double* rate, double overlap) {
-            for (std::size_t l = 0; l < n; ++l)
-                if (!outlet_[l]) {
-                    h_[l] += rate[l] * overlap;
-                    uplifted_[l] += rate[l] * overlap;
-                }
-        });
+        for_history_intervals(history_, history_k_, history_rate_, n, time_, time_ + dt,
+                              [&](const double* rate, double overlap) {
+                                  for (std::size_t l = 0; l < n; ++l)
+                                      if (!outlet_[l]) {
+                                          h_[l] += rate[l] * overlap;
+                                          uplifted_[l] += rate[l] * overlap;
+                                      }
+                              });
     time_ += dt;
     // 2. Routing, depressions, drainage area.
     route(h_.data());
@@ -742,9 +729,10 @@ std::int64_t TiledModel::step(double dt) {
     });
     // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
     if (settings_.rock.angle > 0.0)
-        threshold::limit_slopes(tiles_, h_.data(), cell_,
-                                {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
-                                outlet_.data());
+        threshold::limit_slopes(
+            tiles_, h_.data(), cell_,
+            {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
+            outlet_.data());
     return pits;
 }
 

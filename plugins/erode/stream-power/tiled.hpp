@@ -150,16 +150,16 @@ private:
     std::vector<double> history_rate_;
     double time_ = 0.0;  // years since the run began
     std::vector<std::uint8_t> outlet_;
-    std::vector<std::int8_t> dir_;        // D8 code of the receiver, −1 for a root
-    std::vector<std::uint8_t> donors_;    // bit k: owned neighbour k sends its water here
-    std::vector<std::int32_t> trees_;     // local roots (pits, outlets, exits), local index order
-    std::vector<std::int32_t> tree_of_;   // each cell's tree (index into trees_)
+    std::vector<std::int8_t> dir_;  // D8 code of the receiver, −1 for a root
+    std::vector<std::uint8_t> donors_;  // bit k: owned neighbour k sends its water here
+    std::vector<std::int32_t> trees_;  // local roots (pits, outlets, exits), local index order
+    std::vector<std::int32_t> tree_of_;  // each cell's tree (index into trees_)
     std::vector<std::int64_t> tree_start_;  // each tree's first position in stack_ (+ end)
-    std::vector<std::int32_t> stack_;     // the trees, each receiver before its donors
-    std::vector<std::int32_t> edge_;      // the tile's edge cells, local indices
+    std::vector<std::int32_t> stack_;  // the trees, each receiver before its donors
+    std::vector<std::int32_t> edge_;  // the tile's edge cells, local indices
     std::vector<double> grown_h_, grown_v_, grown_done_, grown_label_;  // over ghosted() (halo 1)
-    std::vector<std::int64_t> label_;     // resolve_pits: each cell's basin (its pit or outlet)
-    std::vector<double> count_, area_;    // cells upstream (with itself), m²
+    std::vector<std::int64_t> label_;  // resolve_pits: each cell's basin (its pit or outlet)
+    std::vector<double> count_, area_;  // cells upstream (with itself), m²
     std::vector<double> pow_table_;
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::int64_t pits_ = 0;

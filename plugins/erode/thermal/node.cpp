@@ -100,8 +100,7 @@ NodeOutputs run(NodeContext& ctx) {
         }
     } else {
         s.hardness = thermal::Hardness::layer;
-        if (!hm->has_layer(hardness))
-            throw BadInput("hardness: the input has no layer '" + hardness + "'");
+        if (!hm->has_layer(hardness)) throw BadInput("hardness: the input has no layer '" + hardness + "'");
         layer = std::as_const(*hm).layer(hardness).data;
     }
 

@@ -42,7 +42,7 @@ struct Offset {
 constexpr Offset kVonNeumann[] = {{1, 0, false}, {-1, 0, false}, {0, 1, false}, {0, -1, false}};
 constexpr Offset kRotated[] = {{1, 1, true}, {-1, 1, true}, {1, -1, true}, {-1, -1, true}};
 constexpr Offset kMoore[] = {{1, 0, false}, {-1, 0, false}, {0, 1, false}, {0, -1, false},
-                             {1, 1, true},  {-1, 1, true},  {1, -1, true},  {-1, -1, true}};
+                             {1, 1, true},  {-1, 1, true},  {1, -1, true}, {-1, -1, true}};
 
 template <Neighbourhood N>
 constexpr auto& offsets() {
@@ -190,7 +190,7 @@ OROGEN_THERMAL_CLONES void update_row(const Rows3& in, const Rule& r, const floa
 #pragma GCC unroll 8
         for (int k = 0; k < K; ++k) {
             const float e = nb[k][x] - h;  // drop from the neighbour (from a wall: its F is 0)
-            const float fn = nf[k][x];     // loaded unconditionally so the loop vectorises
+            const float fn = nf[k][x];  // loaded unconditionally so the loop vectorises
             gain += e > t[k] ? fn * e : 0.0f;
         }
         dst[x] = (h - o[x]) + gain;
@@ -220,8 +220,8 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
     // two per thread, so that the recomputed halos (2·steps·(steps−1) rows
     // of heights per band) cost little. The result does not depend on them.
     const std::int64_t per_thread_bands = 2 * std::int64_t(std::max(1, thread_count()));
-    const std::int64_t band = std::max<std::int64_t>(
-        16, steps == 1 ? hgt / 32 : (hgt + per_thread_bands - 1) / per_thread_bands);
+    const std::int64_t band =
+        std::max<std::int64_t>(16, steps == 1 ? hgt / 32 : (hgt + per_thread_bands - 1) / per_thread_bands);
     const std::int64_t bands = (hgt + band - 1) / band;
     // Local rows: column 0 on a 64-byte boundary (the loops' centre loads and
     // stores are whole cache lines), a wall column on each side, and not a
@@ -244,8 +244,8 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
                 for (std::size_t i = 0; i < edge_rows; ++i) {
                     const std::int64_t y = (b + 1) * band - halo + std::int64_t(i);
                     if (y < hgt)
-                        std::memcpy(edges.data() + (std::size_t(b) * edge_rows + i) * std::size_t(w),
-                                    in.row(int(y)), std::size_t(w) * sizeof(float));
+                        std::memcpy(edges.data() + (std::size_t(b) * edge_rows + i) * std::size_t(w), in.row(int(y)),
+                                    std::size_t(w) * sizeof(float));
                 }
         });
     // Input row y for the band [y0, y1) with index b.
@@ -259,8 +259,8 @@ void sweep(ConstGridView in, GridView out, const Rule& r, int steps) {
         FlushDenormals ftz;
         thread_local std::vector<float> store;
         store.resize(stride * rows + 16);
-        float* const base = reinterpret_cast<float*>((reinterpret_cast<std::uintptr_t>(store.data()) + 63) &
-                                                     ~std::uintptr_t(63));
+        float* const base =
+            reinterpret_cast<float*>((reinterpret_cast<std::uintptr_t>(store.data()) + 63) & ~std::uintptr_t(63));
         auto slot = [&](std::size_t i) { return base + stride * i + 16; };  // column 0 of local row i
         // Rows outside the grid: heights (wall) and F (0).
         float* const wall_row = slot(rows - 2);

@@ -26,16 +26,16 @@ namespace orogen::thermal {
 
 enum class Neighbourhood {
     von_neumann,  ///< 4 axis neighbours, distance = cell
-    rotated,      ///< the thesis's rotated von Neumann: the 4 diagonals, distance = cell·√2.
-                  ///< Never moves material between the sub-lattices x+y even / odd, which
-                  ///< then drift apart: a diagonal hatching. Kept for the thesis's experiments.
-    moore,        ///< all 8
+    rotated,  ///< the thesis's rotated von Neumann: the 4 diagonals, distance = cell·√2.
+    ///< Never moves material between the sub-lattices x+y even / odd, which
+    ///< then drift apart: a diagonal hatching. Kept for the thesis's experiments.
+    moore,  ///< all 8
 };
 
 enum class Hardness {
     constant,  ///< every cell moves material alike (softness 1)
-    height,    ///< the thesis's height-aware hardness: softness = ((h_max − h)/(h_max − h_min))²
-    layer,     ///< softness = 1 − clamp(layer, 0, 1) from a hardness layer
+    height,  ///< the thesis's height-aware hardness: softness = ((h_max − h)/(h_max − h_min))²
+    layer,  ///< softness = 1 − clamp(layer, 0, 1) from a hardness layer
 };
 
 struct Settings {

@@ -16,10 +16,10 @@ namespace orogen::render {
 /// The bright pass's constants (the thesis's defaults).
 struct BrightPass {
     double average_luminance = 0.5;  ///< the scene's assumed mean luminance
-    double middle_grey = 0.5;        ///< what that mean is scaled to
-    double white = 1.5;              ///< the luminance Reinhard's curve maps to 1 (after scaling)
-    double threshold = 0.4;          ///< mapped luminance below this is dropped
-    int scale = 1;                   ///< output is 1/scale the size (box-averaged): blur less, faster
+    double middle_grey = 0.5;  ///< what that mean is scaled to
+    double white = 1.5;  ///< the luminance Reinhard's curve maps to 1 (after scaling)
+    double threshold = 0.4;  ///< mapped luminance below this is dropped
+    int scale = 1;  ///< output is 1/scale the size (box-averaged): blur less, faster
 };
 
 /// Each pixel's colour times max(Ld − threshold, 0) / Ld, where Ld is its
@@ -45,7 +45,8 @@ Image combine(const Image& original, const Image& bloom, double strength);
 
 /// The whole bloom: bright pass (scale), blur x, blur y, combine.
 struct Bloom {
-    BrightPass bright{.scale = 4};  ///< at quarter size: the glow is soft anyway (sigma ≈ 18 px at 1080p), and 16× cheaper to blur
+    BrightPass bright{
+        .scale = 4};  ///< at quarter size: the glow is soft anyway (sigma ≈ 18 px at 1080p), and 16× cheaper to blur
     /// Gaussian sigma as a fraction of the image width: the thesis's 15 taps
     /// cover ±0.028 of the frame, taken here as ±3 sigma.
     double sigma = 0.028 / 3.0;

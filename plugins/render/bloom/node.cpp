@@ -19,7 +19,10 @@ std::vector<Param> bright_params(int scale) {
         Param::real("grey", 0.5).min(0, true).help("the middle grey that average is scaled to"),
         Param::real("white", 1.5).min(0, true).help("luminance Reinhard's curve maps to 1"),
         Param::real("threshold", 0.4).min(0).help("mapped luminance below this is dropped"),
-        Param::integer("scale", scale).min(1).max(16).help("the bright pass is 1/scale the image's size (box-averaged)"),
+        Param::integer("scale", scale)
+            .min(1)
+            .max(16)
+            .help("the bright pass is 1/scale the image's size (box-averaged)"),
     };
 }
 
@@ -52,9 +55,8 @@ OROGEN_PLUGIN("render-bloom", "0.1.0", registry) {
         .kind = "render",
         .name = "bright-pass",
         .summary = "bloom pass 1: keep what is bright (Reinhard-mapped luminance above a threshold)",
-        .description =
-            "Each pixel's luminance L, scaled by grey/luminance, is mapped by Reinhard's formula\n"
-            "Ld = L (1 + L / white²) / (1 + L); the pixel keeps max(Ld − threshold, 0)/Ld of its colour.",
+        .description = "Each pixel's luminance L, scaled by grey/luminance, is mapped by Reinhard's formula\n"
+                       "Ld = L (1 + L / white²) / (1 + L); the pixel keeps max(Ld − threshold, 0)/Ld of its colour.",
         .inputs = {{"image", ValueType::image, Need::required, "the frame (linear)"}},
         .output = ValueType::image,
         .params = bright_params(1),
@@ -65,16 +67,18 @@ OROGEN_PLUGIN("render-bloom", "0.1.0", registry) {
         .kind = "render",
         .name = "blur",
         .summary = "bloom passes 2 and 3: one axis of a Gaussian blur (run axis=x then axis=y)",
-        .description =
-            "A Gaussian of sigma × the image width, taps out to 3 sigma, the image mirrored at its edges\n"
-            "(which keeps its mean). x then y equals the two-dimensional Gaussian.",
+        .description = "A Gaussian of sigma × the image width, taps out to 3 sigma, the image mirrored at its edges\n"
+                       "(which keeps its mean). x then y equals the two-dimensional Gaussian.",
         .inputs = {{"image", ValueType::image, Need::required, "the image to blur"}},
         .output = ValueType::image,
         .params =
             {
                 Param::choice("axis", {"x", "y"}, "x").help("the direction of this pass"),
-                Param::real("sigma", 0.028 / 3.0).min(0).max(0.25).help(
-                    "standard deviation, a fraction of the image width (the thesis: ±0.028 of the frame = 3 sigma)"),
+                Param::real("sigma", 0.028 / 3.0)
+                    .min(0)
+                    .max(0.25)
+                    .help("standard deviation, a fraction of the image width (the thesis: ±0.028 of the frame = 3 "
+                          "sigma)"),
             },
         .check = [](CheckContext& ctx) { same_size_output(ctx); },
         .run =
@@ -102,8 +106,11 @@ OROGEN_PLUGIN("render-bloom", "0.1.0", registry) {
             },
     });
     std::vector<Param> bloom_params = bright_params(4);
-    bloom_params.push_back(Param::real("sigma", 0.028 / 3.0).min(0).max(0.25).help(
-        "blur standard deviation, a fraction of the image width (±3 sigma = the thesis's ±0.028 of the frame)"));
+    bloom_params.push_back(Param::real("sigma", 0.028 / 3.0)
+                               .min(0)
+                               .max(0.25)
+                               .help("blur standard deviation, a fraction of the image width (±3 sigma = the thesis's "
+                                     "±0.028 of the frame)"));
     bloom_params.push_back(Param::real("strength", 0.667).min(0).help("how much of the blurred bright pass is added"));
     registry.add({
         .kind = "render",

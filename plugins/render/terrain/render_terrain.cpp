@@ -92,7 +92,7 @@ double bytes_per_pixel(int samples) {
 struct TerrainRenderer::Impl {
     std::shared_ptr<const Heightmap> terrain;
     int width = 0, height = 0;  // samples
-    float lo = 0, hi = 0;       // height range, m
+    float lo = 0, hi = 0;  // height range, m
     bool has_water = false;
     GLuint heights = 0, surface = 0, vao = 0;
     // The grid's triangle strips in four drawing orders (Order), each built on first use: drawn nearest rows
@@ -206,7 +206,7 @@ struct TerrainRenderer::Impl {
         const double fx = sx - x0, fy = sy - y0;
         const ConstGridView v = terrain->view();
         return (1 - fy) * ((1 - fx) * v.at(x0, y0) + fx * v.at(x0 + 1, y0)) +
-               fy * ((1 - fx) * v.at(x0, y0 + 1) + fx * v.at(x0 + 1, y0 + 1));
+            fy * ((1 - fx) * v.at(x0, y0 + 1) + fx * v.at(x0 + 1, y0 + 1));
     }
 };
 
@@ -280,10 +280,10 @@ namespace {
 
 /// The sun, the sky and the haze of one frame: the uniforms every lit pass shares.
 struct Light {
-    glm::dvec3 sun;          // unit, towards the sun
-    glm::vec3 sun_colour;    // linear, times the intensity
+    glm::dvec3 sun;  // unit, towards the sun
+    glm::vec3 sun_colour;  // linear, times the intensity
     glm::vec3 zenith, horizon, ambient;  // linear
-    float fog_density = 0;   // 1/m
+    float fog_density = 0;  // 1/m
 
     Light(const Style& st, double radius) {
         sun = direction(st.sun_azimuth, st.sun_elevation);
@@ -316,9 +316,9 @@ glm::dmat4 light_matrix(const glm::dvec3& sun, const glm::dvec3& centre, double 
     const glm::dmat4 light_view = glm::lookAt(centre + sun * radius * 2.0, centre, light_up);
     glm::dvec3 lo(1e300), hi(-1e300);
     for (int c = 0; c < 8; ++c) {
-        const glm::dvec3 p = glm::dvec3(light_view * glm::dvec4(c & 1 ? box_max.x : box_min.x,
-                                                                c & 2 ? box_max.y : box_min.y,
-                                                                c & 4 ? box_max.z : box_min.z, 1.0));
+        const glm::dvec3 p = glm::dvec3(light_view *
+                                        glm::dvec4(c & 1 ? box_max.x : box_min.x, c & 2 ? box_max.y : box_min.y,
+                                                   c & 4 ? box_max.z : box_min.z, 1.0));
         lo = glm::min(lo, p);
         hi = glm::max(hi, p);
     }
@@ -363,9 +363,9 @@ private:
 
 /// What one frame is drawn from: the terrain's box, the camera's matrices and the light.
 struct TerrainRenderer::Impl::Frame {
-    int width = 0, height = 0;     // pixels
-    double exag = 1;               // vertical exaggeration
-    double floor_height = 0;       // m, unexaggerated: the skirt's foot
+    int width = 0, height = 0;  // pixels
+    double exag = 1;  // vertical exaggeration
+    double floor_height = 0;  // m, unexaggerated: the skirt's foot
     glm::dvec3 box_min, box_max, centre;
     double radius = 0, aspect = 1;
     glm::dvec3 eye, target, up{0, 1, 0};
@@ -373,7 +373,7 @@ struct TerrainRenderer::Impl::Frame {
     glm::dmat4 projection{1.0}, view_projection{1.0};
     glm::dmat4 light_view_projection{1.0};
     std::optional<Light> light;
-    bool shaded = true;            // the beauty output (not albedo or normals)
+    bool shaded = true;  // the beauty output (not albedo or normals)
 };
 
 TerrainRenderer::Impl::Frame TerrainRenderer::Impl::frame_box(int frame_width, int frame_height,
@@ -448,8 +448,7 @@ void TerrainRenderer::Impl::fit_orbit(Frame& f, const Camera& camera, glm::dvec3
     // Looking at the terrain's middle (the default target), the land is centred in the frame and fitted
     // again: a few rounds of moving the target by the land's offset from the frame's middle (its extent at the
     // target's distance), so the land fills the frame instead of leaving a band of sky above it.
-    if (!(camera.centre_land && camera.target.x == 0.5 && camera.target.y == 0.5 && std::abs(back.y) < 0.9999))
-        return;
+    if (!(camera.centre_land && camera.target.x == 0.5 && camera.target.y == 0.5 && std::abs(back.y) < 0.9999)) return;
     const glm::dvec3 right = glm::normalize(glm::cross(f.up, back)), upward = glm::cross(back, right);
     for (int round = 0; round < 4; ++round) {
         const glm::dvec3 e = f.target + back * distance;
@@ -496,16 +495,17 @@ void TerrainRenderer::Impl::place_camera(Frame& f, const Camera& camera, const S
         if (std::abs(forward.y) > 0.9999) f.up = {0, 0, -1};
         const double g = ground(f.eye.x, f.eye.z);
         if (!std::isnan(g) && f.eye.y <= g * f.exag)
-            throw BadInput("render:terrain: the camera is inside the terrain (at " + std::to_string(int(f.eye.y / f.exag)) +
-                           " m where the ground is " + std::to_string(int(g)) +
+            throw BadInput("render:terrain: the camera is inside the terrain (at " +
+                           std::to_string(int(f.eye.y / f.exag)) + " m where the ground is " + std::to_string(int(g)) +
                            " m); raise its elevation, distance or height");
         // Beside the terrain and below its lowest point (or below the sea): only the underside and the skirt show.
         const double lowest = st.sea ? std::max(double(lo), st.sea_level) : double(lo);
         if (std::isnan(g) && f.eye.y < lowest * f.exag)
-            throw BadInput("render:terrain: the camera is below the terrain (at " + std::to_string(int(f.eye.y / f.exag)) +
-                           " m, under its lowest point" + (st.sea ? std::string(" or the sea") : std::string()) +
-                           " at " + std::to_string(int(lowest)) +
-                           " m), where it sees only its underside; raise its elevation (above 0° for an orbit) or height");
+            throw BadInput(
+                "render:terrain: the camera is below the terrain (at " + std::to_string(int(f.eye.y / f.exag)) +
+                " m, under its lowest point" + (st.sea ? std::string(" or the sea") : std::string()) + " at " +
+                std::to_string(int(lowest)) +
+                " m), where it sees only its underside; raise its elevation (above 0° for an orbit) or height");
         set_clip_planes(f, st);
         f.projection = glm::perspective(camera.fov * kDegree, f.aspect, f.near_plane, f.far_plane);
     }
@@ -527,16 +527,17 @@ void TerrainRenderer::Impl::set_clip_planes(Frame& f, const Style& st) const {
 void TerrainRenderer::Impl::refuse_a_view_of_nothing(const Frame& f) const {
     bool outside_all[6] = {true, true, true, true, true, true};
     for (int c = 0; c < 8; ++c) {
-        const glm::dvec4 p = f.view_projection * glm::dvec4(c & 1 ? f.box_max.x : f.box_min.x,
-                                                            c & 2 ? f.box_max.y : f.box_min.y,
-                                                            c & 4 ? f.box_max.z : f.box_min.z, 1.0);
+        const glm::dvec4 p = f.view_projection *
+            glm::dvec4(c & 1 ? f.box_max.x : f.box_min.x, c & 2 ? f.box_max.y : f.box_min.y,
+                       c & 4 ? f.box_max.z : f.box_min.z, 1.0);
         const double v[6] = {p.x + p.w, p.w - p.x, p.y + p.w, p.w - p.y, p.z + p.w, p.w - p.z};
         for (int k = 0; k < 6; ++k) outside_all[k] = outside_all[k] && v[k] < 0;
     }
     for (bool o : outside_all)
         if (o)
-            throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
-                           "(target, to, azimuth/elevation) or widen the field of view");
+            throw BadInput(
+                "render:terrain: the camera sees none of the terrain; point it at the terrain "
+                "(target, to, azimuth/elevation) or widen the field of view");
 }
 
 void TerrainRenderer::Impl::set_grid(GLuint p, const glm::mat4& view_projection, double exaggeration) const {
@@ -558,8 +559,8 @@ void TerrainRenderer::Impl::prepare_shadow_map(const Frame& f, const Style& st) 
         shadow_ready = false;
         glGenTextures(1, &shadow_depth);
         glBindTexture(GL_TEXTURE_2D, shadow_depth);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, shadow_size, shadow_size, 0, GL_DEPTH_COMPONENT,
-                     GL_FLOAT, nullptr);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, shadow_size, shadow_size, 0, GL_DEPTH_COMPONENT, GL_FLOAT,
+                     nullptr);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_BORDER);
@@ -710,7 +711,7 @@ gl::Target TerrainRenderer::Impl::draw_reflection(const Frame& f, const Style& s
     const double water_y = st.sea_level * f.exag;
     // y → 2·water_y − y: the mirror in the plane y = water_y
     const glm::dmat4 mirror = glm::translate(glm::dmat4(1.0), glm::dvec3(0, 2 * water_y, 0)) *
-                              glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
+        glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
     const Programs& prog = programs();
     glEnable(GL_CLIP_DISTANCE0);
     for (GLuint p : {prog.shadow, prog.terrain})
@@ -797,9 +798,9 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     gl::check_frame_size("render:terrain", width, height, bytes_per_pixel(st.samples));
     // Auto detail: at most one kept sample per 2.5 pixels of the frame's longer side
     // (llvmpipe pays per triangle; normals and colours come from the full grid anyway).
-    m.build_mesh(st.detail > 0 ? st.detail
-                               : std::max(1, int(std::ceil(std::max(m.width, m.height) /
-                                                           (std::max(width, height) / 2.5)))));
+    m.build_mesh(st.detail > 0
+                     ? st.detail
+                     : std::max(1, int(std::ceil(std::max(m.width, m.height) / (std::max(width, height) / 2.5)))));
     auto t0 = std::chrono::steady_clock::now();
     auto mark = [&](double Timings::*field) {
         if (!timings) return;
@@ -833,8 +834,9 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
         GLuint any = 0;
         glGetQueryObjectuiv(seen.id, GL_QUERY_RESULT, &any);
         if (!any)
-            throw BadInput("render:terrain: the camera sees none of the terrain; point it at the terrain "
-                           "(target, to, azimuth/elevation) or widen the field of view");
+            throw BadInput(
+                "render:terrain: the camera sees none of the terrain; point it at the terrain "
+                "(target, to, azimuth/elevation) or widen the field of view");
     }
     if (f.shaded && particles && particles->count() > 0) m.draw_particles(f, st, camera, *particles);
     const bool reflect = f.shaded && st.sea && st.reflection > 0;

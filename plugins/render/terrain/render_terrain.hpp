@@ -27,14 +27,14 @@ struct Camera {
     /// from north (180: the camera stands south of the target, looking north).
     double azimuth = 200.0;
     double elevation = 20.0;  ///< orbit: degrees above the horizontal
-    double distance = 0.0;    ///< orbit: metres from the target; 0 fits the land (above any sea) in view
+    double distance = 0.0;  ///< orbit: metres from the target; 0 fits the land (above any sea) in view
     Point2 target{0.5, 0.5};  ///< orbit: the point looked at (fraction of the extent), at mid height
     /// orbit with distance 0 and the default target: look at the land's middle in the frame rather than the
     /// terrain's (a picture filled with land); a turntable keeps one pivot instead, so it turns steadily.
     bool centre_land = true;
     Point2 from{0.5, 1.2}, to{0.5, 0.5};  ///< look_at: eye and target (fractions of the extent) ...
     double from_height = 2000.0, to_height = 0.0;  ///< ... and their heights above the terrain's lowest point, m
-    double fov = 40.0;        ///< vertical field of view, degrees, in (0, 180)
+    double fov = 40.0;  ///< vertical field of view, degrees, in (0, 180)
 };
 
 /// How the terrain looks.
@@ -43,26 +43,26 @@ struct Style {
     /// Linear albedo of sand, grass, rock, snow (default: terrain_mesh.hpp's sRGB colours, decoded, with a darker
     /// olive for the vegetation).
     std::array<std::array<float, 3>, 4> materials = default_materials();
-    double jitter = 0.03;          ///< noise on the height bands, fraction of the height range
-    double texture_scale = 0.0;    ///< m, size of the coarsest texture features; 0: an eighth of the terrain's width
-    double exaggeration = 1.0;     ///< vertical scale
-    double sun_azimuth = 250.0;    ///< degrees clockwise from north
-    double sun_elevation = 22.0;   ///< degrees above the horizon
-    double sun_intensity = 2.4;    ///< linear multiplier of the sun's (slightly warm) colour
-    double haze = 0.3;             ///< optical depth of the air across the terrain's diagonal (0: clear)
-    bool sea = false;              ///< a sea at sea_level
-    double sea_level = 0.0;        ///< m
-    double sea_fraction = -1.0;    ///< if ≥ 0: the sea at this fraction of the height range instead of sea_level
+    double jitter = 0.03;  ///< noise on the height bands, fraction of the height range
+    double texture_scale = 0.0;  ///< m, size of the coarsest texture features; 0: an eighth of the terrain's width
+    double exaggeration = 1.0;  ///< vertical scale
+    double sun_azimuth = 250.0;  ///< degrees clockwise from north
+    double sun_elevation = 22.0;  ///< degrees above the horizon
+    double sun_intensity = 2.4;  ///< linear multiplier of the sun's (slightly warm) colour
+    double haze = 0.3;  ///< optical depth of the air across the terrain's diagonal (0: clear)
+    bool sea = false;  ///< a sea at sea_level
+    double sea_level = 0.0;  ///< m
+    double sea_fraction = -1.0;  ///< if ≥ 0: the sea at this fraction of the height range instead of sea_level
     std::string water_layer = "water";  ///< water from this layer when the heightmap has it ("" none)
-    double water_min_depth = 0.05; ///< m: thinner water layers are not drawn
-    double wave_height = 1.0;      ///< m, amplitude of the waves
-    double clarity = 4.0;          ///< m: water depth through which 1/e of the ground shows
+    double water_min_depth = 0.05;  ///< m: thinner water layers are not drawn
+    double wave_height = 1.0;  ///< m, amplitude of the waves
+    double clarity = 4.0;  ///< m: water depth through which 1/e of the ground shows
     /// The sea mirrors the terrain (a planar reflection pass at this fraction of the frame's size; 0: the sky
     /// only). Rivers and lakes from the water layer lie at many heights and reflect the sky.
     double reflection = 0.5;
-    double time = 0.0;             ///< s, moves the waves
-    int shadow_size = 2048;        ///< shadow map side, texels
-    int samples = 1;               ///< multisampling (1, 2, 4 or 8): 4 smooths the edges, costs ~3× the scene pass
+    double time = 0.0;  ///< s, moves the waves
+    int shadow_size = 2048;  ///< shadow map side, texels
+    int samples = 1;  ///< multisampling (1, 2, 4 or 8): 4 smooths the edges, costs ~3× the scene pass
     /// The mesh keeps every detail-th sample (normals and colours stay at full
     /// resolution); 0 picks it per frame so a triangle spans about 2.5 pixels.
     int detail = 0;
