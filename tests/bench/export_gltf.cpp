@@ -3,6 +3,7 @@
 // chunks (16-bit indices) and 2048² texture, written to disk (fsync included).
 #include "export_common.hpp"
 #include <orogen/gltf/gltf_writer.hpp>
+#include <orogen/io.hpp>
 #include <orogen/mesh/terrain_mesh.hpp>
 
 #include <benchmark/benchmark.h>
@@ -29,7 +30,7 @@ static void BM_SplatTexture(benchmark::State& state) {
     const int t = int(state.range(0));
     for (auto _ : state) {
         auto rgba = terrain::bake_splat_texture(ConstGridView(h.data(), 4097, 4097, 20.0), t, t);
-        benchmark::DoNotOptimize(terrain::encode_png_fast(rgba, t, t));
+        benchmark::DoNotOptimize(orogen::encode_rgba_png(rgba, t, t, 1));
     }
 }
 BENCHMARK(BM_SplatTexture)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTime();

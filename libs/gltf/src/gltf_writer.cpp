@@ -33,6 +33,10 @@ namespace orogen::gltf {
 
 namespace {
 
+/// The embedded texture's libdeflate level: the fastest (a texture is baked and encoded on every export; the
+/// file is mostly mesh).
+constexpr int kTextureLevel = 1;
+
 struct ChunkViews {
     std::size_t positions = 0, normals = 0, texcoords = 0, indices = 0;  // byte offsets in the buffer
     std::size_t vertex_count = 0, index_count = 0;
@@ -184,7 +188,7 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     const int tw = std::max(1, std::min(options.texture_size, heights.width - 1));
     const int th = std::max(1, std::min(options.texture_size, heights.height - 1));
     const std::vector<std::uint8_t> png =
-        terrain::encode_png_fast(terrain::bake_splat_texture(heights, tw, th), tw, th);
+        encode_rgba_png(terrain::bake_splat_texture(heights, tw, th), tw, th, kTextureLevel);
 
     // Buffer layout: per chunk positions, normals, texcoords, indices; then the PNG.
     std::vector<ChunkViews> views;

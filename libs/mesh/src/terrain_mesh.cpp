@@ -7,8 +7,6 @@
 #include <cmath>
 #include <cstring>
 
-#include <zlib.h>
-
 namespace orogen::terrain {
 
 std::vector<int> kept_indices(int n, int step) {
@@ -290,80 +288,6 @@ std::vector<std::uint8_t> bake_splat_texture(ConstGridView h, int tw, int th) {
         }
     });
     return rgba;
-}
-
-namespace {
-
-void put_be32(std::vector<std::uint8_t>& out, std::uint32_t v) {
-    for (int i = 3; i >= 0; --i) out.push_back(std::uint8_t((v >> (8 * i)) & 0xff));
-}
-
-void put_chunk(std::vector<std::uint8_t>& out, const char* type, std::span<const std::uint8_t> data) {
-    put_be32(out, std::uint32_t(data.size()));
-    const std::size_t start = out.size();
-    out.insert(out.end(), type, type + 4);
-    out.insert(out.end(), data.begin(), data.end());
-    put_be32(out, std::uint32_t(crc32(0L, out.data() + start, uInt(out.size() - start))));
-}
-
-}  // namespace
-
-std::vector<std::uint8_t> encode_png_fast(std::span<const std::uint8_t> rgba, int width, int height) {
-    const std::size_t stride = std::size_t(width) * 4;
-    if (width < 1 || height < 1 || rgba.size() != stride * std::size_t(height))
-        throw Error("internal error: encode_png_fast got " + std::to_string(rgba.size()) + " bytes for " +
-                    std::to_string(width) + " x " + std::to_string(height) + " RGBA");
-    // Fixed strip count (not the thread count) keeps the output deterministic.
-    const int strips = std::min(height, 16);
-    std::vector<std::vector<std::uint8_t>> packed(static_cast<std::size_t>(strips));
-    std::vector<uLong> adlers(static_cast<std::size_t>(strips));
-    std::vector<std::size_t> lengths(static_cast<std::size_t>(strips));
-    parallel_for(0, strips, 1, [&](std::int64_t s0, std::int64_t s1) {
-        for (std::int64_t s = s0; s < s1; ++s) {
-            const int r0 = int(std::int64_t(height) * s / strips), r1 = int(std::int64_t(height) * (s + 1) / strips);
-            std::vector<std::uint8_t> filtered(std::size_t(r1 - r0) * (stride + 1));
-            std::uint8_t* f = filtered.data();
-            for (int r = r0; r < r1; ++r) {
-                const std::uint8_t* row = rgba.data() + std::size_t(r) * stride;
-                *f++ = 1;  // Sub: each byte minus the same channel of the pixel to its left
-                std::memcpy(f, row, 4);
-                for (std::size_t i = 4; i < stride; ++i) f[i] = std::uint8_t(row[i] - row[i - 4]);
-                f += stride;
-            }
-            z_stream z{};
-            deflateInit2(&z, 1, Z_DEFLATED, -15, 8, Z_DEFAULT_STRATEGY);  // raw deflate, fastest level
-            auto& out = packed[std::size_t(s)];
-            out.resize(deflateBound(&z, uLong(filtered.size())) + 16);
-            z.next_in = filtered.data();
-            z.avail_in = uInt(filtered.size());
-            z.next_out = out.data();
-            z.avail_out = uInt(out.size());
-            // Full flush ends each strip byte-aligned with a fresh dictionary, so
-            // strips concatenate into one valid stream; only the last finishes it.
-            deflate(&z, s + 1 == strips ? Z_FINISH : Z_FULL_FLUSH);
-            out.resize(out.size() - z.avail_out);
-            deflateEnd(&z);
-            adlers[std::size_t(s)] = adler32(1L, filtered.data(), uInt(filtered.size()));
-            lengths[std::size_t(s)] = filtered.size();
-        }
-    });
-    std::vector<std::uint8_t> idat = {0x78, 0x01};  // zlib header: deflate, 32 KiB window, fastest
-    uLong adler = adlers[0];
-    for (std::size_t s = 0; s < packed.size(); ++s) {
-        idat.insert(idat.end(), packed[s].begin(), packed[s].end());
-        if (s > 0) adler = adler32_combine(adler, adlers[s], z_off_t(lengths[s]));
-    }
-    put_be32(idat, std::uint32_t(adler));
-
-    std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    std::vector<std::uint8_t> ihdr;
-    put_be32(ihdr, std::uint32_t(width));
-    put_be32(ihdr, std::uint32_t(height));
-    ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});  // 8-bit RGBA, deflate, adaptive filtering, no interlace
-    put_chunk(png, "IHDR", ihdr);
-    put_chunk(png, "IDAT", idat);
-    put_chunk(png, "IEND", {});
-    return png;
 }
 
 }  // namespace orogen::terrain

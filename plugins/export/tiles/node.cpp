@@ -128,7 +128,7 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
                 const int tw = std::max(1, std::min(texture, 2 * (c.x1 - c.x0)));
                 const int th = std::max(1, std::min(texture, 2 * (c.y1 - c.y0)));
                 const std::vector<std::uint8_t> png =
-                    terrain::encode_png_fast(lod::chunk_texture(c, w.area, cell, lo, hi, tw, th), tw, th);
+                    encode_rgba_png(lod::chunk_texture(c, w.area, cell, lo, hi, tw, th), tw, th, 1);  // fastest level
                 gltf::MeshData data{mesh.positions, mesh.normals, mesh.texcoords, mesh.indices, mesh.min, mesh.max};
                 const std::string name = c.file.substr(0, c.file.size() - 4);
                 gltf::write_mesh(data, png, lod::translation(c, cell), name, targets[first + k]);

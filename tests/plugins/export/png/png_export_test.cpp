@@ -7,6 +7,7 @@
 #include <orogen/io.hpp>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstring>
@@ -31,7 +32,7 @@ TEST(Hillshade, SlopesFacingTheLightAreBrighterAndAFaceTowardsItIsWhite) {
     std::vector<float> east(n * n), west(n * n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
-            east[std::size_t(y * n + x)] = float(x * 2.0);    // 2 m cells: rises 1 m per m to the east
+            east[std::size_t(y * n + x)] = float(x * 2.0);  // 2 m cells: rises 1 m per m to the east
             west[std::size_t(y * n + x)] = float(-x * 2.0);
         }
     const auto lit = png_export::hillshade({east.data(), n, n, 2.0}, 8, 270, 45);
@@ -70,8 +71,7 @@ TEST(PngExportCli, SixteenBitHeightsLayersAndHillshadeRoundTrip) {
     std::memcpy(h.data(), raw.data(), raw.size());
     const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
     const double step = (double(*hi) - *lo) / 65535.0;
-    for (std::size_t i = 0; i < h.size(); ++i)
-        ASSERT_NEAR(*lo + step * png.samples[i], h[i], 0.5 * step + 1e-6) << i;
+    for (std::size_t i = 0; i < h.size(); ++i) ASSERT_NEAR(*lo + step * png.samples[i], h[i], 0.5 * step + 1e-6) << i;
     EXPECT_EQ(read_gray_png(dir / "out" / "height.png").samples, png.samples);  // layer="height" = the heights
     // The eroded layer is its own picture, spread over the full 16-bit range.
     const GrayImage eroded = read_gray_png(dir / "out" / "eroded.png");
@@ -156,6 +156,31 @@ TEST(PngExportCli, EveryContradictionInOneCallIsReportedAtOnce) {
 #define STB_IMAGE_IMPLEMENTATION
 #include <stb/stb_image.h>
 
+// The one RGBA encoder (orogen/io.hpp): every level gives back the very pixels, and level 1 (strips deflated
+// in parallel, for the textures glTF and tiles embed) the same bytes on one thread and on two.
+TEST(RgbaPng, EveryLevelDecodesToThePixelsAndLevelOneToTheSameBytesOnAnyThreadCount) {
+    const int w = 301, h = 203;  // more rows than level 1's 16 strips, odd sizes
+    std::vector<std::uint8_t> rgba(std::size_t(w) * h * 4);
+    for (std::size_t i = 0; i < rgba.size(); ++i)
+        rgba[i] = std::uint8_t((i * 2654435761u) >> 13) & ((i / 4) % 7 ? 0xff : 0x0f);
+    std::vector<std::uint8_t> level1[2];
+    for (int threads : {1, 2}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        level1[threads - 1] = orogen::encode_rgba_png(rgba, w, h, 1);
+    }
+    EXPECT_EQ(level1[0], level1[1]);
+    for (const int level : {1, 6, 12}) {
+        const auto png = orogen::encode_rgba_png(rgba, w, h, level);
+        int dw = 0, dh = 0, channels = 0;
+        stbi_uc* px = stbi_load_from_memory(png.data(), int(png.size()), &dw, &dh, &channels, 4);
+        ASSERT_NE(px, nullptr) << "level " << level << ": " << stbi_failure_reason();
+        EXPECT_EQ(dw, w);
+        EXPECT_EQ(dh, h);
+        EXPECT_EQ(0, std::memcmp(px, rgba.data(), rgba.size())) << "level " << level;
+        stbi_image_free(px);
+    }
+}
+
 TEST(PngExportCli, ReliefIsTheSplatColourShadedByTheLight) {
     TempDir dir;
     const auto spec = dir.write("relief.orogen",
@@ -183,8 +208,9 @@ TEST(PngExportCli, ReliefIsTheSplatColourShadedByTheLight) {
     EXPECT_GT(int(lit[0]) + lit[1] + lit[2], int(shaded[0]) + shaded[1] + shaded[2] + 60);
     stbi_image_free(px);
     // A relief map is 8-bit colour: bits= with it is a mistake.
-    const auto bad = dir.write("bad.orogen", "orogen 1\ngrid 9\nt = generate:fault()\n"
-                                             "export:png(t, path=\"r.png\", relief=true, bits=16)\n");
+    const auto bad = dir.write("bad.orogen",
+                               "orogen 1\ngrid 9\nt = generate:fault()\n"
+                               "export:png(t, path=\"r.png\", relief=true, bits=16)\n");
     const RunResult b = run_orogen("check " + q(bad));
     EXPECT_EQ(b.exit_code, 2);
     EXPECT_NE(b.err.find("bad.orogen:4:36: error: export:png: relief=true writes an 8-bit colour map of the heights; "

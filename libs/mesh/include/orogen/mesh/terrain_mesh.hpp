@@ -144,9 +144,4 @@ std::array<std::uint8_t, 3> splat_colour(const SplatWeights& w);
 /// (unexaggerated) terrain.
 std::vector<std::uint8_t> bake_splat_texture(ConstGridView heights, int texture_width, int texture_height);
 
-/// Encode an RGBA8 image as PNG quickly: rows filtered with "Sub", compressed
-/// by zlib at its fastest level in a fixed number of independent strips (in
-/// parallel), so the bytes are the same whatever the thread count.
-std::vector<std::uint8_t> encode_png_fast(std::span<const std::uint8_t> rgba, int width, int height);
-
 }  // namespace orogen::terrain
