@@ -231,6 +231,26 @@ std::vector<std::uint8_t> filter_rows(const std::uint8_t* raw, int height, std::
     return out;
 }
 
+/// The PNG around a zlib stream `idat` (`size` bytes): signature, IHDR, IDAT chunks of at most `piece`
+/// bytes, IEND.
+void write_png(std::ostream& file, int width, int height, int bits, int colour_type, const std::uint8_t* idat,
+               std::size_t size, std::size_t piece) {
+    static constexpr std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    file.write(reinterpret_cast<const char*>(signature), 8);
+    std::uint8_t ihdr[13];
+    put_u32(ihdr, std::uint32_t(width));
+    put_u32(ihdr + 4, std::uint32_t(height));
+    ihdr[8] = std::uint8_t(bits);
+    ihdr[9] = std::uint8_t(colour_type);
+    ihdr[10] = 0;  // deflate
+    ihdr[11] = 0;  // adaptive filtering
+    ihdr[12] = 0;  // not interlaced
+    write_chunk(file, "IHDR", ihdr, sizeof ihdr);
+    for (std::size_t at = 0; at < size; at += piece) write_chunk(file, "IDAT", idat + at, std::min(piece, size - at));
+    write_chunk(file, "IEND", nullptr, 0);
+    if (!file) throw Error("PNG encoding failed: write failed (disk full?)");
+}
+
 void encode(std::ostream& file, int width, int height, int bits, int colour_type, int channels, const std::uint8_t* raw,
             int level) {
     if (width <= 0 || height <= 0)
@@ -247,40 +267,14 @@ void encode(std::ostream& file, int width, int height, int bits, int colour_type
         libdeflate_zlib_compress(z.get(), filtered.data(), filtered.size(), idat.data(), idat.size());
     if (packed == 0) throw Error("PNG encoding failed: the compressed image did not fit its bound");
 
-    static constexpr std::uint8_t signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
-    file.write(reinterpret_cast<const char*>(signature), 8);
-    std::uint8_t ihdr[13];
-    put_u32(ihdr, std::uint32_t(width));
-    put_u32(ihdr + 4, std::uint32_t(height));
-    ihdr[8] = std::uint8_t(bits);
-    ihdr[9] = std::uint8_t(colour_type);
-    ihdr[10] = 0;  // deflate
-    ihdr[11] = 0;  // adaptive filtering
-    ihdr[12] = 0;  // not interlaced
-    write_chunk(file, "IHDR", ihdr, sizeof ihdr);
     constexpr std::size_t piece = std::size_t(1) << 20;  // IDAT chunks of 1 MiB, as readers stream them
-    for (std::size_t at = 0; at < packed; at += piece)
-        write_chunk(file, "IDAT", idat.data() + at, std::min(piece, packed - at));
-    write_chunk(file, "IEND", nullptr, 0);
-    if (!file) throw Error("PNG encoding failed: write failed (disk full?)");
+    write_png(file, width, height, bits, colour_type, idat.data(), packed, piece);
 }
 
-void put_be32_into(std::vector<std::uint8_t>& out, std::uint32_t v) {
-    for (int i = 3; i >= 0; --i) out.push_back(std::uint8_t((v >> (8 * i)) & 0xff));
-}
-
-void put_chunk_into(std::vector<std::uint8_t>& out, const char* type, std::span<const std::uint8_t> data) {
-    put_be32_into(out, std::uint32_t(data.size()));
-    const std::size_t start = out.size();
-    out.insert(out.end(), type, type + 4);
-    out.insert(out.end(), data.begin(), data.end());
-    put_be32_into(out, std::uint32_t(crc32(0L, out.data() + start, uInt(out.size() - start))));
-}
-
-/// Level 1 (the fastest): rows filtered with "Sub" and compressed by zlib at its fastest level in a fixed
+/// Level 1 (the fastest), its zlib stream: rows filtered with "Sub" and compressed by zlib at its fastest level in a fixed
 /// number of strips on all cores, flushed so that they join into one stream (the bytes do not depend on the
 /// thread count). For the textures glTF and tiles embed on every export.
-std::vector<std::uint8_t> encode_rgba_png_strips(std::span<const std::uint8_t> rgba, int width, int height) {
+std::vector<std::uint8_t> deflate_rgba_strips(std::span<const std::uint8_t> rgba, int width, int height) {
     const std::size_t stride = std::size_t(width) * 4;
     if (width < 1 || height < 1 || rgba.size() != stride * std::size_t(height))
         throw Error("internal error: encode_rgba_png got " + std::to_string(rgba.size()) + " bytes for " +
@@ -325,17 +319,10 @@ std::vector<std::uint8_t> encode_rgba_png_strips(std::span<const std::uint8_t> r
         idat.insert(idat.end(), packed[s].begin(), packed[s].end());
         if (s > 0) adler = adler32_combine(adler, adlers[s], z_off_t(lengths[s]));
     }
-    put_be32_into(idat, std::uint32_t(adler));
-
-    std::vector<std::uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    std::vector<std::uint8_t> ihdr;
-    put_be32_into(ihdr, std::uint32_t(width));
-    put_be32_into(ihdr, std::uint32_t(height));
-    ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});  // 8-bit RGBA, deflate, adaptive filtering, no interlace
-    put_chunk_into(png, "IHDR", ihdr);
-    put_chunk_into(png, "IDAT", idat);
-    put_chunk_into(png, "IEND", {});
-    return png;
+    std::uint8_t tail[4];
+    put_u32(tail, std::uint32_t(adler));
+    idat.insert(idat.end(), tail, tail + 4);
+    return idat;
 }
 
 }  // namespace
@@ -368,9 +355,13 @@ void write_rgba_png(std::ostream& file, int width, int height, std::span<const s
 }
 
 std::vector<std::uint8_t> encode_rgba_png(std::span<const std::uint8_t> rgba, int width, int height, int level) {
-    if (level == 1) return encode_rgba_png_strips(rgba, width, height);
     std::ostringstream out(std::ios::binary);
-    write_rgba_png(out, width, height, rgba, level);
+    if (level == 1) {
+        const std::vector<std::uint8_t> idat = deflate_rgba_strips(rgba, width, height);
+        write_png(out, width, height, 8, 6, idat.data(), idat.size(), idat.size());  // one IDAT chunk
+    } else {
+        write_rgba_png(out, width, height, rgba, level);
+    }
     const std::string bytes = std::move(out).str();
     return {bytes.begin(), bytes.end()};
 }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <cstdlib>
 
 namespace orogen::stream_power {
@@ -23,7 +24,7 @@ double Beds::strength(double zeta, double x, double y) const {
 }
 
 double Beds::landslide_slope(double s) const {
-    constexpr double lo = 5.0 * 3.14159265358979323846 / 180.0, hi = 80.0 * 3.14159265358979323846 / 180.0;
+    constexpr double lo = 5.0 * std::numbers::pi / 180.0, hi = 80.0 * std::numbers::pi / 180.0;
     return std::tan(std::clamp(angle + angle_spread * (2.0 * s - 1.0), lo, hi));
 }
 
