@@ -1,0 +1,196 @@
+// The linear theory of orographic precipitation (orographic_rain.hpp).
+#include <orogen/climate/orographic_rain.hpp>
+
+#include <orogen/analysis/fft.hpp>
+#include <orogen/parallel.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace orogen::climate {
+
+namespace {
+
+constexpr double kSecondsPerYear = 365.25 * 86400.0;
+/// mm/s (kg m⁻² s⁻¹ of water) to m/yr.
+constexpr double kMmPerSecondToMetresPerYear = kSecondsPerYear / 1000.0;
+/// Padding of the coarse grid, in wind lengths U·(τ_c + τ_f): the rain a ridge makes decays downwind over
+/// about one, so three leave e⁻³ of it to wrap around onto the upwind edge.
+constexpr double kPaddingWindLengths = 3.0;
+
+void check(const OrographicRain& r, int width, int height, double cell) {
+    auto bad = [](const std::string& what) { throw std::invalid_argument("orographic rain: " + what); };
+    if (width < 1 || height < 1) bad("the grid is empty");
+    if (!(cell > 0.0) || !std::isfinite(cell)) bad("the cell size must be a positive number of metres");
+    if (!(r.background >= 0.0) || !std::isfinite(r.background)) bad("the background rain must be ≥ 0 m/yr");
+    if (!(r.wind_speed >= 0.0) || !std::isfinite(r.wind_speed)) bad("the wind speed must be ≥ 0 m/s");
+    if (!std::isfinite(r.wind_from)) bad("the wind direction must be a number of degrees");
+    if (!(r.wet_fraction > 0.0 && r.wet_fraction <= 1.0)) bad("the wet fraction must be in (0, 1]");
+    if (!(r.condensation_time >= 0.0) || !(r.fallout_time >= 0.0) || !std::isfinite(r.condensation_time) ||
+        !std::isfinite(r.fallout_time))
+        bad("the condensation and fallout times must be ≥ 0 s");
+    if (!(r.moist_stability >= 0.0) || !std::isfinite(r.moist_stability)) bad("N_m must be ≥ 0 1/s");
+    if (!(r.vapour_scale_height >= 0.0) || !std::isfinite(r.vapour_scale_height)) bad("H_w must be ≥ 0 m");
+    if (!(r.uplift_sensitivity >= 0.0) || !std::isfinite(r.uplift_sensitivity)) bad("C_w must be ≥ 0 kg/m³");
+}
+
+std::size_t padded_length(int n, int padding) {
+    if (padding <= 0) return std::size_t(n);
+    std::size_t p = 1;
+    while (p < std::size_t(n) + 2 * std::size_t(padding)) p <<= 1;
+    return p;
+}
+
+/// 1 at the map's edge falling to 0 over `length` cells (a half cosine): the padding's terrain.
+double ramp(double distance, double length) {
+    if (distance >= length) return 0.0;
+    return 0.5 * (1.0 + std::cos(std::numbers::pi * distance / length));
+}
+
+/// The heights above the lowest on the nx × ny periodic grid: the map at [0, width) × [0, height), the rest
+/// falling from the map's nearest edges to 0 (the lowest height) halfway across the padding.
+std::vector<std::complex<double>> padded_terrain(const double* h, int width, int height, std::size_t nx, std::size_t ny,
+                                                 double lowest) {
+    std::vector<std::complex<double>> t(nx * ny, {0.0, 0.0});
+    const auto W = std::size_t(width), H = std::size_t(height);
+    const double gap_x = double(nx - W), gap_y = double(ny - H);
+    for (std::size_t y = 0; y < H; ++y) {
+        const double* row = h + y * W;
+        for (std::size_t x = 0; x < W; ++x) t[y * nx + x] = row[x] - lowest;
+        // Past the east edge, wrapping round to the west one.
+        for (std::size_t x = W; x < nx; ++x) {
+            const double from_east = double(x - W + 1), from_west = double(nx - x);
+            const double len = 0.5 * (gap_x + 1.0);
+            t[y * nx + x] = (row[W - 1] - lowest) * ramp(from_east, len) + (row[0] - lowest) * ramp(from_west, len);
+        }
+    }
+    for (std::size_t y = H; y < ny; ++y) {
+        const double from_south = double(y - H + 1), from_north = double(ny - y);
+        const double len = 0.5 * (gap_y + 1.0);
+        const double ws = ramp(from_south, len), wn = ramp(from_north, len);
+        for (std::size_t x = 0; x < nx; ++x) t[y * nx + x] = t[(H - 1) * nx + x].real() * ws + t[x].real() * wn;
+    }
+    return t;
+}
+
+/// The wavenumber (rad/m) of transform index i of n samples `spacing` metres apart (numpy's fftfreq order).
+double wavenumber(std::size_t i, std::size_t n, double spacing) {
+    const double f = i < (n + 1) / 2 ? double(i) : double(i) - double(n);
+    return 2.0 * std::numbers::pi * f / (double(n) * spacing);
+}
+
+/// Smith & Barstad's transfer function: P̂/ĥ, in mm/s per metre of terrain.
+std::complex<double> transfer(double k, double l, const Wind& wind, const OrographicRain& r) {
+    const double sigma = wind.east * k + wind.south * l;  // intrinsic frequency, 1/s
+    if (sigma == 0.0) return {0.0, 0.0};  // ridges along the wind lift nothing
+    const double s2 = sigma * sigma, n2 = r.moist_stability * r.moist_stability, k2 = k * k + l * l;
+    const std::complex<double> i{0.0, 1.0};
+    std::complex<double> airflow;
+    if (s2 < n2) {  // buoyancy waves: m real, with σ's sign (energy going up)
+        const double m = std::copysign(std::sqrt((n2 - s2) / s2 * k2), sigma);
+        airflow = 1.0 - i * (r.vapour_scale_height * m);
+    } else {  // evanescent: m = i·|m|, the lift decays with height
+        airflow = 1.0 + r.vapour_scale_height * std::sqrt((s2 - n2) / s2 * k2);
+    }
+    return r.uplift_sensitivity * i * sigma /
+        (airflow * (1.0 + i * (sigma * r.condensation_time)) * (1.0 + i * (sigma * r.fallout_time)));
+}
+
+}  // namespace
+
+Wind wind_components(const OrographicRain& rain) {
+    const double a = rain.wind_from * std::numbers::pi / 180.0;
+    // From the west (270°) the air moves east; from the north (0°) it moves south, down the rows.
+    return {-std::sin(a) * rain.wind_speed, std::cos(a) * rain.wind_speed};
+}
+
+std::vector<double> orographic_rain(const double* heights, int width, int height, double cell,
+                                    const OrographicRain& rain, int padding) {
+    check(rain, width, height, cell);
+    const std::size_t n = std::size_t(width) * std::size_t(height);
+    double lowest = heights[0];
+    for (std::size_t j = 0; j < n; ++j) {
+        if (!std::isfinite(heights[j]))
+            throw std::invalid_argument("orographic rain: height " + std::to_string(j) + " is not a finite number");
+        lowest = std::min(lowest, heights[j]);
+    }
+    const std::size_t nx = padded_length(width, padding), ny = padded_length(height, padding);
+    std::vector<std::complex<double>> t = padded_terrain(heights, width, height, nx, ny, lowest);
+    analysis::fft2(t, nx, ny);
+    const Wind wind = wind_components(rain);
+    parallel_for(0, std::int64_t(ny), 16, [&](std::int64_t y0, std::int64_t y1) {
+        for (auto y = std::size_t(y0); y < std::size_t(y1); ++y) {
+            const double l = wavenumber(y, ny, cell);
+            for (std::size_t x = 0; x < nx; ++x) t[y * nx + x] *= transfer(wavenumber(x, nx, cell), l, wind, rain);
+        }
+    });
+    analysis::fft2(t, nx, ny, true);
+    // The storm rate P_0/f + P_orographic (mm/s … as m/yr) cut at zero, blowing a share f of the year.
+    std::vector<double> out(n);
+    const double f = rain.wet_fraction, storm0 = rain.background / f;
+    for (std::size_t y = 0; y < std::size_t(height); ++y)
+        for (std::size_t x = 0; x < std::size_t(width); ++x) {
+            const double storm = storm0 + t[y * nx + x].real() * kMmPerSecondToMetresPerYear;
+            out[y * std::size_t(width) + x] = f * std::max(0.0, storm);
+        }
+    return out;
+}
+
+std::vector<double> orographic_rain_coarse(const double* heights, int width, int height, double cell,
+                                           const OrographicRain& rain, double resolution) {
+    check(rain, width, height, cell);
+    if (!(resolution > 0.0) || !std::isfinite(resolution))
+        throw std::invalid_argument("orographic rain: the resolution must be a positive number of metres");
+    const int f = std::max(1, int(std::min(resolution / cell, 1e6)));
+    const int cw = (width + f - 1) / f, ch = (height + f - 1) / f;
+    // Block means (a partial block at the east or south edge averages the cells it has).
+    std::vector<double> coarse(std::size_t(cw) * std::size_t(ch), 0.0);
+    parallel_for(0, ch, 4, [&](std::int64_t Y0, std::int64_t Y1) {
+        for (auto Y = int(Y0); Y < int(Y1); ++Y)
+            for (int X = 0; X < cw; ++X) {
+                double sum = 0.0;
+                int count = 0;
+                for (int y = Y * f; y < std::min(height, (Y + 1) * f); ++y)
+                    for (int x = X * f; x < std::min(width, (X + 1) * f); ++x, ++count)
+                        sum += heights[std::size_t(y) * std::size_t(width) + std::size_t(x)];
+                coarse[std::size_t(Y) * std::size_t(cw) + std::size_t(X)] = sum / count;
+            }
+    });
+    const double coarse_cell = cell * f;
+    const double wind_length = rain.wind_speed * (rain.condensation_time + rain.fallout_time);
+    const int padding =
+        std::clamp(int(std::ceil(kPaddingWindLengths * wind_length / coarse_cell)), 1, std::max(cw, ch));
+    const std::vector<double> r = orographic_rain(coarse.data(), cw, ch, coarse_cell, rain, padding);
+    if (f == 1) return r;
+    // Bilinear between the coarse cells' centres (held at the edges).
+    std::vector<double> out(std::size_t(width) * std::size_t(height));
+    auto axis = [f](int i, int n, int& i0, int& i1, double& t) {
+        const double g = std::clamp((i + 0.5) / f - 0.5, 0.0, double(n - 1));
+        i0 = int(g);
+        i1 = std::min(i0 + 1, n - 1);
+        t = g - i0;
+    };
+    parallel_for(0, height, 64, [&](std::int64_t y0, std::int64_t y1) {
+        for (auto y = int(y0); y < int(y1); ++y) {
+            int Y0, Y1;
+            double ty;
+            axis(y, ch, Y0, Y1, ty);
+            const double* a = r.data() + std::size_t(Y0) * std::size_t(cw);
+            const double* b = r.data() + std::size_t(Y1) * std::size_t(cw);
+            for (int x = 0; x < width; ++x) {
+                int X0, X1;
+                double tx;
+                axis(x, cw, X0, X1, tx);
+                const double top = a[X0] + (a[X1] - a[X0]) * tx, bottom = b[X0] + (b[X1] - b[X0]) * tx;
+                out[std::size_t(y) * std::size_t(width) + std::size_t(x)] = top + (bottom - top) * ty;
+            }
+        }
+    });
+    return out;
+}
+
+}  // namespace orogen::climate
