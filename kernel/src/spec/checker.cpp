@@ -189,7 +189,11 @@ public:
           spec_folder_(spec_folder), diags_(diags), output_(std::move(output)), invalid_(invalid) {}
 
     const GridSpec& grid() const override { return grid_; }
-    double memory_share() const override { return TiledRun::runs_tiled(node_) ? tiled_share_ : 1.0; }
+    // A node with a parameter error never runs, and whether it would tile may hang on that parameter
+    // (untiled_because reads the parameters): its whole-grid share stands.
+    double memory_share() const override {
+        return invalid_.empty() && TiledRun::runs_tiled(node_) ? tiled_share_ : 1.0;
+    }
     void set_tiled_share(double share) { tiled_share_ = share; }
     const ValueInfo* input(std::size_t i) const override { return i < inputs_.size() ? inputs_[i] : nullptr; }
     bool given(std::string_view param) const override { return node_.given.count(param) > 0; }

@@ -461,14 +461,17 @@ void FlowRouter::patch_stack() {
         if (block_start[o] - chunks_.back() >= target || o + 1 == block_start.size()) chunks_.push_back(block_start[o]);
 }
 
-void FlowRouter::accumulate() {
+void FlowRouter::accumulate(const double* weight) {
     const double a0 = cell_ * cell_;
-    // Cells, not m²: every cell starts with 1 (a sequential fill, not one in stack order)...
-    parallel_for(0, std::int64_t(size_), 1 << 16,
-                 [&](std::int64_t b, std::int64_t e) { std::fill(area_.begin() + b, area_.begin() + e, 1.0); });
+    // Cells, not m²: every cell starts with 1, or its weight (a sequential fill, not one in stack order)...
+    parallel_for(0, std::int64_t(size_), 1 << 16, [&](std::int64_t b, std::int64_t e) {
+        if (weight) std::copy(weight + b, weight + e, area_.begin() + b);
+        else std::fill(area_.begin() + b, area_.begin() + e, 1.0);
+    });
     // ... and passes its total to its receiver, donors first (reverse stack order).
     // Whole numbers below 2^53 add exactly in any order, so a tiled run that adds
     // its tiles' partial counts gets these bits (floating-point m² would round).
+    // Weights round, but each basin's sums run in one fixed order on one thread.
     const std::int64_t groups = std::int64_t(chunks_.size()) - 1;
     const std::int32_t* stack = stack_.data();
     const std::int32_t* rcv = receiver_.data();
@@ -487,7 +490,7 @@ void FlowRouter::accumulate() {
     });
 }
 
-void FlowRouter::accumulate_multiple(const double* h, double exponent) {
+void FlowRouter::accumulate_multiple(const double* h, double exponent, const double* weight) {
     const int W = width_, H = height_;
     const double a0 = cell_ * cell_;
     const double inv[8] = {1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2, 1.0, 1.0 / kSqrt2};
@@ -529,7 +532,7 @@ void FlowRouter::accumulate_multiple(const double* h, double exponent) {
                     if (mj ? (mj >> ((k + 4) & 7)) & 1u : receiver_[std::size_t(j)] == i) ++count;
                 }
                 pending_[std::size_t(i)] = std::uint8_t(count);
-                area_[std::size_t(i)] = a0;
+                area_[std::size_t(i)] = weight ? a0 * weight[i] : a0;
             }
     });
     // 3. Kahn: a cell passes its area on once all its donors have added theirs.

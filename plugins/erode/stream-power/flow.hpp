@@ -123,8 +123,10 @@ public:
     /// Route water over `h` (row-major, width × height metres): receivers,
     /// depressions (with Depressions::fill, `h` is raised in lakes), stack.
     void route(double* h, Depressions mode);
-    /// Drainage area of every cell (m²): its own cell² plus all its donors'.
-    void accumulate();
+    /// Drainage area of every cell (m²): its own cell² plus all its donors'. With `weight` (one per cell,
+    /// ≥ 0: its rain over the reference rain), each cell adds weight·cell² instead: the area that, under
+    /// the reference rain, would bring the same water.
+    void accumulate(const double* weight = nullptr);
     /// Drainage area by multiple flow directions (Freeman 1991) over `h`, the
     /// heights given to the last route() with Depressions::fill (after it, so
     /// lakes are filled): a cell's water is split among all its strictly lower
@@ -135,7 +137,7 @@ public:
     /// Every edge then goes down or, within a flat, along the D8 tree, so the
     /// graph has no loop; the cells are visited in topological order (Kahn),
     /// sequentially, so the sums are the same on any number of threads.
-    void accumulate_multiple(const double* h, double exponent);
+    void accumulate_multiple(const double* h, double exponent, const double* weight = nullptr);
 
     int width() const { return width_; }
     int height() const { return height_; }

@@ -88,6 +88,11 @@ struct Engine {
     std::vector<double> chi() { return tiled ? tiled->chi(1.0) : whole->chi(1.0); }
 };
 
+/// The parameters of rain="orographic" (an error without it).
+constexpr const char* kRainParams[] = {"rain_background",    "wind_from",      "wind_speed",      "rain_wet_fraction",
+                                       "condensation_time",  "fallout_time",   "moist_stability", "vapour_scale_height",
+                                       "uplift_sensitivity", "rain_resolution"};
+
 stream_power::Settings settings_of(NodeContext& ctx) {
     stream_power::Settings s;
     s.erodibility = ctx.real("erodibility");
@@ -114,6 +119,19 @@ stream_power::Settings settings_of(NodeContext& ctx) {
         s.glaciers.half_width = ctx.real("glacier_half_width");
         s.glaciers.wall_slope = std::tan(ctx.real("trough_wall_angle") * rad);
         s.glaciers.glacier_flux = ctx.real("glacier_min_flux");
+    }
+    if (ctx.text("rain") == "orographic") {
+        s.orographic_rain = true;
+        s.rain.background = ctx.real("rain_background");
+        s.rain.wind_from = ctx.real("wind_from");
+        s.rain.wind_speed = ctx.real("wind_speed");
+        s.rain.wet_fraction = ctx.real("rain_wet_fraction");
+        s.rain.condensation_time = ctx.real("condensation_time");
+        s.rain.fallout_time = ctx.real("fallout_time");
+        s.rain.moist_stability = ctx.real("moist_stability");
+        s.rain.vapour_scale_height = ctx.real("vapour_scale_height");
+        s.rain.uplift_sensitivity = ctx.real("uplift_sensitivity");
+        s.rain_resolution = ctx.real("rain_resolution");
     }
     s.open = *parse_sides(ctx.text("open"));
     s.depressions =
@@ -302,6 +320,11 @@ void write_layers(NodeContext& ctx, Heightmap& hm, Engine& engine, std::int64_t 
         GridView q = hm.layer("ice_flux", 0.0f);
         for (std::size_t i = 0; i < n && i < ice.size(); ++i) q.data[i] = float(ice[i]);
     }
+    if (ctx.text("rain") == "orographic" && engine.whole) {  // orographic rain never tiles either
+        const std::vector<double>& rain = engine.whole->rain();
+        GridView r = hm.layer("rain", 0.0f);
+        for (std::size_t i = 0; i < n && i < rain.size(); ++i) r.data[i] = float(rain[i]);
+    }
     if (ctx.flag("chi")) {
         const std::vector<double> chi = engine.chi();
         GridView c = hm.layer("chi", 0.0f);
@@ -482,6 +505,11 @@ void check(CheckContext& ctx) {
         for (const char* p : {"ela", "ice_balance_gradient", "ice_max_balance", "ice_erodibility", "ice_flux_exponent",
                               "glacier_half_width", "glacier_min_flux", "trough_wall_angle"})
             if (ctx.given(p)) ctx.error(p, std::string(p) + " describes glaciers; give glaciers=true as well");
+    if (ctx.text("rain") == "orographic") ctx.output().layers.insert("rain");
+    else
+        for (const char* p : kRainParams)
+            if (ctx.given(p))
+                ctx.error(p, std::string(p) + " describes orographic rain; give rain=\"orographic\" as well");
 }
 
 }  // namespace
@@ -508,9 +536,11 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "landslide_angle > 0 holds every slope below that threshold after each step (the debris leaves with the "
             "rivers); bed_* cut the rock into tilted beds of varying strength (landslide angle and erodibility); "
             "glaciers=true routes ice from above the ELA down the valleys, eroding K_g Q^m_g S^n and carving "
-            "U-shaped troughs. The same "
+            "U-shaped troughs; rain=orographic weights the drainage area by the rain a moist wind leaves on the "
+            "relief (Smith & Barstad 2004). The same "
             "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
-            "glaciers; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw rivers where "
+            "glaciers, uniform rain; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw "
+            "rivers where "
             "it "
             "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
             "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; "
@@ -656,6 +686,62 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(80.0)
                     .unit("°")
                     .help("glaciers: the slope of a trough's walls at the glacier's margin"),
+                Param::choice("rain", {"uniform", "orographic"}, "uniform")
+                    .help("where the rain falls: uniform, or orographic (Smith & Barstad 2004): a steady moist "
+                          "wind rains on the windward slopes and leaves a dry lee, recomputed each step over the "
+                          "growing relief; a cell counts rain/rain_background of its area, so `erodibility` is for "
+                          "the background rain. Adds the layer rain (m/yr). Not tiled"),
+                Param::real("rain_background", 1.0)
+                    .min(0.0, true)
+                    .max(20.0)
+                    .unit("m/yr")
+                    .help("rain=orographic: the mean annual rain on flat ground (0.3-3 m/yr)"),
+                Param::real("wind_from", 270.0)
+                    .min(0.0)
+                    .max(360.0)
+                    .unit("°")
+                    .help("rain=orographic: azimuth the moist wind blows from, clockwise from north (270: westerly)"),
+                Param::real("wind_speed", 10.0)
+                    .min(0.0)
+                    .max(60.0)
+                    .unit("m/s")
+                    .help("rain=orographic: the moist wind's speed (5-20 m/s)"),
+                Param::real("rain_wet_fraction", 0.1)
+                    .min(0.0, true)
+                    .max(1.0)
+                    .help("rain=orographic: share of the year the moist wind blows and it rains"),
+                Param::real("condensation_time", 1000.0)
+                    .min(0.0)
+                    .max(1e5)
+                    .unit("s")
+                    .help("rain=orographic: tau_c, cloud water to rain and snow (200-2000 s); longer carries the "
+                          "rain further downwind"),
+                Param::real("fallout_time", 1000.0)
+                    .min(0.0)
+                    .max(1e5)
+                    .unit("s")
+                    .help("rain=orographic: tau_f, the time rain and snow take to fall (200-2000 s)"),
+                Param::real("moist_stability", 0.005)
+                    .min(0.0)
+                    .max(0.05)
+                    .unit("1/s")
+                    .help("rain=orographic: N_m, the moist buoyancy frequency (0-0.01; 0 = neutral air)"),
+                Param::real("vapour_scale_height", 2500.0)
+                    .min(0.0)
+                    .max(2e4)
+                    .unit("m")
+                    .help("rain=orographic: H_w, the water vapour's scale height (1-4 km)"),
+                Param::real("uplift_sensitivity", 0.0083)
+                    .min(0.0)
+                    .max(0.1)
+                    .unit("kg/m³")
+                    .help("rain=orographic: C_w, water condensed per metre of lift (0.004-0.01; warm air more)"),
+                Param::real("rain_resolution", 250.0)
+                    .min(1.0)
+                    .max(1e5)
+                    .unit("m")
+                    .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
+                          "below a few km)"),
                 Param::string("open", "nesw")
                     .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
                           "level. none: the lowest cell is the one outlet"),
@@ -687,6 +773,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 if (std::get<std::string>(p.at("routing")) == "mfd") s.mfd_exponent = 1.0;
                 s.deposition = std::get<double>(p.at("deposition"));
                 if (std::get<bool>(p.at("glaciers"))) s.glaciers.balance_gradient = 1.0;
+                s.orographic_rain = std::get<std::string>(p.at("rain")) == "orographic";
                 return stream_power::untiled_because(s);
             },
     });

@@ -32,6 +32,8 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
     : width_(width), height_(height), cell_(cell), settings_(settings), h_(std::move(heights)),
       uplift_(std::move(uplift)), flow_(width, height, cell, settings.open, settings.open.any() ? 0 : lowest_cell(h_)) {
     if (h_.size() != flow_.size()) throw std::invalid_argument("stream_power::Model: heights are not width × height");
+    if (settings.orographic_rain && !(settings.rain.background > 0.0))
+        throw std::invalid_argument("stream_power::Model: orographic rain needs a background rain > 0");
     if (settings.mfd_exponent > 0.0 && settings.depressions != Depressions::fill)
         throw std::invalid_argument("stream_power::Model: multiple flow directions need Depressions::fill");
     if (!uplift_.empty() && uplift_.size() != h_.size())
@@ -85,14 +87,24 @@ void Model::add_history_uplift(double t0, double t1) {
 }
 
 void Model::route_only() {
+    if (settings_.orographic_rain && rain_.empty()) update_rain();
     std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
     flow_.route(copy.data(), settings_.depressions);
     accumulate(copy.data());
 }
 
 void Model::accumulate(const double* routed) {
-    if (settings_.mfd_exponent > 0.0) flow_.accumulate_multiple(routed, settings_.mfd_exponent);
-    else flow_.accumulate();
+    const double* weight = rain_weight_.empty() ? nullptr : rain_weight_.data();
+    if (settings_.mfd_exponent > 0.0) flow_.accumulate_multiple(routed, settings_.mfd_exponent, weight);
+    else flow_.accumulate(weight);
+}
+
+void Model::update_rain() {
+    rain_ =
+        climate::orographic_rain_coarse(h_.data(), width_, height_, cell_, settings_.rain, settings_.rain_resolution);
+    rain_weight_.resize(rain_.size());
+    const double inv = 1.0 / settings_.rain.background;
+    for (std::size_t i = 0; i < rain_.size(); ++i) rain_weight_[i] = rain_[i] * inv;
 }
 
 std::int64_t Model::step(double dt) {
@@ -109,7 +121,8 @@ std::int64_t Model::step(double dt) {
         });
     }
     if (history_.rate) add_history_uplift(time_, time_ + dt);
-    // 2. Routing, depressions, drainage area.
+    // 2. The rain on the uplifted relief; routing, depressions, drainage area (weighted by the rain).
+    if (settings_.orographic_rain) update_rain();
     flow_.route(h, settings_.depressions);
     accumulate(h);
     const std::int64_t pits = flow_.pits();

@@ -33,6 +33,8 @@
 #include "glaciers.hpp"
 #include "rock.hpp"
 
+#include <orogen/climate/orographic_rain.hpp>
+
 #include <orogen/solvers/diffusion.hpp>
 
 #include <algorithm>
@@ -77,6 +79,13 @@ struct Settings {
     /// flow graph, erodes K_g·Q^m_g·S^n in the same implicit sweep as the rivers and carves U-shaped
     /// troughs. Detachment-limited only (deposition = 0), and not tiled.
     Glaciers glaciers;
+    /// Rain that follows the relief (orographic_rain.hpp): with orographic_rain, each step computes
+    /// the rain a steady moist wind leaves on the current heights (Smith & Barstad 2004) on a grid of
+    /// about rain_resolution metres, and each cell adds rain/background of its area to the drainage
+    /// area, so K is the erodibility under the background rain. Not tiled.
+    bool orographic_rain = false;
+    climate::OrographicRain rain;
+    double rain_resolution = 250.0;  ///< m
 };
 
 /// Uplift that varies in time as well as in space: a piecewise-constant rate
@@ -139,6 +148,8 @@ public:
 
     /// Glaciers: each cell's ice flux in the last step (m³/yr); empty without glaciers.
     const std::vector<double>& ice_flux() const { return ice_; }
+    /// With orographic rain: the rain of the last step (m/yr); empty otherwise.
+    const std::vector<double>& rain() const { return rain_; }
     /// Route and accumulate over the current heights without eroding (for the output layers).
     void route_only();
 
@@ -159,6 +170,7 @@ private:
     void incise_with_deposition(double dt);
     void add_history_uplift(double t0, double t1);
     void accumulate(const double* routed);  // D8 or multiple-flow area over the routed heights
+    void update_rain();  // orographic rain over the current heights, and each cell's weight
 
     int width_, height_;
     double cell_;
@@ -169,6 +181,7 @@ private:
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
+    std::vector<double> rain_, rain_weight_;  // orographic rain (m/yr) and rain / background
     double time_ = 0.0, sediment_out_ = 0.0;
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_

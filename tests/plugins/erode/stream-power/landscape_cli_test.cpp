@@ -17,17 +17,18 @@ using namespace orogen::test;
 
 TEST(LandscapeCli, OutOfRangeParametersAreCheckTimeErrors) {
     TempDir dir;
-    const auto spec = dir.write("bad.orogen",
-                                "orogen 1\n"
-                                "grid 65 cell=30\n"
-                                "base = generate:shape(kind=pyramid, height=300)\n"
-                                "a = erode:stream-power(base, m=5, n=0.1, erodibility=1, uplift=100)\n"
-                                "b = erode:stream-power(base, diffusivity=100, dt=0, years=-1)\n"
-                                "c = erode:stream-power(base, uplift_layer=\"uplift\", open=\"nxw\", base_level=\"sea\")\n"
-                                "d = erode:diffusion(base, diffusivity=0)\n"
-                                "e = erode:diffusion(base, years=10, dt=100, fixed=\"top\")\n"
-                                "f = erode:stream-power(base, routing=mfd, depressions=route)\n"
-                                "g = erode:stream-power(base, mfd_exponent=2)\n");
+    const auto spec =
+        dir.write("bad.orogen",
+                  "orogen 1\n"
+                  "grid 65 cell=30\n"
+                  "base = generate:shape(kind=pyramid, height=300)\n"
+                  "a = erode:stream-power(base, m=5, n=0.1, erodibility=1, uplift=100)\n"
+                  "b = erode:stream-power(base, diffusivity=100, dt=0, years=-1)\n"
+                  "c = erode:stream-power(base, uplift_layer=\"uplift\", open=\"nxw\", base_level=\"sea\")\n"
+                  "d = erode:diffusion(base, diffusivity=0)\n"
+                  "e = erode:diffusion(base, years=10, dt=100, fixed=\"top\")\n"
+                  "f = erode:stream-power(base, routing=mfd, depressions=route)\n"
+                  "g = erode:stream-power(base, mfd_exponent=2)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -59,13 +60,15 @@ TEST(LandscapeCli, AGridTooLargeForMemorySaysHowMuchItNeeds) {
     TempDir dir;
     const auto spec = dir.write("huge.orogen",
                                 "orogen 1\n"
-                                "grid " + std::to_string(side) + " cell=30\n"
-                                "base = generate:shape(kind=flat)\n"
-                                "a = erode:stream-power(base)\n");
+                                "grid " +
+                                    std::to_string(side) +
+                                    " cell=30\n"
+                                    "base = generate:shape(kind=flat)\n"
+                                    "a = erode:stream-power(base)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     const std::string want = "huge.orogen:4:5: error: erode:stream-power: a " + std::to_string(side) + " x " +
-                             std::to_string(side) + " grid needs ";
+        std::to_string(side) + " grid needs ";
     EXPECT_NE(r.err.find(want), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("iB for the landscape model, more than half of this machine's "), std::string::npos) << r.err;
 }
@@ -85,7 +88,8 @@ TEST(LandscapeCli, RunsWritesItsLayersAndGivesTheSameBytesOnOneAndTwoThreads) {
     std::string bytes[2];
     for (int t = 0; t < 2; ++t) {
         const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
-        const RunResult r = run_orogen("run " + q(spec) + " --quiet --threads " + std::to_string(t + 1) + " --out " + q(out));
+        const RunResult r =
+            run_orogen("run " + q(spec) + " --quiet --threads " + std::to_string(t + 1) + " --out " + q(out));
         ASSERT_EQ(r.exit_code, 0) << r.err;
         bytes[t] = slurp(out + "/b.r32");
         bytes[t] += slurp(out + "/drainage.png") + slurp(out + "/direction.png") + slurp(out + "/chi.png");
@@ -129,16 +133,17 @@ TEST(LandscapeCli, DepositionAndUpliftHistoryAreCheckedBeforeTheRun) {
 
 TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
     TempDir dir;
-    const auto spec = dir.write("rock.orogen",
-                                "orogen 1\n"
-                                "grid 65 cell=30\n"
-                                "base = generate:shape(kind=pyramid, height=300)\n"
-                                "a = erode:stream-power(base, bed_dip=20)\n"
-                                "b = erode:stream-power(base, bed_thickness=50, bed_angle_spread=10)\n"
-                                "c = erode:stream-power(base, landslide_angle=30, bed_thickness=50, bed_angle_spread=28)\n"
-                                "d = erode:stream-power(base, ela=2000)\n"
-                                "e = erode:stream-power(base, glaciers=true, deposition=1)\n"
-                                "f = erode:stream-power(base, landslide_angle=85)\n");
+    const auto spec =
+        dir.write("rock.orogen",
+                  "orogen 1\n"
+                  "grid 65 cell=30\n"
+                  "base = generate:shape(kind=pyramid, height=300)\n"
+                  "a = erode:stream-power(base, bed_dip=20)\n"
+                  "b = erode:stream-power(base, bed_thickness=50, bed_angle_spread=10)\n"
+                  "c = erode:stream-power(base, landslide_angle=30, bed_thickness=50, bed_angle_spread=28)\n"
+                  "d = erode:stream-power(base, ela=2000)\n"
+                  "e = erode:stream-power(base, glaciers=true, deposition=1)\n"
+                  "f = erode:stream-power(base, landslide_angle=85)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -154,6 +159,54 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:9:46: error: 'landslide_angle' of erode:stream-power is 85, out of range [0, 80] °",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+}
+
+TEST(LandscapeCli, RainParametersAreCheckedBeforeTheRun) {
+    TempDir dir;
+    const auto spec = dir.write("rain.orogen",
+                                "orogen 1\n"
+                                "grid 65 cell=30\n"
+                                "base = generate:shape(kind=pyramid, height=300)\n"
+                                "a = erode:stream-power(base, wind_from=200)\n"
+                                "b = erode:stream-power(base, rain=orographic, rain_background=0)\n"
+                                "c = erode:stream-power(base, rain=monsoon)\n");
+    const RunResult r = run_orogen("check " + q(spec));
+    EXPECT_EQ(r.exit_code, 2);
+    for (const char* want : {
+             "rain.orogen:4:40: error: erode:stream-power: wind_from describes orographic rain; give "
+             "rain=\"orographic\" as well",
+             "rain.orogen:5:63: error: 'rain_background' of erode:stream-power is 0, out of range (0, 20] m/yr",
+             "rain.orogen:6:35: error: 'rain' of erode:stream-power is 'monsoon', which is not one of uniform, "
+             "orographic",
+         })
+        EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
+    // A choice that is not one of the choices stops there: no internal message about the missing value.
+    EXPECT_EQ(r.err.find("map::at"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("3 errors"), std::string::npos) << r.err;
+}
+
+TEST(LandscapeCli, OrographicRainAddsItsLayerAndGivesTheSameBytesOnOneAndTwoThreads) {
+    TempDir dir;
+    const auto spec = dir.write("wet.orogen",
+                                "orogen 1\n"
+                                "seed 5\n"
+                                "grid 129 cell=60\n"
+                                "base = generate:diamond-square(roughness=0.5, amplitude=600)\n"
+                                "a = erode:stream-power(base, years=2e5, dt=2e4, rain=orographic, wind_from=300, "
+                                "rain_background=0.7)\n"
+                                "export:raw(a, path=\"a.r32\")\n"
+                                "export:png(a, path=\"rain.png\", layer=\"rain\", bits=16)\n");
+    std::string bytes[2];
+    for (int t = 0; t < 2; ++t) {
+        const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
+        const RunResult r =
+            run_orogen("run " + q(spec) + " --no-cache --threads " + std::to_string(t + 1) + " --out " + q(out));
+        ASSERT_EQ(r.exit_code, 0) << r.err;
+        ASSERT_TRUE(std::filesystem::exists(std::filesystem::path(out) / "rain.png"));
+        bytes[t] = slurp(std::filesystem::path(out) / "a.r32");
+    }
+    EXPECT_FALSE(bytes[0].empty());
+    EXPECT_EQ(bytes[0], bytes[1]);
 }
 
 TEST(LandscapeCli, UpliftFromThePlatesHistoryWithDepositionGivesTheSameBytesOnOneAndTwoThreads) {
@@ -193,8 +246,8 @@ TEST(LandscapeCli, TimelapseRecordsEveryKStepsOnAClockOfYears) {
               "export:test-series(t.timelapse, path=\"t.txt\")\n"
               "export:test-series(d.timelapse, path=\"d.txt\")\n"
               "export:raw(t, path=\"t.r32\")\n");
-    const RunResult r = run_orogen("run s.orogen --out out --quiet", std::string("OROGEN_PLUGIN_PATH=") + OROGEN_FAKE_PLUGIN_DIR,
-                                   dir.path());
+    const RunResult r = run_orogen("run s.orogen --out out --quiet",
+                                   std::string("OROGEN_PLUGIN_PATH=") + OROGEN_FAKE_PLUGIN_DIR, dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     auto read = [&](const char* name) {
         std::istringstream in(slurp(dir / "out" / name));

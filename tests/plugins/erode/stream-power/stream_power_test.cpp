@@ -70,8 +70,8 @@ TEST_P(SteadyState, ChannelsObeyTheAnalyticalSlopeAreaRelation) {
         const std::int32_t r = f.receivers()[i];
         if (r == std::int32_t(i) || a < 10 * cell * cell) continue;
         const double slope = (hh[i] - hh[std::size_t(r)]) / f.distance(std::int64_t(i));
-        const double expected = std::pow(U / s.erodibility, 1.0 / s.slope_exponent) *
-                                std::pow(a, -s.area_exponent / s.slope_exponent);
+        const double expected =
+            std::pow(U / s.erodibility, 1.0 / s.slope_exponent) * std::pow(a, -s.area_exponent / s.slope_exponent);
         worst = std::max(worst, std::abs(slope / expected - 1.0));
         la.push_back(std::log(a));
         ls.push_back(std::log(slope));
@@ -81,13 +81,13 @@ TEST_P(SteadyState, ChannelsObeyTheAnalyticalSlopeAreaRelation) {
     EXPECT_LT(worst, 0.02) << "largest relative deviation from S = (U/K)^(1/n) A^(-m/n)";
     const auto [slope, intercept] = fit(la, ls);
     EXPECT_NEAR(-slope, 0.5, 0.01) << "concavity m/n from the slope-area fit";
-    EXPECT_NEAR(std::exp(intercept), std::pow(U / s.erodibility, 1.0 / s.slope_exponent), 0.02 * std::pow(U / s.erodibility, 1.0 / s.slope_exponent));
+    EXPECT_NEAR(std::exp(intercept), std::pow(U / s.erodibility, 1.0 / s.slope_exponent),
+                0.02 * std::pow(U / s.erodibility, 1.0 / s.slope_exponent));
 }
 
-INSTANTIATE_TEST_SUITE_P(StreamPower, SteadyState, ::testing::Values(SteadyCase{1.0, 1e-5}, SteadyCase{2.0, 1e-7}, SteadyCase{0.7, 3e-5}),
-                         [](const auto& info) {
-                             return "n" + std::to_string(int(info.param.n * 10));
-                         });
+INSTANTIATE_TEST_SUITE_P(StreamPower, SteadyState,
+                         ::testing::Values(SteadyCase{1.0, 1e-5}, SteadyCase{2.0, 1e-7}, SteadyCase{0.7, 3e-5}),
+                         [](const auto& info) { return "n" + std::to_string(int(info.param.n * 10)); });
 
 TEST(StreamPower, AChannelAreaScalesIncisionByOneMinusExpOfAreaOverIt) {
     // Settings::channel_area A_c: at steady state U = K·A^m·(1 − e^(−A/A_c))·S, so
@@ -179,7 +179,7 @@ TEST(Beds, ABedDipsTowardsItsAzimuthAndKeepsItsStrength) {
     }
     EXPECT_GT(differ, 190) << "beds a thickness apart must (almost always) differ in strength";
     beds.erodibility_contrast = 9.0;
-    EXPECT_DOUBLE_EQ(beds.erodibility_factor(0.0), 3.0);   // the weakest: √contrast times the average K
+    EXPECT_DOUBLE_EQ(beds.erodibility_factor(0.0), 3.0);  // the weakest: √contrast times the average K
     EXPECT_DOUBLE_EQ(beds.erodibility_factor(1.0), 1.0 / 3.0);
     beds.angle = 35.0 * M_PI / 180.0;
     beds.angle_spread = 10.0 * M_PI / 180.0;
@@ -339,8 +339,8 @@ TEST(Glaciers, GlaciatedValleysEndDeeperAndWiderAndTheBitsHoldOnTwoThreads) {
     std::vector<double> start(std::size_t(w) * h);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            start[std::size_t(y) * w + x] =
-                1200.0 * std::sin(M_PI * y / (h - 1)) + 150.0 * std::abs(std::sin(0.25 * x)) + 5.0 * random::uniform(4, x, y);
+            start[std::size_t(y) * w + x] = 1200.0 * std::sin(M_PI * y / (h - 1)) +
+                150.0 * std::abs(std::sin(0.25 * x)) + 5.0 * random::uniform(4, x, y);
     Settings s;
     s.erodibility = 5e-6;
     s.area_exponent = 0.5;
@@ -360,8 +360,8 @@ TEST(Glaciers, GlaciatedValleysEndDeeperAndWiderAndTheBitsHoldOnTwoThreads) {
         Model glaciers(w, h, cell, start, std::vector<double>(start.size(), 5e-4), iced);
         glaciers.run(3e5, 2e4);
         runs[t] = glaciers.heights();
-        ice_cells = std::size_t(std::count_if(glaciers.ice_flux().begin(), glaciers.ice_flux().end(),
-                                              [](double q) { return q > 0.0; }));
+        ice_cells = std::size_t(
+            std::count_if(glaciers.ice_flux().begin(), glaciers.ice_flux().end(), [](double q) { return q > 0.0; }));
     }
     EXPECT_EQ(0, std::memcmp(runs[0].data(), runs[1].data(), runs[0].size() * 8)) << "1 and 2 threads";
     ASSERT_GT(ice_cells, std::size_t(200));
@@ -439,7 +439,8 @@ TEST(StreamPower, OneStepOfARiverEqualsTheImplicitSchemeSolvedByHand) {
             expect[std::size_t(x)] = 0.5 * (lo + hi);
         }
         for (int x = 0; x < w; ++x)
-            ASSERT_NEAR(model.heights()[std::size_t(x)], expect[std::size_t(x)], 1e-7 * (1.0 + std::abs(expect[std::size_t(x)])))
+            ASSERT_NEAR(model.heights()[std::size_t(x)], expect[std::size_t(x)],
+                        1e-7 * (1.0 + std::abs(expect[std::size_t(x)])))
                 << "n = " << n << ", x = " << x;
     }
 }
@@ -483,7 +484,8 @@ TEST(StreamPower, AKnickpointTravelsUpstreamAtTheKinematicWaveSpeed) {
     // Well downstream of it the river is back at its old profile; well upstream nothing has moved yet
     // (the implicit upwind scheme smears the front over about sqrt(distance · cell)).
     for (int x = 1; x < expected - 50; ++x) EXPECT_NEAR(model.heights()[std::size_t(x)], h0[std::size_t(x)], 2.0) << x;
-    for (int x = expected + 50; x < w; ++x) EXPECT_NEAR(model.heights()[std::size_t(x)], start[std::size_t(x)], 2.0) << x;
+    for (int x = expected + 50; x < w; ++x)
+        EXPECT_NEAR(model.heights()[std::size_t(x)], start[std::size_t(x)], 2.0) << x;
 }
 
 /// Follows receivers from every cell; checks each reaches an outlet within size() hops.
@@ -497,8 +499,8 @@ void expect_every_cell_drains(const FlowRouter& f) {
         if (!f.is_outlet(std::int64_t(i))) {
             // A receiver is a neighbour.
             const std::int64_t d = r[i] - std::int64_t(i), W = f.width();
-            const bool neighbour = d == 1 || d == -1 || d == W || d == -W || d == W + 1 || d == W - 1 ||
-                                   d == -W + 1 || d == -W - 1;
+            const bool neighbour =
+                d == 1 || d == -1 || d == W || d == -W || d == W + 1 || d == W - 1 || d == -W + 1 || d == -W - 1;
             ASSERT_TRUE(neighbour) << "cell " << i;
         }
     }
@@ -622,7 +624,6 @@ TEST(StreamPower, ChiGrowsUpstreamByTheIntegral) {
     }
 }
 
-
 // ---- Multiple flow directions (Freeman 1991) --------------------------------------------------
 
 /// Drainage areas of a cone (a peak of slope `slope` at the centre of an n × n map, every side open)
@@ -634,10 +635,8 @@ std::vector<double> cone_areas(int n, double cell, double exponent, std::vector<
         for (int x = 0; x < n; ++x) hts[std::size_t(y) * n + x] = 1000.0 - 0.2 * cell * std::hypot(x - c, y - c);
     FlowRouter f(n, n, cell, OpenSides{});
     f.route(hts.data(), Depressions::fill);
-    if (exponent > 0.0)
-        f.accumulate_multiple(hts.data(), exponent);
-    else
-        f.accumulate();
+    if (exponent > 0.0) f.accumulate_multiple(hts.data(), exponent);
+    else f.accumulate();
     if (heights) *heights = hts;
     return f.area();
 }
@@ -653,7 +652,9 @@ TEST(MultipleFlow, OnAConeTheAreaSpreadsAsDivergentFlowDoes) {
     // the rays of the grid's 8 directions and stays small between them.
     const int n = 201;
     const double cell = 10.0, c = 0.5 * (n - 1);
-    struct Ring { double mean_ratio = 0, cv = 0; };
+    struct Ring {
+        double mean_ratio = 0, cv = 0;
+    };
     auto ring = [&](const std::vector<double>& area) {
         std::vector<double> ratio;
         for (int y = 0; y < n; ++y)
@@ -738,7 +739,8 @@ TEST(BasinGraph, TheTreeDoesNotDependOnTheOrderTheLinksCameIn) {
     for (std::int32_t b = 1; b < nodes; ++b)
         for (int e = 0; e < 4; ++e) {
             const auto a = std::int32_t(random::uniform(9, k++) * b);  // to a lower node (0: the sea)
-            const double pass = std::floor(random::uniform(9, k++) * 5.0), low = pass - std::floor(random::uniform(9, k++) * 2.0);
+            const double pass = std::floor(random::uniform(9, k++) * 5.0),
+                         low = pass - std::floor(random::uniform(9, k++) * 2.0);
             links.push_back({pass, low, a, b, std::int64_t(k), std::int64_t(k + 1)});
         }
     std::vector<Link> sorted = links;
@@ -819,9 +821,8 @@ TEST(BasinJoin, TilesThatSettleTheirClosedLakesGiveTheWholeGraphsTree) {
         std::vector<std::int64_t> anchors;
         std::int64_t settled = 0;
         for (int t = 0; t < tiles; ++t) {
-            forests.push_back(contract_tile(per_tile[std::size_t(t)], [&](std::int64_t b) {
-                return closed[std::size_t((b - 2) / 5)] != 0;
-            }));
+            forests.push_back(contract_tile(per_tile[std::size_t(t)],
+                                            [&](std::int64_t b) { return closed[std::size_t((b - 2) / 5)] != 0; }));
             const TileForest& f = forests.back();
             deferred.insert(deferred.end(), f.deferred.begin(), f.deferred.end());
             edges.insert(edges.end(), f.edges.begin(), f.edges.end());
@@ -843,7 +844,8 @@ TEST(BasinJoin, TilesThatSettleTheirClosedLakesGiveTheWholeGraphsTree) {
                 EXPECT_EQ(got[b].level, want.level[std::size_t(v)]) << "seed " << seed << " basin " << v;
                 EXPECT_EQ(got[b].in, in) << "seed " << seed << " basin " << v;
                 EXPECT_EQ(got[b].across, across) << "seed " << seed << " basin " << v;
-                if (keys.count(b)) EXPECT_EQ(keys[b].level, want.level[std::size_t(v)]) << "seed " << seed << " key " << v;
+                if (keys.count(b))
+                    EXPECT_EQ(keys[b].level, want.level[std::size_t(v)]) << "seed " << seed << " key " << v;
                 ++settled;
             } else {
                 ASSERT_EQ(keys.count(b), 1u) << "seed " << seed << " basin " << v;
@@ -940,7 +942,7 @@ INSTANTIATE_TEST_SUITE_P(StreamPower, DepositionSteadyState,
                                            DepositionCase{1.0, 1e-5, 1.0, 1.1}),
                          [](const auto& info) {
                              return "n" + std::to_string(int(info.param.n * 10)) + "_G" +
-                                    std::to_string(int(info.param.g)) + (info.param.mfd > 0.0 ? "_mfd" : "");
+                                 std::to_string(int(info.param.g)) + (info.param.mfd > 0.0 ? "_mfd" : "");
                          });
 
 TEST(Deposition, EachCellSolvesItsEquationAndTheSedimentBalances) {
@@ -991,7 +993,7 @@ TEST(Deposition, EachCellSolvesItsEquationAndTheSedimentBalances) {
                 const double x = hn[i] - hn[r];
                 const bool incises = x > 0.0;  // a cell incises if it ends above its receiver
                 const double E = incises ? s.erodibility * dt * std::pow(f.area()[i], s.area_exponent) *
-                                               std::pow(x / f.distance(std::int64_t(i)), n)
+                        std::pow(x / f.distance(std::int64_t(i)), n)
                                          : 0.0;
                 const double Dep = g * V[i] / A[i];
                 const double res = std::abs((hs[i] - hn[i]) - (E - Dep)) / (1.0 + std::abs(hs[i]));
@@ -1001,8 +1003,9 @@ TEST(Deposition, EachCellSolvesItsEquationAndTheSedimentBalances) {
                 deposits += Dep > 1e-6;
             }
             EXPECT_LT(worst, 1e-10) << "n = " << n << ", G = " << g << ": largest residual of a cell's equation";
-            std::printf("n = %g, G = %g: residual %.2g, eroded %.4g m3, deposited %.4g m3, out %.4g m3, balance %.2g m3\n",
-                        n, g, worst, eroded, deposited, model.sediment_out(), eroded - deposited - model.sediment_out());
+            std::printf(
+                "n = %g, G = %g: residual %.2g, eroded %.4g m3, deposited %.4g m3, out %.4g m3, balance %.2g m3\n", n,
+                g, worst, eroded, deposited, model.sediment_out(), eroded - deposited - model.sediment_out());
             EXPECT_GT(deposits, 1000);
             EXPECT_GT(deposited, 0.05 * eroded);
             EXPECT_NEAR(eroded - deposited, model.sediment_out(), 1e-9 * eroded) << "n = " << n << ", G = " << g;
@@ -1067,7 +1070,8 @@ TEST(UpliftHistory, EachIntervalUpliftsByItsOwnFrames) {
     const UpliftHistory early = bump_history(w, h, years, 400.0, 0.0);
     for (int which = 0; which < 2; ++which) {
         Model model(w, h, 30.0, start, {}, s);
-        model.set_uplift_history(which == 0 ? bump_history(w, h, years, 400.0, 0.0) : bump_history(w, h, years, 0.0, 400.0));
+        model.set_uplift_history(which == 0 ? bump_history(w, h, years, 400.0, 0.0)
+                                            : bump_history(w, h, years, 0.0, 400.0));
         model.run(1e5, dt);  // the first half
         const auto mid = model.heights();
         model.run(1e5, dt);  // the second half
@@ -1095,7 +1099,8 @@ TEST(UpliftHistory, WhenTheUpliftComesChangesTheLandscape) {
     double mean[2];
     for (int which = 0; which < 2; ++which) {
         Model model(w, h, 30.0, noise(w, h, 2, 5.0), {}, s);
-        model.set_uplift_history(which == 0 ? bump_history(w, h, years, 400.0, 0.0) : bump_history(w, h, years, 0.0, 400.0));
+        model.set_uplift_history(which == 0 ? bump_history(w, h, years, 400.0, 0.0)
+                                            : bump_history(w, h, years, 0.0, 400.0));
         model.run(years, 2e4);
         mean[which] = std::accumulate(model.heights().begin(), model.heights().end(), 0.0) / double(w * h);
     }
@@ -1129,4 +1134,114 @@ TEST(StreamPower, SameBitsOnOneAndTwoThreadsWithDepositionAndAnUpliftHistory) {
     }
     EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
     EXPECT_EQ(0, std::memcmp(&out[0], &out[1], sizeof(double)));
+}
+
+namespace {
+
+/// A ridge along the y axis, `relief` metres high in the middle column, falling linearly to both sides.
+std::vector<double> ridge(int w, int h, double relief, std::uint64_t seed) {
+    auto v = noise(w, h, seed, 1.0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            v[std::size_t(y) * w + x] += relief * (1.0 - std::abs(x - (w - 1) / 2.0) / ((w - 1) / 2.0));
+    return v;
+}
+
+Settings westerly_rain() {
+    Settings s;
+    s.orographic_rain = true;
+    s.rain.wind_from = 270.0;
+    s.rain_resolution = 1.0;  // the model's own grid
+    return s;
+}
+
+}  // namespace
+
+TEST(OrographicRainInTheModel, EachCellAddsItsRainOverTheBackgroundToTheDrainageArea) {
+    // A plane falling south, water leaving by the south side: every column is one river, and a cell's
+    // drainage area is cell² times the sum of rain/background over the cells above it in its column.
+    const int w = 40, h = 30;
+    const double cell = 250.0;
+    std::vector<double> plane(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) plane[std::size_t(y) * w + x] = 3000.0 - 50.0 * y + 3.0 * std::sin(0.3 * x);
+    Settings s = westerly_rain();
+    s.rain.wind_from = 0.0;  // a northerly, down the slope: wet in the north, drier further down
+    s.rain.background = 0.8;
+    s.open = {false, false, true, false};
+    Model model(w, h, cell, plane, {}, s);
+    model.route_only();
+    const auto& rain = model.rain();
+    const auto& area = model.flow().area();
+    ASSERT_EQ(rain.size(), plane.size());
+    double low = 1e9, high = 0.0;
+    for (int x = 0; x < w; ++x) {
+        double sum = 0.0;
+        for (int y = 0; y < h; ++y) {
+            const std::size_t i = std::size_t(y) * w + x;
+            low = std::min(low, rain[i]);
+            high = std::max(high, rain[i]);
+            sum += rain[i] / 0.8;
+            if (y < h - 1) ASSERT_NEAR(area[i], sum * cell * cell, 1e-9 * sum * cell * cell) << x << ", " << y;
+        }
+    }
+    EXPECT_GT(high, 1.5 * low) << "the rain varies over the map, so the weights are tested";
+}
+
+TEST(OrographicRainInTheModel, TheWindwardSideErodesFasterAndTheDivideMovesDownwind) {
+    // A ridge between two open sides, uplifted evenly. Under uniform rain it stays symmetric; under a
+    // westerly the wet western flank erodes faster, so the west stands lower and the main divide
+    // migrates east, into the rain shadow (as in the Southern Alps or the Olympics).
+    const int w = 121, h = 41;
+    const double cell = 250.0;
+    auto mean_divide = [&](const std::vector<double>& z) {
+        double sum = 0.0;
+        for (int y = 0; y < h; ++y) {
+            int best = 0;
+            for (int x = 1; x < w; ++x)
+                if (z[std::size_t(y) * w + x] > z[std::size_t(y) * w + best]) best = x;
+            sum += best;
+        }
+        return sum / h;
+    };
+    auto half_mean = [&](const std::vector<double>& z, bool west) {
+        double sum = 0.0;
+        for (int y = 0; y < h; ++y)
+            for (int x = west ? 0 : w / 2 + 1; x < (west ? w / 2 : w); ++x) sum += z[std::size_t(y) * w + x];
+        return sum / (double(h) * (w / 2));
+    };
+    double divide[2], west[2], east[2];
+    for (int orographic = 0; orographic < 2; ++orographic) {
+        Settings s = westerly_rain();
+        s.orographic_rain = orographic == 1;
+        s.rain.background = 0.5;
+        s.open = {false, true, false, true};
+        s.diffusivity = 0.01;
+        Model model(w, h, cell, ridge(w, h, 1500.0, 9), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        model.run(2e6, 5e4);
+        divide[orographic] = mean_divide(model.heights());
+        west[orographic] = half_mean(model.heights(), true);
+        east[orographic] = half_mean(model.heights(), false);
+    }
+    EXPECT_NEAR(divide[0], (w - 1) / 2.0, 4.0) << "uniform rain: the divide stays in the middle";
+    EXPECT_NEAR(west[0], east[0], 0.1 * east[0]);
+    EXPECT_GT(divide[1], divide[0] + 5.0) << "the divide moves east, downwind";
+    EXPECT_LT(west[1], 0.85 * east[1]) << "the wet west stands lower than the dry east";
+}
+
+TEST(OrographicRainInTheModel, SameBitsOnOneAndTwoThreads) {
+    const int w = 97, h = 81;
+    std::vector<double> results[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        Settings s = westerly_rain();
+        s.rain.wind_from = 230.0;
+        s.rain_resolution = 120.0;  // 4 cells a block: the coarse path
+        s.diffusivity = 0.02;
+        Model model(w, h, 30.0, ridge(w, h, 800.0, 4), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        model.run(2e5, 2e4);
+        results[t] = model.heights();
+        for (double r : model.rain()) results[t].push_back(r);
+    }
+    EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
 }
