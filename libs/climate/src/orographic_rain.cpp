@@ -29,7 +29,7 @@ void check(const OrographicRain& r, int width, int height, double cell) {
     if (!(r.background >= 0.0) || !std::isfinite(r.background)) bad("the background rain must be ≥ 0 m/yr");
     if (!(r.wind_speed >= 0.0) || !std::isfinite(r.wind_speed)) bad("the wind speed must be ≥ 0 m/s");
     if (!std::isfinite(r.wind_from)) bad("the wind direction must be a number of degrees");
-    if (!(r.wet_fraction > 0.0 && r.wet_fraction <= 1.0)) bad("the wet fraction must be in (0, 1]");
+    if (!(r.wind_share > 0.0 && r.wind_share <= 1.0)) bad("the wind's share of the year must be in (0, 1]");
     if (!(r.condensation_time >= 0.0) || !(r.fallout_time >= 0.0) || !std::isfinite(r.condensation_time) ||
         !std::isfinite(r.fallout_time))
         bad("the condensation and fallout times must be ≥ 0 s");
@@ -129,13 +129,14 @@ std::vector<double> orographic_rain(const double* heights, int width, int height
         }
     });
     analysis::fft2(t, nx, ny, true);
-    // The storm rate P_0/f + P_orographic (mm/s … as m/yr) cut at zero, blowing a share f of the year.
+    // A share f of the year the moist wind rains P_0 + P_orographic (mm/s, here as m/yr), cut at zero in
+    // the lee; the rest of the year other weather rains P_0 evenly.
     std::vector<double> out(n);
-    const double f = rain.wet_fraction, storm0 = rain.background / f;
+    const double f = rain.wind_share, p0 = rain.background;
     for (std::size_t y = 0; y < std::size_t(height); ++y)
         for (std::size_t x = 0; x < std::size_t(width); ++x) {
-            const double storm = storm0 + t[y * nx + x].real() * kMmPerSecondToMetresPerYear;
-            out[y * std::size_t(width) + x] = f * std::max(0.0, storm);
+            const double windy = std::max(0.0, p0 + t[y * nx + x].real() * kMmPerSecondToMetresPerYear);
+            out[y * std::size_t(width) + x] = (1.0 - f) * p0 + f * windy;
         }
     return out;
 }

@@ -89,7 +89,7 @@ struct Engine {
 };
 
 /// The parameters of rain="orographic" (an error without it).
-constexpr const char* kRainParams[] = {"rain_background",    "wind_from",      "wind_speed",      "rain_wet_fraction",
+constexpr const char* kRainParams[] = {"rain_background",    "wind_from",      "wind_speed",      "wind_share",
                                        "condensation_time",  "fallout_time",   "moist_stability", "vapour_scale_height",
                                        "uplift_sensitivity", "rain_resolution"};
 
@@ -125,7 +125,7 @@ stream_power::Settings settings_of(NodeContext& ctx) {
         s.rain.background = ctx.real("rain_background");
         s.rain.wind_from = ctx.real("wind_from");
         s.rain.wind_speed = ctx.real("wind_speed");
-        s.rain.wet_fraction = ctx.real("rain_wet_fraction");
+        s.rain.wind_share = ctx.real("wind_share");
         s.rain.condensation_time = ctx.real("condensation_time");
         s.rain.fallout_time = ctx.real("fallout_time");
         s.rain.moist_stability = ctx.real("moist_stability");
@@ -706,10 +706,11 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(60.0)
                     .unit("m/s")
                     .help("rain=orographic: the moist wind's speed (5-20 m/s)"),
-                Param::real("rain_wet_fraction", 0.1)
+                Param::real("wind_share", 0.1)
                     .min(0.0, true)
                     .max(1.0)
-                    .help("rain=orographic: share of the year the moist wind blows and it rains"),
+                    .help("rain=orographic: share of the year the moist wind blows; the rest of the year other "
+                          "weather rains rain_background evenly, so the lee keeps (1 - wind_share) of it"),
                 Param::real("condensation_time", 1000.0)
                     .min(0.0)
                     .max(1e5)

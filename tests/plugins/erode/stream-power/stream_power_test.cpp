@@ -1215,6 +1215,7 @@ TEST(OrographicRainInTheModel, TheWindwardSideErodesFasterAndTheDivideMovesDownw
         Settings s = westerly_rain();
         s.orographic_rain = orographic == 1;
         s.rain.background = 0.5;
+        s.rain.wind_share = 0.5;  // the moist wind half the year: a clear rain shadow
         s.open = {false, true, false, true};
         s.diffusivity = 0.01;
         Model model(w, h, cell, ridge(w, h, 1500.0, 9), std::vector<double>(std::size_t(w) * h, 1e-3), s);

@@ -17,9 +17,15 @@
 // crests, a dry lee (the rain shadow). No Coriolis term (ranges under a few
 // hundred kilometres).
 //
-// Units: heights m, wind m/s, times s, C_w kg/m³; the storm rate comes out in
-// kg m⁻² s⁻¹ = mm/s and is returned as mean annual rain, m/yr, for a wind
-// that blows a `wet_fraction` of the year (the rest of the year is dry).
+// Units: heights m, wind m/s, times s, C_w kg/m³; the rain rate comes out in
+// kg m⁻² s⁻¹ = mm/s and is returned as mean annual rain, m/yr: the moist wind
+// blows a share f of the year (`wind_share`), the rest of the year other
+// weather rains P_0 evenly, so
+//
+//     P_year = (1 − f)·P_0 + f·max(0, P_0 + P_orographic):
+//
+// flat ground gets P_0, the lee no less than (1 − f)·P_0 (f = 1: a lee that
+// the wind's rain alone waters, dry where the shadow is deep).
 //
 // Smith, R.B. & Barstad, I. (2004), A linear theory of orographic
 // precipitation, J. Atmos. Sci. 61, 1377–1391.
@@ -33,7 +39,7 @@ struct OrographicRain {
     double background = 1.0;  ///< P_0, m/yr: the mean annual rain on flat ground
     double wind_speed = 10.0;  ///< m/s, the moist wind's
     double wind_from = 270.0;  ///< azimuth the wind blows from, ° clockwise from north (270: westerly)
-    double wet_fraction = 0.1;  ///< share of the year the moist wind blows and it rains
+    double wind_share = 0.1;  ///< f: share of the year the moist wind blows (the rest rains P_0 evenly)
     double condensation_time = 1000.0;  ///< τ_c, s: cloud water to hydrometeors (200–2000 s)
     double fallout_time = 1000.0;  ///< τ_f, s: hydrometeors to the ground (200–2000 s)
     double moist_stability = 0.005;  ///< N_m, 1/s: the moist buoyancy frequency (0–0.01)
