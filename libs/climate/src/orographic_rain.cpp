@@ -143,6 +143,13 @@ std::vector<double> orographic_rain(const double* heights, int width, int height
 
 std::vector<double> orographic_rain_coarse(const double* heights, int width, int height, double cell,
                                            const OrographicRain& rain, double resolution) {
+    std::vector<double> out;
+    orographic_rain_coarse(heights, width, height, cell, rain, resolution, out);
+    return out;
+}
+
+void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
+                            double resolution, std::vector<double>& out) {
     check(rain, width, height, cell);
     if (!(resolution > 0.0) || !std::isfinite(resolution))
         throw std::invalid_argument("orographic rain: the resolution must be a positive number of metres");
@@ -165,33 +172,39 @@ std::vector<double> orographic_rain_coarse(const double* heights, int width, int
     const double wind_length = rain.wind_speed * (rain.condensation_time + rain.fallout_time);
     const int padding =
         std::clamp(int(std::ceil(kPaddingWindLengths * wind_length / coarse_cell)), 1, std::max(cw, ch));
-    const std::vector<double> r = orographic_rain(coarse.data(), cw, ch, coarse_cell, rain, padding);
-    if (f == 1) return r;
-    // Bilinear between the coarse cells' centres (held at the edges).
-    std::vector<double> out(std::size_t(width) * std::size_t(height));
-    auto axis = [f](int i, int n, int& i0, int& i1, double& t) {
-        const double g = std::clamp((i + 0.5) / f - 0.5, 0.0, double(n - 1));
-        i0 = int(g);
-        i1 = std::min(i0 + 1, n - 1);
-        t = g - i0;
+    std::vector<double> r = orographic_rain(coarse.data(), cw, ch, coarse_cell, rain, padding);
+    if (f == 1) {
+        out = std::move(r);
+        return;
+    }
+    // Bilinear between the coarse cells' centres (held at the edges); each column's pair of coarse
+    // columns and weight computed once.
+    struct Axis {
+        int i0, i1;
+        double t;
     };
-    parallel_for(0, height, 64, [&](std::int64_t y0, std::int64_t y1) {
+    auto axis = [f](int i, int n) {
+        const double g = std::clamp((i + 0.5) / f - 0.5, 0.0, double(n - 1));
+        const int i0 = int(g);
+        return Axis{i0, std::min(i0 + 1, n - 1), g - i0};
+    };
+    std::vector<Axis> columns(static_cast<std::size_t>(width));
+    for (int x = 0; x < width; ++x) columns[std::size_t(x)] = axis(x, cw);
+    out.resize(std::size_t(width) * std::size_t(height));
+    parallel_for(0, height, 16, [&](std::int64_t y0, std::int64_t y1) {
+        std::vector<double> across(static_cast<std::size_t>(cw));  // the row's rain between its two coarse rows
         for (auto y = int(y0); y < int(y1); ++y) {
-            int Y0, Y1;
-            double ty;
-            axis(y, ch, Y0, Y1, ty);
-            const double* a = r.data() + std::size_t(Y0) * std::size_t(cw);
-            const double* b = r.data() + std::size_t(Y1) * std::size_t(cw);
+            const Axis a = axis(y, ch);
+            const double* top = r.data() + std::size_t(a.i0) * std::size_t(cw);
+            const double* bottom = r.data() + std::size_t(a.i1) * std::size_t(cw);
+            for (int X = 0; X < cw; ++X) across[std::size_t(X)] = top[X] + (bottom[X] - top[X]) * a.t;
+            double* row = out.data() + std::size_t(y) * std::size_t(width);
             for (int x = 0; x < width; ++x) {
-                int X0, X1;
-                double tx;
-                axis(x, cw, X0, X1, tx);
-                const double top = a[X0] + (a[X1] - a[X0]) * tx, bottom = b[X0] + (b[X1] - b[X0]) * tx;
-                out[std::size_t(y) * std::size_t(width) + std::size_t(x)] = top + (bottom - top) * ty;
+                const Axis& c = columns[std::size_t(x)];
+                row[x] = across[std::size_t(c.i0)] + (across[std::size_t(c.i1)] - across[std::size_t(c.i0)]) * c.t;
             }
         }
     });
-    return out;
 }
 
 }  // namespace orogen::climate

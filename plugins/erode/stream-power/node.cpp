@@ -321,7 +321,7 @@ void write_layers(NodeContext& ctx, Heightmap& hm, Engine& engine, std::int64_t 
         for (std::size_t i = 0; i < n && i < ice.size(); ++i) q.data[i] = float(ice[i]);
     }
     if (ctx.text("rain") == "orographic" && engine.whole) {  // orographic rain never tiles either
-        const std::vector<double>& rain = engine.whole->rain();
+        const std::vector<double> rain = engine.whole->rain();
         GridView r = hm.layer("rain", 0.0f);
         for (std::size_t i = 0; i < n && i < rain.size(); ++i) r.data[i] = float(rain[i]);
     }

@@ -87,7 +87,7 @@ void Model::add_history_uplift(double t0, double t1) {
 }
 
 void Model::route_only() {
-    if (settings_.orographic_rain && rain_.empty()) update_rain();
+    if (settings_.orographic_rain && rain_weight_.empty()) update_rain();
     std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
     flow_.route(copy.data(), settings_.depressions);
     accumulate(copy.data());
@@ -100,11 +100,20 @@ void Model::accumulate(const double* routed) {
 }
 
 void Model::update_rain() {
-    rain_ =
-        climate::orographic_rain_coarse(h_.data(), width_, height_, cell_, settings_.rain, settings_.rain_resolution);
-    rain_weight_.resize(rain_.size());
+    // Only the weights are kept (rain() multiplies back): one array of the grid's size, reused each step.
+    climate::orographic_rain_coarse(h_.data(), width_, height_, cell_, settings_.rain, settings_.rain_resolution,
+                                    rain_weight_);
     const double inv = 1.0 / settings_.rain.background;
-    for (std::size_t i = 0; i < rain_.size(); ++i) rain_weight_[i] = rain_[i] * inv;
+    double* w = rain_weight_.data();
+    parallel_for(0, std::int64_t(rain_weight_.size()), 1 << 16, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i) w[i] *= inv;
+    });
+}
+
+std::vector<double> Model::rain() const {
+    std::vector<double> r(rain_weight_);
+    for (double& v : r) v *= settings_.rain.background;
+    return r;
 }
 
 std::int64_t Model::step(double dt) {

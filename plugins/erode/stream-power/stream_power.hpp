@@ -149,7 +149,7 @@ public:
     /// Glaciers: each cell's ice flux in the last step (m³/yr); empty without glaciers.
     const std::vector<double>& ice_flux() const { return ice_; }
     /// With orographic rain: the rain of the last step (m/yr); empty otherwise.
-    const std::vector<double>& rain() const { return rain_; }
+    std::vector<double> rain() const;
     /// Route and accumulate over the current heights without eroding (for the output layers).
     void route_only();
 
@@ -181,7 +181,7 @@ private:
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
-    std::vector<double> rain_, rain_weight_;  // orographic rain (m/yr) and rain / background
+    std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
     double time_ = 0.0, sediment_out_ = 0.0;
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_

@@ -1171,7 +1171,7 @@ TEST(OrographicRainInTheModel, EachCellAddsItsRainOverTheBackgroundToTheDrainage
     s.open = {false, false, true, false};
     Model model(w, h, cell, plane, {}, s);
     model.route_only();
-    const auto& rain = model.rain();
+    const auto rain = model.rain();
     const auto& area = model.flow().area();
     ASSERT_EQ(rain.size(), plane.size());
     double low = 1e9, high = 0.0;

@@ -62,6 +62,10 @@ std::vector<double> orographic_rain(const double* heights, int width, int height
 /// wavelengths much under 2π·U·τ), so a 200–500 m grid gives the same field for a small share of the work.
 std::vector<double> orographic_rain_coarse(const double* heights, int width, int height, double cell,
                                            const OrographicRain& rain, double resolution);
+/// The same into `out` (resized to width × height): a caller that asks every step reuses its memory
+/// (at 4097² a fresh 134 MB array a step cost more in page faults than the transforms).
+void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
+                            double resolution, std::vector<double>& out);
 
 /// The wind's components: east (x) and south (down the rows, y), m/s.
 struct Wind {
