@@ -167,6 +167,21 @@ struct UpliftInputs {
                                        : diffusion::Solver(hm.width(), hm.height(), hm.cell(), ds);
         for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
     }
+    /// The uplift falls towards the open sides (the sides held at base level) over uplift_edge_taper
+    /// metres, as a range's uplift falls to its foreland: rate × smoothstep(d/taper), d the distance to
+    /// the nearest open side. Without it, full uplift beside a side held fixed raises a wall that short,
+    /// straight rivers drain in parallel.
+    void taper(std::vector<double>& rate) const {
+        const double taper = ctx.real("uplift_edge_taper");
+        if (!(taper > 0.0)) return;
+        const stream_power::OpenSides open = *parse_sides(ctx.text("open"));
+        const TileRect own = tiles ? tiles->owned() : TileRect{0, 0, hm.width(), hm.height()};
+        const int W = tiles ? tiles->grid_width() : hm.width(), H = tiles ? tiles->grid_height() : hm.height();
+        for (int y = 0; y < own.height; ++y)
+            for (int x = 0; x < own.width; ++x)
+                rate[std::size_t(y) * std::size_t(own.width) + std::size_t(x)] *=
+                    stream_power::edge_taper(own.x0 + x, own.y0 + y, W, H, hm.cell(), open, taper);
+    }
     /// The fastest |rate + base| over every rank (m/yr).
     double fastest(const std::vector<double>& rate, double base) const {
         double fastest = 0.0;
@@ -182,7 +197,10 @@ std::vector<double> steady_uplift(const UpliftInputs& in) {
     const double uniform = ctx.real("uplift") * 1e-3;  // mm/yr → m/yr
     std::vector<double> uplift(in.n, uniform);
     const std::string& layer = ctx.text("uplift_layer");
-    if (layer.empty()) return uplift;
+    if (layer.empty()) {
+        in.taper(uplift);
+        return uplift;
+    }
     if (!in.hm.has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
     const ConstGridView u = in.hm.layer(layer);
     const double years = ctx.real("uplift_layer_years");
@@ -195,6 +213,7 @@ std::vector<double> steady_uplift(const UpliftInputs& in) {
     }
     in.smooth(rate);
     for (std::size_t i = 0; i < in.n; ++i) uplift[i] += rate[i];
+    in.taper(uplift);
     const double fastest = in.fastest(uplift, 0.0);
     if (fastest * 1e3 > kMaxUpliftMmYr) {
         std::ostringstream msg;
@@ -271,6 +290,7 @@ stream_power::UpliftHistory uplift_history(const UpliftInputs& in) {
                                " holds a non-finite height at sample " + std::to_string(in.sample(i)));
         }
         in.smooth(rate);
+        in.taper(rate);
         return rate;
     };
     const double uniform = ctx.real("uplift") * 1e-3;
@@ -418,6 +438,10 @@ NodeOutputs run(NodeContext& ctx) {
 }
 
 void check(CheckContext& ctx) {
+    if (const auto sides = parse_sides(ctx.text("open")); sides && !sides->any() && ctx.real("uplift_edge_taper") > 0.0)
+        ctx.error("uplift_edge_taper",
+                  "uplift_edge_taper tapers the uplift towards the open sides, and open=" + ctx.text("open") +
+                      " opens none; open some sides or give uplift_edge_taper=0");
     if (!parse_sides(ctx.text("open")))
         ctx.error("open",
                   "'" + ctx.text("open") +
@@ -575,6 +599,13 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(kMaxUpliftMmYr)
                     .unit("mm/yr")
                     .help("uniform rock uplift rate (0.1-10 mm/yr in active ranges)"),
+                Param::real("uplift_edge_taper", 0.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("the uplift (all of it) falls smoothly to zero over this distance towards the open sides, "
+                          "as a range's uplift falls to its foreland (0 = the same right up to the sides, which "
+                          "are held at base level)"),
                 Param::string("uplift_layer", "")
                     .help("a layer of the input read as uplift (m) gained over uplift_layer_years, added to "
                           "`uplift`; \"\" = none"),

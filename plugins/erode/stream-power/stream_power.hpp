@@ -245,6 +245,20 @@ inline double inverse_channel_area(const Settings& s) { return s.channel_area > 
 /// The hillslope diffusion a step applies: implicit, open sides fixed, closed sides closed.
 diffusion::Settings hillslope_settings(const Settings& settings);
 
+/// The share of the uplift vertex (x, y) of a width × height grid (cells of `cell` m) keeps when the
+/// uplift falls to zero towards the open sides over `taper` metres: smoothstep(d/taper), d the distance
+/// (m) to the nearest open side; 1 with no open side or taper ≤ 0.
+inline double edge_taper(int x, int y, int width, int height, double cell, const OpenSides& open, double taper) {
+    if (!(taper > 0.0)) return 1.0;
+    double d = taper;
+    if (open.west) d = std::min(d, x * cell);
+    if (open.east) d = std::min(d, (width - 1 - x) * cell);
+    if (open.north) d = std::min(d, y * cell);
+    if (open.south) d = std::min(d, (height - 1 - y) * cell);
+    const double s = d / taper;
+    return s * s * (3.0 - 2.0 * s);
+}
+
 /// The outlet with every side closed: the lowest cell (lowest index among equals).
 std::int64_t lowest_cell(const std::vector<double>& heights);
 

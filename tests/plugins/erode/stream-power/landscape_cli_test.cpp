@@ -161,7 +161,7 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
 
-TEST(LandscapeCli, RainParametersAreCheckedBeforeTheRun) {
+TEST(LandscapeCli, RainAndUpliftTaperParametersAreCheckedBeforeTheRun) {
     TempDir dir;
     const auto spec = dir.write("rain.orogen",
                                 "orogen 1\n"
@@ -169,7 +169,8 @@ TEST(LandscapeCli, RainParametersAreCheckedBeforeTheRun) {
                                 "base = generate:shape(kind=pyramid, height=300)\n"
                                 "a = erode:stream-power(base, wind_from=200)\n"
                                 "b = erode:stream-power(base, rain=orographic, rain_background=0)\n"
-                                "c = erode:stream-power(base, rain=monsoon)\n");
+                                "c = erode:stream-power(base, rain=monsoon)\n"
+                                "d = erode:stream-power(base, open=none, uplift_edge_taper=500)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -178,11 +179,13 @@ TEST(LandscapeCli, RainParametersAreCheckedBeforeTheRun) {
              "rain.orogen:5:63: error: 'rain_background' of erode:stream-power is 0, out of range (0, 20] m/yr",
              "rain.orogen:6:35: error: 'rain' of erode:stream-power is 'monsoon', which is not one of uniform, "
              "orographic",
+             "rain.orogen:7:59: error: erode:stream-power: uplift_edge_taper tapers the uplift towards the open "
+             "sides, and open=none opens none; open some sides or give uplift_edge_taper=0",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
     // A choice that is not one of the choices stops there: no internal message about the missing value.
     EXPECT_EQ(r.err.find("map::at"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("3 errors"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("4 errors"), std::string::npos) << r.err;
 }
 
 TEST(LandscapeCli, OrographicRainAddsItsLayerAndGivesTheSameBytesOnOneAndTwoThreads) {

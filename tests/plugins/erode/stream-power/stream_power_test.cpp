@@ -1246,3 +1246,19 @@ TEST(OrographicRainInTheModel, SameBitsOnOneAndTwoThreads) {
     }
     EXPECT_EQ(0, std::memcmp(results[0].data(), results[1].data(), results[0].size() * sizeof(double)));
 }
+
+TEST(UpliftEdgeTaper, TheUpliftFallsSmoothlyToTheOpenSidesOnly) {
+    // 101 × 51 vertices 30 m apart, open west and south, a 600 m (20-cell) taper.
+    const OpenSides open{false, false, true, true};  // north, east, south, west
+    auto at = [&](int x, int y) { return edge_taper(x, y, 101, 51, 30.0, open, 600.0); };
+    EXPECT_EQ(at(0, 20), 0.0);  // on the west side
+    EXPECT_EQ(at(40, 50), 0.0);  // on the south side
+    EXPECT_EQ(at(50, 20), 1.0);  // further than the taper from both
+    EXPECT_EQ(at(100, 0), 1.0);  // the north-east corner: closed sides keep their uplift
+    EXPECT_DOUBLE_EQ(at(10, 20), 0.5);  // halfway: smoothstep(1/2)
+    EXPECT_DOUBLE_EQ(at(5, 20), 0.25 * 0.25 * 2.5);  // smoothstep(1/4) = 5/32
+    EXPECT_DOUBLE_EQ(at(30, 45), at(5, 20));  // 5 cells from the south side, the nearer
+    for (int x = 0; x < 20; ++x) EXPECT_LT(at(x, 20), at(x + 1, 20)) << x;  // rising...
+    EXPECT_EQ(edge_taper(0, 0, 101, 51, 30.0, open, 0.0), 1.0);  // ...and no taper: everything
+    EXPECT_EQ(edge_taper(0, 0, 101, 51, 30.0, OpenSides{false, false, false, false}, 600.0), 1.0);
+}
