@@ -117,7 +117,7 @@ BENCHMARK(BM_PayloadHash)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime()
 // ------------------------------------------------------------ exports and the cache (issue 30)
 //
 // The whole CLI on a 4097² grid, `export:tiles(format=glb, tile_size=513)` (85 GLB chunks and a tileset,
-// ~1.1 GB), without the cache, with a cold cache, warm into the same --out, and warm into a new --out;
+// ~1.1 GB; spec 0) or `export:gltf` (one 0.68 GB .glb, the issue's case; spec 1), without the cache, with a cold cache, warm into the same --out, and warm into a new --out;
 // then a plain `cp -r` of the same files, in the same process run, so the figures share the machine's
 // load. Each iteration is one child process; the counters are its peak RSS (MiB) and its CPU (user +
 // system, every thread). The scratch folder is under /tmp, on the same disk as the cache folder.
@@ -132,6 +132,12 @@ const fs::path& glb_scratch() {
         std::fputs("orogen 1\nseed 7\ngrid 4097 cell=10\n"
                    "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
                    "export:tiles(t, path=\"tiles/t.json\", tile_size=513, format=glb)\n",
+                   spec);
+        std::fclose(spec);
+        spec = std::fopen((*p / "gltf.orogen").c_str(), "w");
+        std::fputs("orogen 1\nseed 7\ngrid 4097 cell=10\n"
+                   "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
+                   "export:gltf(t, path=\"t.glb\")\n",
                    spec);
         std::fclose(spec);
         std::atexit([] { std::error_code ec; fs::remove_all(glb_scratch(), ec); });  // whichever benchmarks ran
@@ -167,8 +173,12 @@ Child run_child(const std::vector<std::string>& args) {
     return c;
 }
 
-std::vector<std::string> orogen_run(const fs::path& out, const char* cache_mode) {
-    std::vector<std::string> a{OROGEN_CLI, "run", (glb_scratch() / "glb.orogen").string(), "--out", out.string(),
+/// The spec of scenario `spec` (0: export:tiles, 1: export:gltf) and its --out folder.
+fs::path spec_path(int spec) { return glb_scratch() / (spec == 0 ? "glb.orogen" : "gltf.orogen"); }
+fs::path out_path(int spec) { return glb_scratch() / (spec == 0 ? "out" : "out-gltf"); }
+
+std::vector<std::string> orogen_run(const fs::path& out, const char* cache_mode, int spec = 0) {
+    std::vector<std::string> a{OROGEN_CLI, "run", spec_path(spec).string(), "--out", out.string(),
                                "--threads", "2", "--quiet"};
     if (std::string(cache_mode) == "none") a.push_back("--no-cache");
     else a.insert(a.end(), {"--cache", (glb_scratch() / "cache").string()});
@@ -188,16 +198,17 @@ void report(benchmark::State& state, const std::vector<Child>& runs) {
 
 }  // namespace
 
-/// 0: --no-cache; 1: a cold cache (emptied before each run); 2: warm, into the same --out (files in place);
-/// 3: warm, into a new --out (the recorded GLB files are missing: the exporter runs again).
+/// Mode 0: --no-cache; 1: a cold cache (emptied before each run); 2: warm, into the same --out (files in
+/// place); 3: warm, into a new --out (the recorded GLB files are missing: the exporter runs again).
+/// Spec 0: export:tiles; 1: export:gltf.
 static void BM_Glb4097Run(benchmark::State& state) {
-    const int mode = int(state.range(0));
-    const fs::path out = glb_scratch() / "out", cache_dir = glb_scratch() / "cache";
+    const int mode = int(state.range(0)), spec = int(state.range(1));
+    const fs::path out = out_path(spec), cache_dir = glb_scratch() / "cache";
     std::vector<Child> runs;
     if (mode >= 2) {  // warm the cache (and --out) once
         fs::remove_all(cache_dir);
         fs::remove_all(out);
-        if (run_child(orogen_run(out, "cache")).status != 0) state.SkipWithError("warming failed");
+        if (run_child(orogen_run(out, "cache", spec)).status != 0) state.SkipWithError("warming failed");
     }
     for (auto _ : state) {
         state.PauseTiming();
@@ -205,17 +216,26 @@ static void BM_Glb4097Run(benchmark::State& state) {
         if (mode != 2) fs::remove_all(out);
         ::sync();
         state.ResumeTiming();
-        runs.push_back(run_child(orogen_run(out, mode == 0 ? "none" : "cache")));
+        runs.push_back(run_child(orogen_run(out, mode == 0 ? "none" : "cache", spec)));
     }
     report(state, runs);
-    state.SetLabel(mode == 0 ? "--no-cache" : mode == 1 ? "cold cache" : mode == 2 ? "warm, same --out" : "warm, new --out");
+    state.SetLabel(std::string(spec == 0 ? "tiles, " : "gltf, ") +
+                   (mode == 0   ? "--no-cache"
+                    : mode == 1 ? "cold cache"
+                    : mode == 2 ? "warm, same --out"
+                                : "warm, new --out"));
 }
-BENCHMARK(BM_Glb4097Run)->DenseRange(0, 3)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Glb4097Run)
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 /// `cp -r` of the files the run above wrote (its --out), to a fresh folder on the same disk.
 static void BM_Glb4097PlainCopy(benchmark::State& state) {
-    const fs::path out = glb_scratch() / "out", copy = glb_scratch() / "copy";
-    if (!fs::exists(out / "manifest.json")) run_child(orogen_run(out, "none"));
+    const int spec = int(state.range(0));
+    const fs::path out = out_path(spec), copy = glb_scratch() / "copy";
+    if (!fs::exists(out / "manifest.json")) run_child(orogen_run(out, "none", spec));
     std::vector<Child> runs;
     for (auto _ : state) {
         state.PauseTiming();
@@ -229,5 +249,6 @@ static void BM_Glb4097PlainCopy(benchmark::State& state) {
     for (const auto& e : fs::recursive_directory_iterator(out))
         if (e.is_regular_file()) bytes += e.file_size();
     state.counters["MiB"] = double(bytes) / double(1 << 20);
+    state.SetLabel(spec == 0 ? "tiles" : "gltf");
 }
-BENCHMARK(BM_Glb4097PlainCopy)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_Glb4097PlainCopy)->Arg(0)->Arg(1)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -168,7 +168,8 @@ TEST(CacheEntry, EveryStorableValueTypeRoundTripsBitForBit) {
     ph->collisions.push_back({4, 7, 8, {1, 2}, {3, 4}, BoundaryKind::transform, 0.125});
 
     cache::Contents c;
-    c.values = {{"", Value(hm)}, {"img8", Value(img8)}, {"imgf", Value(imgf)}, {"particles", Value(ps)}, {"plates", Value(ph)}};
+    c.values = {
+        {"", Value(hm)}, {"img8", Value(img8)}, {"imgf", Value(imgf)}, {"particles", Value(ps)}, {"plates", Value(ph)}};
     c.files = {{"sub/a.png", {9, 8, 7}}, {"empty.txt", {}}};
     c.recorded = {{"tiles/t_l0_x0_y0.glb", 875u << 20, std::string(64, 'c')}};
     c.messages = {"scree: warning: steep"};
@@ -266,6 +267,25 @@ TEST(CacheEntry, LargeValuesRoundTripThroughTheParallelCopies) {
     EXPECT_EQ(d.values[1].second.image()->rgba8, img->rgba8);
     EXPECT_EQ(d.files, c.files);
     EXPECT_EQ(cache::encode(key, d), bytes);
+    // Encoded as the store writes it, streamed 8 MiB at a time with each block's checksum taken on its way
+    // out: the same seal as over the whole payload (reseal() recomputes it from the whole buffer), and the
+    // same bytes as a second, separately streamed encoding.
+    ASSERT_GT(bytes.size(), std::size_t(19) << 20);
+    auto resealed = bytes;
+    cache::reseal(resealed, key);
+    EXPECT_EQ(resealed, bytes);
+    std::vector<std::uint8_t> streamed;
+    std::size_t pieces = 0;
+    const std::uint64_t size = cache::encode_into(
+        key, c,
+        {[&](std::span<const std::uint8_t> b) {
+             ++pieces;
+             streamed.insert(streamed.end(), b.begin(), b.end());
+         },
+         [&](std::span<const std::uint8_t> h) { std::memcpy(streamed.data(), h.data(), h.size()); }});
+    EXPECT_EQ(size, bytes.size());
+    EXPECT_EQ(streamed, bytes);
+    EXPECT_GE(pieces, 4u) << "the payload went out in pieces, not whole";
     // One flipped bit in the last layer: refused, whichever core copied or checked that part.
     auto bad = bytes;
     bad[bytes.size() - (3u << 20) - 4096] ^= 0x04;
@@ -283,15 +303,14 @@ std::string refusal(const cache::Contents& c, const std::function<void(std::vect
     cache::reseal(bytes, key);
     try {
         cache::decode(bytes, key);
-    } catch (const cache::CorruptEntry& e) {
-        return e.what();
-    }
+    } catch (const cache::CorruptEntry& e) { return e.what(); }
     return "accepted";
 }
 
 /// Replace the first occurrence of `from` after the 192-byte header in `bytes` by `to` (the same length). (Not
 /// in the header: its format version, 3, is a little-endian int like the sizes these tests edit.)
-void replace_bytes(std::vector<std::uint8_t>& bytes, const std::vector<std::uint8_t>& from, const std::vector<std::uint8_t>& to) {
+void replace_bytes(std::vector<std::uint8_t>& bytes, const std::vector<std::uint8_t>& from,
+                   const std::vector<std::uint8_t>& to) {
     const auto it = std::search(bytes.begin() + 192, bytes.end(), from.begin(), from.end());
     ASSERT_NE(it, bytes.end());
     std::copy(to.begin(), to.end(), it);
@@ -333,7 +352,10 @@ TEST(CacheEntry, ASealedButInvalidPayloadIsRefusedNamingWhatIsWrong) {
     cr.recorded = {{"abc/x.png", 3, std::string(64, 'a')}};
     EXPECT_EQ(refusal(cr, [](auto&) {}), "accepted");
     EXPECT_EQ(refusal(cr, path("../../x.p")), "a kept file has a bad path ('../../x.p')");
-    EXPECT_EQ(refusal(cr, [](auto& b) { replace_bytes(b, {'a', 'a', 'a', 'a'}, {'a', 'A', 'a', 'a'}); }),
+    EXPECT_EQ(refusal(cr,
+                      [](auto& b) {
+                          replace_bytes(b, {'a', 'a', 'a', 'a'}, {'a', 'A', 'a', 'a'});
+                      }),
               "a recorded file's SHA-256 is not 64 hex digits");
 
     auto hm = std::make_shared<Heightmap>(3, 2, 4.0, 1.0f);
@@ -367,7 +389,9 @@ TEST(CacheKey, ThePluginsAndTheKernelsBinaryIdentityAreInTheKey) {
     node.node = &desc;
     node.label = "x";
     Plan plan;
-    const auto key = [&](std::string_view identity) { return cache::node_key(plan, node, {}, "p", "0.1.0", identity, 7); };
+    const auto key = [&](std::string_view identity) {
+        return cache::node_key(plan, node, {}, "p", "0.1.0", identity, 7);
+    };
     EXPECT_EQ(key("build-id:aa11"), key("build-id:aa11"));
     EXPECT_NE(key("build-id:aa11"), key("build-id:aa12"));
     EXPECT_NE(key("build-id:aa11"), key("sha256:aa11"));
@@ -397,7 +421,8 @@ TEST(CacheKey, ALoadedPluginsIdentityIsItsBuildIdAndTwoBuildsDiffer) {
 
 TEST(CacheRun, ARebuiltPluginWithTheSameVersionDoesNotFindTheOldBuildsResults) {
     TempDir dir;
-    const fs::path spec = dir.write("s.orogen", "orogen 1\ngrid 9 cell=1\nh = generate:test-stale()\nexport:raw(h, path=\"h.r32\")\n");
+    const fs::path spec =
+        dir.write("s.orogen", "orogen 1\ngrid 9 cell=1\nh = generate:test-stale()\nexport:raw(h, path=\"h.r32\")\n");
     const auto run = [&](const char* variant, const std::string& out) {
         return run_orogen("run " + q(spec) + " --out " + q(dir / out) + " --cache " + q(dir / "cache"),
                           "OROGEN_PLUGIN_PATH=" + q(OROGEN_STALE_PLUGIN_DIR + std::string(variant)));
@@ -441,8 +466,9 @@ TEST(CacheEntry, TheFuzzCorpusHoldsRealEntriesThatDecodeOnceResealed) {
         ++decoded;
     }
     EXPECT_GE(decoded, 8);
-    EXPECT_EQ(kinds, (std::set<int>{int(ValueType::heightmap), int(ValueType::image), int(ValueType::particles),
-                                    int(ValueType::plates), 100}));
+    EXPECT_EQ(kinds,
+              (std::set<int>{int(ValueType::heightmap), int(ValueType::image), int(ValueType::particles),
+                             int(ValueType::plates), 100}));
 }
 
 TEST(CacheEntry, SizesParseWithUnits) {
@@ -531,8 +557,8 @@ TEST(CacheRun, LargeFilesAreRecordedByDigestAndTheirExportRunsAgainWhenTheyAreMi
         const test::RunResult r = f.cached("a", limit);
         ASSERT_EQ(r.exit_code, 0) << r.err;
         const auto rows = cache_column(r.out);
-        EXPECT_EQ(count_rows(rows, ""), 1) << r.out;               // export:raw
-        EXPECT_EQ(row(rows, "scree"), "cached, read") << r.out;    // what it exports
+        EXPECT_EQ(count_rows(rows, ""), 1) << r.out;  // export:raw
+        EXPECT_EQ(row(rows, "scree"), "cached, read") << r.out;  // what it exports
         EXPECT_EQ(disk_hashes(f.dir / "a"), reference) << damage;
         EXPECT_EQ(slurp(f.dir / "a" / "manifest.json"), slurp(f.dir / "plain" / "manifest.json"));
     }
@@ -554,11 +580,11 @@ TEST(CacheRun, ADownstreamChangeRecomputesOnlyWhatItFeeds) {
     const test::RunResult r = f.cached("b", "--set scree.talus=30");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto rows = cache_column(r.out);
-    EXPECT_EQ(row(rows, "base"), "cached") << r.out;         // not even read: nothing that ran needed it
-    EXPECT_EQ(row(rows, "cut"), "cached, read") << r.out;    // read: the thermal erosion starts from it
-    EXPECT_EQ(row(rows, "scree"), "") << r.out;              // recomputed
-    EXPECT_EQ(count_rows(rows, ""), 3) << r.out;             // with the two exports of scree
-    EXPECT_EQ(count_rows(rows, "cached"), 2) << r.out;       // export:png(base) put back from the cache
+    EXPECT_EQ(row(rows, "base"), "cached") << r.out;  // not even read: nothing that ran needed it
+    EXPECT_EQ(row(rows, "cut"), "cached, read") << r.out;  // read: the thermal erosion starts from it
+    EXPECT_EQ(row(rows, "scree"), "") << r.out;  // recomputed
+    EXPECT_EQ(count_rows(rows, ""), 3) << r.out;  // with the two exports of scree
+    EXPECT_EQ(count_rows(rows, "cached"), 2) << r.out;  // export:png(base) put back from the cache
 
     const test::RunResult plain = f.run("plain", "--no-cache --set scree.talus=30");
     ASSERT_EQ(plain.exit_code, 0) << plain.err;
@@ -610,7 +636,9 @@ TEST(CacheRun, DamagedOrTruncatedEntriesAreRecomputedWithAWarningNeverUsed) {
     f.dir.write("t.orogen", std::string(spec_text) + "export:png(scree, path=\"again.png\")\n");
     const test::RunResult r = f.cached("b");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::regex warning("orogen: warning: the cache entry of '[^']+' \\([0-9a-f]{64}\\.orc\\) is damaged \\([^\\n]*\\); recomputing it\\n");
+    const std::regex warning(
+        "orogen: warning: the cache entry of '[^']+' \\([0-9a-f]{64}\\.orc\\) is damaged \\([^\\n]*\\); recomputing "
+        "it\\n");
     const auto n = std::distance(std::sregex_iterator(r.err.begin(), r.err.end(), warning), std::sregex_iterator());
     EXPECT_EQ(n, 6) << r.err;
     EXPECT_NE(r.err.find("truncated"), std::string::npos) << r.err;
@@ -640,7 +668,8 @@ TEST(CacheRun, AnEntryWrittenByAnotherVersionIsIgnored) {
     const test::RunResult r = f.cached("b");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("orogen: note: ignoring the cache entry of 'scree': written by orogen 0.0.1-elsewhere"),
-              std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
     EXPECT_EQ(count_rows(cache_column(r.out), ""), 6) << r.out;
     EXPECT_EQ(manifest_hashes(f.dir / "b"), manifest_hashes(f.dir / "a"));
 }
@@ -650,7 +679,8 @@ TEST(CacheRun, AFolderThatCannotBeWrittenGivesAWarningAndTheRunGoesOn) {
     const fs::path file = f.dir.write("not-a-folder", "x");
     const test::RunResult r = f.run("a", "--cache " + q(file / "cache"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.err.find("orogen: warning: cache folder " + (file / "cache").string() + ": cannot create it"), std::string::npos)
+    EXPECT_NE(r.err.find("orogen: warning: cache folder " + (file / "cache").string() + ": cannot create it"),
+              std::string::npos)
         << r.err;
     EXPECT_NE(r.err.find("running without the cache"), std::string::npos) << r.err;
     EXPECT_EQ(manifest_hashes(f.dir / "a").size(), 4u);
@@ -666,8 +696,8 @@ TEST(CacheRun, EvictionKeepsTheFolderUnderItsLimitAndKeepsTheRecentEntries) {
     // Room for about two runs' entries.
     const std::uint64_t limit = one_run * 2 + one_run / 2;
     for (int seed = 10; seed < 15; ++seed) {
-        const test::RunResult r = f.cached("s" + std::to_string(seed), "--seed " + std::to_string(seed) +
-                                                                     " --cache-size " + std::to_string(limit));
+        const test::RunResult r = f.cached("s" + std::to_string(seed),
+                                           "--seed " + std::to_string(seed) + " --cache-size " + std::to_string(limit));
         ASSERT_EQ(r.exit_code, 0) << r.err;
         EXPECT_LE(entry_bytes(f.cache), limit) << "after seed " << seed;
     }
@@ -682,10 +712,11 @@ TEST(CacheRun, EvictionKeepsTheFolderUnderItsLimitAndKeepsTheRecentEntries) {
 
 TEST(CacheRun, SeriesAreMadeOnlyWhenANodeThatRunsNeedsThem) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 5\n"
-                          "f = generate:test-frames(frames=4)\n"
-                          "g = generate:test-add(f, amount=2)\n"
-                          "export:test-series(g, path=\"s.txt\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 5\n"
+              "f = generate:test-frames(frames=4)\n"
+              "g = generate:test-add(f, amount=2)\n"
+              "export:test-series(g, path=\"s.txt\")\n");
     const std::string env = "OROGEN_PLUGIN_PATH=" + std::string(OROGEN_FAKE_PLUGIN_DIR);
     const std::string cache = " --cache " + q(dir / "cache");
     const test::RunResult plain = run_orogen("run s.orogen --out plain --no-cache", env, dir.path());
@@ -758,15 +789,21 @@ TEST(CacheCommand, InfoCountsTheEntriesAndClearRemovesThemAndNothingElse) {
     EXPECT_NE(info.out.find("temporaries:  1 (13 bytes)"), std::string::npos) << info.out;
     // The size, to the byte when small enough, else to a tenth of the unit.
     char expected_size[64];
-    std::snprintf(expected_size, sizeof expected_size, bytes < 1024 ? "%.0f bytes" : bytes < (1u << 20) ? "%.1f KiB" : "%.1f MiB",
-                  bytes < 1024 ? double(bytes) : bytes < (1u << 20) ? double(bytes) / 1024 : double(bytes) / (1 << 20));
+    std::snprintf(expected_size, sizeof expected_size,
+                  bytes < 1024             ? "%.0f bytes"
+                      : bytes < (1u << 20) ? "%.1f KiB"
+                                           : "%.1f MiB",
+                  bytes < 1024             ? double(bytes)
+                      : bytes < (1u << 20) ? double(bytes) / 1024
+                                           : double(bytes) / (1 << 20));
     EXPECT_NE(info.out.find(std::string("entries:      6 (") + expected_size + ")"), std::string::npos) << info.out;
 
     const test::RunResult clear = run_orogen("cache clear --cache " + q(f.cache));
     ASSERT_EQ(clear.exit_code, 0) << clear.err;
-    EXPECT_NE(clear.out.find("removed 6 cache entries (" + std::string(expected_size) + ")"), std::string::npos) << clear.out;
+    EXPECT_NE(clear.out.find("removed 6 cache entries (" + std::string(expected_size) + ")"), std::string::npos)
+        << clear.out;
     EXPECT_TRUE(entries(f.cache).empty());
-    EXPECT_TRUE(fs::exists(mine));                                       // not an entry: left alone
+    EXPECT_TRUE(fs::exists(mine));  // not an entry: left alone
     EXPECT_TRUE(fs::exists(f.cache / ".tmp-0123456789abcdef-1-0"));  // a run in progress may be writing it
     const test::RunResult after = run_orogen("cache info --cache " + q(f.cache));
     EXPECT_NE(after.out.find("entries:      0 (0 bytes)"), std::string::npos) << after.out;
@@ -813,15 +850,18 @@ TEST(CacheCommand, TheDefaultFolderAndBadUsage) {
 TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
     TempDir dir;
     const auto make_png = [&](int seed) {
-        dir.write("gen.orogen", "orogen 1\ngrid 65 cell=10\nh = generate:diamond-square(amplitude=300)\n"
-                                "export:png(h, path=\"in.png\", bits=16)\n");
-        const test::RunResult r = run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
+        dir.write("gen.orogen",
+                  "orogen 1\ngrid 65 cell=10\nh = generate:diamond-square(amplitude=300)\n"
+                  "export:png(h, path=\"in.png\", bits=16)\n");
+        const test::RunResult r =
+            run_orogen("run gen.orogen --out png --no-cache --seed " + std::to_string(seed), "", dir.path());
         ASSERT_EQ(r.exit_code, 0) << r.err;
         fs::copy_file(dir / "png" / "in.png", dir / "in.png", fs::copy_options::overwrite_existing);
     };
     make_png(1);
-    dir.write("use.orogen", "orogen 1\ngrid 65 cell=10\nh = import:png(path=\"in.png\", low=0, high=300)\n"
-                            "s = erode:thermal(h, talus=30, iterations=5)\nexport:png(s, path=\"s.png\", bits=16)\n");
+    dir.write("use.orogen",
+              "orogen 1\ngrid 65 cell=10\nh = import:png(path=\"in.png\", low=0, high=300)\n"
+              "s = erode:thermal(h, talus=30, iterations=5)\nexport:png(s, path=\"s.png\", bits=16)\n");
     const std::string cache = " --cache " + q(dir / "cache");
     ASSERT_EQ(run_orogen("run use.orogen --out a" + cache, "", dir.path()).exit_code, 0);
     const test::RunResult same = run_orogen("run use.orogen --out b" + cache, "", dir.path());
@@ -844,9 +884,10 @@ TEST(CacheRun, AnImporterAlwaysRunsAndWhatFollowsIsKeyedByWhatItRead) {
 
 TEST(CacheRun, WhatACachedNodeSaidIsSaidAgainWithoutReadingItsValues) {
     TempDir dir;
-    dir.write("p.orogen", "orogen 1\nseed 5\ngrid 65 cell=100\ncrust = generate:diamond-square(amplitude=100)\n"
-                          "plates = tectonics:plates(crust, plates=3, steps=20)\n"
-                          "export:png(plates, path=\"p.png\", bits=16)\n");
+    dir.write("p.orogen",
+              "orogen 1\nseed 5\ngrid 65 cell=100\ncrust = generate:diamond-square(amplitude=100)\n"
+              "plates = tectonics:plates(crust, plates=3, steps=20)\n"
+              "export:png(plates, path=\"p.png\", bits=16)\n");
     const std::string cache = " --cache " + q(dir / "cache");
     const test::RunResult first = run_orogen("run p.orogen --out a" + cache, "", dir.path());
     ASSERT_EQ(first.exit_code, 0) << first.err;

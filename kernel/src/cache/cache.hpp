@@ -113,6 +113,16 @@ bool storable(ValueType type);
 
 /// Serialize into one buffer: header + payload, as written to disk.
 std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents);
+/// Where encode_into() puts an entry: `append` gets its bytes in order (the header as zeros first), then
+/// `header` the real first header_size bytes, once the payload's size and checksum are known.
+struct EntrySink {
+    std::function<void(std::span<const std::uint8_t>)> append;
+    std::function<void(std::span<const std::uint8_t>)> header;
+};
+/// The same bytes as encode(), streamed: at most 8 MiB of the payload is held at a time. Returns the size.
+std::uint64_t encode_into(const Digest& key, const Contents& contents, const EntrySink& sink);
+/// About how large an entry of `contents` is (bytes), before encoding it.
+std::size_t estimated_size(const Contents& contents);
 /// Parse a whole entry. Throws CorruptEntry (damaged, truncated, wrong hash) or OtherVersion.
 Contents decode(std::span<const std::uint8_t> entry, const Digest& key);
 

@@ -146,38 +146,67 @@ Digest payload_hash(std::span<const std::uint8_t> payload) {
     return combine_blocks(payload.size(), digests);
 }
 
-std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
-    std::size_t reserve = header_size + 1024;
-    for (const auto& [name, v] : contents.values) reserve += estimate(v) + name.size();
-    for (const auto& [path, bytes] : contents.files) reserve += bytes.size() + path.size() + 128;
-    for (const auto& f : contents.recorded) reserve += f.path.size() + f.sha256.size() + 32;
-    for (const auto& m : contents.messages) reserve += m.size() + 8;
-    Writer w(reserve);
-    w.buffer().resize(header_size, 0);
-    w.u32(std::uint32_t(contents.messages.size()));
-    for (const auto& m : contents.messages) w.str(m);
-    const std::size_t message_bytes = w.buffer().size() - header_size;
+std::size_t estimated_size(const Contents& contents) {
+    std::size_t bytes = header_size + 1024;
+    for (const auto& [name, v] : contents.values) bytes += estimate(v) + name.size();
+    for (const auto& [path, data] : contents.files) bytes += data.size() + path.size() + 128;
+    for (const auto& f : contents.recorded) bytes += f.path.size() + f.sha256.size() + 32;
+    for (const auto& m : contents.messages) bytes += m.size() + 8;
+    return bytes;
+}
+
+std::uint64_t encode_into(const Digest& key, const Contents& contents, const EntrySink& sink) {
+    // 1. The header (zeros for now) and the messages block, padded to 64 bytes.
+    Writer head(header_size + 1024);
+    head.buffer().resize(header_size, 0);
+    head.u32(std::uint32_t(contents.messages.size()));
+    for (const auto& m : contents.messages) head.str(m);
+    const std::size_t message_bytes = head.buffer().size() - header_size;
     if (message_bytes > max_message_bytes) throw Error("the node printed more than 1 MiB of messages");
-    w.buffer().resize((w.buffer().size() + 63) / 64 * 64, 0);
-    const std::size_t payload_offset = w.buffer().size();
+    head.buffer().resize((head.buffer().size() + 63) / 64 * 64, 0);
+    const Digest messages = detail::sha256_of(head.buffer().data() + header_size, message_bytes);
+    sink.append(head.buffer());
+    // 2. The payload, streamed in whole hash blocks, each block's checksum taken on its way out (both cores).
+    std::vector<Digest> blocks;
+    Writer w(0);
+    w.stream_to(hash_block, 8 * hash_block, [&](std::span<const std::uint8_t> piece) {
+        const std::size_t first = blocks.size(), count = hash_blocks(piece.size());
+        blocks.resize(first + count);
+        parallel_for(0, std::int64_t(count), 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (std::int64_t b = b0; b < b1; ++b)
+                blocks[first + std::size_t(b)] = block_checksum(piece, std::size_t(b));
+        });
+        sink.append(piece);
+    });
     write_payload(w, contents);
-    std::vector<std::uint8_t>& buf = w.buffer();
-    const std::span<const std::uint8_t> payload(buf.data() + payload_offset, buf.size() - payload_offset);
-    std::uint8_t* h = buf.data();
+    w.finish();
+    const std::size_t payload_size = w.size();
+    if (blocks.empty()) blocks.push_back(block_checksum({}, 0));  // an empty payload is one empty block
+    // 3. The header, now that the payload's size and checksum are known.
+    std::uint8_t* h = head.buffer().data();
     std::memcpy(h, magic, sizeof magic);
     put<std::uint32_t>(h + 8, format_version);
     put<std::uint32_t>(h + 12, header_size);
     std::strncpy(reinterpret_cast<char*>(h + 16), OROGEN_VERSION, 31);
-    put<std::uint64_t>(h + 48, payload.size());
-    const Digest ph = payload_checksum(payload);
+    put<std::uint64_t>(h + 48, payload_size);
+    const Digest ph = combine_checksums(payload_size, blocks);
     std::memcpy(h + 56, ph.data(), 32);
     std::memcpy(h + 88, key.data(), 32);
     put<std::uint32_t>(h + 120, std::uint32_t(contents.messages.size()));
     put<std::uint32_t>(h + 124, std::uint32_t(contents.files.size() + contents.recorded.size()));
     put<std::uint64_t>(h + 128, message_bytes);
-    const Digest messages = detail::sha256_of(buf.data() + header_size, message_bytes);
     std::memcpy(h + 136, messages.data(), messages.size());
-    return std::move(buf);
+    sink.header(std::span<const std::uint8_t>(h, header_size));
+    return head.buffer().size() + payload_size;
+}
+
+std::vector<std::uint8_t> encode(const Digest& key, const Contents& contents) {
+    std::vector<std::uint8_t> out;
+    out.reserve(estimated_size(contents));
+    encode_into(key, contents,
+                {[&](std::span<const std::uint8_t> bytes) { out.insert(out.end(), bytes.begin(), bytes.end()); },
+                 [&](std::span<const std::uint8_t> header) { std::memcpy(out.data(), header.data(), header.size()); }});
+    return out;
 }
 
 namespace {

@@ -46,9 +46,35 @@ public:
         if (reserve >= (std::size_t(4) << 20)) advise_huge_pages(buf_.data(), reserve);
     }
     std::vector<std::uint8_t>& buffer() { return buf_; }
+    /// Stream from now on: whenever `threshold` bytes are held, hand the whole multiples of `block` among
+    /// them to `sink`, in order, and drop them (an entry of a 4097² heightmap then never holds a second
+    /// 64 MiB copy). finish() hands on the rest. Offsets (size(), the arrays' alignment) count every byte.
+    void stream_to(std::size_t block, std::size_t threshold, std::function<void(std::span<const std::uint8_t>)> sink) {
+        block_ = block;
+        threshold_ = std::max(threshold, block);
+        sink_ = std::move(sink);
+        buf_.reserve(threshold_);
+    }
+    void finish() {
+        if (sink_ && !buf_.empty()) sink_(std::span<const std::uint8_t>(buf_));
+        flushed_ += buf_.size();
+        buf_.clear();
+    }
+    /// Bytes written so far, streamed or held.
+    std::size_t size() const { return flushed_ + buf_.size(); }
     void raw(const void* p, std::size_t n) {
         const auto* b = static_cast<const std::uint8_t*>(p);
-        buf_.insert(buf_.end(), b, b + n);
+        if (!sink_) {
+            buf_.insert(buf_.end(), b, b + n);
+            return;
+        }
+        while (n > 0) {
+            const std::size_t take = std::min(n, threshold_ - buf_.size());
+            buf_.insert(buf_.end(), b, b + take);
+            b += take;
+            n -= take;
+            if (buf_.size() >= threshold_) flush_blocks();
+        }
     }
     void u8(std::uint8_t v) { raw(&v, 1); }
     void u32(std::uint32_t v) { raw(&v, 4); }
@@ -65,7 +91,8 @@ public:
     void array(const T* data, std::size_t n) {
         static_assert(std::is_trivially_copyable_v<T>);
         u64(n);
-        buf_.resize((buf_.size() + array_alignment - 1) / array_alignment * array_alignment, 0);
+        static constexpr std::uint8_t zeros[array_alignment] = {};
+        raw(zeros, (array_alignment - size() % array_alignment) % array_alignment);
         raw(data, n * sizeof(T));
     }
     template <typename T>
@@ -74,7 +101,15 @@ public:
     }
 
 private:
+    void flush_blocks() {
+        const std::size_t whole = buf_.size() / block_ * block_;
+        sink_(std::span<const std::uint8_t>(buf_.data(), whole));
+        buf_.erase(buf_.begin(), buf_.begin() + std::ptrdiff_t(whole));
+        flushed_ += whole;
+    }
     std::vector<std::uint8_t> buf_;
+    std::size_t flushed_ = 0, block_ = 0, threshold_ = 0;
+    std::function<void(std::span<const std::uint8_t>)> sink_;
 };
 
 /// The copies out of the mapping that decode() leaves for later, to run them all at once on every core

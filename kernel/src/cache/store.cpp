@@ -179,13 +179,7 @@ std::optional<Contents> Store::load(const Digest& key, const std::string& what) 
 
 bool Store::save(const Digest& key, const Contents& contents) {
     if (!usable_ || save_failed_) return false;
-    std::vector<std::uint8_t> bytes;
-    try {
-        bytes = encode(key, contents);
-    } catch (const std::bad_alloc&) {
-        return false;  // too big to copy now: the run goes on uncached
-    }
-    if (bytes.size() > settings_.max_bytes) return false;  // would evict everything else and itself
+    if (estimated_size(contents) > settings_.max_bytes) return false;  // would evict everything else and itself
     static std::atomic<unsigned> counter{0};
     const fs::path final_path = path(key);
     const fs::path tmp = settings_.folder /
@@ -194,18 +188,36 @@ bool Store::save(const Digest& key, const Contents& contents) {
     const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd < 0) why = errno_text(errno);
     else {
-        std::size_t done = 0;
-        while (done < bytes.size()) {
-            const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-            if (n < 0) {
-                if (errno == EINTR) continue;
-                why = errno_text(errno);
-                break;
+        // Streamed straight into the file (encode_into): the entry is never whole in memory, so keeping a
+        // 4097² heightmap costs 8 MiB beside it, not a second 64 MiB copy.
+        auto write_all = [&](std::span<const std::uint8_t> bytes, off_t at, bool positioned) {
+            std::size_t done = 0;
+            while (why.empty() && done < bytes.size()) {
+                const ssize_t n = positioned ? ::pwrite(fd, bytes.data() + done, bytes.size() - done, at + off_t(done))
+                                             : ::write(fd, bytes.data() + done, bytes.size() - done);
+                if (n < 0) {
+                    if (errno != EINTR) why = errno_text(errno);
+                    continue;
+                }
+                done += std::size_t(n);
             }
-            done += std::size_t(n);
+        };
+        std::uint64_t size = 0;
+        bool too_big = false;
+        try {
+            size = encode_into(key, contents,
+                               {[&](std::span<const std::uint8_t> b) { write_all(b, 0, false); },
+                                [&](std::span<const std::uint8_t> h) { write_all(h, 0, true); }});
+            too_big = size > settings_.max_bytes;
+        } catch (const std::bad_alloc&) {
+            too_big = true;  // too big to encode now: the run goes on uncached
         }
         if (::close(fd) != 0 && why.empty()) why = errno_text(errno);
         // No fsync: an entry torn by a power cut fails its hash and is recomputed.
+        if (too_big && why.empty()) {
+            ::unlink(tmp.c_str());
+            return false;
+        }
         if (why.empty() && ::rename(tmp.c_str(), final_path.c_str()) != 0) why = errno_text(errno);
         if (!why.empty()) ::unlink(tmp.c_str());
     }
