@@ -1,164 +1,214 @@
-// A unit test of the kernel's MPI tiling itself (NodeTiling over mpi_comm), not of a whole run: under
-// `mpirun -n R*C tiling_probe W H R C`, every rank fills its owned tile with a known function of the
-// global coordinates, and checks what the primitives give back against that function:
-//   - exchange() of int64, double and float grids (several at once), ghost widths 1-3: every ghost
-//     vertex, corners (diagonal neighbours) included, holds the function at its global position, the
-//     owned part is unchanged, and the ghosted rectangle stops at the grid's edges;
-//   - reduce() sum / min / max over every rank;
-//   - carry() east with gather_rows(): each row's sum over the whole grid, carried tile to tile.
-// The first wrong value is printed (rank, what, x, y, got, want) and the rank exits 1, so mpirun fails.
-// Plain main rather than GoogleTest: every rank checks its own part, and the ranks agree on the outcome.
+// A unit test of the kernel's MPI tiling (NodeTiling, kernel/src/tiles), run
+// under mpiexec on one split: `tiling_probe ROWSxCOLS WIDTH HEIGHT`. Each rank
+// fills its owned tile with a known function of GLOBAL coordinates, then the
+// halo exchange (ghost widths 1-3, several grids at once, float, double and
+// int64), reduce, carry, fetch_samples, scatter and gather must give every
+// cell exactly that function (or its known sum). The first wrong cell is
+// printed (rank, x, y, got, want) and the probe exits 1; a usage error exits 2.
 #include "tiles/mpi_comm.hpp"
 #include "tiles/tiles.hpp"
 
-#include <cmath>
+#include <orogen/tiles.hpp>
+#include <orogen/values.hpp>
+
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
+#include <exception>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 namespace {
 
-using namespace orogen;
+using orogen::TileRect;
+using orogen::Tiling;
 
-/// A value no neighbour could send by accident: distinct for every vertex of grids up to 100003 rows.
-std::int64_t f(int x, int y) { return std::int64_t(x) * 100003 + y; }
+/// The value every rank agrees is at global vertex (x, y); exact in float
+/// (below 2^24 for grids under 160 columns) and in double and int64.
+template <typename T>
+T value_at(int x, int y, int salt) {
+    return T(std::int64_t(x) * 100003 % 16381 * 1000 + std::int64_t(y) * 7 + salt);
+}
+template <>
+std::int64_t value_at<std::int64_t>(int x, int y, int salt) {
+    return std::int64_t(x) * 100003 + y + std::int64_t(salt) * 1000000007;
+}
 
-struct Probe {
-    int rank;
-    int failures = 0;
-    template <typename T>
-    void expect(bool ok, const char* what, int x, int y, T got, std::int64_t want) {
-        if (ok) return;
-        if (failures++ < 5)
-            std::fprintf(stderr, "tiling_probe: rank %d, %s at (%d, %d): got %.17g, want %lld\n", rank, what, x, y,
-                         double(got), (long long)want);
-    }
-};
+int failures = 0;
 
 template <typename T>
-std::vector<T> filled(const Tiling& t, std::int64_t scale, std::int64_t offset, T ghost) {
-    const TileRect g = t.ghosted(), o = t.owned();
-    std::vector<T> v(std::size_t(g.width) * std::size_t(g.height), ghost);
-    for (int y = o.y0; y < o.y1(); ++y)
-        for (int x = o.x0; x < o.x1(); ++x)
-            v[std::size_t(y - g.y0) * std::size_t(g.width) + std::size_t(x - g.x0)] = T(f(x, y) * scale + offset);
-    return v;
+void expect_cell(int rank, const char* what, int x, int y, T got, T want) {
+    if (got == want) return;
+    if (failures++ == 0)  // the first wrong cell says most; the count comes at the end
+        std::fprintf(stderr, "FAIL rank %d %s: cell (x=%d, y=%d) got %.17g want %.17g\n", rank, what, x, y, double(got),
+                     double(want));
 }
 
+void expect_true(int rank, const char* what, bool ok) {
+    if (!ok && failures++ == 0) std::fprintf(stderr, "FAIL rank %d: %s\n", rank, what);
+}
+
+/// One exchange of three grids of type T: every cell of each ghosted grid,
+/// owned part and ghosts (corners from the diagonal neighbours included),
+/// must then hold value_at() of its global coordinate.
 template <typename T>
-void check_grid(Probe& p, const Tiling& t, const std::vector<T>& v, std::int64_t scale, std::int64_t offset,
-                const char* what) {
-    const TileRect g = t.ghosted();
-    for (int y = g.y0; y < g.y1(); ++y)
-        for (int x = g.x0; x < g.x1(); ++x) {
-            const T got = v[std::size_t(y - g.y0) * std::size_t(g.width) + std::size_t(x - g.x0)];
-            const std::int64_t want = f(x, y) * scale + offset;
-            p.expect(got == T(want), what, x, y, got, want);
-        }
-}
-
-void check_ghosted_rect(Probe& p, const Tiling& t) {
-    const TileRect o = t.owned(), g = t.ghosted();
-    const int h = t.halo();
-    const int want_x0 = std::max(0, o.x0 - h), want_y0 = std::max(0, o.y0 - h);
-    const int want_x1 = std::min(t.grid_width(), o.x1() + h), want_y1 = std::min(t.grid_height(), o.y1() + h);
-    p.expect(g.x0 == want_x0 && g.y0 == want_y0, "ghosted corner", g.x0, g.y0, 0, std::int64_t(want_x0));
-    p.expect(g.x1() == want_x1 && g.y1() == want_y1, "ghosted far corner", g.x1(), g.y1(), 0, std::int64_t(want_x1));
-}
-
-void exchanges(Probe& p, TiledRun& run) {
-    for (int halo = 1; halo <= 3; ++halo) {
-        NodeTiling t(run, halo);
-        check_ghosted_rect(p, t);
-        // Two int64 grids in one exchange, then a double grid, then two float views.
-        auto a = filled<std::int64_t>(t, 1, 0, -1), b = filled<std::int64_t>(t, 3, 7, -1);
-        std::int64_t* ints[2] = {a.data(), b.data()};
-        t.exchange(std::span<std::int64_t* const>(ints, 2));
-        check_grid(p, t, a, 1, 0, "int64 grid 1");
-        check_grid(p, t, b, 3, 7, "int64 grid 2");
-        auto d = filled<double>(t, 1, -5, std::numeric_limits<double>::quiet_NaN());
-        double* doubles[1] = {d.data()};
-        t.exchange(std::span<double* const>(doubles, 1));
-        check_grid(p, t, d, 1, -5, "double grid");
-        // Floats hold whole numbers exactly below 2^24: a smaller function of the coordinates.
-        const TileRect g = t.ghosted(), o = t.owned();
-        std::vector<float> u(std::size_t(g.width) * std::size_t(g.height), -1.0f), w = u;
-        for (int y = o.y0; y < o.y1(); ++y)
-            for (int x = o.x0; x < o.x1(); ++x) {
-                u[std::size_t(y - g.y0) * std::size_t(g.width) + std::size_t(x - g.x0)] = float(x * 1000 + y);
-                w[std::size_t(y - g.y0) * std::size_t(g.width) + std::size_t(x - g.x0)] = float(-(x * 1000 + y));
-            }
-        const GridView views[2] = {{u.data(), g.width, g.height, 1.0}, {w.data(), g.width, g.height, 1.0}};
-        t.exchange(std::span<const GridView>(views, 2));
-        for (int y = g.y0; y < g.y1(); ++y)
-            for (int x = g.x0; x < g.x1(); ++x) {
-                const std::size_t i = std::size_t(y - g.y0) * std::size_t(g.width) + std::size_t(x - g.x0);
-                p.expect(u[i] == float(x * 1000 + y), "float view 1", x, y, u[i], x * 1000 + y);
-                p.expect(w[i] == float(-(x * 1000 + y)), "float view 2", x, y, w[i], -(x * 1000 + y));
-            }
+void check_exchange(Tiling& tiling, const char* what) {
+    const TileRect own = tiling.owned(), g = tiling.ghosted();
+    const int h = tiling.halo();
+    // The ghosted rectangle: owned grown by the halo, clipped to the grid (no ghosts past its edge).
+    const TileRect want_g{std::max(0, own.x0 - h), std::max(0, own.y0 - h), 0, 0};
+    expect_true(tiling.rank(), "ghosted() starts at owned() - halo, clipped at 0",
+                g.x0 == want_g.x0 && g.y0 == want_g.y0);
+    expect_true(tiling.rank(), "ghosted() ends at owned() + halo, clipped at the grid's edge",
+                g.x1() == std::min(tiling.grid_width(), own.x1() + h) &&
+                    g.y1() == std::min(tiling.grid_height(), own.y1() + h));
+    constexpr int kGrids = 3;
+    std::vector<std::vector<T>> grids;
+    for (int k = 0; k < kGrids; ++k) {
+        std::vector<T> tile(std::size_t(own.width) * std::size_t(own.height));
+        for (int y = 0; y < own.height; ++y)
+            for (int x = 0; x < own.width; ++x)
+                tile[std::size_t(y) * std::size_t(own.width) + std::size_t(x)] = value_at<T>(own.x0 + x, own.y0 + y, k);
+        grids.push_back(tiling.ghosted_copy(tile.data()));
     }
+    std::vector<T*> pointers;
+    for (auto& grid : grids) pointers.push_back(grid.data());
+    tiling.exchange(std::span<T* const>(pointers));
+    for (int k = 0; k < kGrids; ++k)
+        for (int y = 0; y < g.height; ++y)
+            for (int x = 0; x < g.width; ++x)
+                expect_cell(tiling.rank(), what, g.x0 + x, g.y0 + y,
+                            grids[std::size_t(k)][std::size_t(y) * std::size_t(g.width) + std::size_t(x)],
+                            value_at<T>(g.x0 + x, g.y0 + y, k));
 }
 
-void reductions(Probe& p, TiledRun& run) {
-    NodeTiling t(run, 1);
-    const int R = t.ranks(), r = t.rank();
-    std::int64_t v[3] = {r + 1, 10 - r, 3 * r};
-    t.reduce(std::span<std::int64_t>(v, 3), Tiling::Reduce::sum);
-    p.expect(v[0] == std::int64_t(R) * (R + 1) / 2, "reduce sum", 0, 0, v[0], std::int64_t(R) * (R + 1) / 2);
-    p.expect(v[1] == 10LL * R - std::int64_t(R) * (R - 1) / 2, "reduce sum", 1, 0, v[1],
-             10LL * R - std::int64_t(R) * (R - 1) / 2);
-    const double lo = t.reduce(double(r) - 0.5, Tiling::Reduce::min),
-                 hi = t.reduce(double(r) + 0.25, Tiling::Reduce::max);
-    p.expect(lo == -0.5, "reduce min", 0, 0, lo, 0);
-    p.expect(hi == R - 1 + 0.25, "reduce max", 0, 0, hi, R - 1);
+/// reduce(): sums, minima and maxima of every rank's index and tile size.
+void check_reduce(Tiling& tiling) {
+    const int n = tiling.ranks(), r = tiling.rank();
+    const TileRect own = tiling.owned();
+    expect_cell(r, "reduce sum of tile areas", 0, 0,
+                tiling.reduce<std::int64_t>(std::int64_t(own.width) * own.height, Tiling::Reduce::sum),
+                std::int64_t(tiling.grid_width()) * tiling.grid_height());
+    expect_cell(r, "reduce sum (double)", 0, 0, tiling.reduce<double>(r + 0.5, Tiling::Reduce::sum),
+                n * (n - 1) / 2.0 + 0.5 * n);
+    std::vector<float> span_values{float(r), float(-r)};
+    tiling.reduce(std::span<float>(span_values), Tiling::Reduce::max);
+    expect_cell(r, "reduce max", 0, 0, span_values[0], float(n - 1));
+    expect_cell(r, "reduce max", 1, 0, span_values[1], 0.0f);
+    expect_cell(r, "reduce min", 0, 0, tiling.reduce<std::int64_t>(r - 7, Tiling::Reduce::min), std::int64_t(-7));
 }
 
-void carried_row_sums(Probe& p, TiledRun& run) {
-    NodeTiling t(run, 1);
-    const TileRect o = t.owned();
-    std::vector<double> sums(std::size_t(o.height), 0.0);
-    t.carry(Tiling::Toward::east, sums, 1, [&](int first, int count) {
-        for (int line = first; line < first + count; ++line)
-            for (int x = o.x0; x < o.x1(); ++x) sums[std::size_t(line)] += double(f(x, o.y0 + line));
+/// carry() east and south: a running sum along each whole row (column) of the
+/// grid, which each tile continues from its upstream neighbour's.
+void check_carry(Tiling& tiling) {
+    const TileRect own = tiling.owned();
+    const int r = tiling.rank();
+    std::vector<double> rows(std::size_t(own.height), 0.0);
+    tiling.carry(Tiling::Toward::east, rows, 1, [&](int first, int count) {
+        for (int y = first; y < first + count; ++y)
+            for (int x = own.x0; x < own.x1(); ++x) rows[std::size_t(y)] += value_at<double>(x, own.y0 + y, 0);
     });
-    const std::vector<double> rows = t.gather_rows(sums, 1);
-    const int W = t.grid_width();
-    for (int y = 0; y < t.grid_height(); ++y) {
-        // Σ_x (100003 x + y) over the whole row.
-        const std::int64_t want = 100003LL * W * (W - 1) / 2 + std::int64_t(W) * y;
-        p.expect(rows.size() == std::size_t(t.grid_height()) && rows[std::size_t(y)] == double(want), "carried row sum",
-                 W, y, rows.size() > std::size_t(y) ? rows[std::size_t(y)] : -1.0, want);
+    for (int y = 0; y < own.height; ++y) {
+        double want = 0.0;  // the sum of the row up to this tile's east edge, in the same order
+        for (int x = 0; x < own.x1(); ++x) want += value_at<double>(x, own.y0 + y, 0);
+        expect_cell(r, "carry east", own.x1() - 1, own.y0 + y, rows[std::size_t(y)], want);
     }
+    std::vector<double> columns(std::size_t(own.width), 0.0);
+    tiling.carry(Tiling::Toward::north, columns, 1, [&](int first, int count) {
+        for (int x = first; x < first + count; ++x)
+            for (int y = own.y1() - 1; y >= own.y0; --y) columns[std::size_t(x)] += value_at<double>(own.x0 + x, y, 1);
+    });
+    for (int x = 0; x < own.width; ++x) {
+        double want = 0.0;  // from the grid's south edge up to this tile's north edge
+        for (int y = tiling.grid_height() - 1; y >= own.y0; --y) want += value_at<double>(own.x0 + x, y, 1);
+        expect_cell(r, "carry north", own.x0 + x, own.y0, columns[std::size_t(x)], want);
+    }
+}
+
+/// fetch_samples(), scatter_from_rank0() and the run's gather(): whole-grid
+/// values read back through the tiles.
+void check_moving(Tiling& tiling, orogen::TiledRun& run) {
+    const TileRect own = tiling.owned();
+    const int r = tiling.rank(), w = tiling.grid_width(), h = tiling.grid_height();
+    std::vector<float> mine(std::size_t(own.width) * std::size_t(own.height));
+    for (int y = 0; y < own.height; ++y)
+        for (int x = 0; x < own.width; ++x)
+            mine[std::size_t(y) * std::size_t(own.width) + std::size_t(x)] = value_at<float>(own.x0 + x, own.y0 + y, 2);
+    // A lattice every 3rd column from rank-dependent starts, keeping the far edges.
+    const orogen::AxisSamples columns{r % 3, 3, (w - 1 - r % 3) / 3, w - 1}, rows{0, 2, (h - 1) / 2, h - 1};
+    const std::vector<float> got = tiling.fetch_samples(mine.data(), columns, rows);
+    expect_true(r, "fetch_samples size", got.size() == std::size_t(columns.size()) * std::size_t(rows.size()));
+    for (int j = 0; j < rows.size() && failures == 0; ++j)
+        for (int i = 0; i < columns.size(); ++i)
+            expect_cell(r, "fetch_samples", columns.at(i), rows.at(j),
+                        got[std::size_t(j) * std::size_t(columns.size()) + std::size_t(i)],
+                        value_at<float>(columns.at(i), rows.at(j), 2));
+    std::unique_ptr<orogen::Heightmap> whole;
+    if (r == 0) {
+        whole = std::make_unique<orogen::Heightmap>(w, h, 1.0);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                whole->heights()[std::size_t(y) * std::size_t(w) + std::size_t(x)] = value_at<float>(x, y, 3);
+    }
+    const auto tile = tiling.scatter_from_rank0(whole.get());
+    expect_true(r, "scatter_from_rank0 tile size", tile->width() == own.width && tile->height() == own.height);
+    for (int y = 0; y < own.height && failures == 0; ++y)
+        for (int x = 0; x < own.width; ++x)
+            expect_cell(r, "scatter_from_rank0", own.x0 + x, own.y0 + y,
+                        tile->heights()[std::size_t(y) * std::size_t(own.width) + std::size_t(x)],
+                        value_at<float>(own.x0 + x, own.y0 + y, 3));
+    const orogen::Heightmap mine_map(own.width, own.height, 1.0, mine);
+    const auto gathered = run.gather(&mine_map);
+    if (r != 0) return;
+    expect_true(r, "gather size on rank 0", gathered && gathered->width() == w && gathered->height() == h);
+    for (int y = 0; y < h && failures == 0; ++y)
+        for (int x = 0; x < w; ++x)
+            expect_cell(r, "gather", x, y, gathered->heights()[std::size_t(y) * std::size_t(w) + std::size_t(x)],
+                        value_at<float>(x, y, 2));
+}
+
+int probe(int rows, int cols, int width, int height, int rank) {
+    orogen::TiledRun run(orogen::split_grid(width, height, rows, cols), rank);
+    for (int halo = 1; halo <= 3; ++halo) {
+        orogen::NodeTiling tiling(run, halo);
+        const std::string what = "exchange halo " + std::to_string(halo);
+        check_exchange<float>(tiling, (what + " float").c_str());
+        check_exchange<double>(tiling, (what + " double").c_str());
+        check_exchange<std::int64_t>(tiling, (what + " int64").c_str());
+    }
+    orogen::NodeTiling tiling(run, 1);
+    check_reduce(tiling);
+    check_carry(tiling);
+    check_moving(tiling, run);
+    // Every rank learns whether any failed, so the exit codes agree.
+    return run.agree(failures ? 1 : 0);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 5) {
-        std::fprintf(stderr, "usage: mpirun -n R*C tiling_probe WIDTH HEIGHT R C\n");
+    int rows = 0, cols = 0, width = 0, height = 0;
+    if (argc != 4 || std::sscanf(argv[1], "%dx%d", &rows, &cols) != 2 || (width = std::atoi(argv[2])) < 1 ||
+        (height = std::atoi(argv[3])) < 1) {
+        std::fprintf(stderr, "usage: mpiexec -n R*C tiling_probe RxC WIDTH HEIGHT\n");
         return 2;
     }
-    mpi::Session session(argc, argv);
-    const int W = std::atoi(argv[1]), H = std::atoi(argv[2]), R = std::atoi(argv[3]), C = std::atoi(argv[4]);
-    const TileSplit split = split_grid(W, H, R, C);
-    if (split.count() != session.size()) {
-        std::fprintf(stderr, "tiling_probe: %dx%d tiles need %d ranks, mpirun gave %d\n", R, C, split.count(),
-                     session.size());
-        return 2;
+    try {
+        orogen::mpi::Session session(argc, argv);
+        if (session.size() != rows * cols) {
+            std::fprintf(stderr, "tiling_probe: %d ranks for a %dx%d split\n", session.size(), rows, cols);
+            return 2;
+        }
+        const int code = probe(rows, cols, width, height, session.rank());
+        if (code == 0 && session.rank() == 0)
+            std::printf("tiling_probe %dx%d on %dx%d: every cell as expected\n", rows, cols, width, height);
+        if (failures) std::fprintf(stderr, "rank %d: %d wrong cells or checks\n", session.rank(), failures);
+        return code;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "tiling_probe: %s\n", e.what());
+        orogen::mpi::abort_all(1);
     }
-    TiledRun run(split, session.rank());
-    Probe p{session.rank()};
-    exchanges(p, run);
-    reductions(p, run);
-    carried_row_sums(p, run);
-    // Every rank learns whether any failed, so all exit alike.
-    int worst = p.failures > 0 ? 1 : 0;
-    mpi::max_all(&worst, 1);
-    if (session.rank() == 0)
-        std::printf("tiling_probe: %dx%d tiles of a %dx%d grid: %s\n", R, C, W, H,
-                    worst ? "FAILED" : "all checks pass");
-    return worst;
 }
