@@ -15,6 +15,23 @@ namespace {
 
 using namespace orogen::test;
 
+/// `spec` run on 1 thread and on 2 (`flags` after `run SPEC`), each into its own folder under `dir`:
+/// the runs and their folders, for the determinism tests below to compare.
+struct OneAndTwoThreads {
+    RunResult run[2];
+    std::string out[2];
+};
+OneAndTwoThreads run_on_one_and_two_threads(const TempDir& dir, const std::filesystem::path& spec,
+                                            const std::string& flags = "") {
+    OneAndTwoThreads r;
+    for (int t = 0; t < 2; ++t) {
+        r.out[t] = (dir / ("out" + std::to_string(t + 1))).string();
+        r.run[t] =
+            run_orogen("run " + q(spec) + flags + " --threads " + std::to_string(t + 1) + " --out " + q(r.out[t]));
+    }
+    return r;
+}
+
 TEST(LandscapeCli, OutOfRangeParametersAreCheckTimeErrors) {
     TempDir dir;
     const auto spec =
@@ -85,12 +102,11 @@ TEST(LandscapeCli, RunsWritesItsLayersAndGivesTheSameBytesOnOneAndTwoThreads) {
                                 "export:png(b, path=\"drainage.png\", layer=\"drainage\", bits=16)\n"
                                 "export:png(b, path=\"direction.png\", layer=\"flow_direction\")\n"
                                 "export:png(b, path=\"chi.png\", layer=\"chi\", bits=16)\n");
+    const OneAndTwoThreads runs = run_on_one_and_two_threads(dir, spec, " --quiet");
     std::string bytes[2];
     for (int t = 0; t < 2; ++t) {
-        const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
-        const RunResult r =
-            run_orogen("run " + q(spec) + " --quiet --threads " + std::to_string(t + 1) + " --out " + q(out));
-        ASSERT_EQ(r.exit_code, 0) << r.err;
+        const std::string& out = runs.out[t];
+        ASSERT_EQ(runs.run[t].exit_code, 0) << runs.run[t].err;
         bytes[t] = slurp(out + "/b.r32");
         bytes[t] += slurp(out + "/drainage.png") + slurp(out + "/direction.png") + slurp(out + "/chi.png");
         // The heights changed: rivers cut the cone.
@@ -199,14 +215,12 @@ TEST(LandscapeCli, OrographicRainAddsItsLayerAndGivesTheSameBytesOnOneAndTwoThre
                                 "rain_background=0.7)\n"
                                 "export:raw(a, path=\"a.r32\")\n"
                                 "export:png(a, path=\"rain.png\", layer=\"rain\", bits=16)\n");
+    const OneAndTwoThreads runs = run_on_one_and_two_threads(dir, spec, " --no-cache");
     std::string bytes[2];
     for (int t = 0; t < 2; ++t) {
-        const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
-        const RunResult r =
-            run_orogen("run " + q(spec) + " --no-cache --threads " + std::to_string(t + 1) + " --out " + q(out));
-        ASSERT_EQ(r.exit_code, 0) << r.err;
-        ASSERT_TRUE(std::filesystem::exists(std::filesystem::path(out) / "rain.png"));
-        bytes[t] = slurp(std::filesystem::path(out) / "a.r32");
+        ASSERT_EQ(runs.run[t].exit_code, 0) << runs.run[t].err;
+        ASSERT_TRUE(std::filesystem::exists(std::filesystem::path(runs.out[t]) / "rain.png"));
+        bytes[t] = slurp(runs.out[t] + "/a.r32");
     }
     EXPECT_FALSE(bytes[0].empty());
     EXPECT_EQ(bytes[0], bytes[1]);
@@ -224,10 +238,11 @@ TEST(LandscapeCli, UpliftFromThePlatesHistoryWithDepositionGivesTheSameBytesOnOn
                                 "uplift_history_years=2e5, uplift_smoothing=500, deposition=1)\n"
                                 "export:raw(a, path=\"a.r32\")\n"
                                 "export:raw(p, path=\"p.r32\")\n");
+    const OneAndTwoThreads runs = run_on_one_and_two_threads(dir, spec);
     std::string bytes[2];
     for (int t = 0; t < 2; ++t) {
-        const std::string out = (dir / ("out" + std::to_string(t + 1))).string();
-        const RunResult r = run_orogen("run " + q(spec) + " --threads " + std::to_string(t + 1) + " --out " + q(out));
+        const RunResult& r = runs.run[t];
+        const std::string& out = runs.out[t];
         ASSERT_EQ(r.exit_code, 0) << r.err;
         EXPECT_NE(r.err.find("km³ of sediment left by the outlets"), std::string::npos) << r.err;
         bytes[t] = slurp(out + "/a.r32");
