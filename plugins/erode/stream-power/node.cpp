@@ -438,15 +438,16 @@ NodeOutputs run(NodeContext& ctx) {
 }
 
 void check(CheckContext& ctx) {
-    if (const auto sides = parse_sides(ctx.text("open")); sides && !sides->any() && ctx.real("uplift_edge_taper") > 0.0)
-        ctx.error("uplift_edge_taper",
-                  "uplift_edge_taper tapers the uplift towards the open sides, and open=" + ctx.text("open") +
-                      " opens none; open some sides or give uplift_edge_taper=0");
-    if (!parse_sides(ctx.text("open")))
+    const auto sides = parse_sides(ctx.text("open"));
+    if (!sides)
         ctx.error("open",
                   "'" + ctx.text("open") +
                       "' is not a set of sides; write the letters of the open sides (n, e, s, w), e.g. "
                       "\"nesw\", or all or none (every side closed: the lowest cell is the outlet)");
+    else if (!sides->any() && ctx.real("uplift_edge_taper") > 0.0)
+        ctx.error("uplift_edge_taper",
+                  "uplift_edge_taper tapers the uplift towards the open sides, and open=" + ctx.text("open") +
+                      " opens none; open some sides or give uplift_edge_taper=0");
     if (!parse_base_level(ctx.text("base_level")))
         ctx.error("base_level",
                   "'" + ctx.text("base_level") +
@@ -564,9 +565,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "relief (Smith & Barstad 2004). The same "
             "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
             "glaciers, uniform rain; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw "
-            "rivers where "
-            "it "
-            "exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 north-east; -1 "
+            "rivers where it exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 "
+            "north-east; -1 "
             "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; "
             "added to "
             "an earlier eroder's), uplifted (the rock uplift it received, m; eroded + uplifted is the net change) and, "
