@@ -511,7 +511,8 @@ void check(CheckContext& ctx) {
     // In a tiled run each rank holds its tile's model only (memory_share: this machine's share of the grid).
     const double need = ctx.memory_share() * double(w) * double(hgt) *
         double(stream_power::kBytesPerCell +
-               (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0));
+               (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0) +
+               (ctx.text("rain") == "orographic" ? stream_power::kBytesPerCellRain : 0));
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (have > 0 && need > 0.5 * have) {
         std::ostringstream msg;

@@ -266,5 +266,7 @@ std::int64_t lowest_cell(const std::vector<double>& heights);
 inline constexpr std::size_t kBytesPerCell = 8 + 8 + 8 + 8 + 4 + 4 + 4 + 4 + 1 + 1 + 8 + 16 + 6;
 /// Extra bytes per cell with deposition > 0 (seven doubles, a position and a flag of scratch).
 inline constexpr std::size_t kBytesPerCellDeposition = 7 * 8 + 4 + 1;
+/// Extra bytes per cell with orographic rain: each cell's weight (the coarse grid and its transform are small).
+inline constexpr std::size_t kBytesPerCellRain = 8;
 
 }  // namespace orogen::stream_power
