@@ -168,6 +168,13 @@ void orographic_rain_coarse(const double* heights, int width, int height, double
                 coarse[std::size_t(Y) * std::size_t(cw) + std::size_t(X)] = sum / count;
             }
     });
+    // A non-finite height makes its block's mean non-finite: name the height, not the block.
+    for (std::size_t b = 0; b < coarse.size(); ++b)
+        if (!std::isfinite(coarse[b]))
+            for (std::size_t j = 0; j < std::size_t(width) * std::size_t(height); ++j)
+                if (!std::isfinite(heights[j]))
+                    throw std::invalid_argument("orographic rain: height " + std::to_string(j) +
+                                                " is not a finite number");
     const double coarse_cell = cell * f;
     const double wind_length = rain.wind_speed * (rain.condensation_time + rain.fallout_time);
     const int padding =

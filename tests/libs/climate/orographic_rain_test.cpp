@@ -257,6 +257,12 @@ TEST(OrographicRain, BadInputIsRefusedSayingWhat) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("height 37"), std::string::npos) << e.what();
     }
+    try {  // on the coarse grid too (4 cells a block): the height's own index, not its block's
+        orogen::climate::orographic_rain_coarse(h.data(), 16, 16, 30.0, r, 120.0);
+        FAIL() << "a NaN height was taken on the coarse grid";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("height 37"), std::string::npos) << e.what();
+    }
     h[37] = 100.0;
     r.wind_share = 0.0;
     EXPECT_THROW(orogen::climate::orographic_rain(h.data(), 16, 16, 30.0, r, 4), std::invalid_argument);
