@@ -17,6 +17,7 @@
 
 #include "orogen_test.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -68,6 +69,24 @@ bool read_terrain(const fs::path& path, std::vector<float>& heights, int side = 
 }
 
 /// Runs `spec_name` (pipelines/) with `extra` arguments and checks its terrain.r32 (1025², 30 m) against kBands.
+/// The deepest one-cell slot (m): over the interior samples and the four axes through each (east–west,
+/// north–south, both diagonals), how far the sample lies below the lower of its two neighbours on that axis.
+/// A river that cuts debris or rock as a D8 line leaves slots; real valleys are wider than one 30 m cell.
+double deepest_slot(const std::vector<float>& h, int side) {
+    double deepest = 0.0;
+    const int axes[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+    for (int y = 1; y + 1 < side; ++y)
+        for (int x = 1; x + 1 < side; ++x) {
+            const double z = h[std::size_t(y) * side + x];
+            for (const auto& a : axes) {
+                const double one = h[std::size_t(y + a[1]) * side + (x + a[0])];
+                const double other = h[std::size_t(y - a[1]) * side + (x - a[0])];
+                deepest = std::max(deepest, std::min(one, other) - z);
+            }
+        }
+    return deepest;
+}
+
 void expect_inside_the_bands(const std::string& spec_name, const std::string& extra) {
     TempDir dir;
     const fs::path spec = fs::path(OROGEN_SOURCE_DIR) / "pipelines" / (spec_name + ".orogen");
@@ -83,6 +102,9 @@ void expect_inside_the_bands(const std::string& spec_name, const std::string& ex
         EXPECT_GE(v, b.low) << info.key << " (" << spec_name << " " << extra << ")";
         EXPECT_LE(v, b.high) << info.key << " (" << spec_name << " " << extra << ")";
     }
+    // The gorges the rivers cut in the debris have slumped to 40° (a 25 m drop a cell): no slot one cell wide
+    // deeper than 40 m. Before the pipelines' `banks` pass they reached 142 m.
+    EXPECT_LE(deepest_slot(h, kSide), 40.0) << spec_name << " " << extra;
 }
 
 class DefaultPipeline : public testing::TestWithParam<int> {};
