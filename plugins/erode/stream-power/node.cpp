@@ -583,10 +583,9 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             {
                 Param::real("years", 1e6).min(0.0, true).max(1e9).unit("yr").help("simulated time"),
                 Param::real("dt", 1e4).min(0.0, true).max(1e8).unit("yr").help(
-                    "time step (any size is stable and steady states are exact; the transient is resolved only "
-                    "while a knickpoint moves at most about a cell a step, K*A^m*dt/cell <= 1: for the default "
-                    "pipeline's rivers of 1-100 km2 at 30 m, dt of 70-1800 yr. Larger steps smear the incision "
-                    "upstream, so a landscape tuned at one dt changes at another; docs/landscape.md)"),
+                    "time step (any size is stable and steady states are exact; a transient is not: each step lets the "
+                    "soil creep for the whole dt before the rivers incise, so a landscape tuned at one dt changes at "
+                    "another, most with strong creep; docs/landscape.md)"),
                 Param::real("erodibility", 2e-5)
                     .min(0.0, true)
                     .max(1e-2)
