@@ -119,51 +119,61 @@ std::vector<double> Model::rain() const {
 std::int64_t Model::step(double dt) {
     const std::size_t n = h_.size();
     double* h = h_.data();
-    // 1. Uplift (outlets are base level: they stay).
-    if (!uplift_.empty()) {
-        parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
-            for (std::int64_t i = b; i < e; ++i)
-                if (!flow_.is_outlet(i)) {
-                    h[i] += uplift_[std::size_t(i)] * dt;
-                    uplifted_[std::size_t(i)] += uplift_[std::size_t(i)] * dt;
-                }
-        });
-    }
-    if (history_.rate) add_history_uplift(time_, time_ + dt);
+    const int subs = std::max(1, settings_.substeps);
+    const double sub = dt / subs;  // yr: each sub-step's uplift, creep, incision and landslides
+    // 1. Uplift (outlets are base level: they stay): the first sub-step's, then the rest between incisions.
+    // The constant rate's share is rate·length (for one sub-step, length = dt exactly: the same bits as ever).
+    auto uplift = [&](double t0, double t1, double length) {
+        if (!uplift_.empty()) {
+            parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
+                for (std::int64_t i = b; i < e; ++i)
+                    if (!flow_.is_outlet(i)) {
+                        h[i] += uplift_[std::size_t(i)] * length;
+                        uplifted_[std::size_t(i)] += uplift_[std::size_t(i)] * length;
+                    }
+            });
+        }
+        if (history_.rate) add_history_uplift(t0, t1);
+    };
+    uplift(time_, subs == 1 ? time_ + dt : time_ + sub, subs == 1 ? dt : sub);
     // 2. The rain on the uplifted relief; routing, depressions, drainage area (weighted by the rain).
     if (settings_.orographic_rain) update_rain();
     flow_.route(h, settings_.depressions);
     accumulate(h);
     const std::int64_t pits = flow_.pits();
-    // 3. Hillslope diffusion, before the incision and after the routing: the
-    // implicit incision then leaves every eroded cell strictly above its
-    // receiver, so the next step's routing finds (almost) no pits. Diffusion
-    // after the incision raises valley floors unevenly and left 450–700 pits a
-    // step at 1025² (20,000 at 4097²), each paid for by a local flood, the
-    // basin graph and a second stack walk. Both orders are first-order
-    // splittings of the same equation; this one uses the step's flow graph
-    // for the diffused heights, as the incision uses it for the uplifted ones.
-    if (diffusion_) {
-        std::vector<std::pair<std::int64_t, double>> sink;
-        if (!settings_.open.any())
-            for (std::size_t i = 0; i < n; ++i)
-                if (flow_.is_outlet(std::int64_t(i))) sink.emplace_back(std::int64_t(i), h[i]);
-        diffusion_->step(h, dt);
-        for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
+    for (int k = 0; k < subs; ++k) {
+        if (k > 0) uplift(time_ + k * sub, k + 1 == subs ? time_ + dt : time_ + (k + 1) * sub, sub);
+        const double t = subs == 1 ? dt : sub;
+        // 3. Hillslope diffusion, before the incision and after the routing: the
+        // implicit incision then leaves every eroded cell strictly above its
+        // receiver, so the next step's routing finds (almost) no pits. Diffusion
+        // after the incision raises valley floors unevenly and left 450–700 pits a
+        // step at 1025² (20,000 at 4097²), each paid for by a local flood, the
+        // basin graph and a second stack walk. Both orders are first-order
+        // splittings of the same equation; this one uses the step's flow graph
+        // for the diffused heights, as the incision uses it for the uplifted ones.
+        if (diffusion_) {
+            std::vector<std::pair<std::int64_t, double>> sink;
+            if (!settings_.open.any())
+                for (std::size_t i = 0; i < n; ++i)
+                    if (flow_.is_outlet(std::int64_t(i))) sink.emplace_back(std::int64_t(i), h[i]);
+            diffusion_->step(h, t);
+            for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
+        }
+        // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
+        rock_at(settings_.rock, h, uplifted_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
+        if (settings_.glaciers.any()) glacial_factors(t);
+        if (settings_.deposition > 0.0) incise_with_deposition(t);
+        else incise(t);
+        if (settings_.glaciers.any())
+            carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
+        // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
+        if (settings_.rock.angle > 0.0)
+            threshold::limit_slopes(
+                h, width_, height_, cell_,
+                {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
+                flow_.outlets().data());
     }
-    // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
-    rock_at(settings_.rock, h, uplifted_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
-    if (settings_.glaciers.any()) glacial_factors(dt);
-    if (settings_.deposition > 0.0) incise_with_deposition(dt);
-    else incise(dt);
-    if (settings_.glaciers.any())
-        carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
-    // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
-    if (settings_.rock.angle > 0.0)
-        threshold::limit_slopes(
-            h, width_, height_, cell_,
-            {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
-            flow_.outlets().data());
     time_ += dt;
     return pits;
 }

@@ -69,6 +69,12 @@ struct Settings {
     /// shaped by creep (and, after the run, by landslides: erode:thermal) rather than by D8 lines one cell wide; above a few A_c the
     /// factor is 1 and the law is unchanged.
     double channel_area = 0.0;
+    /// Sub-steps per step (≥ 1): the step's routing and drainage area serve this many sub-steps of
+    /// uplift, creep, incision and landslides of dt/substeps each. Creep for a whole coarse step
+    /// works on the slots the last incision left (U·dt deep) and the incision clears what it moved
+    /// into them at once; sub-steps make that error small at the price of the cheap parts only
+    /// (docs/landscape.md, "The time step is part of a calibration").
+    int substeps = 1;
     /// The rock (rock.hpp): landslides at a threshold angle and beds of varying strength. With
     /// rock.angle > 0, after each step's incision whatever stands steeper than its rock's landslide
     /// angle slides away (threshold_slopes.hpp: the rivers carry the debris off, as in ranges that

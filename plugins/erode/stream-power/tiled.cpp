@@ -680,60 +680,72 @@ void TiledModel::set_uplift_history(UpliftHistory history) {
 
 std::int64_t TiledModel::step(double dt) {
     const std::size_t n = h_.size();
-    // 1. Uplift (outlets are base level: they stay).
-    if (!uplift_.empty())
-        for (std::size_t l = 0; l < n; ++l)
-            if (!outlet_[l]) {
-                h_[l] += uplift_[l] * dt;
-                uplifted_[l] += uplift_[l] * dt;
-            }
-    if (history_.rate)
-        for_history_intervals(history_, history_k_, history_rate_, n, time_, time_ + dt,
-                              [&](const double* rate, double overlap) {
-                                  for (std::size_t l = 0; l < n; ++l)
-                                      if (!outlet_[l]) {
-                                          h_[l] += rate[l] * overlap;
-                                          uplifted_[l] += rate[l] * overlap;
-                                      }
-                              });
+    const int subs = std::max(1, settings_.substeps);
+    const double sub = dt / subs;  // yr (Model::step: the step's routing serves every sub-step)
+    // 1. Uplift (outlets are base level: they stay); for one sub-step, rate·dt exactly.
+    auto uplift = [&](double t0, double t1, double length) {
+        if (!uplift_.empty())
+            for (std::size_t l = 0; l < n; ++l)
+                if (!outlet_[l]) {
+                    h_[l] += uplift_[l] * length;
+                    uplifted_[l] += uplift_[l] * length;
+                }
+        if (history_.rate)
+            for_history_intervals(history_, history_k_, history_rate_, n, t0, t1,
+                                  [&](const double* rate, double overlap) {
+                                      for (std::size_t l = 0; l < n; ++l)
+                                          if (!outlet_[l]) {
+                                              h_[l] += rate[l] * overlap;
+                                              uplifted_[l] += rate[l] * overlap;
+                                          }
+                                  });
+    };
+    const double t_start = time_;
+    uplift(t_start, subs == 1 ? t_start + dt : t_start + sub, subs == 1 ? dt : sub);
     time_ += dt;
     // 2. Routing, depressions, drainage area.
     route(h_.data());
     accumulate();
     const std::int64_t pits = pits_;
-    // 3. Hillslope diffusion across the tiles (the declared sink stays at base level).
-    if (diffusion_) {
-        const std::int64_t sink = settings_.open.any() ? -1 : local_of(sink_);
-        const double sink_h = sink >= 0 ? h_[std::size_t(sink)] : 0.0;
-        diffusion_->step(h_.data(), dt);
-        if (sink >= 0) h_[std::size_t(sink)] = sink_h;
-    }
-    // 4. Implicit incision, receivers first (Model::incise, the same arithmetic), in the rock each cell shows.
-    rock_at(settings_.rock, h_.data(), uplifted_.data(), n, own_.width, own_.x0, own_.y0, cell_, rock_slopes_, rock_k_);
-    const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
-    const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
-    const double c1 = K * dt / std::pow(cell_, ns), c2 = K * dt / std::pow(cell_ * kSqrt2, ns);
-    const double* tab = pow_table_.data();
-    const double inv_ac = inverse_channel_area(settings_);
-    propagate(h_, [&](std::size_t l, double hr) {
-        const double hi = h_[l];
-        if (hi <= hr) return;
-        const int k = dir_[l];
-        double F = area_power(area_[l], tab, inv_a0, a0, m, inv_ac) * ((k & 1) ? c2 : c1);
-        if (!rock_k_.empty()) F *= rock_k_[l];
-        if (ns == 1.0) {
-            const double wt = 1.0 / (1.0 + F);
-            h_[l] = hr + (hi - hr) * wt;
-        } else {
-            h_[l] = hr + incised_drop(hi - hr, F, ns);
+    for (int k = 0; k < subs; ++k) {
+        if (k > 0) uplift(t_start + k * sub, k + 1 == subs ? t_start + dt : t_start + (k + 1) * sub, sub);
+        const double t = subs == 1 ? dt : sub;
+        // 3. Hillslope diffusion across the tiles (the declared sink stays at base level).
+        if (diffusion_) {
+            const std::int64_t sink = settings_.open.any() ? -1 : local_of(sink_);
+            const double sink_h = sink >= 0 ? h_[std::size_t(sink)] : 0.0;
+            diffusion_->step(h_.data(), t);
+            if (sink >= 0) h_[std::size_t(sink)] = sink_h;
         }
-    });
-    // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
-    if (settings_.rock.angle > 0.0)
-        threshold::limit_slopes(
-            tiles_, h_.data(), cell_,
-            {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
-            outlet_.data());
+        // 4. Implicit incision, receivers first (Model::incise, the same arithmetic), in the rock each cell
+        // shows.
+        rock_at(settings_.rock, h_.data(), uplifted_.data(), n, own_.width, own_.x0, own_.y0, cell_, rock_slopes_,
+                rock_k_);
+        const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
+        const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
+        const double c1 = K * t / std::pow(cell_, ns), c2 = K * t / std::pow(cell_ * kSqrt2, ns);
+        const double* tab = pow_table_.data();
+        const double inv_ac = inverse_channel_area(settings_);
+        propagate(h_, [&](std::size_t l, double hr) {
+            const double hi = h_[l];
+            if (hi <= hr) return;
+            const int d = dir_[l];
+            double F = area_power(area_[l], tab, inv_a0, a0, m, inv_ac) * ((d & 1) ? c2 : c1);
+            if (!rock_k_.empty()) F *= rock_k_[l];
+            if (ns == 1.0) {
+                const double wt = 1.0 / (1.0 + F);
+                h_[l] = hr + (hi - hr) * wt;
+            } else {
+                h_[l] = hr + incised_drop(hi - hr, F, ns);
+            }
+        });
+        // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
+        if (settings_.rock.angle > 0.0)
+            threshold::limit_slopes(
+                tiles_, h_.data(), cell_,
+                {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
+                outlet_.data());
+    }
     return pits;
 }
 

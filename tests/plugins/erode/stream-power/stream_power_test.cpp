@@ -123,6 +123,45 @@ TEST(StreamPower, AChannelAreaScalesIncisionByOneMinusExpOfAreaOverIt) {
     EXPECT_GT(steepest_ratio, 5.0) << "small catchments must be steeper than the plain law's";
 }
 
+TEST(StreamPower, SubStepsBringACoarseStepToTheFineStepsTerrain) {
+    // Creep for a whole coarse step works on the slots the last incision left; with Settings::substeps
+    // the step's routing serves sub-steps of uplift, creep and incision, and the terrain of dt = 3e4 in
+    // 6 sub-steps must lie much nearer that of dt = 5e3 than dt = 3e4 alone does. One sub-step is the
+    // plain step, bit for bit.
+    const int w = 96, h = 96;
+    const double cell = 30.0, U = 1e-3;
+    Settings s;
+    s.erodibility = 1e-6;
+    s.area_exponent = 0.7;
+    s.diffusivity = 0.6;
+    s.channel_area = 3e4;
+    auto run = [&](double dt, int substeps) {
+        Settings t = s;
+        t.substeps = substeps;
+        Model model(w, h, cell, noise(w, h, 3, 20.0), std::vector<double>(std::size_t(w) * h, U), t);
+        model.run(6e5, dt);
+        return model.heights();
+    };
+    auto rms = [](const std::vector<double>& a, const std::vector<double>& b) {
+        double sum = 0.0;
+        for (std::size_t i = 0; i < a.size(); ++i) sum += (a[i] - b[i]) * (a[i] - b[i]);
+        return std::sqrt(sum / double(a.size()));
+    };
+    const auto fine = run(5e3, 1), coarse = run(3e4, 1), substepped = run(3e4, 6);
+    const double coarse_error = rms(coarse, fine), substepped_error = rms(substepped, fine);
+    EXPECT_GT(coarse_error, 1.0) << "m: the coarse step must differ from the fine one for this test to mean anything";
+    RecordProperty("coarse_rms_m", std::to_string(coarse_error));
+    RecordProperty("substepped_rms_m", std::to_string(substepped_error));
+    EXPECT_LT(substepped_error, 0.35 * coarse_error)
+        << "coarse " << coarse_error << " m, sub-stepped " << substepped_error << " m (RMS from dt = 5e3)";
+    {
+        Settings t = s;
+        Model plain(w, h, cell, noise(w, h, 3, 20.0), std::vector<double>(std::size_t(w) * h, U), t);
+        plain.run(6e5, 3e4);
+        EXPECT_EQ(plain.heights(), coarse) << "substeps = 1 is the plain step";
+    }
+}
+
 TEST(Landslides, AfterEveryStepNoHillslopeStandsSteeperThanItsThreshold) {
     // Fast uplift and no creep would steepen the hillslopes without end; landslides hold every vertex at
     // most S_c·d above each neighbour (D8 distances), and the rivers still reach steady state below it.
