@@ -586,7 +586,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 Param::real("dt", 1e4).min(0.0, true).max(1e8).unit("yr").help(
                     "time step (any size is stable and steady states are exact; a transient is not: each step lets the "
                     "soil creep for the whole dt before the rivers incise, so a landscape tuned at one dt changes at "
-                    "another, most with strong creep; substeps resolves it cheaply; docs/landscape.md)"),
+                    "another, most with strong creep: it converges once dt/substeps is below about cell^2/D, 750-1500 "
+                    "yr at 30 m with D of 0.6-1.2 m2/yr; docs/landscape.md)"),
                 Param::real("erodibility", 2e-5)
                     .min(0.0, true)
                     .max(1e-2)
@@ -653,7 +654,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("sub-steps per step: each step's routing serves this many sub-steps of uplift, creep, "
                           "incision and landslides of dt/substeps each, so the creep and the incision no longer run "
                           "a whole dt apart (the part of a step that sets its accuracy; the routing is most of the "
-                          "cost). 6 at dt=6e4 gives nearly the terrain of dt=1e4 in 60% of its time"),
+                          "cost). 6 at dt=6e4 gives nearly the terrain of dt=1e4 in 60% of its time; the split "
+                          "converges once dt/substeps is below about cell^2/D"),
                 Param::real("landslide_angle", 0.0)
                     .min(0.0)
                     .max(80.0)
