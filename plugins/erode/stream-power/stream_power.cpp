@@ -122,7 +122,7 @@ std::int64_t Model::step(double dt) {
     const int subs = std::max(1, settings_.substeps);
     const double sub = dt / subs;  // yr: each sub-step's uplift, creep, incision and landslides
     // 1. Uplift (outlets are base level: they stay): the first sub-step's, then the rest between incisions.
-    // The constant rate's share is rate·length (for one sub-step, length = dt exactly: the same bits as ever).
+    // The constant rate's share is rate·length (for one sub-step, dt / 1 = dt exactly: the same bits as ever).
     auto uplift = [&](double t0, double t1, double length) {
         if (!uplift_.empty()) {
             parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
@@ -135,7 +135,7 @@ std::int64_t Model::step(double dt) {
         }
         if (history_.rate) add_history_uplift(t0, t1);
     };
-    uplift(time_, subs == 1 ? time_ + dt : time_ + sub, subs == 1 ? dt : sub);
+    uplift(time_, time_ + sub, sub);
     // 2. The rain on the uplifted relief; routing, depressions, drainage area (weighted by the rain).
     if (settings_.orographic_rain) update_rain();
     flow_.route(h, settings_.depressions);
@@ -143,7 +143,6 @@ std::int64_t Model::step(double dt) {
     const std::int64_t pits = flow_.pits();
     for (int k = 0; k < subs; ++k) {
         if (k > 0) uplift(time_ + k * sub, k + 1 == subs ? time_ + dt : time_ + (k + 1) * sub, sub);
-        const double t = subs == 1 ? dt : sub;
         // 3. Hillslope diffusion, before the incision and after the routing: the
         // implicit incision then leaves every eroded cell strictly above its
         // receiver, so the next step's routing finds (almost) no pits. Diffusion
@@ -157,14 +156,14 @@ std::int64_t Model::step(double dt) {
             if (!settings_.open.any())
                 for (std::size_t i = 0; i < n; ++i)
                     if (flow_.is_outlet(std::int64_t(i))) sink.emplace_back(std::int64_t(i), h[i]);
-            diffusion_->step(h, t);
+            diffusion_->step(h, sub);
             for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
         }
         // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
         rock_at(settings_.rock, h, uplifted_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
-        if (settings_.glaciers.any()) glacial_factors(t);
-        if (settings_.deposition > 0.0) incise_with_deposition(t);
-        else incise(t);
+        if (settings_.glaciers.any()) glacial_factors(sub);
+        if (settings_.deposition > 0.0) incise_with_deposition(sub);
+        else incise(sub);
         if (settings_.glaciers.any())
             carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
         // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).

@@ -701,7 +701,7 @@ std::int64_t TiledModel::step(double dt) {
                                   });
     };
     const double t_start = time_;
-    uplift(t_start, subs == 1 ? t_start + dt : t_start + sub, subs == 1 ? dt : sub);
+    uplift(t_start, t_start + sub, sub);
     time_ += dt;
     // 2. Routing, depressions, drainage area.
     route(h_.data());
@@ -709,12 +709,11 @@ std::int64_t TiledModel::step(double dt) {
     const std::int64_t pits = pits_;
     for (int k = 0; k < subs; ++k) {
         if (k > 0) uplift(t_start + k * sub, k + 1 == subs ? t_start + dt : t_start + (k + 1) * sub, sub);
-        const double t = subs == 1 ? dt : sub;
         // 3. Hillslope diffusion across the tiles (the declared sink stays at base level).
         if (diffusion_) {
             const std::int64_t sink = settings_.open.any() ? -1 : local_of(sink_);
             const double sink_h = sink >= 0 ? h_[std::size_t(sink)] : 0.0;
-            diffusion_->step(h_.data(), t);
+            diffusion_->step(h_.data(), sub);
             if (sink >= 0) h_[std::size_t(sink)] = sink_h;
         }
         // 4. Implicit incision, receivers first (Model::incise, the same arithmetic), in the rock each cell
@@ -723,7 +722,7 @@ std::int64_t TiledModel::step(double dt) {
                 rock_k_);
         const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
         const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
-        const double c1 = K * t / std::pow(cell_, ns), c2 = K * t / std::pow(cell_ * kSqrt2, ns);
+        const double c1 = K * sub / std::pow(cell_, ns), c2 = K * sub / std::pow(cell_ * kSqrt2, ns);
         const double* tab = pow_table_.data();
         const double inv_ac = inverse_channel_area(settings_);
         propagate(h_, [&](std::size_t l, double hr) {
