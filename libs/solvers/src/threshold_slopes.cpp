@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <span>
 #include <utility>
 #include <stdexcept>
@@ -29,24 +30,54 @@ struct Sweeps {
     /// How far above a neighbour `cell` away vertex i may stand, straight (1) or diagonal (√2).
     double step(std::size_t i) const { return (slopes ? slopes[i] : slope) * cell; }
 
-    /// Row r of the columns [a, b) from row `from` (r ± 1): its three neighbours there, those in the
-    /// columns just outside [a, b) read from `west` and `east` (a copy of those columns, by row, or null
-    /// where the grid ends). Returns the vertices lowered.
-    std::int64_t row_from(int r, int from, int a, int b, const double* west, const double* east) const {
+    /// Row r's vertices in the columns [a, b), taken east- or westward: each from its eight
+    /// neighbours (edge_bound over the stencil's eight triangles); those in the columns just outside
+    /// [a, b) read from `west` and `east` (a copy of those columns, by row, or null where the grid
+    /// ends). Returns the vertices lowered.
+    std::int64_t row_update(int r, int a, int b, const double* west, const double* east, bool eastward) const {
+        constexpr double kNone = std::numeric_limits<double>::infinity();
         std::int64_t lowered = 0;
-        const double* src = g + std::size_t(from) * std::size_t(gw);
         const std::size_t base = std::size_t(r) * std::size_t(gw);
-        double* dst = g + base;
+        double* row = g + base;
+        const double* up = r > 0 ? row - gw : nullptr;
+        const double* down = r + 1 < gh ? row + gw : nullptr;
         const std::uint8_t* fx = fixed ? fixed + base : nullptr;
-        for (int c = a; c < b; ++c) {
-            const double straight = step(base + std::size_t(c)), diagonal = straight * kSqrt2;
-            double best = src[c] + straight;
-            if (c > a) best = std::min(best, src[c - 1] + diagonal);
-            else if (west) best = std::min(best, west[from] + diagonal);
-            if (c + 1 < b) best = std::min(best, src[c + 1] + diagonal);
-            else if (east) best = std::min(best, east[from] + diagonal);
-            if (best < dst[c] && (fx == nullptr || fx[c] == 0)) {
-                dst[c] = best;
+        // The value of line `l` (up, row or down; row y of the edge copies) at column c, or none.
+        auto at = [&](const double* l, int y, int c) {
+            if (l == nullptr) return kNone;
+            if (c < a) return west ? west[y] : kNone;
+            if (c >= b) return east ? east[y] : kNone;
+            return l[c];
+        };
+        for (int k = 0; k < b - a; ++k) {
+            const int c = eastward ? a + k : b - 1 - k;
+            if (fx && fx[c]) continue;
+            const double step = this->step(base + std::size_t(c)), diagonal = step * kSqrt2;
+            double n, s, w, e, nw, ne, sw, se;
+            if (up && down && c > a && c + 1 < b) {  // inside the strip, between two rows: no test
+                n = up[c], s = down[c], w = row[c - 1], e = row[c + 1];
+                nw = up[c - 1], ne = up[c + 1], sw = down[c - 1], se = down[c + 1];
+            } else {
+                n = at(up, r - 1, c), s = at(down, r + 1, c), w = at(row, r, c - 1), e = at(row, r, c + 1);
+                nw = at(up, r - 1, c - 1), ne = at(up, r - 1, c + 1);
+                sw = at(down, r + 1, c - 1), se = at(down, r + 1, c + 1);
+            }
+            // Every bound is at least the lower of its two neighbours + step (√(1 + t²) ≥ 1): a vertex
+            // no more than that above its lowest neighbour keeps its height.
+            const double straight = std::min(std::min(n, s), std::min(w, e));
+            const double corner = std::min(std::min(nw, ne), std::min(sw, se));
+            if (!(std::min(straight, corner) + step < row[c])) continue;
+            double best = std::min(straight + step, corner + diagonal);
+            // An edge's inner points give more than min(axial, diagonal) + 1.03·step, and its axial
+            // end already gave axial + step ≥ best: only an edge whose corner is below best − step can
+            // lower the vertex further (the skipped ones could not: the same value, in less time).
+            auto edge = [&](double axial, double corner_h) {
+                if (corner_h + step < best) best = std::min(best, edge_interior(axial, corner_h, step));
+            };
+            edge(n, nw), edge(n, ne), edge(s, sw), edge(s, se);
+            edge(w, nw), edge(w, sw), edge(e, ne), edge(e, se);
+            if (best < row[c]) {
+                row[c] = best;
                 ++lowered;
             }
         }
@@ -57,7 +88,7 @@ struct Sweeps {
     /// strip reads its neighbours' edge columns as they were when the sweep began (values only fall, so
     /// a stale one lowers less, never wrongly; a round that changes nothing read none stale), so the
     /// strips run in parallel and never touch each other's memory.
-    std::int64_t vertical_pass(bool down) const {
+    std::int64_t vertical_pass(bool down, bool eastward) const {
         constexpr int kStrip = 256;
         const int strips = (x1 - x0 + kStrip - 1) / kStrip;
         // First every strip's edge columns, before any strip moves: then no thread reads what another writes.
@@ -82,46 +113,21 @@ struct Sweeps {
                 const double* e = b < gw ? edge(int(s), 1) : nullptr;
                 std::int64_t mine = 0;
                 if (down)
-                    for (int r = std::max(y0, 1); r < y1; ++r) mine += row_from(r, r - 1, a, b, w, e);
+                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, w, e, eastward);
                 else
-                    for (int r = std::min(y1, gh - 1) - 1; r >= y0; --r) mine += row_from(r, r + 1, a, b, w, e);
+                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, w, e, eastward);
                 lowered += mine;
             }
         });
         return lowered.load();
     }
 
-    std::int64_t vertical() const { return vertical_pass(true) + vertical_pass(false); }
-
-    /// East then west along each row, the rows in parallel (each reads and writes only its own).
-    std::int64_t horizontal() const {
-        std::atomic<std::int64_t> lowered{0};
-        parallel_for(y0, y1, 64, [&](std::int64_t b, std::int64_t e) {
-            std::int64_t mine = 0;
-            for (std::int64_t r = b; r < e; ++r) {
-                const std::size_t base = std::size_t(r) * std::size_t(gw);
-                double* row = g + base;
-                const std::uint8_t* fx = fixed ? fixed + base : nullptr;
-                for (int c = std::max(x0, 1); c < x1; ++c)
-                    if (const double v = row[c - 1] + step(base + std::size_t(c));
-                        v < row[c] && (fx == nullptr || fx[c] == 0)) {
-                        row[c] = v;
-                        ++mine;
-                    }
-                for (int c = std::min(x1, gw - 1) - 1; c >= x0; --c)
-                    if (const double v = row[c + 1] + step(base + std::size_t(c));
-                        v < row[c] && (fx == nullptr || fx[c] == 0)) {
-                        row[c] = v;
-                        ++mine;
-                    }
-            }
-            lowered += mine;
-        });
-        return lowered.load();
+    /// One round: the four orders of fast sweeping (Zhao 2005), down and up the rows, east- and
+    /// westward along them, so a slope facing any way is carried across the grid in one round.
+    std::int64_t round() const {
+        return vertical_pass(true, true) + vertical_pass(false, false) + vertical_pass(true, false) +
+            vertical_pass(false, true);
     }
-
-    /// One round: every vertex updated from all eight neighbours at least once.
-    std::int64_t round() const { return vertical() + horizontal(); }
 };
 
 void check_slope(double cell, const Slopes& slopes) {

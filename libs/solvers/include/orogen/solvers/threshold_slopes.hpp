@@ -9,17 +9,30 @@
 //
 //     h'(x) = min over y of ( h(y) + S_c · d(x, y) ),
 //
-// the highest surface at or below h whose slope between neighbouring
-// vertices nowhere exceeds S_c = tan(angle), d the length of the shortest
-// path over the 8-neighbour grid (cell and cell·√2 steps). What is above h'
+// the highest surface at or below h whose slope nowhere exceeds
+// S_c = tan(angle), d the distance from x to y over the grid. What is above h'
 // has slid away; nothing is raised, so the limit makes no pit (a lowered
 // vertex lies S_c·d above the neighbour that lowered it).
 //
+// d is the Euclidean distance, not the 8-neighbour path's: with only the
+// cell and cell·√2 steps every slope would face one of eight directions
+// (octagonal cones; planar facets at 22.5° + k·45° that make a hillshade
+// look cut from crystal, up to 8 % further than the true distance between
+// them). So a vertex is also held by the points between a straight
+// neighbour and the diagonal one beside it, at t = 1/4, 1/2, 3/4 of the way
+// (edge_bound below): the semi-Lagrangian stencil of the eikonal equation
+// |∇h'| = S_c (Tsitsiklis 1995, Sethian & Vladimirsky 2001), linear between
+// the two neighbours, so a plane at the threshold is held at any azimuth
+// to 0.5 %. Every bound is a sum of the neighbours' heights with weights
+// ≥ 0 and a constant, so it rises (or stays) when they rise, in floating
+// point too.
+//
 // Computed as a greatest fixed point, h' = min(h, min over neighbours of
-// h'(nb) + S_c·d), by sweeps of that update in the four directions (down,
-// up, right, left: each reads the row or column it just finished, so a
-// sweep's vertices on one row or column are independent and run in
-// parallel) until a round changes nothing (usually two to four rounds). The
+// the bounds they give), by Gauss–Seidel sweeps in the four orders of fast
+// sweeping (Zhao 2005: down or up the rows, east- or westward along them;
+// strips of columns side by side in parallel, each reading its neighbours'
+// edge columns as they were when the sweep began) until a round changes
+// nothing (usually two to four rounds). The
 // update is monotone, even in floating point (rounding is monotone), so any
 // order of sweeps, any thread count and any split into tiles reach the very
 // same bits: the greatest fixed point below h.
@@ -27,9 +40,25 @@
 
 #include <orogen/tiles.hpp>
 
+#include <algorithm>
 #include <cstdint>
 
 namespace orogen::threshold {
+
+/// The lowest height (m) the points strictly between a straight neighbour at `axial` and the
+/// diagonal neighbour beside it at `diagonal` let a vertex keep, the threshold rising `step` =
+/// S_c·cell per cell: the least of (1 − t)·axial + t·diagonal + step·√(1 + t²) over t = 1/4, 1/2, 3/4.
+inline double edge_interior(double axial, double diagonal, double step) {
+    constexpr double kL1 = 1.0307764064044151, kL2 = 1.1180339887498949, kL3 = 1.25;  // √(1 + t²)
+    return std::min(std::min(0.75 * axial + 0.25 * diagonal + step * kL1, 0.5 * axial + 0.5 * diagonal + step * kL2),
+                    0.25 * axial + 0.75 * diagonal + step * kL3);
+}
+
+/// The whole edge, its ends (the two neighbours, t = 0 and 1) included.
+inline double edge_bound(double axial, double diagonal, double step) {
+    constexpr double kSqrt2 = 1.4142135623730951;
+    return std::min(std::min(axial + step, diagonal + step * kSqrt2), edge_interior(axial, diagonal, step));
+}
 
 /// What a limit did.
 struct Result {
