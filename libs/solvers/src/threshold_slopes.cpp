@@ -26,6 +26,12 @@ struct Sweeps {
     const std::uint8_t* fixed;  // gw × gh, or null
     const double* slopes;  // gw × gh S_c per vertex (m/m), or null: `slope` everywhere
     double slope, cell;  // S_c (m/m), the vertex spacing (m)
+    /// gw × gh: the pass in which each vertex was last lowered (0: not yet), or null. With it, a pass
+    /// after the first takes only the vertices with a neighbour (or themselves) lowered in the pass
+    /// before or in this one: a vertex none of whose neighbours moved since it was last taken already
+    /// stands at or below its bound. That changes which updates run, not the fixed point they reach.
+    std::int32_t* moved = nullptr;
+    mutable int pass = 0;  // the passes so far
 
     /// How far above a neighbour `cell` away vertex i may stand, straight (1) or diagonal (√2).
     double step(std::size_t i) const { return (slopes ? slopes[i] : slope) * cell; }
@@ -34,7 +40,9 @@ struct Sweeps {
     /// neighbours (edge_bound over the stencil's eight triangles); those in the columns just outside
     /// [a, b) read from `west` and `east` (a copy of those columns, by row, or null where the grid
     /// ends). Returns the vertices lowered.
-    std::int64_t row_update(int r, int a, int b, const double* west, const double* east, bool eastward) const {
+    /// `west_moved`, `east_moved`: `moved` of the same columns, copied likewise (with `moved` only).
+    std::int64_t row_update(int r, int a, int b, const double* west, const double* east, const std::int32_t* west_moved,
+                            const std::int32_t* east_moved, bool eastward) const {
         constexpr double kNone = std::numeric_limits<double>::infinity();
         std::int64_t lowered = 0;
         const std::size_t base = std::size_t(r) * std::size_t(gw);
@@ -49,9 +57,29 @@ struct Sweeps {
             if (c >= b) return east ? east[y] : kNone;
             return l[c];
         };
+        const int since = pass - 1;  // lowered in the pass before or in this one
+        const bool skip = moved != nullptr && pass > 1;
+        auto moved_at = [&](int y, int c) {
+            if (y < 0 || y >= gh) return false;
+            if (c < a) return west_moved != nullptr && west_moved[y] >= since;
+            if (c >= b) return east_moved != nullptr && east_moved[y] >= since;
+            return moved[std::size_t(y) * std::size_t(gw) + std::size_t(c)] >= since;
+        };
         for (int k = 0; k < b - a; ++k) {
             const int c = eastward ? a + k : b - 1 - k;
             if (fx && fx[c]) continue;
+            if (skip) {
+                bool any = false;
+                if (r > 0 && r + 1 < gh && c > a && c + 1 < b) {
+                    const std::int32_t* m = moved + base + std::size_t(c) - 1;
+                    for (const std::int32_t* l : {m - gw, m, m + gw})
+                        any = any || l[0] >= since || l[1] >= since || l[2] >= since;
+                } else {
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dx = -1; dx <= 1; ++dx) any = any || moved_at(r + dy, c + dx);
+                }
+                if (!any) continue;
+            }
             const double step = this->step(base + std::size_t(c)), diagonal = step * kSqrt2;
             double n, s, w, e, nw, ne, sw, se;
             if (up && down && c > a && c + 1 < b) {  // inside the strip, between two rows: no test
@@ -78,6 +106,7 @@ struct Sweeps {
             edge(w, nw), edge(w, sw), edge(e, ne), edge(e, se);
             if (best < row[c]) {
                 row[c] = best;
+                if (moved) moved[base + std::size_t(c)] = pass;
                 ++lowered;
             }
         }
@@ -97,12 +126,19 @@ struct Sweeps {
             return edges.data() + (std::size_t(s) * 2 + std::size_t(side)) * std::size_t(gh);
         };
         auto strip = [&](int s) { return std::pair{x0 + s * kStrip, std::min(x1, x0 + (s + 1) * kStrip)}; };
+        ++pass;
+        std::vector<std::int32_t> edge_moved(moved ? edges.size() : 0);
+        auto edge_m = [&](int s, int side) {
+            return moved ? edge_moved.data() + (std::size_t(s) * 2 + std::size_t(side)) * std::size_t(gh) : nullptr;
+        };
         for (int s = 0; s < strips; ++s) {
             const auto [a, b] = strip(s);
             for (int r = 0; r < gh; ++r) {
                 const std::size_t row = std::size_t(r) * std::size_t(gw);
                 if (a > 0) edge(s, 0)[r] = g[row + std::size_t(a - 1)];
                 if (b < gw) edge(s, 1)[r] = g[row + std::size_t(b)];
+                if (moved && a > 0) edge_m(s, 0)[r] = moved[row + std::size_t(a - 1)];
+                if (moved && b < gw) edge_m(s, 1)[r] = moved[row + std::size_t(b)];
             }
         }
         std::atomic<std::int64_t> lowered{0};
@@ -111,11 +147,13 @@ struct Sweeps {
                 const auto [a, b] = strip(int(s));
                 const double* w = a > 0 ? edge(int(s), 0) : nullptr;
                 const double* e = b < gw ? edge(int(s), 1) : nullptr;
+                const std::int32_t* wm = a > 0 ? edge_m(int(s), 0) : nullptr;
+                const std::int32_t* em = b < gw ? edge_m(int(s), 1) : nullptr;
                 std::int64_t mine = 0;
                 if (down)
-                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, w, e, eastward);
+                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, w, e, wm, em, eastward);
                 else
-                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, w, e, eastward);
+                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, w, e, wm, em, eastward);
                 lowered += mine;
             }
         });
@@ -156,7 +194,9 @@ Result limit_slopes(double* heights, int width, int height, double cell, const S
     check_slope(cell, slopes);
     const std::size_t n = std::size_t(width) * std::size_t(height);
     const std::vector<double> before(heights, heights + n);
-    const Sweeps s{heights, width, height, 0, 0, width, height, fixed, slopes.per_vertex, slopes.uniform, cell};
+    std::vector<std::int32_t> moved(n, 0);
+    const Sweeps s{heights,           width,          height, 0,           0, width, height, fixed,
+                   slopes.per_vertex, slopes.uniform, cell,   moved.data()};
     Result result;
     do ++result.rounds;
     while (s.round() > 0);

@@ -22,8 +22,8 @@
 // neighbour and the diagonal one beside it, at t = 1/4, 1/2, 3/4 of the way
 // (edge_bound below): the semi-Lagrangian stencil of the eikonal equation
 // |∇h'| = S_c (Tsitsiklis 1995, Sethian & Vladimirsky 2001), linear between
-// the two neighbours, so a plane at the threshold is held at any azimuth
-// to 0.5 %. Every bound is a sum of the neighbours' heights with weights
+// the two neighbours, so a valley side at any azimuth stands within 2 % of
+// S_c times its distance to the river (tests/libs/solvers). Every bound is a sum of the neighbours' heights with weights
 // ≥ 0 and a constant, so it rises (or stays) when they rise, in floating
 // point too.
 //
@@ -32,7 +32,9 @@
 // sweeping (Zhao 2005: down or up the rows, east- or westward along them;
 // strips of columns side by side in parallel, each reading its neighbours'
 // edge columns as they were when the sweep began) until a round changes
-// nothing (usually two to four rounds). The
+// nothing (usually two to four rounds). After the first sweep a sweep takes
+// only the vertices next to one lowered since (the others already stand at
+// or below their bound): fewer updates, the same fixed point. The
 // update is monotone, even in floating point (rounding is monotone), so any
 // order of sweeps, any thread count and any split into tiles reach the very
 // same bits: the greatest fixed point below h.
