@@ -1,9 +1,11 @@
 // Tests of the threshold-slope limit (threshold_slopes.hpp): the known surfaces
-// it must give (a cone around a fixed point, a plane away from a fixed
-// line), the three properties that define it on rough relief (nothing
-// steeper than S_c, nothing raised, each lowered vertex held up by the
-// neighbour that lowered it, so no pit), and the same bits as a plain
-// Jacobi iteration to the fixed point and on any thread count.
+// it must give (a round cone around a fixed point, valley sides at the
+// threshold whatever the valley's azimuth, a plane away from a fixed
+// edge), the three properties that define it on rough relief (nothing
+// steeper than S_c, nothing raised, each lowered vertex held exactly at
+// the bound its neighbours give it, above a lower one, so no pit), and the
+// same bits as a plain Jacobi iteration to the fixed point and on any
+// thread count.
 #include <orogen/solvers/threshold_slopes.hpp>
 
 #include <orogen/random.hpp>
@@ -39,7 +41,7 @@ struct Neighbour {
 constexpr Neighbour kNeighbours[] = {{-1, -1, kSqrt2}, {0, -1, 1.0},    {1, -1, kSqrt2}, {-1, 0, 1.0},
                                      {1, 0, 1.0},      {-1, 1, kSqrt2}, {0, 1, 1.0},     {1, 1, kSqrt2}};
 
-/// The bound each vertex gets from its neighbours (-1: outside the grid) in v: the least edge_bound
+/// The bound vertex (x, y) gets from its neighbours in v (none outside the grid): the least edge_bound
 /// over the eight triangles of its stencil, each a straight neighbour and a diagonal one beside it.
 double bound_at(const std::vector<double>& v, int w, int h, int x, int y, double step) {
     auto at = [&](int dx, int dy) {
