@@ -36,10 +36,8 @@ std::vector<std::uint8_t> sides() {
     return f;
 }
 
-void BM_threshold_from_rough(benchmark::State& state) {
-    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
-    const auto start = rough();
-    const auto fixed = sides();
+/// Times the limit of a copy of `start` (the copy untimed), reporting its rounds.
+void limit_copies(benchmark::State& state, const std::vector<double>& start, const std::vector<std::uint8_t>& fixed) {
     for (auto _ : state) {
         state.PauseTiming();
         auto h = start;
@@ -48,6 +46,11 @@ void BM_threshold_from_rough(benchmark::State& state) {
         benchmark::DoNotOptimize(r);
         state.counters["rounds"] = r.rounds;
     }
+}
+
+void BM_threshold_from_rough(benchmark::State& state) {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
+    limit_copies(state, rough(), sides());
 }
 BENCHMARK(BM_threshold_from_rough)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
@@ -58,14 +61,7 @@ void BM_threshold_after_uplift(benchmark::State& state) {
     threshold::limit_slopes(limited.data(), kSide, kSide, kCell, {kSlope}, fixed.data());
     for (std::size_t i = 0; i < limited.size(); ++i)
         if (!fixed[i]) limited[i] += 30.0;
-    for (auto _ : state) {
-        state.PauseTiming();
-        auto h = limited;
-        state.ResumeTiming();
-        const auto r = threshold::limit_slopes(h.data(), kSide, kSide, kCell, {kSlope}, fixed.data());
-        benchmark::DoNotOptimize(r);
-        state.counters["rounds"] = r.rounds;
-    }
+    limit_copies(state, limited, fixed);
 }
 BENCHMARK(BM_threshold_after_uplift)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
