@@ -110,6 +110,8 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.rock.dip_south = -std::cos(ctx.real("bed_dip_toward") * rad);
     s.rock.angle_spread = ctx.real("bed_angle_spread") * rad;
     s.rock.erodibility_contrast = ctx.real("bed_erodibility_contrast");
+    s.rock.fold_amplitude = ctx.real("bed_fold_amplitude");
+    s.rock.fold_wavelength = ctx.real("bed_fold_wavelength");
     s.rock.seed = ctx.seed();
     if (ctx.flag("glaciers")) {
         s.glaciers.ela = ctx.real("ela");
@@ -464,7 +466,8 @@ void check(CheckContext& ctx) {
     // The beds' parameters describe beds: without a thickness there are none, and a spread of landslide
     // angles needs landslides.
     if (!(ctx.real("bed_thickness") > 0.0))
-        for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast"})
+        for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast",
+                              "bed_fold_amplitude", "bed_fold_wavelength"})
             if (ctx.given(p))
                 ctx.error(p, std::string(p) + " describes the rock's beds; give bed_thickness (m) as well");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
@@ -685,6 +688,19 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(1000.0)
                     .help("erodibility of the weakest bed over the strongest's (1 = the same; shale against "
                           "sandstone ~10, Sklar & Dietrich 2001)"),
+                Param::real("bed_fold_amplitude", 0.0)
+                    .min(0.0)
+                    .max(1e5)
+                    .unit("m")
+                    .help("folded beds: their surfaces rise and fall by up to this in folds whose axes run along "
+                          "the strike, so the outcrops bend and end instead of running straight across the map "
+                          "(a few bed thicknesses; 0 = planar beds)"),
+                Param::real("bed_fold_wavelength", 5000.0)
+                    .min(100.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("the folds' wavelength across their axes (3 times as long along them): 1-10 km in "
+                          "fold-and-thrust belts"),
                 Param::boolean("glaciers", false)
                     .help("valley glaciers: ice gathers above the ELA, flows down the valleys, erodes "
                           "ice_erodibility*Q^ice_flux_exponent*S^n and carves U-shaped troughs (docs/landscape.md); "

@@ -8,10 +8,15 @@
 // beds). This is what spreads a range's slopes over many angles rather than
 // one, and cuts benches, hogbacks and strike valleys where the beds surface.
 //
-// The beds are planar, `thickness` metres thick, dipping at `dip` towards
-// azimuth `toward`; each has a strength s in (0, 1), one of 256 classes drawn
-// from the seed and its index (counter-based: the same beds on any thread
-// count and any tiling).
+// The beds are `thickness` metres thick, dipping at `dip` towards azimuth
+// `toward`; each has a strength s in (0, 1), one of 256 classes drawn from
+// the seed and its index (counter-based: the same beds on any thread count
+// and any tiling). Planar beds crop out in bands that run straight across a
+// whole range, a tell no real range shows: real strata are folded. With a
+// fold amplitude the bed surfaces rise and fall by up to that many metres
+// in folds `fold_wavelength` across and three times as long along their
+// axes, which run along the strike (a smooth random field from the seed):
+// the outcrops bend, close around the folds' noses and end.
 // The rock a cell shows is the one at its rock height ζ = h − uplift received
 // (the height that rock had at the start: the beds rise with the uplift, and
 // erosion digs into them). Its landslide angle is angle + spread·(2s − 1) and
@@ -33,12 +38,21 @@ struct Beds {
     double angle = 0.0;  ///< mean landslide angle, radians (0: no landslides)
     double angle_spread = 0.0;  ///< radians: ± from the weakest bed to the strongest
     double erodibility_contrast = 1.0;  ///< K of the weakest bed / K of the strongest (≥ 1)
+    double fold_amplitude = 0.0;  ///< m: the bed surfaces rise and fall by up to this (0: planar beds)
+    double fold_wavelength = 5000.0;  ///< m, across the fold axes (3 times as long along them)
     std::uint64_t seed = 0;
 
     /// A bed's strength is one of this many classes, s = (k + 1/2)/kStrengths.
     static constexpr int kStrengths = 256;
 
     bool layered() const { return thickness > 0.0; }
+    bool folded() const { return layered() && fold_amplitude > 0.0; }
+    /// The height (m) the folds lift the bed surfaces at (x, y) (m from the grid's north-west corner,
+    /// x east, y south), in [-fold_amplitude, fold_amplitude]; 0 when not folded.
+    double fold(double x, double y) const;
+    /// The height (m) above the bed surface through the origin of the rock at rock height `zeta` (m)
+    /// at (x, y) is zeta + offset(x, y): the dip's and the folds' part, the same at every step.
+    double offset(double x, double y) const;
     /// The strength class k of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
     /// corner, x east, y south), from the seed and the bed's index; kStrengths/2 when unlayered.
     int bed_class(double zeta, double x, double y) const;
@@ -50,10 +64,15 @@ struct Beds {
     double erodibility_factor(double s) const;
 };
 
-/// Each cell's landslide slope (tan) and erodibility factor, from its height and the uplift it received
-/// (both `count` values of a width-`width` block whose first cell is (x0, y0) of the grid, cells `cell`
-/// metres apart). `slopes` / `factors` are resized; either is left empty when it would be uniform.
-void rock_at(const Beds& beds, const double* heights, const double* uplifted, std::size_t count, int width, int x0,
-             int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors);
+/// Beds::offset of each of the `count` cells of a width-`width` block whose first cell is (x0, y0) of the
+/// grid, cells `cell` metres apart; left empty when the rock is not layered. Computed once per run.
+void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0, double cell,
+                 std::vector<double>& offsets);
+
+/// Each cell's landslide slope (tan) and erodibility factor, from its height, the uplift it received and
+/// its bed_offsets (all `count` values). `slopes` / `factors` are resized; either is left empty when it
+/// would be uniform.
+void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
+             std::vector<double>& slopes, std::vector<double>& factors);
 
 }  // namespace orogen::stream_power

@@ -186,6 +186,7 @@ private:
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
+    std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
     double time_ = 0.0, sediment_out_ = 0.0;

@@ -159,7 +159,9 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "c = erode:stream-power(base, landslide_angle=30, bed_thickness=50, bed_angle_spread=28)\n"
                   "d = erode:stream-power(base, ela=2000)\n"
                   "e = erode:stream-power(base, glaciers=true, deposition=1)\n"
-                  "f = erode:stream-power(base, landslide_angle=85)\n");
+                  "f = erode:stream-power(base, landslide_angle=85)\n"
+                  "g = erode:stream-power(base, bed_fold_amplitude=200)\n"
+                  "h = erode:stream-power(base, bed_thickness=50, bed_fold_amplitude=200, bed_fold_wavelength=50)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -173,6 +175,10 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:8:39: error: erode:stream-power: glaciers erode detachment-limited for now; give "
              "deposition=0 or glaciers=false",
              "rock.orogen:9:46: error: 'landslide_angle' of erode:stream-power is 85, out of range [0, 80] °",
+             "rock.orogen:10:49: error: erode:stream-power: bed_fold_amplitude describes the rock's beds; give "
+             "bed_thickness (m) as well",
+             "rock.orogen:11:92: error: 'bed_fold_wavelength' of erode:stream-power is 50, out of range [100, "
+             "1000000] m",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }

@@ -16,6 +16,7 @@
 #include <cstring>
 #include <map>
 #include <numeric>
+#include <set>
 #include <vector>
 
 namespace {
@@ -224,6 +225,56 @@ TEST(Beds, ABedDipsTowardsItsAzimuthAndKeepsItsStrength) {
     beds.angle_spread = 10.0 * M_PI / 180.0;
     EXPECT_NEAR(beds.landslide_slope(0.0), std::tan(25.0 * M_PI / 180.0), 1e-12);
     EXPECT_NEAR(beds.landslide_slope(1.0), std::tan(45.0 * M_PI / 180.0), 1e-12);
+}
+
+TEST(Beds, FoldsBendTheOutcropsWithinTheirAmplitudeAndRunAlongTheStrike) {
+    // Beds dipping 20° towards 30°, folded by up to 400 m in folds 4 km across. On a level surface a planar
+    // bed crops out along the strike as a straight band; a folded one bends in and out of it.
+    Beds beds;
+    beds.thickness = 100.0;
+    beds.dip_slope = std::tan(20.0 * M_PI / 180.0);
+    beds.dip_east = std::sin(30.0 * M_PI / 180.0);
+    beds.dip_south = -std::cos(30.0 * M_PI / 180.0);
+    beds.seed = 5;
+    const double strike_e = -beds.dip_south, strike_s = beds.dip_east;  // along the strike
+    auto classes_along_strike = [&] {
+        std::set<int> seen;
+        for (int k = 0; k < 400; ++k)
+            seen.insert(beds.bed_class(300.0, 15000.0 + 50.0 * k * strike_e, 15000.0 + 50.0 * k * strike_s));
+        return seen.size();
+    };
+    EXPECT_EQ(classes_along_strike(), 1u) << "a planar bed's outcrop runs straight along the strike";
+    EXPECT_EQ(beds.fold(1234.0, 5678.0), 0.0);
+
+    beds.fold_amplitude = 400.0;
+    beds.fold_wavelength = 4000.0;
+    EXPECT_GE(classes_along_strike(), 4u) << "folds carry the outcrop across several beds along the strike";
+    double sum2 = 0.0, step_across = 0.0, step_along = 0.0, biggest_cell_step = 0.0;
+    const int n = 4000;
+    for (int k = 0; k < n; ++k) {
+        const double x = 37.0 * k, y = 60000.0 - 23.0 * k - 9.0 * (k % 17) * 100.0;
+        const double f = beds.fold(x, y);
+        ASSERT_LE(std::abs(f), beds.fold_amplitude) << "at " << x << ", " << y;
+        sum2 += f * f;
+        // The folds' axes run along the strike: the surfaces change faster across them (along the dip).
+        const double d = 1000.0;
+        step_across += std::abs(beds.fold(x + d * beds.dip_east, y + d * beds.dip_south) - f);
+        step_along += std::abs(beds.fold(x + d * strike_e, y + d * strike_s) - f);
+        // Smooth: one 30 m cell moves a surface by a small part of the amplitude.
+        biggest_cell_step = std::max(biggest_cell_step, std::abs(beds.fold(x + 30.0, y) - f));
+    }
+    const double rms = std::sqrt(sum2 / n);
+    EXPECT_GT(rms, 0.15 * beds.fold_amplitude) << "the folds must have some height";
+    EXPECT_GT(step_across, 1.8 * step_along) << "folds three times as long as they are wide";
+    EXPECT_LT(biggest_cell_step, 0.05 * beds.fold_amplitude);
+    // The beds still dip, with the folds' lift added: the same bed lies tan(dip)·along lower `along` metres
+    // towards the dip, and as much higher as the folds lift it more there.
+    for (int k = 0; k < 200; ++k) {
+        const double z = -500.0 + 7.3 * k, x = 13.0 * k, y = 5000.0 - 11.0 * k, along = 250.0;
+        const double x2 = x + along * beds.dip_east, y2 = y + along * beds.dip_south;
+        EXPECT_EQ(beds.bed_class(z, x, y),
+                  beds.bed_class(z - beds.dip_slope * along + (beds.fold(x2, y2) - beds.fold(x, y)), x2, y2));
+    }
 }
 
 TEST(Beds, StrongBedsStandSteeperThanWeakOnes) {
