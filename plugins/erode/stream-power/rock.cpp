@@ -30,6 +30,12 @@ double value_noise(double u, double v, std::uint64_t seed, std::uint64_t octave)
 /// Keeps the folds' random values apart from the beds' strengths, which use the seed itself.
 constexpr std::uint64_t kFoldSalt = 0x666f6c6473ull;  // "folds"
 
+/// The strength class of the bed at height q (m) above the bed surface through the origin.
+int class_of(const Beds& beds, double q) {
+    const auto bed = static_cast<std::int64_t>(std::floor(q / beds.thickness));
+    return int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(bed)));
+}
+
 }  // namespace
 
 double Beds::fold(double x, double y) const {
@@ -48,13 +54,6 @@ double Beds::offset(double x, double y) const {
     // given height there lies in a lower bed.
     return dip_slope * (x * dip_east + y * dip_south) - fold(x, y);
 }
-
-namespace {
-int class_of(const Beds& beds, double q) {
-    const auto bed = static_cast<std::int64_t>(std::floor(q / beds.thickness));
-    return int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(bed)));
-}
-}  // namespace
 
 int Beds::bed_class(double zeta, double x, double y) const {
     if (!layered()) return kStrengths / 2;
