@@ -23,9 +23,9 @@
 // (edge_bound below): the semi-Lagrangian stencil of the eikonal equation
 // |∇h'| = S_c (Tsitsiklis 1995, Sethian & Vladimirsky 2001), linear between
 // the two neighbours, so a valley side at any azimuth stands within 2 % of
-// S_c times its distance to the river (tests/libs/solvers). Every bound is a sum of the neighbours' heights with weights
-// ≥ 0 and a constant, so it rises (or stays) when they rise, in floating
-// point too.
+// S_c times its distance to the river (tests/libs/solvers). Every bound is
+// a sum of the neighbours' heights with weights ≥ 0 and a constant, so it
+// rises (or stays) when they rise, in floating point too.
 //
 // Computed as a greatest fixed point, h' = min(h, min over neighbours of
 // the bounds they give), by Gauss–Seidel sweeps in the four orders of fast
