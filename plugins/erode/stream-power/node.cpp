@@ -112,6 +112,9 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.rock.erodibility_contrast = ctx.real("bed_erodibility_contrast");
     s.rock.fold_amplitude = ctx.real("bed_fold_amplitude");
     s.rock.fold_wavelength = ctx.real("bed_fold_wavelength");
+    s.rock.thickness_spread = ctx.real("bed_thickness_spread");
+    s.rock.fault_spacing = ctx.real("bed_fault_spacing");
+    s.rock.fault_throw = ctx.real("bed_fault_throw");
     s.rock.seed = ctx.seed();
     if (ctx.flag("glaciers")) {
         s.glaciers.ela = ctx.real("ela");
@@ -466,10 +469,18 @@ void check(CheckContext& ctx) {
     // The beds' parameters describe beds: without a thickness there are none, and a spread of landslide
     // angles needs landslides.
     if (!(ctx.real("bed_thickness") > 0.0))
-        for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast",
-                              "bed_fold_amplitude", "bed_fold_wavelength"})
+        for (const char* p :
+             {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast", "bed_fold_amplitude",
+              "bed_fold_wavelength", "bed_thickness_spread", "bed_fault_spacing", "bed_fault_throw"})
             if (ctx.given(p))
                 ctx.error(p, std::string(p) + " describes the rock's beds; give bed_thickness (m) as well");
+    if ((ctx.real("bed_fault_spacing") > 0.0) != (ctx.real("bed_fault_throw") > 0.0))
+        ctx.error(ctx.real("bed_fault_spacing") > 0.0 ? "bed_fault_spacing" : "bed_fault_throw",
+                  "faults need both a spacing and a throw; give bed_fault_spacing (m) and bed_fault_throw (m)");
+    if (const double spacing = ctx.real("bed_fault_spacing"); spacing > 0.0 && spacing < 100.0)
+        ctx.error("bed_fault_spacing",
+                  "faults closer than 100 m apart would shatter the rock cell by cell; give "
+                  "bed_fault_spacing >= 100 (m), or 0 for no faults");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
@@ -701,6 +712,23 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .unit("m")
                     .help("the folds' wavelength across their axes (3 times as long along them): 1-10 km in "
                           "fold-and-thrust belts"),
+                Param::real("bed_thickness_spread", 0.0)
+                    .min(0.0)
+                    .max(0.95)
+                    .help("beds of uneven thickness: from (1 - this) to (1 + this) times bed_thickness, so the "
+                          "outcrops are spaced unevenly (0 = all alike)"),
+                Param::real("bed_fault_spacing", 0.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("faulted beds: one fault of random strike, 1-3 times this long, per this square on "
+                          "average; the outcrops step across each fault (0 = no faults; give bed_fault_throw)"),
+                Param::real("bed_fault_throw", 0.0)
+                    .min(0.0)
+                    .max(1e5)
+                    .unit("m")
+                    .help("the faults' largest vertical offset of the beds, at a fault's middle (1/4 to all of "
+                          "it, from the seed; a bed thickness or more to show)"),
                 Param::boolean("glaciers", false)
                     .help("valley glaciers: ice gathers above the ELA, flows down the valleys, erodes "
                           "ice_erodibility*Q^ice_flux_exponent*S^n and carves U-shaped troughs (docs/landscape.md); "

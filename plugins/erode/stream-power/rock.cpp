@@ -30,10 +30,52 @@ double value_noise(double u, double v, std::uint64_t seed, std::uint64_t octave)
 /// Keeps the folds' random values apart from the beds' strengths, which use the seed itself.
 constexpr std::uint64_t kFoldSalt = 0x666f6c6473ull;  // "folds"
 
+/// ... and the beds' thicknesses and the faults from the strengths and from each other.
+constexpr std::uint64_t kThicknessSalt = 0x746869636bull;  // "thick"
+constexpr std::uint64_t kFaultSalt = 0x6661756c7473ull;  // "faults"
+
 /// The strength class of the bed at height q (m) above the bed surface through the origin.
 int class_of(const Beds& beds, double q) {
-    const auto bed = static_cast<std::int64_t>(std::floor(q / beds.thickness));
-    return int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(bed)));
+    return int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(beds.bed_at(q))));
+}
+
+/// One fault: its trace's middle (m), the unit vector along it, its half-length (m) and its throw (m, the
+/// far side of the trace (left of the direction) is lifted by half of it, the near side dropped by half).
+struct Fault {
+    double x = 0.0, y = 0.0, along_x = 1.0, along_y = 0.0, half_length = 0.0, throw_m = 0.0;
+};
+
+/// The fault of lattice square (a, b) (squares `fault_spacing` across, a east, b south): its middle
+/// anywhere in the square, any strike, 1–3 spacings long, a throw of 1/4 to all of fault_throw.
+Fault fault_in(const Beds& beds, std::int64_t a, std::int64_t b) {
+    const std::uint64_t s = random::hash(beds.seed, kFaultSalt);
+    const auto u = [&](std::uint64_t k) { return random::uniform(s, std::uint64_t(a), std::uint64_t(b), k); };
+    const double spacing = beds.fault_spacing, strike = std::numbers::pi * u(2);
+    return {(double(a) + u(0)) * spacing, (double(b) + u(1)) * spacing,           std::cos(strike), std::sin(strike),
+            spacing * (0.5 + u(3)),       beds.fault_throw * (0.25 + 0.75 * u(4))};
+}
+
+/// How far a fault lifts the beds at (x, y): ± half its throw on either side of the trace, greatest at its
+/// middle and dying away (smoothly, as (1 − r²)²) to nothing at its half-length from the middle.
+double fault_lift(const Fault& f, double x, double y) {
+    const double dx = x - f.x, dy = y - f.y;
+    const double along = dx * f.along_x + dy * f.along_y, across = dy * f.along_x - dx * f.along_y;
+    const double r2 = (along * along + across * across) / (f.half_length * f.half_length);
+    if (r2 >= 1.0) return 0.0;
+    return (across >= 0.0 ? 0.5 : -0.5) * f.throw_m * (1.0 - r2) * (1.0 - r2);
+}
+
+/// The faults' lift at (x, y): the sum over the 5 × 5 lattice squares around it (a fault reaches at most
+/// 1.5 spacings from its middle, which lies in its square), in one fixed order. `fault_of(a, b)` gives
+/// square (a, b)'s fault, so a caller can look them up in a table rather than draw them again.
+template <typename FaultOf>
+double faults_lift(const Beds& beds, double x, double y, FaultOf&& fault_of) {
+    const auto a0 = static_cast<std::int64_t>(std::floor(x / beds.fault_spacing));
+    const auto b0 = static_cast<std::int64_t>(std::floor(y / beds.fault_spacing));
+    double lift = 0.0;
+    for (std::int64_t b = b0 - 2; b <= b0 + 2; ++b)
+        for (std::int64_t a = a0 - 2; a <= a0 + 2; ++a) lift += fault_lift(fault_of(a, b), x, y);
+    return lift;
 }
 
 }  // namespace
@@ -49,10 +91,30 @@ double Beds::fold(double x, double y) const {
     return fold_amplitude * f / 1.5;
 }
 
+double Beds::fault(double x, double y) const {
+    if (!faulted()) return 0.0;
+    return faults_lift(*this, x, y, [&](std::int64_t a, std::int64_t b) { return fault_in(*this, a, b); });
+}
+
 double Beds::offset(double x, double y) const {
-    // The bed's base rises towards the dip's opposite and where the folds lift it (an arch): the rock at a
-    // given height there lies in a lower bed.
-    return dip_slope * (x * dip_east + y * dip_south) - fold(x, y);
+    // The bed's base rises towards the dip's opposite and where the folds or the faults lift it: the rock
+    // at a given height there lies in a lower bed.
+    return dip_slope * (x * dip_east + y * dip_south) - fold(x, y) - fault(x, y);
+}
+
+std::int64_t Beds::bed_at(double q) const {
+    auto bed = static_cast<std::int64_t>(std::floor(q / thickness));
+    if (thickness_spread > 0.0) {
+        // Bed k's base is at thickness·(k + spread·(u_k − 1/2)): within half a thickness of k·thickness,
+        // so q lies in bed k − 1, k or k + 1, and two bases tell which.
+        const std::uint64_t s = random::hash(seed, kThicknessSalt);
+        const auto base = [&](std::int64_t k) {
+            return thickness * (double(k) + thickness_spread * (random::uniform(s, std::uint64_t(k)) - 0.5));
+        };
+        if (q < base(bed)) --bed;
+        else if (q >= base(bed + 1)) ++bed;
+    }
+    return bed;
 }
 
 int Beds::bed_class(double zeta, double x, double y) const {
@@ -76,10 +138,31 @@ void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0,
                  std::vector<double>& offsets) {
     offsets.resize(beds.layered() ? count : 0);
     if (!beds.layered()) return;
+    // The faults of every lattice square within reach of the block, drawn once (Beds::fault draws the 25
+    // around a point each time it is asked); faults_lift adds them up in the same order either way.
+    std::vector<Fault> table;
+    std::int64_t a_lo = 0, b_lo = 0, a_count = 0;
+    if (beds.faulted()) {
+        const int height = int(count / std::size_t(width));
+        const auto square = [&](int c) { return static_cast<std::int64_t>(std::floor(c * cell / beds.fault_spacing)); };
+        a_lo = square(x0) - 2, b_lo = square(y0) - 2;
+        a_count = square(x0 + width - 1) + 3 - a_lo;
+        const std::int64_t b_count = square(y0 + height - 1) + 3 - b_lo;
+        table.resize(std::size_t(a_count * b_count));
+        for (std::int64_t b = 0; b < b_count; ++b)
+            for (std::int64_t a = 0; a < a_count; ++a)
+                table[std::size_t(b * a_count + a)] = fault_in(beds, a_lo + a, b_lo + b);
+    }
+    const auto fault_of = [&](std::int64_t a, std::int64_t b) -> const Fault& {
+        return table[std::size_t((b - b_lo) * a_count + (a - a_lo))];
+    };
     parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i)
-            offsets[std::size_t(i)] =
-                beds.offset(double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
+        for (std::int64_t i = b; i < e; ++i) {
+            const double x = double(x0 + int(i % width)) * cell, y = double(y0 + int(i / width)) * cell;
+            double offset = beds.dip_slope * (x * beds.dip_east + y * beds.dip_south) - beds.fold(x, y);
+            if (beds.faulted()) offset -= faults_lift(beds, x, y, fault_of);
+            offsets[std::size_t(i)] = offset;
+        }
     });
 }
 

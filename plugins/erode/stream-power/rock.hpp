@@ -16,7 +16,15 @@
 // fold amplitude the bed surfaces rise and fall by up to that many metres
 // in folds `fold_wavelength` across and three times as long along their
 // axes, which run along the strike (a smooth random field from the seed):
-// the outcrops bend, close around the folds' noses and end.
+// the outcrops bend, close around the folds' noses and end. Real beds are
+// not all one thickness either: with a thickness spread each bed's base is
+// moved by up to ±spread/2 of a thickness, so beds run from (1 − spread) to
+// (1 + spread) times `thickness` and the outcrops are spaced unevenly. And
+// real strata are broken by faults: with a fault spacing, faults of random
+// strike, one per `fault_spacing` square on average and 1–3 spacings long,
+// offset the beds by up to `fault_throw` metres. The throw is greatest at a
+// fault's middle and dies away towards its tips and away from it (over half
+// its length), so the outcrops step across each fault and run on beyond it.
 // The rock a cell shows is the one at its rock height ζ = h − uplift received
 // (the height that rock had at the start: the beds rise with the uplift, and
 // erosion digs into them). Its landslide angle is angle + spread·(2s − 1) and
@@ -40,6 +48,9 @@ struct Beds {
     double erodibility_contrast = 1.0;  ///< K of the weakest bed / K of the strongest (≥ 1)
     double fold_amplitude = 0.0;  ///< m: the bed surfaces rise and fall by up to this (0: planar beds)
     double fold_wavelength = 5000.0;  ///< m, across the fold axes (3 times as long along them)
+    double thickness_spread = 0.0;  ///< beds are (1 ± spread) × thickness thick, in [0, 0.95] (0: all alike)
+    double fault_spacing = 0.0;  ///< m: one fault per this square on average (0: no faults)
+    double fault_throw = 0.0;  ///< m: the largest vertical offset of the beds across a fault
     std::uint64_t seed = 0;
 
     /// A bed's strength is one of this many classes, s = (k + 1/2)/kStrengths.
@@ -47,12 +58,19 @@ struct Beds {
 
     bool layered() const { return thickness > 0.0; }
     bool folded() const { return layered() && fold_amplitude > 0.0; }
+    bool faulted() const { return layered() && fault_spacing > 0.0 && fault_throw > 0.0; }
     /// The height (m) the folds lift the bed surfaces at (x, y) (m from the grid's north-west corner,
     /// x east, y south), in [-fold_amplitude, fold_amplitude]; 0 when not folded.
     double fold(double x, double y) const;
+    /// The height (m) the faults lift the beds at (x, y) by (it jumps across each fault's trace); 0 when
+    /// not faulted.
+    double fault(double x, double y) const;
     /// The height (m) above the bed surface through the origin of the rock at rock height `zeta` (m)
-    /// at (x, y) is zeta + offset(x, y): the dip's and the folds' part, the same at every step.
+    /// at (x, y) is zeta + offset(x, y): the dip's, the folds' and the faults' part, the same at every step.
     double offset(double x, double y) const;
+    /// The index of the bed whose base is the highest at or below height q (m) above the bed surface
+    /// through the origin: floor(q / thickness) when the beds are all alike.
+    std::int64_t bed_at(double q) const;
     /// The strength class k of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
     /// corner, x east, y south), from the seed and the bed's index; kStrengths/2 when unlayered.
     int bed_class(double zeta, double x, double y) const;

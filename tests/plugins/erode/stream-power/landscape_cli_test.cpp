@@ -161,7 +161,10 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "e = erode:stream-power(base, glaciers=true, deposition=1)\n"
                   "f = erode:stream-power(base, landslide_angle=85)\n"
                   "g = erode:stream-power(base, bed_fold_amplitude=200)\n"
-                  "h = erode:stream-power(base, bed_thickness=50, bed_fold_amplitude=200, bed_fold_wavelength=50)\n");
+                  "h = erode:stream-power(base, bed_thickness=50, bed_fold_amplitude=200, bed_fold_wavelength=50)\n"
+                  "i = erode:stream-power(base, bed_thickness=50, bed_fault_spacing=2000)\n"
+                  "j = erode:stream-power(base, bed_thickness=50, bed_fault_spacing=50, bed_fault_throw=100)\n"
+                  "k = erode:stream-power(base, bed_thickness=50, bed_thickness_spread=1)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -179,6 +182,11 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "bed_thickness (m) as well",
              "rock.orogen:11:92: error: 'bed_fold_wavelength' of erode:stream-power is 50, out of range [100, "
              "1000000] m",
+             "rock.orogen:12:66: error: erode:stream-power: faults need both a spacing and a throw; give "
+             "bed_fault_spacing (m) and bed_fault_throw (m)",
+             "rock.orogen:13:66: error: erode:stream-power: faults closer than 100 m apart would shatter the rock "
+             "cell by cell; give bed_fault_spacing >= 100 (m), or 0 for no faults",
+             "rock.orogen:14:69: error: 'bed_thickness_spread' of erode:stream-power is 1, out of range [0, 0.95]",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }

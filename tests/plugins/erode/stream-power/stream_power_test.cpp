@@ -277,6 +277,78 @@ TEST(Beds, FoldsBendTheOutcropsWithinTheirAmplitudeAndRunAlongTheStrike) {
     }
 }
 
+TEST(Beds, UnevenBedsRunFromOneMinusToOnePlusTheSpreadTimesTheThickness) {
+    Beds beds;
+    beds.thickness = 100.0;
+    beds.seed = 7;
+    for (int k = -3000; k < 3000; ++k) {
+        const double q = 3.7 * k;
+        ASSERT_EQ(beds.bed_at(q), std::int64_t(std::floor(q / beds.thickness))) << "even beds at " << q;
+    }
+    beds.thickness_spread = 0.8;
+    // Walk up through 100 km of beds, half a metre at a time: each bed follows the one below, and its
+    // thickness is within (1 ± spread)·thickness; thin and thick ones both occur, averaging the thickness.
+    const double step = 0.5;
+    std::int64_t bed = beds.bed_at(-50000.0);
+    double base = -50000.0, thinnest = 1e9, thickest = 0.0, total = 0.0;
+    int beds_seen = 0;
+    for (double q = -50000.0 + step; q < 50000.0; q += step) {
+        const std::int64_t next = beds.bed_at(q);
+        if (next == bed) continue;
+        ASSERT_EQ(next, bed + 1) << "at " << q;
+        if (beds_seen++ > 0) {
+            thinnest = std::min(thinnest, q - base), thickest = std::max(thickest, q - base);
+            total += q - base;
+        }
+        bed = next, base = q;
+    }
+    EXPECT_GE(thinnest, 20.0 - step);
+    EXPECT_LE(thickest, 180.0 + step);
+    EXPECT_LT(thinnest, 40.0) << "the spread must show";
+    EXPECT_GT(thickest, 160.0);
+    EXPECT_NEAR(total / (beds_seen - 1), beds.thickness, 5.0);
+}
+
+TEST(Beds, FaultsStepTheBedsAcrossTheirTracesAndDieAwayFromThem) {
+    Beds beds;
+    beds.thickness = 100.0;
+    beds.seed = 11;
+    beds.fold_amplitude = 300.0;
+    EXPECT_EQ(beds.fault(1234.0, 5678.0), 0.0);
+    beds.fault_spacing = 3000.0;
+    beds.fault_throw = 300.0;
+    // Along a 60 km line, a metre at a time: the lift changes smoothly (one fault's steepest slope is 0.77
+    // throw per half-length, 0.15 m per m here) but for steps at the faults' traces, each at most the throw.
+    int steps = 0;
+    double biggest_step = 0.0, biggest_lift = 0.0;
+    double before = beds.fault(0.0, 12345.0);
+    for (double x = 1.0; x < 60000.0; x += 1.0) {
+        const double lift = beds.fault(x, 12345.0 + 0.2 * x);
+        const double change = std::abs(lift - before);
+        if (change > 0.35) ++steps, biggest_step = std::max(biggest_step, change);
+        biggest_lift = std::max(biggest_lift, std::abs(lift));
+        before = lift;
+    }
+    // ~0.4 traces cross a line per km at one 1.5–4.5 km fault per 9 km².
+    EXPECT_GE(steps, 8);
+    EXPECT_LE(steps, 60);
+    EXPECT_LE(biggest_step, beds.fault_throw);
+    EXPECT_GT(biggest_step, 0.3 * beds.fault_throw);
+    EXPECT_GT(biggest_lift, 0.1 * beds.fault_throw);
+    // A block's offsets, drawn from a table of faults once, are Beds::offset's to the bit, on any block.
+    beds.dip_slope = 0.3;
+    beds.thickness_spread = 0.5;
+    for (const auto [x0, y0] : {std::pair{0, 0}, std::pair{37, 101}, std::pair{-250, 400}}) {
+        const int width = 150, height = 90;
+        const double cell = 30.0;
+        std::vector<double> offsets;
+        bed_offsets(beds, std::size_t(width * height), width, x0, y0, cell, offsets);
+        for (int i = 0; i < width * height; ++i)
+            ASSERT_EQ(offsets[std::size_t(i)], beds.offset((x0 + i % width) * cell, (y0 + i / width) * cell))
+                << "cell " << i << " of the block at " << x0 << ", " << y0;
+    }
+}
+
 TEST(Beds, StrongBedsStandSteeperThanWeakOnes) {
     // Flat-lying beds 60 m thick under a rising block: after the run, hillslopes in strong rock are steeper
     // than in weak rock (their landslide angle is higher, their rivers slower).
