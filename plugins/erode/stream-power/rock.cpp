@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <cstdlib>
+#include <limits>
 
 namespace orogen::stream_power {
 
@@ -102,17 +103,19 @@ double Beds::offset(double x, double y) const {
     return dip_slope * (x * dip_east + y * dip_south) - fold(x, y) - fault(x, y);
 }
 
+double Beds::bed_base(std::int64_t k) const {
+    if (!(thickness_spread > 0.0)) return thickness * double(k);
+    const std::uint64_t s = random::hash(seed, kThicknessSalt);
+    return thickness * (double(k) + thickness_spread * (random::uniform(s, std::uint64_t(k)) - 0.5));
+}
+
 std::int64_t Beds::bed_at(double q) const {
     auto bed = static_cast<std::int64_t>(std::floor(q / thickness));
     if (thickness_spread > 0.0) {
-        // Bed k's base is at thickness·(k + spread·(u_k − 1/2)): within half a thickness of k·thickness,
-        // so q lies in bed k − 1, k or k + 1, and two bases tell which.
-        const std::uint64_t s = random::hash(seed, kThicknessSalt);
-        const auto base = [&](std::int64_t k) {
-            return thickness * (double(k) + thickness_spread * (random::uniform(s, std::uint64_t(k)) - 0.5));
-        };
-        if (q < base(bed)) --bed;
-        else if (q >= base(bed + 1)) ++bed;
+        // Bed k's base is within half a thickness of k·thickness, so q lies in bed k − 1, k or k + 1, and
+        // two bases tell which.
+        if (q < bed_base(bed)) --bed;
+        else if (q >= bed_base(bed + 1)) ++bed;
     }
     return bed;
 }
@@ -182,9 +185,46 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
         slope_of[k] = beds.landslide_slope(s);
         factor_of[k] = beds.erodibility_factor(s);
     }
+    // The beds the cells lie in this step, from the lowest to the highest, with one more each side: their
+    // bases and classes drawn once into a table rather than hashed per cell (bed_at and class_of's own
+    // expressions, so the same bits). A cell outside the table (a height not finite, or a range of more
+    // than kMaxBeds beds) falls back on class_of.
+    constexpr std::int64_t kMaxBeds = std::int64_t(1) << 20;
+    const double thickness = beds.thickness;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t i = 0; i < count; ++i) {
+        const double q = (heights[i] - uplifted[i]) + offsets[i];
+        lo = std::min(lo, q), hi = std::max(hi, q);
+    }
+    std::int64_t first = 0;
+    std::vector<double> base;
+    std::vector<int> klass;
+    if (lo <= hi && (hi - lo) / thickness < double(kMaxBeds)) {
+        first = static_cast<std::int64_t>(std::floor(lo / thickness)) - 1;
+        const std::int64_t beds_in = static_cast<std::int64_t>(std::floor(hi / thickness)) + 2 - first + 1;
+        base.resize(std::size_t(beds_in));
+        klass.resize(std::size_t(beds_in));
+        for (std::int64_t j = 0; j < beds_in; ++j) {
+            base[std::size_t(j)] = beds.bed_base(first + j);
+            klass[std::size_t(j)] = int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(first + j)));
+        }
+    }
+    const bool uneven = beds.thickness_spread > 0.0;
+    const std::int64_t last = first + std::int64_t(base.size()) - 1;
     parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e; ++i) {
-            const int k = class_of(beds, (heights[i] - uplifted[i]) + offsets[i]);
+            const double q = (heights[i] - uplifted[i]) + offsets[i];
+            int k;
+            if (const double bed = std::floor(q / thickness); bed > double(first) && bed < double(last)) {
+                std::size_t j = std::size_t(static_cast<std::int64_t>(bed) - first);
+                if (uneven) {
+                    if (q < base[j]) --j;
+                    else if (q >= base[j + 1]) ++j;
+                }
+                k = klass[j];
+            } else {
+                k = class_of(beds, q);
+            }
             if (vary_slope) slopes[std::size_t(i)] = slope_of[k];
             if (vary_k) factors[std::size_t(i)] = factor_of[k];
         }

@@ -71,6 +71,9 @@ struct Beds {
     /// The index of the bed whose base is the highest at or below height q (m) above the bed surface
     /// through the origin: floor(q / thickness) when the beds are all alike.
     std::int64_t bed_at(double q) const;
+    /// The height (m) of bed k's base above the bed surface through the origin: k·thickness, moved by up
+    /// to ±thickness_spread/2 of a thickness.
+    double bed_base(std::int64_t k) const;
     /// The strength class k of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
     /// corner, x east, y south), from the seed and the bed's index; kStrengths/2 when unlayered.
     int bed_class(double zeta, double x, double y) const;
