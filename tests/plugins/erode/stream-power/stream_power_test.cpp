@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <set>
@@ -346,6 +347,40 @@ TEST(Beds, FaultsStepTheBedsAcrossTheirTracesAndDieAwayFromThem) {
         for (int i = 0; i < width * height; ++i)
             ASSERT_EQ(offsets[std::size_t(i)], beds.offset((x0 + i % width) * cell, (y0 + i / width) * cell))
                 << "cell " << i << " of the block at " << x0 << ", " << y0;
+    }
+}
+
+TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
+    // rock_at draws the beds of a step into a table; every cell must get what bed_class says of it, at any
+    // height, for even and uneven beds, and a height that is not finite must not reach past the table.
+    Beds beds;
+    beds.thickness = 40.0;
+    beds.dip_slope = 0.2;
+    beds.angle = 0.6;
+    beds.angle_spread = 0.3;
+    beds.erodibility_contrast = 4.0;
+    beds.seed = 3;
+    const int width = 64, height = 48;
+    const std::size_t n = std::size_t(width * height);
+    std::vector<double> heights(n), uplifted(n), offsets, slopes, factors;
+    for (std::size_t i = 0; i < n; ++i) {
+        heights[i] = 1500.0 * std::sin(0.37 * double(i)) + 0.5 * double(i);
+        uplifted[i] = 100.0 + 0.01 * double(i);
+    }
+    heights[17] = std::numeric_limits<double>::quiet_NaN();
+    for (const double spread : {0.0, 0.9}) {
+        beds.thickness_spread = spread;
+        bed_offsets(beds, n, width, 5, 9, 30.0, offsets);
+        rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, slopes, factors);
+        ASSERT_EQ(slopes.size(), n);
+        ASSERT_EQ(factors.size(), n);
+        for (std::size_t i = 0; i < n; ++i) {
+            if (i == 17) continue;
+            const double x = (5 + int(i) % width) * 30.0, y = (9 + int(i) / width) * 30.0;
+            const double s = beds.strength(heights[i] - uplifted[i], x, y);
+            ASSERT_EQ(slopes[i], beds.landslide_slope(s)) << "cell " << i << ", spread " << spread;
+            ASSERT_EQ(factors[i], beds.erodibility_factor(s)) << "cell " << i << ", spread " << spread;
+        }
     }
 }
 
