@@ -110,7 +110,11 @@ double Beds::bed_base(std::int64_t k) const {
 }
 
 std::int64_t Beds::bed_at(double q) const {
-    auto bed = static_cast<std::int64_t>(std::floor(q / thickness));
+    // A height that is not finite (the run reports it, naming the node and step) or beyond any bed index
+    // lies in bed 0 rather than in an undefined cast.
+    const double index = std::floor(q / thickness);
+    if (!(std::abs(index) < 0x1p62)) return 0;
+    auto bed = static_cast<std::int64_t>(index);
     if (thickness_spread > 0.0) {
         // Bed k's base is within half a thickness of k·thickness, so q lies in bed k − 1, k or k + 1, and
         // two bases tell which.
