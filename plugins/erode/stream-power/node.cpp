@@ -115,6 +115,7 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.rock.thickness_spread = ctx.real("bed_thickness_spread");
     s.rock.fault_spacing = ctx.real("bed_fault_spacing");
     s.rock.fault_throw = ctx.real("bed_fault_throw");
+    s.rock.block_spread = ctx.real("landslide_block_spread");
     s.rock.seed = ctx.seed();
     if (ctx.flag("glaciers")) {
         s.glaciers.ela = ctx.real("ela");
@@ -481,6 +482,9 @@ void check(CheckContext& ctx) {
         ctx.error("bed_fault_spacing",
                   "faults closer than 100 m apart would shatter the rock cell by cell; give "
                   "bed_fault_spacing >= 100 (m), or 0 for no faults");
+    if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
+        ctx.error("landslide_block_spread",
+                  "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
@@ -677,6 +681,12 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("threshold hillslope angle: after each step whatever stands steeper slides away, the "
                           "rivers carrying the debris off (25-40° in ranges that erode fast, Montgomery & Brandon "
                           "2002); hillslopes end planar at it, divides sharp. 0 = no landslides"),
+                Param::real("landslide_block_spread", 0.0)
+                    .min(0.0)
+                    .max(2.0)
+                    .help("joint blocks: each cell's rock, a cell deep, stands up to this share steeper (tan) than "
+                          "its bed's landslide slope, from the seed, so threshold hillslopes break into spurs and "
+                          "chutes instead of planes (0.3-1; 0 = planar)"),
                 Param::real("bed_thickness", 0.0)
                     .min(0.0)
                     .max(1e5)
@@ -843,11 +853,12 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("drainage area: d8 (all water to the steepest neighbour) or mfd (split among the lower "
                           "neighbours by slope^mfd_exponent, Freeman 1991: wider, smoother hillslope areas); the "
                           "incision follows the steepest neighbour either way"),
-                Param::real("mfd_exponent", 1.1)
-                    .min(0.0, true)
-                    .max(100.0)
-                    .help("routing=mfd: weight of a lower neighbour = slope^p (1.1: Freeman 1991; larger "
-                          "concentrates the flow, towards D8)"),
+                Param::
+                    real("mfd_exponent", 1.1)
+                        .min(0.0, true)
+                        .max(100.0)
+                        .help("routing=mfd: weight of a lower neighbour = slope^p (1.1: Freeman 1991; larger "
+                              "concentrates the flow, towards D8)"),
                 Param::boolean("chi", false).help("also write the layer chi (m; reference area 1 m^2)"),
                 timelapse_param(),
             },

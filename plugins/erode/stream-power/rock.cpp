@@ -34,6 +34,7 @@ constexpr std::uint64_t kFoldSalt = 0x666f6c6473ull;  // "folds"
 /// ... and the beds' thicknesses and the faults from the strengths and from each other.
 constexpr std::uint64_t kThicknessSalt = 0x746869636bull;  // "thick"
 constexpr std::uint64_t kFaultSalt = 0x6661756c7473ull;  // "faults"
+constexpr std::uint64_t kBlockSalt = 0x626c6f636bull;  // "block"
 
 /// The strength class of the bed at height q (m) above the bed surface through the origin.
 int class_of(const Beds& beds, double q) {
@@ -174,9 +175,11 @@ void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0,
 }
 
 void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
-             std::vector<double>& slopes, std::vector<double>& factors) {
-    const bool vary_slope = beds.layered() && beds.angle > 0.0 && beds.angle_spread > 0.0;
-    const bool vary_k = beds.layered() && beds.erodibility_contrast != 1.0;
+             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors) {
+    const bool layered = beds.layered();
+    const bool blocky = beds.angle > 0.0 && beds.block_spread > 0.0;
+    const bool vary_slope = (layered && beds.angle > 0.0 && beds.angle_spread > 0.0) || blocky;
+    const bool vary_k = layered && beds.erodibility_contrast != 1.0;
     slopes.resize(vary_slope ? count : 0);
     factors.resize(vary_k ? count : 0);
     if (!vary_slope && !vary_k) return;
@@ -195,41 +198,60 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
     // than kMaxBeds beds) falls back on class_of.
     constexpr std::int64_t kMaxBeds = std::int64_t(1) << 20;
     const double thickness = beds.thickness;
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-    for (std::size_t i = 0; i < count; ++i) {
-        const double q = (heights[i] - uplifted[i]) + offsets[i];
-        lo = std::min(lo, q), hi = std::max(hi, q);
-    }
     std::int64_t first = 0;
     std::vector<double> base;
     std::vector<int> klass;
-    if (lo <= hi && (hi - lo) / thickness < double(kMaxBeds)) {
-        first = static_cast<std::int64_t>(std::floor(lo / thickness)) - 1;
-        const std::int64_t beds_in = static_cast<std::int64_t>(std::floor(hi / thickness)) + 2 - first + 1;
-        base.resize(std::size_t(beds_in));
-        klass.resize(std::size_t(beds_in));
-        for (std::int64_t j = 0; j < beds_in; ++j) {
-            base[std::size_t(j)] = beds.bed_base(first + j);
-            klass[std::size_t(j)] = int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(first + j)));
+    if (layered) {
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (std::size_t i = 0; i < count; ++i) {
+            const double q = (heights[i] - uplifted[i]) + offsets[i];
+            lo = std::min(lo, q), hi = std::max(hi, q);
+        }
+        if (lo <= hi && (hi - lo) / thickness < double(kMaxBeds)) {
+            first = static_cast<std::int64_t>(std::floor(lo / thickness)) - 1;
+            const std::int64_t beds_in = static_cast<std::int64_t>(std::floor(hi / thickness)) + 2 - first + 1;
+            base.resize(std::size_t(beds_in));
+            klass.resize(std::size_t(beds_in));
+            for (std::int64_t j = 0; j < beds_in; ++j) {
+                base[std::size_t(j)] = beds.bed_base(first + j);
+                klass[std::size_t(j)] = int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(first + j)));
+            }
         }
     }
     const bool uneven = beds.thickness_spread > 0.0;
     const std::int64_t last = first + std::int64_t(base.size()) - 1;
+    // The joint blocks: one per cell and cell-deep slice of rock height, keyed by the cell's place in the
+    // whole grid (the same on any tiling). No block stands steeper than the landslide angles' 80°.
+    const std::uint64_t block_seed = random::hash(beds.seed, kBlockSalt);
+    const double steepest = std::tan(80.0 * std::numbers::pi / 180.0);
     parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e; ++i) {
-            const double q = (heights[i] - uplifted[i]) + offsets[i];
-            int k;
-            if (const double bed = std::floor(q / thickness); bed > double(first) && bed < double(last)) {
-                std::size_t j = std::size_t(static_cast<std::int64_t>(bed) - first);
-                if (uneven) {
-                    if (q < base[j]) --j;
-                    else if (q >= base[j + 1]) ++j;
+            const double zeta = heights[i] - uplifted[i];
+            int k = kStrengths / 2;
+            if (layered) {
+                const double q = zeta + offsets[i];
+                if (const double bed = std::floor(q / thickness); bed > double(first) && bed < double(last)) {
+                    std::size_t j = std::size_t(static_cast<std::int64_t>(bed) - first);
+                    if (uneven) {
+                        if (q < base[j]) --j;
+                        else if (q >= base[j + 1]) ++j;
+                    }
+                    k = klass[j];
+                } else {
+                    k = class_of(beds, q);
                 }
-                k = klass[j];
-            } else {
-                k = class_of(beds, q);
             }
-            if (vary_slope) slopes[std::size_t(i)] = slope_of[k];
+            if (vary_slope) {
+                double slope = slope_of[k];
+                if (blocky) {
+                    const double slice = std::floor(zeta / cell);
+                    const std::int64_t key = std::abs(slice) < 0x1p62 ? static_cast<std::int64_t>(slice) : 0;
+                    const double u = random::uniform(block_seed, std::uint64_t(x0 + int(i % width)),
+                                                     std::uint64_t(y0 + int(i / width)), std::uint64_t(key));
+                    slope = std::min(slope * (1.0 + beds.block_spread * u), steepest);
+                }
+                slopes[std::size_t(i)] = slope;
+            }
             if (vary_k) factors[std::size_t(i)] = factor_of[k];
         }
     });

@@ -30,6 +30,13 @@
 // erosion digs into them). Its landslide angle is angle + spread·(2s − 1) and
 // its erodibility K·contrast^(1/2 − s): the weakest bed erodes √contrast
 // times faster than the average, the strongest √contrast times slower.
+// Within a bed the rock is not one either: it is cut by joints into blocks
+// of sounder and weaker rock (Selby 1980 on rock mass strength). With a
+// block spread each cell's block, a cell deep, stands steeper than its bed's
+// landslide slope by a share of it up to block_spread (tan, from the seed,
+// the cell and the slice of rock height): threshold hillslopes break into
+// spurs and chutes instead of standing as planes, and as erosion cuts down
+// through the blocks the pattern changes.
 #pragma once
 
 #include <cstddef>
@@ -51,6 +58,9 @@ struct Beds {
     double thickness_spread = 0.0;  ///< beds are (1 ± spread) × thickness thick, in [0, 0.95] (0: all alike)
     double fault_spacing = 0.0;  ///< m: one fault per this square on average (0: no faults)
     double fault_throw = 0.0;  ///< m: the largest vertical offset of the beds across a fault
+    /// Each cell's block of rock (a cell deep) stands up to this share steeper (tan) than its bed's landslide
+    /// slope, from the seed (0: every block as its bed).
+    double block_spread = 0.0;
     std::uint64_t seed = 0;
 
     /// A bed's strength is one of this many classes, s = (k + 1/2)/kStrengths.
@@ -91,9 +101,10 @@ void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0,
                  std::vector<double>& offsets);
 
 /// Each cell's landslide slope (tan) and erodibility factor, from its height, the uplift it received and
-/// its bed_offsets (all `count` values). `slopes` / `factors` are resized; either is left empty when it
-/// would be uniform.
+/// its bed_offsets (all `count` values) of a width-`width` block whose first cell is (x0, y0) of the grid,
+/// cells `cell` metres apart (the joint blocks are a cell wide and deep). `slopes` / `factors` are resized;
+/// either is left empty when it would be uniform.
 void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
-             std::vector<double>& slopes, std::vector<double>& factors);
+             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors);
 
 }  // namespace orogen::stream_power

@@ -164,7 +164,8 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "h = erode:stream-power(base, bed_thickness=50, bed_fold_amplitude=200, bed_fold_wavelength=50)\n"
                   "i = erode:stream-power(base, bed_thickness=50, bed_fault_spacing=2000)\n"
                   "j = erode:stream-power(base, bed_thickness=50, bed_fault_spacing=50, bed_fault_throw=100)\n"
-                  "k = erode:stream-power(base, bed_thickness=50, bed_thickness_spread=1)\n");
+                  "k = erode:stream-power(base, bed_thickness=50, bed_thickness_spread=1)\n"
+                  "l = erode:stream-power(base, landslide_block_spread=0.5)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -187,6 +188,8 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:13:66: error: erode:stream-power: faults closer than 100 m apart would shatter the rock "
              "cell by cell; give bed_fault_spacing >= 100 (m), or 0 for no faults",
              "rock.orogen:14:69: error: 'bed_thickness_spread' of erode:stream-power is 1, out of range [0, 0.95]",
+             "rock.orogen:15:53: error: erode:stream-power: landslide_block_spread roughens the landslide slopes; "
+             "give landslide_angle as well",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }

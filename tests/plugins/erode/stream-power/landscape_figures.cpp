@@ -32,10 +32,11 @@ int main(int argc, char** argv) {
         return 2;
     }
     const auto s = orogen::landscape::measure(z.data(), w, h, cell);
-    std::printf("median slope %.1f deg | steeper than 40 deg %.1f %% | pits %.3f %% | concavity %.2f (%d bins) | "
-                "Hack %.2f (%d bins) | relief %.0f m\n",
-                s.median_slope_deg, 100 * s.steeper_than_40, 100 * s.pit_share, s.concavity, s.concavity_bins, s.hack,
-                s.hack_bins, s.relief);
+    std::printf(
+        "median slope %.1f deg | steeper than 40 deg %.1f %% | pits %.3f %% | concavity %.2f (%d bins) | "
+        "Hack %.2f (%d bins) | relief %.0f m\n",
+        s.median_slope_deg, 100 * s.steeper_than_40, 100 * s.pit_share, s.concavity, s.concavity_bins, s.hack,
+        s.hack_bins, s.relief);
     if (argc < 6) return 0;
 
     std::vector<double> filled(z.begin(), z.end());
@@ -43,8 +44,7 @@ int main(int argc, char** argv) {
     flow.route(filled.data(), orogen::stream_power::Depressions::fill);
     if (argc > 6)  // multiple flow directions (Freeman 1991) with this exponent
         flow.accumulate_multiple(filled.data(), std::stod(argv[6]));
-    else
-        flow.accumulate();
+    else flow.accumulate();
     const auto& area = flow.area();
     double amax = 0.0;
     for (double a : area) amax = std::max(amax, a);
@@ -57,14 +57,16 @@ int main(int argc, char** argv) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             // Hillshade, light from the north-west, 45° up.
-            const double dx = (at(x + 1, y) - at(x - 1, y)) / (2 * cell), dy = (at(x, y + 1) - at(x, y - 1)) / (2 * cell);
+            const double dx = (at(x + 1, y) - at(x - 1, y)) / (2 * cell),
+                         dy = (at(x, y + 1) - at(x, y - 1)) / (2 * cell);
             const double nx = -dx, ny = -dy, nz = 1.0, len = std::sqrt(nx * nx + ny * ny + nz * nz);
             const double lx = -0.5, ly = -0.5, lz = std::sqrt(0.5);
             const double shade = std::clamp((nx * lx + ny * ly + nz * lz) / len, 0.0, 1.0);
             double r = 90 + 150 * shade, g = r, b = r;
             const double a = area[std::size_t(y) * std::size_t(w) + std::size_t(x)];
             if (a >= a_min) {
-                const double t = std::log(a / a_min) / std::log(amax / a_min);  // 0 at the channel head, 1 at the outlet
+                const double t =
+                    std::log(a / a_min) / std::log(amax / a_min);  // 0 at the channel head, 1 at the outlet
                 const double k = 0.55 + 0.45 * t;
                 r = r * (1 - k) + 20 * k, g = g * (1 - k) + (90 - 50 * t) * k, b = b * (1 - k) + (220 - 60 * t) * k;
             }

@@ -371,7 +371,7 @@ TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
     for (const double spread : {0.0, 0.9}) {
         beds.thickness_spread = spread;
         bed_offsets(beds, n, width, 5, 9, 30.0, offsets);
-        rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, slopes, factors);
+        rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 5, 9, 30.0, slopes, factors);
         ASSERT_EQ(slopes.size(), n);
         ASSERT_EQ(factors.size(), n);
         for (std::size_t i = 0; i < n; ++i) {
@@ -381,6 +381,51 @@ TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
             ASSERT_EQ(slopes[i], beds.landslide_slope(s)) << "cell " << i << ", spread " << spread;
             ASSERT_EQ(factors[i], beds.erodibility_factor(s)) << "cell " << i << ", spread " << spread;
         }
+    }
+}
+
+TEST(Beds, JointBlocksStandUpToTheSpreadSteeperThanTheirBedAndTileAlike) {
+    // One rock (no beds) and bedded rock: each cell's landslide slope is its bed's times 1 + spread·u, u in
+    // [0, 1) from the cell's place in the whole grid and its cell-deep slice of rock; the same for a cell
+    // whichever block of the grid (tile) it is computed in.
+    for (const double thickness : {0.0, 40.0}) {
+        Beds beds;
+        beds.thickness = thickness;
+        beds.angle = 0.6;
+        beds.angle_spread = thickness > 0.0 ? 0.2 : 0.0;
+        beds.block_spread = 0.5;
+        beds.seed = 4;
+        const int width = 80, height = 60;
+        const std::size_t n = std::size_t(width * height);
+        std::vector<double> heights(n), uplifted(n, 0.0), offsets, slopes, factors;
+        for (std::size_t i = 0; i < n; ++i) heights[i] = 900.0 * std::cos(0.011 * double(i)) + 0.3 * double(i);
+        bed_offsets(beds, n, width, 0, 0, 30.0, offsets);
+        rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 0, 0, 30.0, slopes, factors);
+        ASSERT_EQ(slopes.size(), n) << "joint blocks vary the slope even in one rock";
+        double lowest_share = 1.0, highest_share = 0.0, sum = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            const double x = double(int(i) % width) * 30.0, y = double(int(i) / width) * 30.0;
+            const double bed = beds.landslide_slope(beds.strength(heights[i], x, y));
+            const double share = slopes[i] / bed - 1.0;
+            ASSERT_GE(share, -1e-12) << "cell " << i << ": no block is weaker than its bed";
+            ASSERT_LT(share, beds.block_spread + 1e-12) << "cell " << i;
+            lowest_share = std::min(lowest_share, share), highest_share = std::max(highest_share, share);
+            sum += share;
+        }
+        EXPECT_LT(lowest_share, 0.02);
+        EXPECT_GT(highest_share, 0.48);
+        EXPECT_NEAR(sum / double(n), 0.25, 0.02) << "u uniform in [0, 1)";
+        // The right half of the grid as its own block (a tile) gives its cells the same slopes.
+        const int half = width / 2;
+        std::vector<double> h2, u2, o2, s2, f2;
+        for (int y = 0; y < height; ++y)
+            for (int x = half; x < width; ++x) h2.push_back(heights[std::size_t(y * width + x)]), u2.push_back(0.0);
+        bed_offsets(beds, h2.size(), width - half, half, 0, 30.0, o2);
+        rock_at(beds, h2.data(), u2.data(), o2.data(), h2.size(), width - half, half, 0, 30.0, s2, f2);
+        for (int y = 0; y < height; ++y)
+            for (int x = half; x < width; ++x)
+                ASSERT_EQ(s2[std::size_t(y * (width - half) + x - half)], slopes[std::size_t(y * width + x)])
+                    << "cell " << x << ", " << y;
     }
 }
 
