@@ -53,8 +53,14 @@ Fault fault_in(const Beds& beds, std::int64_t a, std::int64_t b) {
     const std::uint64_t s = random::hash(beds.seed, kFaultSalt);
     const auto u = [&](std::uint64_t k) { return random::uniform(s, std::uint64_t(a), std::uint64_t(b), k); };
     const double spacing = beds.fault_spacing, strike = std::numbers::pi * u(2);
-    return {(double(a) + u(0)) * spacing, (double(b) + u(1)) * spacing,           std::cos(strike), std::sin(strike),
-            spacing * (0.5 + u(3)),       beds.fault_throw * (0.25 + 0.75 * u(4))};
+    Fault f;
+    f.x = (double(a) + u(0)) * spacing;
+    f.y = (double(b) + u(1)) * spacing;
+    f.along_x = std::cos(strike);
+    f.along_y = std::sin(strike);
+    f.half_length = spacing * (0.5 + u(3));
+    f.throw_m = beds.fault_throw * (0.25 + 0.75 * u(4));
+    return f;
 }
 
 /// How far a fault lifts the beds at (x, y): ± half its throw on either side of the trace, greatest at its
