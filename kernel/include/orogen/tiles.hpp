@@ -119,6 +119,10 @@ public:
     /// row-major) in its owned part, T() in the ghosts (exchange() fills them).
     template <typename T>
     std::vector<T> ghosted_copy(const T* tile) const;
+    /// The same into `held`, reusing its memory (a solver's working grid kept
+    /// between the steps of a run: no fresh pages to fault in each step).
+    template <typename T>
+    void ghosted_copy(const T* tile, std::vector<T>& held) const;
     /// Collective: fills the ghosts of each of `grids` (ghosted grids,
     /// row-major) with the neighbouring ranks' owned values, corners included;
     /// the owned parts are sent, never changed. One opening agreement and one
@@ -218,12 +222,18 @@ private:
 
 template <typename T>
 std::vector<T> Tiling::ghosted_copy(const T* tile) const {
+    std::vector<T> held;
+    ghosted_copy(tile, held);
+    return held;
+}
+
+template <typename T>
+void Tiling::ghosted_copy(const T* tile, std::vector<T>& held) const {
     const TileRect own = owned(), g = ghosted();
-    std::vector<T> held(std::size_t(g.width) * std::size_t(g.height), T());
+    held.assign(std::size_t(g.width) * std::size_t(g.height), T());
     const std::size_t ox = std::size_t(own.x0 - g.x0), oy = std::size_t(own.y0 - g.y0);
     for (std::size_t y = 0; y < std::size_t(own.height); ++y)
         std::copy_n(tile + y * std::size_t(own.width), own.width, held.data() + (y + oy) * std::size_t(g.width) + ox);
-    return held;
 }
 
 template <typename T>

@@ -190,11 +190,15 @@ void account(const double* before, const double* after, std::size_t count, doubl
 }  // namespace
 
 Result limit_slopes(double* heights, int width, int height, double cell, const Slopes& slopes,
-                    const std::uint8_t* fixed, double* removed) {
+                    const std::uint8_t* fixed, double* removed, Scratch* scratch) {
     check_slope(cell, slopes);
     const std::size_t n = std::size_t(width) * std::size_t(height);
-    const std::vector<double> before(heights, heights + n);
-    std::vector<std::int32_t> moved(n, 0);
+    Scratch own;
+    Scratch& mem = scratch ? *scratch : own;
+    std::vector<double>& before = mem.before;
+    std::vector<std::int32_t>& moved = mem.moved;
+    before.assign(heights, heights + n);
+    moved.assign(n, 0);
     const Sweeps s{heights,           width,          height, 0,           0, width, height, fixed,
                    slopes.per_vertex, slopes.uniform, cell,   moved.data()};
     Result result;
@@ -205,17 +209,20 @@ Result limit_slopes(double* heights, int width, int height, double cell, const S
 }
 
 Result limit_slopes(Tiling& tiles, double* heights, double cell, const Slopes& slopes, const std::uint8_t* fixed,
-                    double* removed) {
+                    double* removed, Scratch* scratch) {
     check_slope(cell, slopes);
     if (tiles.halo() < 1) throw std::logic_error("threshold slopes: a tiled limit needs a halo of at least 1");
     const TileRect own = tiles.owned(), ghost = tiles.ghosted();
     const std::size_t n = std::size_t(own.width) * std::size_t(own.height);
-    std::vector<double> g = tiles.ghosted_copy(heights);
+    Scratch mine_only;
+    Scratch& mem = scratch ? *scratch : mine_only;
+    std::vector<double>& g = mem.heights;
+    tiles.ghosted_copy(heights, g);
     // The ghosts' flags and slopes are never read: only owned vertices are lowered, by their own slope.
-    std::vector<std::uint8_t> gfixed;
-    if (fixed) gfixed = tiles.ghosted_copy(fixed);
-    std::vector<double> gslopes;
-    if (slopes.per_vertex) gslopes = tiles.ghosted_copy(slopes.per_vertex);
+    std::vector<std::uint8_t>& gfixed = mem.fixed;
+    if (fixed) tiles.ghosted_copy(fixed, gfixed);
+    std::vector<double>& gslopes = mem.slopes;
+    if (slopes.per_vertex) tiles.ghosted_copy(slopes.per_vertex, gslopes);
     const Sweeps s{g.data(),
                    ghost.width,
                    ghost.height,
@@ -236,7 +243,8 @@ Result limit_slopes(Tiling& tiles, double* heights, double cell, const Slopes& s
         if (changed == 0) break;
     }
     // The tile's part of the ghosted grid back into `heights`, and what it lost.
-    std::vector<double> before(heights, heights + n);
+    std::vector<double>& before = mem.before;
+    before.assign(heights, heights + n);
     for (int r = 0; r < own.height; ++r)
         std::copy_n(g.data() + std::size_t(r + s.y0) * std::size_t(ghost.width) + std::size_t(s.x0),
                     std::size_t(own.width), heights + std::size_t(r) * std::size_t(own.width));

@@ -172,7 +172,7 @@ std::int64_t Model::step(double dt) {
             threshold::limit_slopes(
                 h, width_, height_, cell_,
                 {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
-                flow_.outlets().data());
+                flow_.outlets().data(), nullptr, &slope_scratch_);
     }
     time_ += dt;
     return pits;

@@ -36,6 +36,7 @@
 #include <orogen/climate/orographic_rain.hpp>
 
 #include <orogen/solvers/diffusion.hpp>
+#include <orogen/solvers/threshold_slopes.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -186,6 +187,7 @@ private:
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
+    threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell

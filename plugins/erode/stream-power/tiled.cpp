@@ -744,7 +744,7 @@ std::int64_t TiledModel::step(double dt) {
             threshold::limit_slopes(
                 tiles_, h_.data(), cell_,
                 {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
-                outlet_.data());
+                outlet_.data(), nullptr, &slope_scratch_);
     }
     return pits;
 }

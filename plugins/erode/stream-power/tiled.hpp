@@ -42,6 +42,7 @@
 #include "stream_power.hpp"
 
 #include <orogen/solvers/diffusion.hpp>
+#include <orogen/solvers/threshold_slopes.hpp>
 #include <orogen/tiles.hpp>
 
 #include <chrono>
@@ -143,6 +144,7 @@ private:
     double cell_;
     Settings settings_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
+    threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::int64_t sink_ = -1;  // every side closed: the outlet (whole-grid index)
     std::vector<double> h_, uplift_, uplifted_;

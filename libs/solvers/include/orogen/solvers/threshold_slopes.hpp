@@ -44,6 +44,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <vector>
 
 namespace orogen::threshold {
 
@@ -76,20 +77,30 @@ struct Slopes {
     const double* per_vertex = nullptr;  ///< one per vertex (the tile's in a tiled run), each > 0
 };
 
+/// Working memory a limit may keep between calls (a model's steps): the grids it would otherwise
+/// allocate afresh each call. At 4097² these are 0.3 GB a step, and faulting their pages in cost
+/// more than the sweeps over them (docs/benchmarks.md). What it holds between calls means nothing.
+struct Scratch {
+    std::vector<double> before, heights, slopes;
+    std::vector<std::int32_t> moved;
+    std::vector<std::uint8_t> fixed;
+};
+
 /// Lowers `heights` (width × height, row-major, row 0 north, metres, vertices
 /// `cell` metres apart) in place to the greatest surface below them whose
 /// slope down to a neighbour nowhere exceeds `slopes`.
 /// `fixed` (optional, one flag per vertex): vertices that keep their height
 /// (base level), though they still limit their neighbours. `removed` (optional,
-/// one per vertex): each vertex's lowering is added to it (m).
+/// one per vertex): each vertex's lowering is added to it (m). `scratch` (optional): working
+/// memory kept by the caller; the result is the same bits with or without it.
 Result limit_slopes(double* heights, int width, int height, double cell, const Slopes& slopes,
-                    const std::uint8_t* fixed = nullptr, double* removed = nullptr);
+                    const std::uint8_t* fixed = nullptr, double* removed = nullptr, Scratch* scratch = nullptr);
 
 /// The same on this rank's tile of a tiled run (the tiles' halo must be ≥ 1):
 /// `heights`, `fixed` and `removed` are the tile's (owned().width ×
 /// owned().height). Collective; every vertex gets the bits the whole grid's
 /// limit gives it. The Result is the whole grid's (reduced over the ranks).
 Result limit_slopes(Tiling& tiles, double* heights, double cell, const Slopes& slopes,
-                    const std::uint8_t* fixed = nullptr, double* removed = nullptr);
+                    const std::uint8_t* fixed = nullptr, double* removed = nullptr, Scratch* scratch = nullptr);
 
 }  // namespace orogen::threshold
