@@ -116,6 +116,8 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.rock.fault_spacing = ctx.real("bed_fault_spacing");
     s.rock.fault_throw = ctx.real("bed_fault_throw");
     s.rock.block_spread = ctx.real("landslide_block_spread");
+    s.rock.facies_length = ctx.real("bed_facies_length");
+    s.rock.facies_share = ctx.real("bed_facies_share");
     s.rock.seed = ctx.seed();
     if (ctx.flag("glaciers")) {
         s.glaciers.ela = ctx.real("ela");
@@ -470,9 +472,9 @@ void check(CheckContext& ctx) {
     // The beds' parameters describe beds: without a thickness there are none, and a spread of landslide
     // angles needs landslides.
     if (!(ctx.real("bed_thickness") > 0.0))
-        for (const char* p :
-             {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast", "bed_fold_amplitude",
-              "bed_fold_wavelength", "bed_thickness_spread", "bed_fault_spacing", "bed_fault_throw"})
+        for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast",
+                              "bed_fold_amplitude", "bed_fold_wavelength", "bed_thickness_spread", "bed_fault_spacing",
+                              "bed_fault_throw", "bed_facies_length", "bed_facies_share"})
             if (ctx.given(p))
                 ctx.error(p, std::string(p) + " describes the rock's beds; give bed_thickness (m) as well");
     if ((ctx.real("bed_fault_spacing") > 0.0) != (ctx.real("bed_fault_throw") > 0.0))
@@ -482,6 +484,14 @@ void check(CheckContext& ctx) {
         ctx.error("bed_fault_spacing",
                   "faults closer than 100 m apart would shatter the rock cell by cell; give "
                   "bed_fault_spacing >= 100 (m), or 0 for no faults");
+    if (const double length = ctx.real("bed_facies_length"); length > 0.0 && length < 100.0)
+        ctx.error("bed_facies_length",
+                  "facies changing within less than 100 m would speckle the beds cell by cell; give "
+                  "bed_facies_length >= 100 (m), or 0 for beds of one strength each");
+    if (ctx.given("bed_facies_share") && !(ctx.real("bed_facies_length") > 0.0))
+        ctx.error("bed_facies_share",
+                  "bed_facies_share sets how much the facies change a bed's strength; give bed_facies_length (m) "
+                  "as well");
     if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("landslide_block_spread",
                   "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
@@ -739,6 +749,18 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .unit("m")
                     .help("the faults' largest vertical offset of the beds, at a fault's middle (1/4 to all of "
                           "it, from the seed; a bed thickness or more to show)"),
+                Param::real("bed_facies_length", 0.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("beds whose facies change along them: each bed's strength drifts over about this "
+                          "distance, so cliff bands fade into benches along their outcrop and weak beds stiffen "
+                          "(a few km; 0 = each bed one strength across the map)"),
+                Param::real("bed_facies_share", 0.5)
+                    .min(0.0)
+                    .max(1.0)
+                    .help("how much of a bed's strength its facies set (0 = none, 1 = all: the bed's own strength "
+                          "is forgotten)"),
                 Param::boolean("glaciers", false)
                     .help("valley glaciers: ice gathers above the ELA, flows down the valleys, erodes "
                           "ice_erodibility*Q^ice_flux_exponent*S^n and carves U-shaped troughs (docs/landscape.md); "
@@ -849,10 +871,11 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 Param::choice("depressions", {"fill", "route"}, "fill")
                     .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
                           "the heights stay)"),
-                Param::choice("routing", {"d8", "mfd"}, "d8")
-                    .help("drainage area: d8 (all water to the steepest neighbour) or mfd (split among the lower "
-                          "neighbours by slope^mfd_exponent, Freeman 1991: wider, smoother hillslope areas); the "
-                          "incision follows the steepest neighbour either way"),
+                Param::
+                    choice("routing", {"d8", "mfd"}, "d8")
+                        .help("drainage area: d8 (all water to the steepest neighbour) or mfd (split among the lower "
+                              "neighbours by slope^mfd_exponent, Freeman 1991: wider, smoother hillslope areas); the "
+                              "incision follows the steepest neighbour either way"),
                 Param::
                     real("mfd_exponent", 1.1)
                         .min(0.0, true)

@@ -14,12 +14,14 @@ namespace orogen::stream_power {
 
 namespace {
 
-/// Value noise in [-1, 1]: the seed's random values at the integer lattice points, blended by the quintic
-/// fade 6t⁵ − 15t⁴ + 10t³ (smooth to the second derivative, so the folded beds have no creases).
+/// The quintic fade 6t⁵ − 15t⁴ + 10t³: blends lattice values smoothly to the second derivative (so the
+/// folded beds have no creases and a facies has no edge).
+double fade(double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
+
+/// Value noise in [-1, 1]: the seed's random values at the integer lattice points, blended by the fade.
 double value_noise(double u, double v, std::uint64_t seed, std::uint64_t octave) {
     const double fu = std::floor(u), fv = std::floor(v);
     const auto i = static_cast<std::int64_t>(fu), j = static_cast<std::int64_t>(fv);
-    const auto fade = [](double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); };
     const double a = fade(u - fu), b = fade(v - fv);
     const auto at = [&](std::int64_t di, std::int64_t dj) {
         return random::uniform_in(-1.0, 1.0, seed, octave, std::uint64_t(i + di), std::uint64_t(j + dj));
@@ -35,10 +37,88 @@ constexpr std::uint64_t kFoldSalt = 0x666f6c6473ull;  // "folds"
 constexpr std::uint64_t kThicknessSalt = 0x746869636bull;  // "thick"
 constexpr std::uint64_t kFaultSalt = 0x6661756c7473ull;  // "faults"
 constexpr std::uint64_t kBlockSalt = 0x626c6f636bull;  // "block"
+constexpr std::uint64_t kFaciesSalt = 0x666163696573ull;  // "facies"
 
-/// The strength class of the bed at height q (m) above the bed surface through the origin.
-int class_of(const Beds& beds, double q) {
-    return int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(beds.bed_at(q))));
+/// Φ⁻¹(p), the standard normal quantile, p in (0, 1): Acklam's rational approximation (relative error
+/// below 1.2·10⁻⁹; a strength class is 1/256 wide).
+double normal_quantile(double p) {
+    constexpr double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
+                            1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+    constexpr double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                            6.680131188771972e+01, -1.328068155288572e+01};
+    constexpr double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                            -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+    constexpr double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00, 3.754408661907416e+00};
+    constexpr double tail = 0.02425;
+    p = std::clamp(p, 1e-12, 1.0 - 1e-12);
+    const auto tail_x = [&](double q) {
+        return (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+            ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+    };
+    if (p < tail) return tail_x(std::sqrt(-2.0 * std::log(p)));
+    if (p > 1.0 - tail) return -tail_x(std::sqrt(-2.0 * std::log(1.0 - p)));
+    const double q = p - 0.5, r = q * q;
+    return (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+}
+
+/// The strength classes' normal scores: each class's middle, Φ⁻¹((k + 1/2)/kStrengths), and the bounds
+/// between them, Φ⁻¹(k/kStrengths) for k = 1 … kStrengths − 1.
+struct NormalScores {
+    double middle[Beds::kStrengths];
+    double bound[Beds::kStrengths - 1];
+};
+const NormalScores& normal_scores() {
+    static const NormalScores scores = [] {
+        NormalScores s{};
+        for (int k = 0; k < Beds::kStrengths; ++k) s.middle[k] = normal_quantile((k + 0.5) / Beds::kStrengths);
+        for (int k = 1; k < Beds::kStrengths; ++k) s.bound[k - 1] = normal_quantile(double(k) / Beds::kStrengths);
+        return s;
+    }();
+    return scores;
+}
+
+/// A facies lattice node's normal score for bed `bed`, from its draw.
+double facies_node(std::uint64_t facies_seed, std::int64_t bed, std::int64_t a, std::int64_t b) {
+    return normal_quantile(random::uniform(facies_seed, std::uint64_t(bed), std::uint64_t(a), std::uint64_t(b)));
+}
+
+/// Where a coordinate (m) lies on the facies lattice: the node below it, the fade t towards the next, and
+/// (1 − t)² + t², what the blend's variance shrinks to between the two.
+struct LatticeAt {
+    std::int64_t node;
+    double fade, shrink;
+};
+LatticeAt lattice_at(const Beds& beds, double x) {
+    const double u = x / beds.facies_length, fu = std::floor(u), t = fade(u - fu);
+    return {static_cast<std::int64_t>(fu), t, (1.0 - t) * (1.0 - t) + t * t};
+}
+
+/// The class of a bed drawn as class k where its facies change it: in normal scores, the bed's own score
+/// weighted by √(1 − share²) plus share times a standard normal field along the bed (the lattice nodes'
+/// scores n00 … n11 blended by the fades, divided by the blend's standard deviation so the field is
+/// standard normal everywhere, not only at the nodes). The sum is standard normal too, so the classes stay
+/// evenly spread, as without facies: the facies move strength along a bed, they do not make the rock
+/// stronger or weaker on the whole.
+int facies_class(const Beds& beds, int k, double n00, double n10, double n01, double n11, const LatticeAt& u,
+                 const LatticeAt& v) {
+    const NormalScores& scores = normal_scores();
+    const double lo = n00 + u.fade * (n10 - n00), hi = n01 + u.fade * (n11 - n01);
+    const double field = (lo + v.fade * (hi - lo)) / std::sqrt(u.shrink * v.shrink);
+    const double w = beds.facies_share;
+    const double z = std::sqrt(1.0 - w * w) * scores.middle[k] + w * field;
+    return int(std::upper_bound(scores.bound, scores.bound + Beds::kStrengths - 1, z) - scores.bound);
+}
+
+/// The strength class of the bed at height q (m) above the bed surface through the origin, at (x, y) (m).
+int class_of(const Beds& beds, double q, double x, double y) {
+    const std::int64_t bed = beds.bed_at(q);
+    const int k = int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(bed)));
+    if (!beds.facies()) return k;
+    const LatticeAt u = lattice_at(beds, x), v = lattice_at(beds, y);
+    const std::uint64_t s = random::hash(beds.seed, kFaciesSalt);
+    const auto node = [&](std::int64_t da, std::int64_t db) { return facies_node(s, bed, u.node + da, v.node + db); };
+    return facies_class(beds, k, node(0, 0), node(1, 0), node(0, 1), node(1, 1), u, v);
 }
 
 /// One fault: its trace's middle (m), the unit vector along it, its half-length (m) and its throw (m, the
@@ -134,7 +214,7 @@ std::int64_t Beds::bed_at(double q) const {
 int Beds::bed_class(double zeta, double x, double y) const {
     if (!layered()) return kStrengths / 2;
     // q is the height above the bed surface through the origin.
-    return class_of(*this, zeta + offset(x, y));
+    return class_of(*this, zeta + offset(x, y), x, y);
 }
 
 double Beds::strength(double zeta, double x, double y) const {
@@ -224,6 +304,26 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
             }
         }
     }
+    // With facies, each bed's draws at the corners of the lattice cells the block covers, likewise in a
+    // table (class_of's draws), and each column's and row of cells' place on the lattice.
+    const bool facies = beds.facies() && !base.empty();
+    std::vector<double> corner;
+    std::vector<LatticeAt> column_at, row_at;
+    std::int64_t a_lo = 0, b_lo = 0, a_count = 0, b_count = 0;
+    if (facies) {
+        const int rows = int(count / std::size_t(width));
+        for (int c = 0; c < width; ++c) column_at.push_back(lattice_at(beds, double(x0 + c) * cell));
+        for (int r = 0; r < rows; ++r) row_at.push_back(lattice_at(beds, double(y0 + r) * cell));
+        a_lo = column_at.front().node, b_lo = row_at.front().node;
+        a_count = column_at.back().node + 2 - a_lo, b_count = row_at.back().node + 2 - b_lo;
+        corner.resize(base.size() * std::size_t(a_count * b_count));
+        const std::uint64_t s = random::hash(beds.seed, kFaciesSalt);
+        for (std::size_t j = 0; j < base.size(); ++j)
+            for (std::int64_t bb = 0; bb < b_count; ++bb)
+                for (std::int64_t a = 0; a < a_count; ++a)
+                    corner[(j * std::size_t(b_count) + std::size_t(bb)) * std::size_t(a_count) + std::size_t(a)] =
+                        facies_node(s, first + std::int64_t(j), a_lo + a, b_lo + bb);
+    }
     const bool uneven = beds.thickness_spread > 0.0;
     const std::int64_t last = first + std::int64_t(base.size()) - 1;
     // The joint blocks: one per cell and cell-deep slice of rock height, keyed by the cell's place in the
@@ -243,8 +343,17 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
                         else if (q >= base[j + 1]) ++j;
                     }
                     k = klass[j];
+                    if (facies) {
+                        const LatticeAt& u = column_at[std::size_t(i % width)];
+                        const LatticeAt& v = row_at[std::size_t(i / width)];
+                        const double* n0 = corner.data() +
+                            (j * std::size_t(b_count) + std::size_t(v.node - b_lo)) * std::size_t(a_count) +
+                            std::size_t(u.node - a_lo);
+                        const double* n1 = n0 + a_count;
+                        k = facies_class(beds, k, n0[0], n0[1], n1[0], n1[1], u, v);
+                    }
                 } else {
-                    k = class_of(beds, q);
+                    k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
                 }
             }
             if (vary_slope) {

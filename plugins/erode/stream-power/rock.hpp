@@ -30,6 +30,13 @@
 // erosion digs into them). Its landslide angle is angle + spread·(2s − 1) and
 // its erodibility K·contrast^(1/2 − s): the weakest bed erodes √contrast
 // times faster than the average, the strongest √contrast times slower.
+// Nor is a bed one rock from end to end: its facies change along it (a
+// sandstone grades into siltstone, a reef limestone into marl away from the
+// reef). With a facies length each bed's strength drifts along it, blended
+// smoothly between values drawn for the bed at the corners of a lattice
+// that many metres across: a cliff band fades out along its outcrop into a
+// bench and a weak bed stiffens, as real ones do, rather than each bed
+// holding one strength across the whole map.
 // Within a bed the rock is not one either: it is cut by joints into blocks
 // of sounder and weaker rock (Selby 1980 on rock mass strength). With a
 // block spread each cell's block, a cell deep, stands steeper than its bed's
@@ -61,6 +68,8 @@ struct Beds {
     /// Each cell's block of rock (a cell deep) stands up to this share steeper (tan) than its bed's landslide
     /// slope, from the seed (0: every block as its bed).
     double block_spread = 0.0;
+    double facies_length = 0.0;  ///< m: a bed's strength drifts along it over about this (0: one per bed)
+    double facies_share = 0.5;  ///< how much of a bed's strength the drift sets, in [0, 1]
     std::uint64_t seed = 0;
 
     /// A bed's strength is one of this many classes, s = (k + 1/2)/kStrengths.
@@ -69,6 +78,7 @@ struct Beds {
     bool layered() const { return thickness > 0.0; }
     bool folded() const { return layered() && fold_amplitude > 0.0; }
     bool faulted() const { return layered() && fault_spacing > 0.0 && fault_throw > 0.0; }
+    bool facies() const { return layered() && facies_length > 0.0 && facies_share > 0.0; }
     /// The height (m) the folds lift the bed surfaces at (x, y) (m from the grid's north-west corner,
     /// x east, y south), in [-fold_amplitude, fold_amplitude]; 0 when not folded.
     double fold(double x, double y) const;
@@ -85,7 +95,8 @@ struct Beds {
     /// to ±thickness_spread/2 of a thickness.
     double bed_base(std::int64_t k) const;
     /// The strength class k of the bed at rock height `zeta` (m) at (x, y) (m from the grid's north-west
-    /// corner, x east, y south), from the seed and the bed's index; kStrengths/2 when unlayered.
+    /// corner, x east, y south), from the seed and the bed's index (and, with facies, where along the bed
+    /// (x, y) lies); kStrengths/2 when unlayered.
     int bed_class(double zeta, double x, double y) const;
     /// Its strength, (k + 1/2)/kStrengths in (0, 1).
     double strength(double zeta, double x, double y) const;

@@ -165,7 +165,9 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "i = erode:stream-power(base, bed_thickness=50, bed_fault_spacing=2000)\n"
                   "j = erode:stream-power(base, bed_thickness=50, bed_fault_spacing=50, bed_fault_throw=100)\n"
                   "k = erode:stream-power(base, bed_thickness=50, bed_thickness_spread=1)\n"
-                  "l = erode:stream-power(base, landslide_block_spread=0.5)\n");
+                  "l = erode:stream-power(base, landslide_block_spread=0.5)\n"
+                  "m = erode:stream-power(base, bed_thickness=50, bed_facies_length=40)\n"
+                  "n = erode:stream-power(base, bed_thickness=50, bed_facies_share=0.3)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -190,6 +192,10 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:14:69: error: 'bed_thickness_spread' of erode:stream-power is 1, out of range [0, 0.95]",
              "rock.orogen:15:53: error: erode:stream-power: landslide_block_spread roughens the landslide slopes; "
              "give landslide_angle as well",
+             "rock.orogen:16:66: error: erode:stream-power: facies changing within less than 100 m would speckle the "
+             "beds cell by cell; give bed_facies_length >= 100 (m), or 0 for beds of one strength each",
+             "rock.orogen:17:65: error: erode:stream-power: bed_facies_share sets how much the facies change a bed's "
+             "strength; give bed_facies_length (m) as well",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }

@@ -350,6 +350,75 @@ TEST(Beds, FaultsStepTheBedsAcrossTheirTracesAndDieAwayFromThem) {
     }
 }
 
+TEST(Beds, FaciesDriftABedsStrengthAlongItSmoothlyAndByTheirShare) {
+    // Flat-lying beds 100 m thick: walking east through one bed (rock height 50 m), its strength is one
+    // class without facies; with them it drifts over the facies length, a few classes per 30 m cell at
+    // most, and by no more than its share of the whole range.
+    Beds beds;
+    beds.thickness = 100.0;
+    beds.seed = 6;
+    const double own = beds.strength(50.0, 0.0, 0.0);
+    auto walk = [&](auto&& each) {
+        for (int c = 0; c < 1000; ++c) each(30.0 * c, beds.bed_class(50.0, 30.0 * c, 4321.0));
+    };
+    std::set<int> seen;
+    walk([&](double, int k) { seen.insert(k); });
+    EXPECT_EQ(seen.size(), 1u) << "without facies a bed is one strength along its whole outcrop";
+
+    beds.facies_length = 2000.0;
+    beds.facies_share = 1.0;
+    seen.clear();
+    int previous = -1, largest_step = 0;
+    walk([&](double, int k) {
+        ASSERT_GE(k, 0);
+        ASSERT_LT(k, Beds::kStrengths);
+        if (previous >= 0) largest_step = std::max(largest_step, std::abs(k - previous));
+        previous = k;
+        seen.insert(k);
+    });
+    EXPECT_GT(seen.size(), 40u) << "over 30 km (15 facies lengths) the bed's strength must range widely";
+    // Smooth: a 30 m step (1/67 of a lattice cell) moves the class by a few at most; an edge would jump by
+    // up to the whole range.
+    EXPECT_LE(largest_step, 12) << "a facies changes smoothly, without edges";
+
+    // The facies move strength along a bed; they do not make the rock stronger or weaker on the whole: over
+    // many beds and places the classes stay evenly spread, for any share (a plain blend of the lattice
+    // draws would crowd them to the middle, half as many in the outer eighths). A small share keeps a bed
+    // near its own strength.
+    double drift_small = 0.0, drift_full = 0.0;
+    for (const double share : {0.25, 0.6, 1.0}) {
+        beds.facies_share = share;
+        int bins[8] = {};
+        double drift = 0.0;
+        // 3000 beds, each at 10 places 2.5 lattice cells apart (nearly independent draws).
+        for (int bed = 0; bed < 3000; ++bed)
+            for (int p = 0; p < 10; ++p) {
+                const double z = 100.0 * bed + 50.0, x = 5000.0 * p + 11.0 * (bed % 100), y = 3000.0 + 7.0 * bed;
+                const int k = beds.bed_class(z, x, y);
+                ASSERT_GE(k, 0);
+                ASSERT_LT(k, Beds::kStrengths);
+                ++bins[k * 8 / Beds::kStrengths];
+                beds.facies_length = 0.0;
+                drift += std::abs(k - beds.bed_class(z, x, y));
+                beds.facies_length = 2000.0;
+            }
+        for (int b = 0; b < 8; ++b)
+            EXPECT_NEAR(bins[b], 30000 / 8, 30000 / 8 * 0.1) << "share " << share << ", eighth " << b;
+        if (share == 0.25) drift_small = drift;
+        if (share == 1.0) drift_full = drift;
+    }
+    EXPECT_LT(drift_small, 0.4 * drift_full);
+    // Two beds drift apart, not together: the drift is drawn for each bed.
+    int differ = 0;
+    for (int c = 0; c < 1000; ++c) {
+        const double x = 30.0 * c;
+        const double a = beds.strength(50.0, x, 0.0) - beds.strength(50.0, 0.0, 0.0);
+        const double b = beds.strength(150.0, x, 0.0) - beds.strength(150.0, 0.0, 0.0);
+        differ += std::abs(a - b) > 2.0 / Beds::kStrengths;
+    }
+    EXPECT_GT(differ, 500);
+}
+
 TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
     // rock_at draws the beds of a step into a table; every cell must get what bed_class says of it, at any
     // height, for even and uneven beds, and a height that is not finite must not reach past the table.
@@ -368,8 +437,10 @@ TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
         uplifted[i] = 100.0 + 0.01 * double(i);
     }
     heights[17] = std::numeric_limits<double>::quiet_NaN();
-    for (const double spread : {0.0, 0.9}) {
+    for (const auto [spread, facies] : {std::pair{0.0, 0.0}, std::pair{0.9, 0.0}, std::pair{0.9, 700.0}}) {
         beds.thickness_spread = spread;
+        beds.facies_length = facies;  // lattice cells of 700 m: a block of 64 × 48 cells of 30 m spans several
+        beds.facies_share = 0.6;
         bed_offsets(beds, n, width, 5, 9, 30.0, offsets);
         rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 5, 9, 30.0, slopes, factors);
         ASSERT_EQ(slopes.size(), n);
@@ -378,8 +449,9 @@ TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
             if (i == 17) continue;
             const double x = (5 + int(i) % width) * 30.0, y = (9 + int(i) / width) * 30.0;
             const double s = beds.strength(heights[i] - uplifted[i], x, y);
-            ASSERT_EQ(slopes[i], beds.landslide_slope(s)) << "cell " << i << ", spread " << spread;
-            ASSERT_EQ(factors[i], beds.erodibility_factor(s)) << "cell " << i << ", spread " << spread;
+            ASSERT_EQ(slopes[i], beds.landslide_slope(s)) << "cell " << i << ", spread " << spread << ", " << facies;
+            ASSERT_EQ(factors[i], beds.erodibility_factor(s))
+                << "cell " << i << ", spread " << spread << ", " << facies;
         }
     }
 }
