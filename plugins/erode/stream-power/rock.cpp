@@ -305,17 +305,22 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
         }
     }
     // With facies, each bed's draws at the corners of the lattice cells the block covers, likewise in a
-    // table (class_of's draws), and each column's and row of cells' place on the lattice.
-    const bool facies = beds.facies() && !base.empty();
+    // table (class_of's draws), and each column's and row of cells' place on the lattice. Not when the
+    // table would hold more than a few corners per cell (many thin beds, a short facies length): then
+    // each cell draws its own corners (class_of), which costs less than drawing them all.
+    bool facies = false;
     std::vector<double> corner;
     std::vector<LatticeAt> column_at, row_at;
     std::int64_t a_lo = 0, b_lo = 0, a_count = 0, b_count = 0;
-    if (facies) {
+    if (beds.facies() && !base.empty()) {
         const int rows = int(count / std::size_t(width));
         for (int c = 0; c < width; ++c) column_at.push_back(lattice_at(beds, double(x0 + c) * cell));
         for (int r = 0; r < rows; ++r) row_at.push_back(lattice_at(beds, double(y0 + r) * cell));
         a_lo = column_at.front().node, b_lo = row_at.front().node;
         a_count = column_at.back().node + 2 - a_lo, b_count = row_at.back().node + 2 - b_lo;
+        facies = double(base.size()) * double(a_count) * double(b_count) <= 4.0 * double(count) + 65536.0;
+    }
+    if (facies) {
         corner.resize(base.size() * std::size_t(a_count * b_count));
         const std::uint64_t s = random::hash(beds.seed, kFaciesSalt);
         for (std::size_t j = 0; j < base.size(); ++j)
@@ -351,6 +356,8 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
                             std::size_t(u.node - a_lo);
                         const double* n1 = n0 + a_count;
                         k = facies_class(beds, k, n0[0], n0[1], n1[0], n1[1], u, v);
+                    } else if (beds.facies()) {
+                        k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
                     }
                 } else {
                     k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);

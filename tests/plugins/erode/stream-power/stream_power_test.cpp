@@ -437,7 +437,14 @@ TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
         uplifted[i] = 100.0 + 0.01 * double(i);
     }
     heights[17] = std::numeric_limits<double>::quiet_NaN();
-    for (const auto [spread, facies] : {std::pair{0.0, 0.0}, std::pair{0.9, 0.0}, std::pair{0.9, 700.0}}) {
+    // The last: beds 4 m thick with facies 100 m across would make a table of 250,000 corners for 3,072
+    // cells; each cell draws its own instead.
+    struct Case {
+        double thickness, spread, facies;
+    };
+    for (const auto [thickness, spread, facies] :
+         {Case{40.0, 0.0, 0.0}, Case{40.0, 0.9, 0.0}, Case{40.0, 0.9, 700.0}, Case{4.0, 0.5, 100.0}}) {
+        beds.thickness = thickness;
         beds.thickness_spread = spread;
         beds.facies_length = facies;  // lattice cells of 700 m: a block of 64 × 48 cells of 30 m spans several
         beds.facies_share = 0.6;
