@@ -24,9 +24,14 @@ bool is_power_of_two(std::size_t n) { return n != 0 && (n & (n - 1)) == 0; }
 Fft::Fft(std::size_t n) : n_(n) {
     if (n == 0) throw std::invalid_argument("Fft: length 0");
     m_ = is_power_of_two(n) ? n : next_power_of_two(2 * n - 1);
-    twiddles_.resize(m_ / 2);
+    // Each stage's twiddles in a row of their own, e^{−2πi k/len} = e^{−2πi k·(m/len)/m} for k < len/2 at
+    // offset len/2 − 1: the values a stage reads, read one after another rather than m/len apart.
+    std::vector<std::complex<double>> full(m_ / 2);
     for (std::size_t k = 0; k < m_ / 2; ++k)
-        twiddles_[k] = std::polar(1.0, -2.0 * std::numbers::pi * double(k) / double(m_));
+        full[k] = std::polar(1.0, -2.0 * std::numbers::pi * double(k) / double(m_));
+    twiddles_.resize(m_ > 1 ? m_ - 1 : 0);
+    for (std::size_t len = 2; len <= m_; len <<= 1)
+        for (std::size_t k = 0; k < len / 2; ++k) twiddles_[len / 2 - 1 + k] = full[k * (m_ / len)];
     if (m_ == n_) return;
     // Bluestein: jk = (j² + k² − (k − j)²)/2, so X[k] = c[k] Σ_j (x[j] c[j]) conj(c[k − j]) with
     // c[k] = e^{−πi k²/n}: a convolution, done at the power-of-two length m. k² is taken mod 2n
@@ -51,16 +56,26 @@ void Fft::radix2(std::span<std::complex<double>> a, bool inverse) const {
         j ^= bit;
         if (i < j) std::swap(a[i], a[j]);
     }
+    // The butterflies in real arithmetic, v·w = (vr·wr − vi·wi, vr·wi + vi·wr): the products and sums
+    // std::complex's operator* forms for finite values (no FMA contraction on this target), so the same
+    // bits, without its NaN branch, which kept the loop from being vectorised. The heights that reach a
+    // transform are finite.
+    double* p = reinterpret_cast<double*>(a.data());
+    const double sign = inverse ? -1.0 : 1.0;
     for (std::size_t len = 2; len <= m; len <<= 1) {
-        const std::size_t half = len / 2, stride = m / len;
-        for (std::size_t i = 0; i < m; i += len)
+        const std::size_t half = len / 2;
+        const double* tw = reinterpret_cast<const double*>(twiddles_.data() + (half - 1));
+        for (std::size_t i = 0; i < m; i += len) {
+            double* lo = p + 2 * i;
+            double* hi = lo + 2 * half;
             for (std::size_t k = 0; k < half; ++k) {
-                const std::complex<double> t = twiddles_[k * stride];
-                const std::complex<double> w{t.real(), inverse ? -t.imag() : t.imag()};
-                const std::complex<double> u = a[i + k], v = a[i + k + half] * w;
-                a[i + k] = u + v;
-                a[i + k + half] = u - v;
+                const double wr = tw[2 * k], wi = sign * tw[2 * k + 1];
+                const double vr = hi[2 * k] * wr - hi[2 * k + 1] * wi, vi = hi[2 * k] * wi + hi[2 * k + 1] * wr;
+                const double ur = lo[2 * k], ui = lo[2 * k + 1];
+                lo[2 * k] = ur + vr, lo[2 * k + 1] = ui + vi;
+                hi[2 * k] = ur - vr, hi[2 * k + 1] = ui - vi;
             }
+        }
     }
 }
 

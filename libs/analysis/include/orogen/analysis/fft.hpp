@@ -28,7 +28,7 @@ private:
     void radix2(std::span<std::complex<double>> data, bool inverse) const;
     std::size_t n_;
     std::size_t m_;  ///< the power-of-two length the radix-2 kernel runs at (n itself, or ≥ 2n − 1 for Bluestein)
-    std::vector<std::complex<double>> twiddles_;  ///< e^{−2πi k/m}, k < m/2
+    std::vector<std::complex<double>> twiddles_;  ///< stage len's e^{−2πi k/len}, k < len/2, at len/2 − 1
     std::vector<std::complex<double>> chirp_;  ///< Bluestein: e^{−πi k²/n}, k < n
     std::vector<std::complex<double>> kernel_;  ///< Bluestein: the forward transform of the conjugate chirp, length m
 };
