@@ -64,15 +64,34 @@ double normal_quantile(double p) {
 
 /// The strength classes' normal scores: each class's middle, Φ⁻¹((k + 1/2)/kStrengths), and the bounds
 /// between them, Φ⁻¹(k/kStrengths) for k = 1 … kStrengths − 1.
+/// The class of a score z is the number of bounds at or below it; `first` holds that number at the lower
+/// edge of each of kBuckets equal buckets over [−kReach, kReach), so finding it takes a step or two from
+/// there rather than a binary search's eight unpredictable branches (a cell's class, every step).
 struct NormalScores {
+    static constexpr int kBuckets = 2048;
+    static constexpr double kReach = 6.0;
     double middle[Beds::kStrengths];
     double bound[Beds::kStrengths - 1];
+    int first[kBuckets];
+
+    /// The number of bounds at or below z: std::upper_bound's answer.
+    int class_of(double z) const {
+        const double t = (z + kReach) * (kBuckets / (2.0 * kReach));
+        int k = first[t > 0.0 ? (t < kBuckets - 1 ? int(t) : kBuckets - 1) : 0];
+        while (k < Beds::kStrengths - 1 && bound[k] <= z) ++k;
+        while (k > 0 && bound[k - 1] > z) --k;  // a bucket's edge rounded past z
+        return k;
+    }
 };
 const NormalScores& normal_scores() {
     static const NormalScores scores = [] {
         NormalScores s{};
         for (int k = 0; k < Beds::kStrengths; ++k) s.middle[k] = normal_quantile((k + 0.5) / Beds::kStrengths);
         for (int k = 1; k < Beds::kStrengths; ++k) s.bound[k - 1] = normal_quantile(double(k) / Beds::kStrengths);
+        for (int b = 0; b < NormalScores::kBuckets; ++b) {
+            const double edge = -NormalScores::kReach + b * (2.0 * NormalScores::kReach / NormalScores::kBuckets);
+            s.first[b] = int(std::upper_bound(s.bound, s.bound + Beds::kStrengths - 1, edge) - s.bound);
+        }
         return s;
     }();
     return scores;
@@ -100,14 +119,14 @@ LatticeAt lattice_at(const Beds& beds, double x) {
 /// standard normal everywhere, not only at the nodes). The sum is standard normal too, so the classes stay
 /// evenly spread, as without facies: the facies move strength along a bed, they do not make the rock
 /// stronger or weaker on the whole.
-int facies_class(const Beds& beds, int k, double n00, double n10, double n01, double n11, const LatticeAt& u,
-                 const LatticeAt& v) {
+inline int facies_class(const Beds& beds, int k, double n00, double n10, double n01, double n11, const LatticeAt& u,
+                        const LatticeAt& v) {
     const NormalScores& scores = normal_scores();
     const double lo = n00 + u.fade * (n10 - n00), hi = n01 + u.fade * (n11 - n01);
     const double field = (lo + v.fade * (hi - lo)) / std::sqrt(u.shrink * v.shrink);
     const double w = beds.facies_share;
     const double z = std::sqrt(1.0 - w * w) * scores.middle[k] + w * field;
-    return int(std::upper_bound(scores.bound, scores.bound + Beds::kStrengths - 1, z) - scores.bound);
+    return scores.class_of(z);
 }
 
 /// The strength class of the bed at height q (m) above the bed surface through the origin, at (x, y) (m).
