@@ -31,6 +31,11 @@ struct Sweeps {
     /// before or in this one: a vertex none of whose neighbours moved since it was last taken already
     /// stands at or below its bound. That changes which updates run, not the fixed point they reach.
     std::int32_t* moved = nullptr;
+    /// With `moved`: for each strip of columns (vertical_pass) and row, the pass in which a vertex of that
+    /// strip's row was last lowered (the largest `moved` there), strips × gh. A row none of whose own,
+    /// upper or lower strip rows (nor the edge columns beside them) moved since is skipped whole, without
+    /// looking at its vertices one by one: in the later passes most rows are.
+    std::int32_t* strip_rows = nullptr;
     mutable int pass = 0;  // the passes so far
 
     /// How far above a neighbour `cell` away vertex i may stand, straight (1) or diagonal (√2).
@@ -41,8 +46,9 @@ struct Sweeps {
     /// [a, b) read from `west` and `east` (a copy of those columns, by row, or null where the grid
     /// ends). Returns the vertices lowered.
     /// `west_moved`, `east_moved`: `moved` of the same columns, copied likewise (with `moved` only).
+    /// `rows`: the strip's column of strip_rows (gh values), or null.
     std::int64_t row_update(int r, int a, int b, const double* west, const double* east, const std::int32_t* west_moved,
-                            const std::int32_t* east_moved, bool eastward) const {
+                            const std::int32_t* east_moved, std::int32_t* rows, bool eastward) const {
         constexpr double kNone = std::numeric_limits<double>::infinity();
         std::int64_t lowered = 0;
         const std::size_t base = std::size_t(r) * std::size_t(gw);
@@ -59,6 +65,13 @@ struct Sweeps {
         };
         const int since = pass - 1;  // lowered in the pass before or in this one
         const bool skip = moved != nullptr && pass > 1;
+        if (skip && rows) {
+            bool any = false;
+            for (int y = std::max(r - 1, 0); y <= std::min(r + 1, gh - 1); ++y)
+                any = any || rows[y] >= since || (west_moved && west_moved[y] >= since) ||
+                    (east_moved && east_moved[y] >= since);
+            if (!any) return 0;
+        }
         auto moved_at = [&](int y, int c) {
             if (y < 0 || y >= gh) return false;
             if (c < a) return west_moved != nullptr && west_moved[y] >= since;
@@ -107,7 +120,71 @@ struct Sweeps {
             if (best < row[c]) {
                 row[c] = best;
                 if (moved) moved[base + std::size_t(c)] = pass;
+                if (rows) rows[r] = pass;
                 ++lowered;
+            }
+        }
+        return lowered;
+    }
+
+    /// The least bound vertex (r, c)'s neighbours give it now (row_update's, the same bits: the least of
+    /// the same candidates; none from beyond the grid).
+    double bound_of(int r, int c) const {
+        constexpr double kNone = std::numeric_limits<double>::infinity();
+        auto at = [&](int y, int x) {
+            return y < 0 || y >= gh || x < 0 || x >= gw ? kNone : g[std::size_t(y) * std::size_t(gw) + std::size_t(x)];
+        };
+        const double step = this->step(std::size_t(r) * std::size_t(gw) + std::size_t(c)), diagonal = step * kSqrt2;
+        const double n = at(r - 1, c), s = at(r + 1, c), w = at(r, c - 1), e = at(r, c + 1);
+        const double nw = at(r - 1, c - 1), ne = at(r - 1, c + 1), sw = at(r + 1, c - 1), se = at(r + 1, c + 1);
+        const double straight = std::min(std::min(n, s), std::min(w, e));
+        const double corner = std::min(std::min(nw, ne), std::min(sw, se));
+        double best = std::min(straight + step, corner + diagonal);
+        auto edge = [&](double axial, double corner_h) {
+            if (corner_h + step < best) best = std::min(best, edge_interior(axial, corner_h, step));
+        };
+        edge(n, nw), edge(n, ne), edge(s, sw), edge(s, se);
+        edge(w, nw), edge(w, sw), edge(e, ne), edge(e, se);
+        return best;
+    }
+
+    /// After a round of sweeps on the whole grid (x0 = y0 = 0, with `moved`): the rest of the way to the
+    /// fixed point from a work list rather than by more rounds. The later rounds lower a few hundred
+    /// vertices in a million, yet each of their passes looks at every row. Only a neighbour of a vertex
+    /// lowered in the last pass can stand above its bound now (a vertex any earlier lowering could have
+    /// left above it was taken again in a later pass: the skip rule in row_update); those go on the list,
+    /// and a vertex lowered from it puts its neighbours on it. Monotone updates in any order reach the
+    /// same greatest fixed point, so the same bits as more rounds. Returns the vertices lowered.
+    std::int64_t settle(std::vector<std::int32_t>& list, std::vector<std::uint8_t>& listed) const {
+        const std::size_t count = std::size_t(gw) * std::size_t(gh);
+        listed.assign(count, 0);
+        list.clear();
+        auto put_around = [&](int r, int c) {
+            for (int y = std::max(r - 1, 0); y <= std::min(r + 1, gh - 1); ++y)
+                for (int x = std::max(c - 1, 0); x <= std::min(c + 1, gw - 1); ++x) {
+                    const std::size_t i = std::size_t(y) * std::size_t(gw) + std::size_t(x);
+                    if (listed[i] || (fixed && fixed[i])) continue;
+                    listed[i] = 1;
+                    list.push_back(std::int32_t(i));
+                }
+        };
+        for (std::size_t i = 0; i < count; ++i)
+            if (moved[i] == pass) put_around(int(i / std::size_t(gw)), int(i % std::size_t(gw)));
+        std::int64_t lowered = 0;
+        for (std::size_t head = 0; head < list.size(); ++head) {
+            const std::size_t i = std::size_t(list[head]);
+            listed[i] = 0;
+            const int r = int(i / std::size_t(gw)), c = int(i % std::size_t(gw));
+            const double best = bound_of(r, c);
+            if (best < g[i]) {
+                g[i] = best;
+                ++lowered;
+                put_around(r, c);
+            }
+            // A long list is compacted now and then (what was taken is done with).
+            if (head > (std::size_t(1) << 20) && head * 2 > list.size()) {
+                list.erase(list.begin(), list.begin() + std::ptrdiff_t(head + 1));
+                head = std::size_t(-1);
             }
         }
         return lowered;
@@ -117,9 +194,11 @@ struct Sweeps {
     /// strip reads its neighbours' edge columns as they were when the sweep began (values only fall, so
     /// a stale one lowers less, never wrongly; a round that changes nothing read none stale), so the
     /// strips run in parallel and never touch each other's memory.
+    static constexpr int kStrip = 256;
+    int strip_count() const { return (x1 - x0 + kStrip - 1) / kStrip; }
+
     std::int64_t vertical_pass(bool down, bool eastward) const {
-        constexpr int kStrip = 256;
-        const int strips = (x1 - x0 + kStrip - 1) / kStrip;
+        const int strips = strip_count();
         // First every strip's edge columns, before any strip moves: then no thread reads what another writes.
         std::vector<double> edges(std::size_t(strips) * 2 * std::size_t(gh));
         auto edge = [&](int s, int side) {
@@ -149,11 +228,12 @@ struct Sweeps {
                 const double* e = b < gw ? edge(int(s), 1) : nullptr;
                 const std::int32_t* wm = a > 0 ? edge_m(int(s), 0) : nullptr;
                 const std::int32_t* em = b < gw ? edge_m(int(s), 1) : nullptr;
+                std::int32_t* rows = strip_rows ? strip_rows + std::size_t(s) * std::size_t(gh) : nullptr;
                 std::int64_t mine = 0;
                 if (down)
-                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, w, e, wm, em, eastward);
+                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, w, e, wm, em, rows, eastward);
                 else
-                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, w, e, wm, em, eastward);
+                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, w, e, wm, em, rows, eastward);
                 lowered += mine;
             }
         });
@@ -199,11 +279,17 @@ Result limit_slopes(double* heights, int width, int height, double cell, const S
     std::vector<std::int32_t>& moved = mem.moved;
     before.assign(heights, heights + n);
     moved.assign(n, 0);
-    const Sweeps s{heights,           width,          height, 0,           0, width, height, fixed,
-                   slopes.per_vertex, slopes.uniform, cell,   moved.data()};
+    Sweeps s{heights, width, height, 0, 0, width, height, fixed, slopes.per_vertex, slopes.uniform, cell, moved.data()};
+    mem.strip_rows.assign(std::size_t(s.strip_count()) * std::size_t(height), 0);
+    s.strip_rows = mem.strip_rows.data();
     Result result;
-    do ++result.rounds;
-    while (s.round() > 0);
+    // One round of sweeps carries each slope across the grid and does nearly all the lowering; a work
+    // list finishes it (a second "round", the last one the list's emptying).
+    result.rounds = 1;
+    if (s.round() > 0) {
+        s.settle(mem.list, mem.listed);
+        result.rounds = 2;
+    }
     account(before.data(), heights, n, removed, result);
     return result;
 }

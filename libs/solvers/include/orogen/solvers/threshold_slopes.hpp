@@ -82,8 +82,8 @@ struct Slopes {
 /// more than the sweeps over them (docs/benchmarks.md). What it holds between calls means nothing.
 struct Scratch {
     std::vector<double> before, heights, slopes;
-    std::vector<std::int32_t> moved;
-    std::vector<std::uint8_t> fixed;
+    std::vector<std::int32_t> moved, strip_rows, list;
+    std::vector<std::uint8_t> fixed, listed;
 };
 
 /// Lowers `heights` (width × height, row-major, row 0 north, metres, vertices
