@@ -31,11 +31,14 @@
 // the bounds they give), by Gauss–Seidel sweeps in the four orders of fast
 // sweeping (Zhao 2005: down or up the rows, east- or westward along them;
 // strips of columns side by side in parallel, each reading its neighbours'
-// edge columns as they were when the sweep began) until a round changes
-// nothing (usually two to four rounds). After the first sweep a sweep takes
-// only the vertices next to one lowered since (the others already stand at
-// or below their bound): fewer updates, the same fixed point. The
-// update is monotone, even in floating point (rounding is monotone), so any
+// edge columns as they were when the sweep began). After the first sweep a
+// sweep takes only the vertices next to one lowered since (the others
+// already stand at or below their bound): fewer updates, the same fixed
+// point. One round of four sweeps does nearly all the lowering; on one
+// grid a work list then finishes it (a vertex lowered puts its neighbours
+// on the list), where further rounds would look at every row to lower a
+// few hundred vertices; a tiled run sweeps until a round changes nothing,
+// exchanging its edges between rounds. The update is monotone, even in floating point (rounding is monotone), so any
 // order of sweeps, any thread count and any split into tiles reach the very
 // same bits: the greatest fixed point below h.
 #pragma once
