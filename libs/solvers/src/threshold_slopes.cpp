@@ -17,6 +17,24 @@ namespace {
 
 constexpr double kSqrt2 = 1.4142135623730951;
 
+/// The least bound a vertex's eight neighbours (n, s, w, e and the corners; +∞ where there is none) give it,
+/// the threshold rising `step` per cell: edge_bound over the stencil's eight triangles. An edge's inner
+/// points give more than min(axial, corner) + 1.03·step, and its axial end already gave axial + step ≥
+/// best: only an edge whose corner is below best − step can lower the vertex further (the skipped ones
+/// could not: the same value, in less time).
+inline double stencil_bound(double n, double s, double w, double e, double nw, double ne, double sw, double se,
+                            double step) {
+    const double straight = std::min(std::min(n, s), std::min(w, e));
+    const double corner = std::min(std::min(nw, ne), std::min(sw, se));
+    double best = std::min(straight + step, corner + step * kSqrt2);
+    auto edge = [&](double axial, double corner_h) {
+        if (corner_h + step < best) best = std::min(best, edge_interior(axial, corner_h, step));
+    };
+    edge(n, nw), edge(n, ne), edge(s, sw), edge(s, se);
+    edge(w, nw), edge(w, sw), edge(e, ne), edge(e, se);
+    return best;
+}
+
 /// A grid the sweeps update in its rectangle [x0, x1) × [y0, y1), reading every
 /// vertex of the grid (the rest: a tile's ghosts, which they never write).
 struct Sweeps {
@@ -93,7 +111,7 @@ struct Sweeps {
                 }
                 if (!any) continue;
             }
-            const double step = this->step(base + std::size_t(c)), diagonal = step * kSqrt2;
+            const double step = this->step(base + std::size_t(c));
             double n, s, w, e, nw, ne, sw, se;
             if (up && down && c > a && c + 1 < b) {  // inside the strip, between two rows: no test
                 n = up[c], s = down[c], w = row[c - 1], e = row[c + 1];
@@ -108,15 +126,7 @@ struct Sweeps {
             const double straight = std::min(std::min(n, s), std::min(w, e));
             const double corner = std::min(std::min(nw, ne), std::min(sw, se));
             if (!(std::min(straight, corner) + step < row[c])) continue;
-            double best = std::min(straight + step, corner + diagonal);
-            // An edge's inner points give more than min(axial, diagonal) + 1.03·step, and its axial
-            // end already gave axial + step ≥ best: only an edge whose corner is below best − step can
-            // lower the vertex further (the skipped ones could not: the same value, in less time).
-            auto edge = [&](double axial, double corner_h) {
-                if (corner_h + step < best) best = std::min(best, edge_interior(axial, corner_h, step));
-            };
-            edge(n, nw), edge(n, ne), edge(s, sw), edge(s, se);
-            edge(w, nw), edge(w, sw), edge(e, ne), edge(e, se);
+            const double best = stencil_bound(n, s, w, e, nw, ne, sw, se, step);
             if (best < row[c]) {
                 row[c] = best;
                 if (moved) moved[base + std::size_t(c)] = pass;
@@ -127,25 +137,15 @@ struct Sweeps {
         return lowered;
     }
 
-    /// The least bound vertex (r, c)'s neighbours give it now (row_update's, the same bits: the least of
-    /// the same candidates; none from beyond the grid).
+    /// The least bound vertex (r, c)'s neighbours give it now (none from beyond the grid): row_update's.
     double bound_of(int r, int c) const {
         constexpr double kNone = std::numeric_limits<double>::infinity();
         auto at = [&](int y, int x) {
             return y < 0 || y >= gh || x < 0 || x >= gw ? kNone : g[std::size_t(y) * std::size_t(gw) + std::size_t(x)];
         };
-        const double step = this->step(std::size_t(r) * std::size_t(gw) + std::size_t(c)), diagonal = step * kSqrt2;
-        const double n = at(r - 1, c), s = at(r + 1, c), w = at(r, c - 1), e = at(r, c + 1);
-        const double nw = at(r - 1, c - 1), ne = at(r - 1, c + 1), sw = at(r + 1, c - 1), se = at(r + 1, c + 1);
-        const double straight = std::min(std::min(n, s), std::min(w, e));
-        const double corner = std::min(std::min(nw, ne), std::min(sw, se));
-        double best = std::min(straight + step, corner + diagonal);
-        auto edge = [&](double axial, double corner_h) {
-            if (corner_h + step < best) best = std::min(best, edge_interior(axial, corner_h, step));
-        };
-        edge(n, nw), edge(n, ne), edge(s, sw), edge(s, se);
-        edge(w, nw), edge(w, sw), edge(e, ne), edge(e, se);
-        return best;
+        const double step = this->step(std::size_t(r) * std::size_t(gw) + std::size_t(c));
+        return stencil_bound(at(r - 1, c), at(r + 1, c), at(r, c - 1), at(r, c + 1), at(r - 1, c - 1), at(r - 1, c + 1),
+                             at(r + 1, c - 1), at(r + 1, c + 1), step);
     }
 
     /// After a round of sweeps on the whole grid (x0 = y0 = 0, with `moved`): the rest of the way to the

@@ -360,7 +360,10 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
             int k = kStrengths / 2;
             if (layered) {
                 const double q = zeta + offsets[i];
-                if (const double bed = std::floor(q / thickness); bed > double(first) && bed < double(last)) {
+                // In the table, unless its facies have no table of corners; otherwise (a height outside the
+                // table, many corners) the cell's bed and facies are drawn directly.
+                const double bed = std::floor(q / thickness);
+                if (bed > double(first) && bed < double(last) && (facies || !beds.facies())) {
                     std::size_t j = std::size_t(static_cast<std::int64_t>(bed) - first);
                     if (uneven) {
                         if (q < base[j]) --j;
@@ -375,8 +378,6 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
                             std::size_t(u.node - a_lo);
                         const double* n1 = n0 + a_count;
                         k = facies_class(beds, k, n0[0], n0[1], n1[0], n1[1], u, v);
-                    } else if (beds.facies()) {
-                        k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
                     }
                 } else {
                     k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
