@@ -5,6 +5,7 @@
 #include <orogen/random.hpp>
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <numbers>
 #include <cstdlib>
@@ -90,7 +91,7 @@ const NormalScores& normal_scores() {
         for (int k = 1; k < Beds::kStrengths; ++k) s.bound[k - 1] = normal_quantile(double(k) / Beds::kStrengths);
         for (int b = 0; b < NormalScores::kBuckets; ++b) {
             const double edge = -NormalScores::kReach + b * (2.0 * NormalScores::kReach / NormalScores::kBuckets);
-            s.first[b] = int(std::upper_bound(s.bound, s.bound + Beds::kStrengths - 1, edge) - s.bound);
+            s.first[b] = int(std::upper_bound(std::begin(s.bound), std::end(s.bound), edge) - s.bound);
         }
         return s;
     }();
