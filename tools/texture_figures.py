@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+"""Texture figures that `orogen analyze` does not report yet (docs/realism.md).
+
+    tools/texture_figures.py FILE [FILE ...]
+
+FILE is a square float32 .r32 (orogen's RAW, metres, 30 m cells unless --cell)
+or any raster GDAL opens (python3-gdal; a geographic one is converted at its mid
+latitude). For each it prints, over the samples steeper than 6° (hillslopes and
+channels, not flats):
+
+- planar %: the share whose Laplacian curvature lies within a fifth of a
+  standard deviation of zero (smooth planes; integer DEMs such as the Rif's
+  quantise it);
+- slope change: the median change of slope (°) from one sample to the next
+  east-west (the slope by central differences);
+- curvature skewness: the skewness of the Laplacian curvature (5-point
+  stencil); positive when sharp concave valley bottoms outweigh sharp convex
+  crests;
+- channel curvature: the mean Laplacian curvature (1/km) of the samples whose
+  D8 drainage area exceeds 1 km² (a V notch at 30 m: 30-40 /km; a valley with a
+  floor or a rounded bottom: less).
+
+They are measured here rather than in `orogen analyze` because they are still
+being judged: the first and last depend on the DEM's vertical resolution, the
+second counts the DEM's own noise.
+"""
+import argparse
+
+import numpy as np
+
+
+def load(path, cell):
+    if path.endswith(".r32"):
+        z = np.fromfile(path, dtype=np.float32)
+        side = int(round(np.sqrt(z.size)))
+        if side * side != z.size:
+            raise SystemExit(f"{path}: {z.size} samples is not a square grid")
+        return z.reshape(side, side).astype(np.float64), cell
+    from osgeo import gdal
+
+    data = gdal.Open(path)
+    if data is None:
+        raise SystemExit(f"{path}: GDAL cannot open it")
+    band = data.GetRasterBand(1)
+    z = band.ReadAsArray().astype(np.float64)
+    if band.GetNoDataValue() is not None:
+        z[z == band.GetNoDataValue()] = np.nan
+    gt = data.GetGeoTransform()
+    size = abs(gt[1])
+    if size < 0.01:  # degrees: metres at the mid latitude
+        size *= 111320.0 * np.cos(np.radians(gt[3] + gt[5] * z.shape[0] / 2))
+    return z, size
+
+
+def d8_area(z, cell):
+    """Drainage area (m²) by D8: each sample drains to its steepest lower neighbour."""
+    rows, cols = z.shape
+    h = np.where(np.isfinite(z), z, -np.inf)
+    index = np.arange(z.size).reshape(z.shape)
+    best = np.zeros(z.shape)
+    receiver = np.full(z.shape, -1, dtype=np.int64)
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di == 0 and dj == 0:
+                continue
+            nb = np.full(z.shape, np.inf)
+            nid = np.full(z.shape, -1, dtype=np.int64)
+            dst = (slice(max(-di, 0), rows + min(-di, 0)), slice(max(-dj, 0), cols + min(-dj, 0)))
+            src = (slice(max(di, 0), rows + min(di, 0)), slice(max(dj, 0), cols + min(dj, 0)))
+            nb[dst] = h[src]
+            nid[dst] = index[src]
+            drop = (h - nb) / (cell * np.hypot(di, dj))
+            better = np.isfinite(drop) & (drop > best)
+            best = np.where(better, drop, best)
+            receiver = np.where(better, nid, receiver)
+    area = np.full(z.size, cell * cell)
+    rcv = receiver.ravel()
+    for i in np.argsort(-h, axis=None, kind="stable"):  # donors before receivers
+        if rcv[i] >= 0:
+            area[rcv[i]] += area[i]
+    return area.reshape(z.shape)
+
+
+def figures(z, cell):
+    gy, gx = np.gradient(z, cell)
+    slope = np.degrees(np.arctan(np.hypot(gx, gy)))
+    lap = (z[:-2, 1:-1] + z[2:, 1:-1] + z[1:-1, :-2] + z[1:-1, 2:] - 4 * z[1:-1, 1:-1]) / cell**2
+    inner = slope[1:-1, 1:-1]
+    steep = (inner > 6.0) & np.isfinite(lap)
+    c = lap[steep]
+    planar = np.mean(np.abs(c) < 0.2 * c.std())
+    skew = np.mean((c - c.mean()) ** 3) / c.std() ** 3
+    change = np.abs(np.diff(slope, axis=1))
+    counted = (slope[:, :-1] > 6.0) & np.isfinite(change)
+    area = d8_area(z, cell)[1:-1, 1:-1]
+    channel = steep & (area > 1e6)
+    return {
+        "planar %": 100.0 * planar,
+        "slope change °": float(np.median(change[counted])),
+        "curvature skewness": float(skew),
+        "channel curvature /km": float(np.mean(lap[channel]) * 1000.0) if channel.any() else float("nan"),
+    }
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("files", nargs="+")
+    p.add_argument("--cell", type=float, default=30.0, help="cell size of .r32 files (m)")
+    a = p.parse_args()
+    rows = [(path, figures(*load(path, a.cell))) for path in a.files]
+    names = list(rows[0][1])
+    width = max(len(path) for path, _ in rows)
+    print("file".ljust(width), *(n.rjust(22) for n in names))
+    for path, f in rows:
+        print(path.ljust(width), *(f"{f[n]:22.2f}" for n in names))
+
+
+if __name__ == "__main__":
+    main()
