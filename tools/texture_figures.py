@@ -25,22 +25,32 @@ being judged: the first and last depend on the DEM's vertical resolution, the
 second counts the DEM's own noise.
 """
 import argparse
+import os
+import sys
 
 import numpy as np
 
 
+def fail(message):
+    """Bad input: say what is wrong on stderr, exit 2 (nothing was measured)."""
+    print(f"texture_figures: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
 def load(path, cell):
+    if not os.path.isfile(path):
+        fail(f"{path}: no such file (give a .r32 terrain or a raster GDAL opens)")
     if path.endswith(".r32"):
         z = np.fromfile(path, dtype=np.float32)
         side = int(round(np.sqrt(z.size)))
         if side * side != z.size:
-            raise SystemExit(f"{path}: {z.size} samples is not a square grid")
+            fail(f"{path}: {z.size} samples is not a square grid")
         return z.reshape(side, side).astype(np.float64), cell
     from osgeo import gdal
 
     data = gdal.Open(path)
     if data is None:
-        raise SystemExit(f"{path}: GDAL cannot open it")
+        fail(f"{path}: GDAL cannot open it")
     band = data.GetRasterBand(1)
     z = band.ReadAsArray().astype(np.float64)
     if band.GetNoDataValue() is not None:
@@ -81,15 +91,21 @@ def d8_area(z, cell):
     return area.reshape(z.shape)
 
 
-def figures(z, cell):
+def figures(path, z, cell):
+    if min(z.shape) < 3:
+        fail(f"{path}: {z.shape[1]} x {z.shape[0]} samples; the curvature needs at least 3 x 3")
     gy, gx = np.gradient(z, cell)
     slope = np.degrees(np.arctan(np.hypot(gx, gy)))
     lap = (z[:-2, 1:-1] + z[2:, 1:-1] + z[1:-1, :-2] + z[1:-1, 2:] - 4 * z[1:-1, 1:-1]) / cell**2
     inner = slope[1:-1, 1:-1]
     steep = (inner > 6.0) & np.isfinite(lap)
+    if not steep.any():
+        fail(f"{path}: no sample is steeper than 6°, so there is no hillslope to measure")
     c = lap[steep]
-    planar = np.mean(np.abs(c) < 0.2 * c.std())
-    skew = np.mean((c - c.mean()) ** 3) / c.std() ** 3
+    spread = c.std()
+    # A surface of one curvature (a plane, a cylinder) has no spread: all of it planar if that is 0.
+    planar = np.mean(np.abs(c) < 0.2 * spread) if spread > 0 else float(np.all(np.abs(c) < 1e-12))
+    skew = np.mean((c - c.mean()) ** 3) / spread**3 if spread > 0 else 0.0
     change = np.abs(np.diff(slope, axis=1))
     counted = (slope[:, :-1] > 6.0) & np.isfinite(change)
     area = d8_area(z, cell)[1:-1, 1:-1]
@@ -107,7 +123,9 @@ def main():
     p.add_argument("files", nargs="+")
     p.add_argument("--cell", type=float, default=30.0, help="cell size of .r32 files (m)")
     a = p.parse_args()
-    rows = [(path, figures(*load(path, a.cell))) for path in a.files]
+    if a.cell <= 0:
+        fail(f"--cell {a.cell}: give the cell size in metres, above 0")
+    rows = [(path, figures(path, *load(path, a.cell))) for path in a.files]
     names = list(rows[0][1])
     width = max(len(path) for path, _ in rows)
     print("file".ljust(width), *(n.rjust(22) for n in names))
