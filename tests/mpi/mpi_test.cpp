@@ -199,7 +199,8 @@ INSTANTIATE_TEST_SUITE_P(Ranks, DiffusionSeam, kErosionCases, kCaseName);
 /// landslides in tilted beds of varying strength (the limit's sweeps meet
 /// at the seams until no tile changes); and sub-steps (creep, incision,
 /// landslides and the history's uplift, split inside steps that span its
-/// frames, three times a step on one routing). A
+/// frames, three times a step on one routing), with rivers lowering their
+/// banks (a bank across a seam pushed by the neighbour's river). A
 /// basin labelled wrongly, a lake filled to another level, a pass reversed
 /// one tile short or an exit's drainage area lost at a seam changes the
 /// heights or the layers (drainage, flow_direction, chi) downstream of it.
@@ -219,7 +220,7 @@ s6 = erode:stream-power(d, years=2e4, dt=1e4, depressions=route, open="we", n=1.
 p  = tectonics:plates(d, plates=4, steps=120, cones=30, height=60, timelapse_every=30)
 s7 = erode:stream-power(p, p.timelapse, years=5e4, dt=1.5e4, uplift_history_years=4e4, uplift_smoothing=60, diffusivity=0.01, uplift_edge_taper=400)
 s8 = erode:stream-power(d, years=6e4, dt=1e4, uplift=3, diffusivity=0.01, landslide_angle=28, bed_thickness=30, bed_dip=25, bed_dip_toward=60, bed_angle_spread=8, bed_erodibility_contrast=4, bed_fold_amplitude=60, bed_fold_wavelength=900, bed_thickness_spread=0.7, bed_fault_spacing=600, bed_fault_throw=50, landslide_block_spread=0.6, bed_facies_length=400, bed_facies_share=0.7)
-s9 = erode:stream-power(p, p.timelapse, years=5e4, dt=2.5e4, uplift_history_years=4e4, substeps=3, uplift=1, diffusivity=0.05, channel_area=2e4, landslide_angle=30)
+s9 = erode:stream-power(p, p.timelapse, years=5e4, dt=2.5e4, uplift_history_years=4e4, substeps=3, uplift=1, diffusivity=0.05, channel_area=2e4, landslide_angle=30, bank_erosion=4, bank_area=1e4)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
 export:video(r, path="s1.mpg", fps=25, quality=0)
 export:vtk(s1, path="s1.vti")

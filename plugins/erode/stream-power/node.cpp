@@ -101,7 +101,10 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.diffusivity = ctx.real("diffusivity");
     s.channel_area = ctx.real("channel_area");
     s.substeps = int(ctx.integer("substeps"));
+    s.banks.erosion = ctx.real("bank_erosion");
+    s.banks.area = ctx.real("bank_area");
     constexpr double rad = std::numbers::pi / 180.0;
+    s.banks.floor_slope = std::tan(ctx.real("bank_floor_slope") * rad);
     s.rock.angle = ctx.real("landslide_angle") * rad;
     s.rock.thickness = ctx.real("bed_thickness");
     s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
@@ -676,6 +679,26 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("drainage area where rivers take over from hillslopes: incision is scaled by "
                           "1 - exp(-A/channel_area), so smaller catchments are shaped by creep (channel heads "
                           "at 1e3-1e5 m², Montgomery & Dietrich 1988); 0 = every cell is a river"),
+                Param::real("bank_erosion", 0.0)
+                    .min(0.0)
+                    .max(10.0)
+                    .help("rivers widen their valleys (lateral erosion, after Langston & Tucker 2018): each "
+                          "incision lowers the two cells across a river by this many times the river's own "
+                          "lowering, shared between them (straight on, half each; at a bend the outer bank takes "
+                          "more), never below the river; 0 = banks stand, 4 = a floor three cells wide"),
+                Param::real("bank_area", 1e6)
+                    .min(1.0)
+                    .max(1e12)
+                    .unit("m²")
+                    .help("drainage area over which a river is wide and deep enough to undercut its banks: "
+                          "bank erosion is scaled by 1 - exp(-A/bank_area)"),
+                Param::real("bank_floor_slope", 1.0)
+                    .min(0.0)
+                    .max(30.0)
+                    .unit("°")
+                    .help("a bank the river has cut down still rises from the river at this angle: the valley "
+                          "floor slopes gently to its river, as the aprons along a mountain valley's foot do "
+                          "(0 = dead flat floors, which hold pits)"),
                 Param::integer("substeps", 1)
                     .min(1)
                     .max(1000)
@@ -868,9 +891,10 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                           "level. none: the lowest cell is the one outlet"),
                 Param::string("base_level", "edge")
                     .help("height of the outlets: edge (they keep the input's heights) or metres, e.g. \"0\""),
-                Param::choice("depressions", {"fill", "route"}, "fill")
-                    .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
-                          "the heights stay)"),
+                Param::
+                    choice("depressions", {"fill", "route"}, "fill")
+                        .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
+                              "the heights stay)"),
                 Param::
                     choice("routing", {"d8", "mfd"}, "d8")
                         .help("drainage area: d8 (all water to the steepest neighbour) or mfd (split among the lower "

@@ -163,8 +163,10 @@ std::int64_t Model::step(double dt) {
         if (bed_offset_.empty()) bed_offsets(settings_.rock, n, width_, 0, 0, cell_, bed_offset_);
         rock_at(settings_.rock, h, uplifted_.data(), bed_offset_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
         if (settings_.glaciers.any()) glacial_factors(sub);
+        if (settings_.banks.any()) bank_before_.assign(h_.begin(), h_.end());
         if (settings_.deposition > 0.0) incise_with_deposition(sub);
         else incise(sub);
+        if (settings_.banks.any()) erode_banks();
         if (settings_.glaciers.any())
             carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
         // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
@@ -176,6 +178,31 @@ std::int64_t Model::step(double dt) {
     }
     time_ += dt;
     return pits;
+}
+
+void Model::erode_banks() {
+    const std::size_t n = h_.size();
+    const std::int32_t* rcv = flow_.receivers().data();
+    bank_dir_.resize(n);
+    // The lowering by this incision goes into bank_before_ (no more use for the old heights).
+    parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
+        for (std::int64_t i = b; i < e; ++i) {
+            const std::int64_t r = rcv[i];
+            bank_before_[std::size_t(i)] = std::max(0.0, bank_before_[std::size_t(i)] - h_[std::size_t(i)]);
+            int code = -1;
+            if (r != i) {
+                const int dx = int(r % width_) - int(i % width_), dy = int(r / width_) - int(i / width_);
+                for (int k = 0; k < 8; ++k)
+                    if (kDx[k] == dx && kDy[k] == dy) code = k;
+            }
+            bank_dir_[std::size_t(i)] = std::int8_t(code);
+        }
+    });
+    const BankWindow w{width_, height_, 0, 0, width_, height_};
+    bank_pushes(settings_.banks, w, bank_dir_.data(), flow_.area().data(), bank_before_.data(), bank_right_,
+                bank_left_);
+    lower_banks(settings_.banks, w, bank_dir_.data(), bank_right_.data(), bank_left_.data(), flow_.outlets().data(),
+                cell_, h_.data(), bank_scratch_);
 }
 
 void Model::glacial_factors(double dt) {

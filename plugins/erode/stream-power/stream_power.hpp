@@ -29,6 +29,7 @@
 // order, so the result is the same on any number of threads.
 #pragma once
 
+#include "banks.hpp"
 #include "flow.hpp"
 #include "glaciers.hpp"
 #include "rock.hpp"
@@ -82,6 +83,10 @@ struct Settings {
     /// erode fast; Burbank et al. 1996, Montgomery & Brandon 2002), so hillslopes end planar at the
     /// threshold and the divides between them sharp.
     Beds rock;
+    /// Rivers that widen their valleys (banks.hpp): with banks.any(), after each incision every river
+    /// lowers the two cells across its flow by a share of its own lowering, the outer bank of a bend
+    /// the most (lateral erosion, Langston & Tucker 2018).
+    Banks banks;
     /// Valley glaciers (glaciers.hpp): with glaciers.any(), ice gathers above the ELA, flows down the
     /// flow graph, erodes K_g·Q^m_g·S^n in the same implicit sweep as the rivers and carves U-shaped
     /// troughs. Detachment-limited only (deposition = 0), and not tiled.
@@ -175,6 +180,7 @@ private:
     void incise(double dt);
     void glacial_factors(double dt);  // ice_ and ice_f_ over this step's flow graph
     void incise_with_deposition(double dt);
+    void erode_banks();  // after the incision: banks.hpp, against the heights saved in bank_before_
     void add_history_uplift(double t0, double t1);
     void accumulate(const double* routed);  // D8 or multiple-flow area over the routed heights
     void update_rain();  // orographic rain over the current heights, and each cell's weight
@@ -189,6 +195,9 @@ private:
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
+    std::vector<double> bank_before_, bank_right_, bank_left_,
+        bank_scratch_;  // banks: heights before the incision, pushes
+    std::vector<std::int8_t> bank_dir_;  // banks: each cell's direction to its receiver (kDx/kDy), −1 at a root
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
     double time_ = 0.0, sediment_out_ = 0.0;

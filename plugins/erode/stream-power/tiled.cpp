@@ -726,6 +726,7 @@ std::int64_t TiledModel::step(double dt) {
         const double c1 = K * sub / std::pow(cell_, ns), c2 = K * sub / std::pow(cell_ * kSqrt2, ns);
         const double* tab = pow_table_.data();
         const double inv_ac = inverse_channel_area(settings_);
+        if (settings_.banks.any()) bank_before_ = h_;
         propagate(h_, [&](std::size_t l, double hr) {
             const double hi = h_[l];
             if (hi <= hr) return;
@@ -739,6 +740,7 @@ std::int64_t TiledModel::step(double dt) {
                 h_[l] = hr + incised_drop(hi - hr, F, ns);
             }
         });
+        if (settings_.banks.any()) erode_banks(bank_before_);
         // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
         if (settings_.rock.angle > 0.0)
             threshold::limit_slopes(
@@ -747,6 +749,41 @@ std::int64_t TiledModel::step(double dt) {
                 outlet_.data(), nullptr, &slope_scratch_);
     }
     return pits;
+}
+
+void TiledModel::erode_banks(const std::vector<double>& before) {
+    const int gw = grown_.width, gh = grown_.height;
+    const int ox = own_.x0 - grown_.x0, oy = own_.y0 - grown_.y0;
+    const std::size_t gn = std::size_t(gw) * std::size_t(gh);
+    bank_area_.assign(gn, 0.0);
+    bank_dir_.assign(gn, -1.0);
+    bank_e_.assign(gn, 0.0);
+    bank_h_.assign(gn, 0.0);
+    bank_outlet_.assign(gn, 0);
+    for (int y = 0; y < own_.height; ++y)
+        for (int x = 0; x < own_.width; ++x) {
+            const std::size_t l = std::size_t(y) * std::size_t(own_.width) + std::size_t(x);
+            const std::size_t g = std::size_t(y + oy) * std::size_t(gw) + std::size_t(x + ox);
+            bank_area_[g] = area_[l];
+            bank_dir_[g] = dir_[l];
+            bank_e_[g] = std::max(0.0, before[l] - h_[l]);  // as Model::erode_banks
+            bank_h_[g] = h_[l];
+            bank_outlet_[g] = outlet_[l];
+        }
+    double* first[] = {bank_area_.data(), bank_dir_.data(), bank_e_.data(), bank_h_.data()};
+    joined([&] { return tiles_.exchange(std::span<double* const>(first)); });
+    bank_code_.resize(gn);
+    for (std::size_t g = 0; g < gn; ++g) bank_code_[g] = std::int8_t(bank_dir_[g]);
+    const BankWindow w{gw, gh, ox, oy, ox + own_.width, oy + own_.height};
+    bank_pushes(settings_.banks, w, bank_code_.data(), bank_area_.data(), bank_e_.data(), bank_right_, bank_left_);
+    double* second[] = {bank_right_.data(), bank_left_.data()};
+    joined([&] { return tiles_.exchange(std::span<double* const>(second)); });
+    lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_outlet_.data(),
+                cell_, bank_h_.data(), bank_scratch_);
+    for (int y = 0; y < own_.height; ++y)
+        for (int x = 0; x < own_.width; ++x)
+            h_[std::size_t(y) * std::size_t(own_.width) + std::size_t(x)] =
+                bank_h_[std::size_t(y + oy) * std::size_t(gw) + std::size_t(x + ox)];
 }
 
 std::vector<double> TiledModel::chi(double a0) {

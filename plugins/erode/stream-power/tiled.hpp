@@ -119,6 +119,8 @@ private:
     void join_on_rank0(ResolveState& st);
     void apply_joined(ResolveState& st, double* h);
     void accumulate();
+    /// Banks (banks.hpp) after an incision from heights `before`: two halo exchanges, the same bits as Model.
+    void erode_banks(const std::vector<double>& before);
     /// Solve `v` down the rivers: f(l, v_receiver) sets v[l] for every cell but the roots, receivers first.
     void propagate(std::vector<double>& v, const std::function<void(std::size_t, double)>& f);
     bool outlet_at(std::int64_t g) const;
@@ -163,6 +165,11 @@ private:
     std::vector<double> grown_h_, grown_v_, grown_done_, grown_label_;  // over ghosted() (halo 1)
     std::vector<std::int64_t> label_;  // resolve_pits: each cell's basin (its pit or outlet)
     std::vector<double> count_, area_;  // cells upstream (with itself), m²
+    // Banks: the heights before the incision (own), and over ghosted() the area, direction, lowering,
+    // heights and pushes the two passes read, each cell's direction as a code, outlets, scratch.
+    std::vector<double> bank_before_, bank_area_, bank_dir_, bank_e_, bank_h_, bank_right_, bank_left_, bank_scratch_;
+    std::vector<std::int8_t> bank_code_;
+    std::vector<std::uint8_t> bank_outlet_;
     std::vector<double> pow_table_;
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::int64_t pits_ = 0;

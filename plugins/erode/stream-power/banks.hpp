@@ -1,0 +1,70 @@
+// banks.hpp — rivers that widen their valleys: lateral erosion of the banks
+// (after Langston & Tucker 2018).
+//
+// A river cuts sideways as well as down: the water undercuts the bank on the
+// outside of each bend, the bank falls in and is carried off, and over time
+// the channel sweeps a valley floor wider than itself. On a grid whose cells
+// (30 m) are wider than the rivers, a channel that only cuts down leaves a
+// V notch one cell wide; real valleys at that cell size have rounded floors
+// several cells across (docs/realism.md: the Laplacian at cells draining
+// more than 1 km² is 8–16 /km in real ranges, 27–29 /km without this).
+//
+// Each incision step, every river cell i (one that drains somewhere) that
+// was lowered by e_i metres lowers its two banks — the neighbours across its
+// flow, at ±90° from the direction to its receiver — by
+//
+//     δ = κ·(1 − e^(−A_i/A_b))·e_i·w,    w = (1 ± b)/2,
+//
+// κ the bank erosion (Langston & Tucker's ratio of lateral to vertical
+// erodibility, times the share of the bank the water reaches), A_b the
+// drainage area over which the river is wide and deep enough to undercut its
+// banks, and b the bend: 0 where the river runs straight on from its main
+// donor (the donor draining the most), ½ at a 45° turn, 1 at 90° or more.
+// The outer bank (on the side the water comes from) takes (1 + b)/2, the
+// inner (1 − b)/2: bends migrate outward, as meanders do. A bank never falls
+// below the river that cuts it (the one pushing hardest, where several do), and
+// outlets stay. What falls in leaves with the river (detachment-limited, as
+// the incision).
+//
+// Both passes read only the heights after the incision and write separate
+// arrays, so the result does not depend on the order or the threads, and a
+// tile with a halo of one cell computes its own cells exactly (tiled.cpp).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace orogen::stream_power {
+
+struct Banks {
+    double erosion = 0.0;  ///< κ, dimensionless (0: banks stand)
+    double area = 1e6;  ///< A_b, m²
+    double floor_slope = 0.0;  ///< tan of the angle at which a lowered bank still rises from its river
+    bool any() const { return erosion > 0.0; }
+};
+
+/// A window of `width` × `height` cells (row-major) in which the cells of
+/// [x0, x1) × [y0, y1) are computed, their neighbours read (a tile's halo, or
+/// the whole grid with the window's edge the grid's).
+struct BankWindow {
+    int width = 0, height = 0;
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+/// First pass: each computed cell's push on its two banks (m): `right` on the
+/// bank at direction (dir + 2) mod 8 (on the right looking downstream), `left`
+/// on (dir + 6) mod 8 (kDx/kDy codes; dir[i] = −1 for a root, which pushes
+/// nothing). `incised` the cell's lowering by the incision (m), `area` its
+/// drainage area (m²); both arrays are resized to the window and zero outside
+/// the computed cells.
+void bank_pushes(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* area,
+                 const double* incised, std::vector<double>& right, std::vector<double>& left);
+
+/// Second pass: lowers each computed cell by what its neighbours push on it,
+/// not below the one pushing hardest plus banks.floor_slope over the distance; `outlet` cells (window-indexed, or null)
+/// stay. Returns the volume removed over the computed cells, m³.
+double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
+                   const double* left, const std::uint8_t* outlet, double cell, double* heights,
+                   std::vector<double>& scratch);
+
+}  // namespace orogen::stream_power

@@ -1,0 +1,232 @@
+// Tests of bank erosion (banks.hpp): the pushes a river gives its banks on
+// hand-made windows with known answers (straight on, at 45° and 90° bends,
+// the main donor), the floor a bank stops at, outlets; and in the model, that
+// rivers grow valley floors and give the same bits on one and two threads.
+#include "banks.hpp"
+#include "flow.hpp"
+#include "stream_power.hpp"
+
+#include <orogen/random.hpp>
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+namespace {
+
+using namespace orogen;
+using namespace orogen::stream_power;
+
+constexpr int kW = 5, kH = 5;
+std::size_t at(int x, int y) { return std::size_t(y) * kW + std::size_t(x); }
+
+struct Window {
+    std::vector<std::int8_t> dir = std::vector<std::int8_t>(kW * kH, -1);
+    std::vector<double> area = std::vector<double>(kW * kH, 900.0);
+    std::vector<double> incised = std::vector<double>(kW * kH, 0.0);
+    std::vector<double> heights = std::vector<double>(kW * kH, 100.0);
+    std::vector<double> right, left, scratch;
+    BankWindow w{kW, kH, 0, 0, kW, kH};
+};
+
+/// A river along row 2 flowing east, lowered by 2 m, draining far more than A_b; its last cell a root.
+Window straight_river() {
+    Window v;
+    for (int x = 0; x < kW; ++x) {
+        v.dir[at(x, 2)] = x + 1 < kW ? 0 : -1;
+        v.area[at(x, 2)] = 1e9;
+        v.incised[at(x, 2)] = 2.0;
+        v.heights[at(x, 2)] = 0.0;
+    }
+    return v;
+}
+
+TEST(Banks, AStraightRiverLowersEachBankByHalfItsShare) {
+    Window v = straight_river();
+    Banks b;
+    b.erosion = 3.0;
+    b.area = 1e4;
+    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    // Flowing east (code 0) the right bank is south (code 2), the left north (code 6): κ·e/2 each.
+    EXPECT_DOUBLE_EQ(v.right[at(1, 2)], 3.0);
+    EXPECT_DOUBLE_EQ(v.left[at(1, 2)], 3.0);
+    EXPECT_EQ(v.right[at(4, 2)], 0.0);  // the root drains nowhere: no push
+    const double removed =
+        lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    for (int x = 0; x < kW; ++x) {
+        const double bank = x + 1 < kW ? 97.0 : 100.0;  // beside the root nothing pushes
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 1)], bank) << x;
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 3)], bank) << x;
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 0)], 100.0) << x;  // only the banks themselves
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 2)], 0.0) << x;  // the river is the incision's
+    }
+    EXPECT_DOUBLE_EQ(removed, 8 * 3.0 * 900.0);
+}
+
+TEST(Banks, ASmallStreamBarelyPushes) {
+    Window v = straight_river();
+    for (int x = 0; x < kW; ++x) v.area[at(x, 2)] = 1e3;
+    Banks b;
+    b.erosion = 3.0;
+    b.area = 1e5;
+    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    EXPECT_NEAR(v.right[at(1, 2)], 3.0 * -std::expm1(-1e3 / 1e5), 1e-15);
+}
+
+TEST(Banks, ABankStopsAboveItsRiverAtTheFloorSlopeAndOutletsStay) {
+    Window v = straight_river();
+    v.heights[at(1, 1)] = 4.0;  // 4 m above the river, pushed 3 m: would end 1 m above it
+    v.heights[at(2, 1)] = 2.0;  // below the floor already: stays
+    v.heights[at(3, 1)] = 50.0;
+    Banks b;
+    b.erosion = 100.0;  // 100 m per bank: every bank reaches its floor
+    b.area = 1e4;
+    b.floor_slope = 0.1;  // 3 m above the river over one 30 m cell
+    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    std::vector<std::uint8_t> outlet(kW * kH, 0);
+    outlet[at(0, 3)] = 1;
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), outlet.data(), 30.0, v.heights.data(), v.scratch);
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 1)], 3.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(2, 1)], 2.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(3, 1)], 3.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(0, 3)], 100.0);  // an outlet
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 3)], 3.0);
+}
+
+/// A river coming into the centre from its donor at direction code `from` (the donor's own flow
+/// direction is `from`) and leaving east; a second, smaller donor from the west.
+Window bend(int from) {
+    Window v;
+    const int cx = 2, cy = 2;
+    v.dir[at(cx, cy)] = 0;
+    v.area[at(cx, cy)] = 1e9;
+    v.incised[at(cx, cy)] = 1.0;
+    const int dx = cx - kDx[from], dy = cy - kDy[from];
+    v.dir[at(dx, dy)] = std::int8_t(from);
+    v.area[at(dx, dy)] = 5e8;
+    if (from != 0) {  // a smaller tributary from the west, running straight on: it must not decide the bend
+        v.dir[at(cx - 1, cy)] = 0;
+        v.area[at(cx - 1, cy)] = 1e8;
+    }
+    return v;
+}
+
+TEST(Banks, AtABendTheOuterBankTakesMore) {
+    Banks b;
+    b.erosion = 1.0;
+    b.area = 1e4;
+    {  // from the north (flowing south, code 2), turning east: 90°, the south bank (right) takes it all
+        Window v = bend(2);
+        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 1.0);
+        EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.0);
+    }
+    {  // from the north-east... flowing south-west (code 3), turning east: 135°, still all on the south bank
+        Window v = bend(3);
+        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 1.0);
+        EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.0);
+    }
+    {  // from the north-west, flowing south-east (code 1): 45°, three quarters on the south bank
+        Window v = bend(1);
+        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 0.75);
+        EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.25);
+    }
+    {  // from the south-west, flowing north-east (code 7): 45° the other way, three quarters on the north bank
+        Window v = bend(7);
+        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 0.25);
+        EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.75);
+    }
+    {  // straight on from the west: half each
+        Window v = bend(0);
+        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 0.5);
+        EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.5);
+    }
+}
+
+TEST(Banks, ADiagonalRiversBanksAreTheDiagonalNeighboursAndTheirFloorIsFarther) {
+    Window v;
+    v.dir[at(2, 2)] = 1;  // flowing south-east: banks at code 3 (south-west) and 7 (north-east)
+    v.area[at(2, 2)] = 1e9;
+    v.incised[at(2, 2)] = 10.0;
+    v.heights[at(2, 2)] = 0.0;
+    Banks b;
+    b.erosion = 100.0;
+    b.area = 1e4;
+    b.floor_slope = 0.1;
+    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    EXPECT_NEAR(v.heights[at(1, 3)], 3.0 * std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(v.heights[at(3, 1)], 3.0 * std::sqrt(2.0), 1e-12);
+    EXPECT_DOUBLE_EQ(v.heights[at(2, 3)], 100.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(3, 2)], 100.0);
+}
+
+std::vector<double> noise(int w, int h, std::uint64_t seed, double amplitude) {
+    std::vector<double> v(std::size_t(w) * std::size_t(h));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) v[std::size_t(y) * w + x] = amplitude * random::uniform(seed, x, y);
+    return v;
+}
+
+/// Mean height of the two cells across each river (A ≥ 40 cells, flowing along an axis) above the river.
+double mean_bank_rise(const Model& model, int w, int h) {
+    double sum = 0.0;
+    int count = 0;
+    for (int y = 1; y + 1 < h; ++y)
+        for (int x = 1; x + 1 < w; ++x) {
+            const std::int64_t i = std::int64_t(y) * w + x;
+            if (model.flow().area()[std::size_t(i)] < 40 * 900.0) continue;
+            const int d = model.flow().direction(i);
+            if (d != 0 && d != 2 && d != 4 && d != 6) continue;
+            const std::int64_t a = i + kDy[(d + 2) % 8] * w + kDx[(d + 2) % 8];
+            const std::int64_t c = i + kDy[(d + 6) % 8] * w + kDx[(d + 6) % 8];
+            sum += 0.5 * (model.heights()[std::size_t(a)] + model.heights()[std::size_t(c)]) -
+                model.heights()[std::size_t(i)];
+            ++count;
+        }
+    return count ? sum / count : 0.0;
+}
+
+TEST(Banks, RiversGrowValleyFloorsAndTheBitsHoldOnTwoThreads) {
+    const int w = 129, h = 97;
+    Settings s;
+    s.erodibility = 2e-5;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.0;
+    s.open = {true, true, false, false};
+    s.rock.angle = 35.0 * M_PI / 180.0;  // landslides hold the walls: without banks, V notches
+    double rise[2] = {0.0, 0.0};
+    std::vector<double> heights[2];
+    for (int with = 0; with < 2; ++with) {
+        s.banks.erosion = with ? 4.0 : 0.0;
+        s.banks.area = 1e4;
+        s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
+        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        model.run(1.2e6, 2e4);
+        model.route_only();
+        rise[with] = mean_bank_rise(model, w, h);
+        heights[with] = model.heights();
+    }
+    // Without banks the cells across a river stand near the landslide angle above it (tan 35° × 30 m = 21 m);
+    // with them the rivers keep a floor beside them.
+    EXPECT_GT(rise[0], 10.0) << rise[1];
+    EXPECT_LT(rise[1], 0.3 * rise[0]);
+    std::vector<double> threads[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
+        s.banks.erosion = 4.0;
+        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        model.run(3e5, 2e4);
+        threads[t] = model.heights();
+    }
+    EXPECT_EQ(0, std::memcmp(threads[0].data(), threads[1].data(), threads[0].size() * sizeof(double)));
+}
+
+}  // namespace
