@@ -1,7 +1,8 @@
 // bench-links: TBB::tbb
 // One step of the stream-power landscape model (orogen::stream_power::Model::step:
 // uplift, D8 routing, pit resolution, drainage area (D8, or multiple flow
-// directions with mfd:1), implicit diffusion, implicit incision) at 1025² and 4097², and its parts. Targets (2 cores): one step
+// directions with mfd:1), implicit diffusion, implicit incision, and with banks:4 the rivers cutting
+// their banks) at 1025² and 4097², and its parts. Targets (2 cores): one step
 // at 1025² ≤ 60 ms, at 4097² ≤ 1.2 s.
 //
 // Two starting states:
@@ -34,8 +35,8 @@ std::vector<double> dome(int n) {
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
             const double r = std::hypot(x - c, y - c) / c;
-            h[std::size_t(y) * n + x] = 1500.0 * (1.0 - r) + 80.0 * std::sin(0.031 * x) * std::cos(0.027 * y) +
-                                        5.0 * random::uniform(3, x, y);
+            h[std::size_t(y) * n + x] =
+                1500.0 * (1.0 - r) + 80.0 * std::sin(0.031 * x) * std::cos(0.027 * y) + 5.0 * random::uniform(3, x, y);
         }
     return h;
 }
@@ -49,7 +50,10 @@ void BM_stream_power_step(benchmark::State& state) {
     s.slope_exponent = 1.0;
     s.diffusivity = state.range(2) ? 0.01 : 0.0;
     s.mfd_exponent = state.range(3) ? 1.1 : 0.0;  // routing=mfd: drainage area by multiple flow directions
-    s.deposition = double(state.range(4));         // G of Yuan et al. (2019); 0: detachment-limited
+    s.deposition = double(state.range(4));  // G of Yuan et al. (2019); 0: detachment-limited
+    s.banks.erosion = double(state.range(5));  // rivers cut their banks (banks.hpp); 0: none
+    s.banks.area = 3e4;
+    s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
     Model model(n, n, 30.0, dome(n), std::vector<double>(std::size_t(n) * n, 1e-3), s);
     for (int i = 0; i < 3; ++i) model.step(1e4);
     std::int64_t pits = 0, passes = 0;
@@ -63,14 +67,15 @@ void BM_stream_power_step(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * std::int64_t(n) * n);
 }
 BENCHMARK(BM_stream_power_step)
-    ->ArgNames({"n", "threads", "diffusion", "mfd", "G"})
-    ->Args({1025, 1, 1, 0, 0})
-    ->Args({1025, 2, 1, 0, 0})
-    ->Args({1025, 2, 0, 0, 0})
-    ->Args({1025, 2, 1, 1, 0})
-    ->Args({1025, 1, 1, 0, 1})
-    ->Args({1025, 2, 1, 0, 1})
-    ->Args({4097, 2, 1, 0, 0})
+    ->ArgNames({"n", "threads", "diffusion", "mfd", "G", "banks"})
+    ->Args({1025, 1, 1, 0, 0, 0})
+    ->Args({1025, 2, 1, 0, 0, 0})
+    ->Args({1025, 2, 0, 0, 0, 0})
+    ->Args({1025, 2, 1, 1, 0, 0})
+    ->Args({1025, 1, 1, 0, 1, 0})
+    ->Args({1025, 2, 1, 0, 1, 0})
+    ->Args({1025, 2, 1, 0, 0, 4})
+    ->Args({4097, 2, 1, 0, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
@@ -87,7 +92,11 @@ void BM_stream_power_route(benchmark::State& state) {
     }
     state.SetItemsProcessed(state.iterations() * std::int64_t(n) * n);
 }
-BENCHMARK(BM_stream_power_route)->ArgNames({"n", "threads"})->Args({1025, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_stream_power_route)
+    ->ArgNames({"n", "threads"})
+    ->Args({1025, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // fsl_lem's protocol: per-step average of the first `steps` steps from noise.
 void BM_stream_power_fsl(benchmark::State& state) {
@@ -109,8 +118,8 @@ void BM_stream_power_fsl(benchmark::State& state) {
         for (int i = 0; i < steps; ++i) pits += double(model.step(2e4));
         benchmark::ClobberMemory();
     }
-    state.counters["ms/step"] = benchmark::Counter(double(steps) * 1e-3, benchmark::Counter::kIsIterationInvariantRate |
-                                                                           benchmark::Counter::kInvert);
+    state.counters["ms/step"] = benchmark::Counter(
+        double(steps) * 1e-3, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
     state.counters["pits/step"] = pits / double(state.iterations() * steps);
 }
 BENCHMARK(BM_stream_power_fsl)

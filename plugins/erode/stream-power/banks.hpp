@@ -10,8 +10,10 @@
 // more than 1 km² is 8–16 /km in real ranges, 27–29 /km without this).
 //
 // Each incision step, every river cell i (one that drains somewhere) that
-// was lowered by e_i metres lowers its two banks — the neighbours across its
-// flow, at ±90° from the direction to its receiver — by
+// was lowered by e_i metres lowers its banks — on each side of its flow the
+// edge neighbour across it (a river along an axis), or the two edge
+// neighbours flanking it, half each (a diagonal river: its diagonal
+// neighbours lie √2 cells off its line, the edge ones half as far) — by
 //
 //     δ = κ·(1 − e^(−A_i/A_b))·e_i·w,    w = (1 ± b)/2,
 //
@@ -22,8 +24,8 @@
 // donor (the donor draining the most), ½ at a 45° turn, 1 at 90° or more.
 // The outer bank (on the side the water comes from) takes (1 + b)/2, the
 // inner (1 − b)/2: bends migrate outward, as meanders do. A bank never falls
-// below the river that cuts it (the one pushing hardest, where several do), and
-// outlets stay. What falls in leaves with the river (detachment-limited, as
+// below the river that cuts it (the one pushing hardest, where several do)
+// plus the floor slope over one cell, and outlets stay. What falls in leaves with the river (detachment-limited, as
 // the incision).
 //
 // Both passes read only the heights after the incision and write separate
@@ -43,6 +45,18 @@ struct Banks {
     bool any() const { return erosion > 0.0; }
 };
 
+/// 1 − e^(−A/A_b) for a drainage area A (m²): from a table when A is a whole number of cells below
+/// 2^16 (as the incision's A^m: most cells drain few cells), else computed. Built once per model.
+class BankAreaFactor {
+public:
+    BankAreaFactor(const Banks& banks, double cell);
+    double operator()(double area) const;
+
+private:
+    std::vector<double> table_;
+    double a0_, inv_a0_, inv_ab_;
+};
+
 /// A window of `width` × `height` cells (row-major) in which the cells of
 /// [x0, x1) × [y0, y1) are computed, their neighbours read (a tile's halo, or
 /// the whole grid with the window's edge the grid's).
@@ -51,17 +65,19 @@ struct BankWindow {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
 };
 
-/// First pass: each computed cell's push on its two banks (m): `right` on the
-/// bank at direction (dir + 2) mod 8 (on the right looking downstream), `left`
-/// on (dir + 6) mod 8 (kDx/kDy codes; dir[i] = −1 for a root, which pushes
-/// nothing). `incised` the cell's lowering by the incision (m), `area` its
-/// drainage area (m²); both arrays are resized to the window and zero outside
-/// the computed cells.
-void bank_pushes(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* area,
-                 const double* incised, std::vector<double>& right, std::vector<double>& left);
+/// First pass: each computed cell's push on its banks (m): `right` on its
+/// right looking downstream (the cell at direction (dir + 2) mod 8 for an axis
+/// flow, half each on (dir + 1) and (dir + 3) for a diagonal one; kDx/kDy
+/// codes), `left` on its left ((dir + 6); (dir + 5) and (dir + 7)); dir[i] = −1
+/// for a root, which pushes nothing. `incised` the cell's lowering by the incision (m), `area` its
+/// drainage area (m²). Both arrays are sized to the window (zeros when they
+/// are not yet); the computed cells are written, the others kept (a tile's
+/// halo, which the exchange after this pass fills).
+void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWindow& w, const std::int8_t* dir,
+                 const double* area, const double* incised, std::vector<double>& right, std::vector<double>& left);
 
 /// Second pass: lowers each computed cell by what its neighbours push on it,
-/// not below the one pushing hardest plus banks.floor_slope over the distance; `outlet` cells (window-indexed, or null)
+/// not below the one pushing hardest plus banks.floor_slope over one cell; `outlet` cells (window-indexed, or null)
 /// stay. Returns the volume removed over the computed cells, m³.
 double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
                    const double* left, const std::uint8_t* outlet, double cell, double* heights,

@@ -498,6 +498,9 @@ void check(CheckContext& ctx) {
     if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("landslide_block_spread",
                   "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
+    for (const char* bank : {"bank_area", "bank_floor_slope"})
+        if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0))
+            ctx.error(bank, std::string(bank) + " shapes the rivers' bank erosion; give bank_erosion > 0 as well");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");

@@ -184,23 +184,23 @@ void Model::erode_banks() {
     const std::size_t n = h_.size();
     const std::int32_t* rcv = flow_.receivers().data();
     bank_dir_.resize(n);
+    if (!bank_factor_) bank_factor_.emplace(settings_.banks, cell_);
+    std::int64_t offset[8];  // index offset of each D8 neighbour: codes without a division per cell
+    for (int k = 0; k < 8; ++k) offset[k] = std::int64_t(kDy[k]) * width_ + kDx[k];
     // The lowering by this incision goes into bank_before_ (no more use for the old heights).
     parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e; ++i) {
-            const std::int64_t r = rcv[i];
             bank_before_[std::size_t(i)] = std::max(0.0, bank_before_[std::size_t(i)] - h_[std::size_t(i)]);
+            const std::int64_t d = std::int64_t(rcv[i]) - i;
             int code = -1;
-            if (r != i) {
-                const int dx = int(r % width_) - int(i % width_), dy = int(r / width_) - int(i / width_);
-                for (int k = 0; k < 8; ++k)
-                    if (kDx[k] == dx && kDy[k] == dy) code = k;
-            }
+            for (int k = 0; k < 8 && d != 0; ++k)
+                if (offset[k] == d) code = k;
             bank_dir_[std::size_t(i)] = std::int8_t(code);
         }
     });
     const BankWindow w{width_, height_, 0, 0, width_, height_};
-    bank_pushes(settings_.banks, w, bank_dir_.data(), flow_.area().data(), bank_before_.data(), bank_right_,
-                bank_left_);
+    bank_pushes(settings_.banks, *bank_factor_, w, bank_dir_.data(), flow_.area().data(), bank_before_.data(),
+                bank_right_, bank_left_);
     lower_banks(settings_.banks, w, bank_dir_.data(), bank_right_.data(), bank_left_.data(), flow_.outlets().data(),
                 cell_, h_.data(), bank_scratch_);
 }

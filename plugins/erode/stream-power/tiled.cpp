@@ -775,7 +775,9 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
     bank_code_.resize(gn);
     for (std::size_t g = 0; g < gn; ++g) bank_code_[g] = std::int8_t(bank_dir_[g]);
     const BankWindow w{gw, gh, ox, oy, ox + own_.width, oy + own_.height};
-    bank_pushes(settings_.banks, w, bank_code_.data(), bank_area_.data(), bank_e_.data(), bank_right_, bank_left_);
+    if (!bank_factor_) bank_factor_.emplace(settings_.banks, cell_);
+    bank_pushes(settings_.banks, *bank_factor_, w, bank_code_.data(), bank_area_.data(), bank_e_.data(), bank_right_,
+                bank_left_);
     double* second[] = {bank_right_.data(), bank_left_.data()};
     joined([&] { return tiles_.exchange(std::span<double* const>(second)); });
     lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_outlet_.data(),

@@ -49,6 +49,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -170,6 +171,7 @@ private:
     std::vector<double> bank_before_, bank_area_, bank_dir_, bank_e_, bank_h_, bank_right_, bank_left_, bank_scratch_;
     std::vector<std::int8_t> bank_code_;
     std::vector<std::uint8_t> bank_outlet_;
+    std::optional<BankAreaFactor> bank_factor_;  // 1 − e^(−A/A_b), built at the first step
     std::vector<double> pow_table_;
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::int64_t pits_ = 0;

@@ -1,6 +1,6 @@
 // Tests of bank erosion (banks.hpp): the pushes a river gives its banks on
 // hand-made windows with known answers (straight on, at 45° and 90° bends,
-// the main donor), the floor a bank stops at, outlets; and in the model, that
+// the main donor, a diagonal river), the floor a bank stops at, outlets; and in the model, that
 // rivers grow valley floors and give the same bits on one and two threads.
 #include "banks.hpp"
 #include "flow.hpp"
@@ -49,7 +49,7 @@ TEST(Banks, AStraightRiverLowersEachBankByHalfItsShare) {
     Banks b;
     b.erosion = 3.0;
     b.area = 1e4;
-    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     // Flowing east (code 0) the right bank is south (code 2), the left north (code 6): κ·e/2 each.
     EXPECT_DOUBLE_EQ(v.right[at(1, 2)], 3.0);
     EXPECT_DOUBLE_EQ(v.left[at(1, 2)], 3.0);
@@ -72,7 +72,7 @@ TEST(Banks, ASmallStreamBarelyPushes) {
     Banks b;
     b.erosion = 3.0;
     b.area = 1e5;
-    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     EXPECT_NEAR(v.right[at(1, 2)], 3.0 * -std::expm1(-1e3 / 1e5), 1e-15);
 }
 
@@ -85,7 +85,7 @@ TEST(Banks, ABankStopsAboveItsRiverAtTheFloorSlopeAndOutletsStay) {
     b.erosion = 100.0;  // 100 m per bank: every bank reaches its floor
     b.area = 1e4;
     b.floor_slope = 0.1;  // 3 m above the river over one 30 m cell
-    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     std::vector<std::uint8_t> outlet(kW * kH, 0);
     outlet[at(0, 3)] = 1;
     lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), outlet.data(), 30.0, v.heights.data(), v.scratch);
@@ -120,52 +120,56 @@ TEST(Banks, AtABendTheOuterBankTakesMore) {
     b.area = 1e4;
     {  // from the north (flowing south, code 2), turning east: 90°, the south bank (right) takes it all
         Window v = bend(2);
-        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
         EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 1.0);
         EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.0);
     }
     {  // from the north-east... flowing south-west (code 3), turning east: 135°, still all on the south bank
         Window v = bend(3);
-        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
         EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 1.0);
         EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.0);
     }
     {  // from the north-west, flowing south-east (code 1): 45°, three quarters on the south bank
         Window v = bend(1);
-        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
         EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 0.75);
         EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.25);
     }
     {  // from the south-west, flowing north-east (code 7): 45° the other way, three quarters on the north bank
         Window v = bend(7);
-        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
         EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 0.25);
         EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.75);
     }
     {  // straight on from the west: half each
         Window v = bend(0);
-        bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+        bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
         EXPECT_DOUBLE_EQ(v.right[at(2, 2)], 0.5);
         EXPECT_DOUBLE_EQ(v.left[at(2, 2)], 0.5);
     }
 }
 
-TEST(Banks, ADiagonalRiversBanksAreTheDiagonalNeighboursAndTheirFloorIsFarther) {
+TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     Window v;
-    v.dir[at(2, 2)] = 1;  // flowing south-east: banks at code 3 (south-west) and 7 (north-east)
+    v.dir[at(2, 2)] = 1;  // flowing south-east: right south and west, left north and east
     v.area[at(2, 2)] = 1e9;
-    v.incised[at(2, 2)] = 10.0;
+    v.incised[at(2, 2)] = 2.0;
     v.heights[at(2, 2)] = 0.0;
     Banks b;
-    b.erosion = 100.0;
+    b.erosion = 4.0;  // 4 m a side, 2 m on each flanking cell
     b.area = 1e4;
-    b.floor_slope = 0.1;
-    bank_pushes(b, v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
-    EXPECT_NEAR(v.heights[at(1, 3)], 3.0 * std::sqrt(2.0), 1e-12);
-    EXPECT_NEAR(v.heights[at(3, 1)], 3.0 * std::sqrt(2.0), 1e-12);
-    EXPECT_DOUBLE_EQ(v.heights[at(2, 3)], 100.0);
-    EXPECT_DOUBLE_EQ(v.heights[at(3, 2)], 100.0);
+    for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 98.0) << k;
+    // The diagonal neighbours lie √2 cells off the river's line (the receiver and the donor on it): untouched.
+    for (int k = 1; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 100.0) << k;
+    // Far enough, every flanking cell stops one cell's floor slope above the river.
+    b.erosion = 400.0;
+    b.floor_slope = 0.1;
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 3.0) << k;
 }
 
 std::vector<double> noise(int w, int h, std::uint64_t seed, double amplitude) {

@@ -167,7 +167,9 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "k = erode:stream-power(base, bed_thickness=50, bed_thickness_spread=1)\n"
                   "l = erode:stream-power(base, landslide_block_spread=0.5)\n"
                   "m = erode:stream-power(base, bed_thickness=50, bed_facies_length=40)\n"
-                  "n = erode:stream-power(base, bed_thickness=50, bed_facies_share=0.3)\n");
+                  "n = erode:stream-power(base, bed_thickness=50, bed_facies_share=0.3)\n"
+                  "o = erode:stream-power(base, bank_floor_slope=2)\n"
+                  "p = erode:stream-power(base, bank_erosion=11)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -196,6 +198,9 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "beds cell by cell; give bed_facies_length >= 100 (m), or 0 for beds of one strength each",
              "rock.orogen:17:65: error: erode:stream-power: bed_facies_share sets how much the facies change a bed's "
              "strength; give bed_facies_length (m) as well",
+             "rock.orogen:18:47: error: erode:stream-power: bank_floor_slope shapes the rivers' bank erosion; give "
+             "bank_erosion > 0 as well",
+             "rock.orogen:19:43: error: 'bank_erosion' of erode:stream-power is 11, out of range [0, 10]",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
