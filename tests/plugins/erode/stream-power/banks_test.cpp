@@ -207,7 +207,6 @@ TEST(Banks, RiversGrowValleyFloorsAndTheBitsHoldOnTwoThreads) {
     s.open = {true, true, false, false};
     s.rock.angle = 35.0 * M_PI / 180.0;  // landslides hold the walls: without banks, V notches
     double rise[2] = {0.0, 0.0};
-    std::vector<double> heights[2];
     for (int with = 0; with < 2; ++with) {
         s.banks.erosion = with ? 4.0 : 0.0;
         s.banks.area = 1e4;
@@ -216,7 +215,6 @@ TEST(Banks, RiversGrowValleyFloorsAndTheBitsHoldOnTwoThreads) {
         model.run(1.2e6, 2e4);
         model.route_only();
         rise[with] = mean_bank_rise(model, w, h);
-        heights[with] = model.heights();
     }
     // Without banks the cells across a river stand near the landslide angle above it (tan 35° × 30 m = 21 m);
     // with them the rivers keep a floor beside them.
