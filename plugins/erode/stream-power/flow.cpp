@@ -99,11 +99,11 @@ double FlowRouter::distance(std::int64_t i) const {
 }
 
 int FlowRouter::direction(std::int64_t i) const {
-    const std::int64_t r = receiver_[std::size_t(i)];
-    if (r == i) return -1;
-    const int dx = int(r % width_ - i % width_), dy = int(r / width_ - i / width_);
+    const std::int64_t d = std::int64_t(receiver_[std::size_t(i)]) - i;
+    if (d == 0) return -1;
+    // Receivers are neighbours, so the index offset alone names the direction (no division per cell).
     for (int k = 0; k < 8; ++k)
-        if (kDx[k] == dx && kDy[k] == dy) return k;
+        if (std::int64_t(kDy[k]) * width_ + kDx[k] == d) return k;
     return -1;
 }
 

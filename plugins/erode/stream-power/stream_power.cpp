@@ -182,20 +182,13 @@ std::int64_t Model::step(double dt) {
 
 void Model::erode_banks() {
     const std::size_t n = h_.size();
-    const std::int32_t* rcv = flow_.receivers().data();
     bank_dir_.resize(n);
     if (!bank_factor_) bank_factor_.emplace(settings_.banks, cell_);
-    std::int64_t offset[8];  // index offset of each D8 neighbour: codes without a division per cell
-    for (int k = 0; k < 8; ++k) offset[k] = std::int64_t(kDy[k]) * width_ + kDx[k];
     // The lowering by this incision goes into bank_before_ (no more use for the old heights).
     parallel_for(0, std::int64_t(n), 1 << 15, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e; ++i) {
             bank_before_[std::size_t(i)] = std::max(0.0, bank_before_[std::size_t(i)] - h_[std::size_t(i)]);
-            const std::int64_t d = std::int64_t(rcv[i]) - i;
-            int code = -1;
-            for (int k = 0; k < 8 && d != 0; ++k)
-                if (offset[k] == d) code = k;
-            bank_dir_[std::size_t(i)] = std::int8_t(code);
+            bank_dir_[std::size_t(i)] = std::int8_t(flow_.direction(i));
         }
     });
     const BankWindow w{width_, height_, 0, 0, width_, height_};
