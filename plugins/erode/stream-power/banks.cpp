@@ -13,17 +13,18 @@ namespace orogen::stream_power {
 namespace {
 
 /// The turn (in 45° steps, 0–4) from direction code `in` to `out`.
-int turn(int in, int out) {
+constexpr int turn(int in, int out) {
     const int d = ((out - in) % 8 + 8) % 8;
     return std::min(d, 8 - d);
 }
 
 /// The share of a river cell's right and left pushes that falls on its edge neighbour at
-/// direction 2·e from it, for each direction d it flows towards: the whole push on the neighbour
-/// across an axis flow ((d + 2) mod 8 right, (d + 6) left), half on each of the two edge neighbours
-/// flanking a diagonal flow on that side ((d + 1), (d + 3) right; (d + 5), (d + 7) left).
+/// direction 2·e from it, for each direction d it flows towards (row d + 1; row 0, a root, pushes
+/// nothing): the whole push on the neighbour across an axis flow ((d + 2) mod 8 right, (d + 6) left),
+/// half on each of the two edge neighbours flanking a diagonal flow on that side ((d + 1), (d + 3)
+/// right; (d + 5), (d + 7) left).
 struct Shares {
-    double right[8][4] = {}, left[8][4] = {};
+    double right[9][4] = {}, left[9][4] = {};
 };
 constexpr Shares make_shares() {
     Shares s;
@@ -31,16 +32,101 @@ constexpr Shares make_shares() {
         for (int e = 0; e < 4; ++e) {
             const int back = 2 * e;
             if (d % 2 == 0) {
-                s.right[d][e] = back == (d + 2) % 8 ? 1.0 : 0.0;
-                s.left[d][e] = back == (d + 6) % 8 ? 1.0 : 0.0;
+                s.right[d + 1][e] = back == (d + 2) % 8 ? 1.0 : 0.0;
+                s.left[d + 1][e] = back == (d + 6) % 8 ? 1.0 : 0.0;
             } else {
-                s.right[d][e] = back == (d + 1) % 8 || back == (d + 3) % 8 ? 0.5 : 0.0;
-                s.left[d][e] = back == (d + 5) % 8 || back == (d + 7) % 8 ? 0.5 : 0.0;
+                s.right[d + 1][e] = back == (d + 1) % 8 || back == (d + 3) % 8 ? 0.5 : 0.0;
+                s.left[d + 1][e] = back == (d + 5) % 8 || back == (d + 7) % 8 ? 0.5 : 0.0;
             }
         }
     return s;
 }
 constexpr Shares kShares = make_shares();
+
+/// The share of a river cell's push that falls on its right bank, by the direction its main donor's
+/// water comes in (row in + 1; row 0: no donor) and the direction it leaves (`out`): ½ where it runs
+/// straight on, else (1 ± b)/2 with b = min(1, ½ per 45° of turn), the outer bank (the one on the side
+/// the water comes from: a positive dot product with the incoming direction) taking more. The right
+/// bank lies at out + 90°, the left at out − 90° and takes the rest.
+struct RightShare {
+    double of[9][8] = {};
+};
+constexpr RightShare make_right_share() {
+    RightShare r;
+    for (int out = 0; out < 8; ++out) {
+        r.of[0][out] = 0.5;
+        for (int in = 0; in < 8; ++in) {
+            const int t = turn(in, out);
+            double w0 = 0.5;
+            if (t > 0) {
+                const double b = t >= 2 ? 1.0 : 0.5 * t;
+                const int s0 = (out + 2) % 8;
+                const bool outer0 = kDx[s0] * kDx[in] + kDy[s0] * kDy[in] > 0;
+                w0 = outer0 ? 0.5 * (1.0 + b) : 0.5 * (1.0 - b);
+            }
+            r.of[in + 1][out] = w0;
+        }
+    }
+    return r;
+}
+constexpr RightShare kRightShare = make_right_share();
+
+/// One cell's right and left pushes (bank_pushes). `Inner`: the cell is not on the window's edge, so
+/// its eight neighbours are read without bounds checks and the main donor is chosen without branches
+/// (which donor drains the most is unpredictable); the same arithmetic and ties either way.
+template <bool Inner>
+inline void push_one(double kappa, const BankAreaFactor& factor, int W, int H, int x, std::int64_t y,
+                     const std::int8_t* dir, const double* area, const double* incised, double* rp, double* lp) {
+    const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
+    const int out = dir[i];
+    rp[i] = lp[i] = 0.0;
+    if (out < 0 || !(incised[i] > 0.0)) return;
+    const double amount = kappa * factor(area[i]) * incised[i];
+    // The main donor: the neighbour sending its water here that drains the most (ties: the lowest
+    // neighbour code, the same on any tiling); `in` is its own direction code, (k + 4) mod 8.
+    int in = -1;
+    double best = -1.0;
+    for (int k = 0; k < 8; ++k) {
+        const int nx = x + kDx[k], ny = int(y) + kDy[k];
+        if (!Inner && (nx < 0 || ny < 0 || nx >= W || ny >= H)) continue;
+        const std::size_t d = std::size_t(ny) * std::size_t(W) + std::size_t(nx);
+        const int back = (k + 4) % 8;
+        const double a = dir[d] == back ? area[d] : -1.0;  // areas are positive: a non-donor never wins
+        in = a > best ? back : in;
+        best = a > best ? a : best;
+    }
+    const double w0 = kRightShare.of[in + 1][out];
+    rp[i] = amount * w0;
+    lp[i] = amount * (1.0 - w0);
+}
+
+/// One cell's new height (lower_banks). `Inner` as in push_one: its four edge neighbours are read
+/// without bounds checks and summed without branches (a root's row of shares is zero, and adding a
+/// zero push changes no sum).
+template <bool Inner>
+inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* dir, const double* right,
+                        const double* left, const std::uint8_t* outlet, double rise, const double* heights,
+                        const std::int64_t* off) {
+    const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
+    const double hl = heights[l];
+    if (outlet && outlet[l]) return hl;
+    double drop = 0.0, strongest = 0.0, floor = 0.0;
+    for (int e = 0; e < 4; ++e) {  // banks are the rivers' edge neighbours
+        if (!Inner) {
+            const int nx = x + kDx[2 * e], ny = int(y) + kDy[2 * e];
+            if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
+        }
+        const std::size_t i = std::size_t(std::int64_t(l) + off[e]);
+        const int d = dir[i] + 1;
+        const int back = (e + 2) % 4;  // the direction from the river cell i to this bank, halved
+        const double p = right[i] * kShares.right[d][back] + left[i] * kShares.left[d][back];
+        drop += p;
+        const double f = heights[i] + rise;
+        floor = p > strongest ? f : floor;
+        strongest = p > strongest ? p : strongest;
+    }
+    return drop > 0.0 && hl > floor ? std::max(floor, hl - drop) : hl;
+}
 
 }  // namespace
 
@@ -48,15 +134,6 @@ BankAreaFactor::BankAreaFactor(const Banks& banks, double cell)
     : a0_(cell * cell), inv_a0_(1.0 / (cell * cell)), inv_ab_(1.0 / banks.area) {
     table_.resize(1 << 16);
     for (std::size_t c = 0; c < table_.size(); ++c) table_[c] = -std::expm1(-double(c) * a0_ * inv_ab_);
-}
-
-double BankAreaFactor::operator()(double area) const {
-    const double c = area * inv_a0_;
-    if (c < double(table_.size() - 1)) {
-        const auto ci = std::size_t(c + 0.5);
-        if (double(ci) * a0_ == area) return table_[ci];
-    }
-    return -std::expm1(-area * inv_ab_);
 }
 
 void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWindow& w, const std::int8_t* dir,
@@ -71,38 +148,19 @@ void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWin
     const int W = w.width, H = w.height;
     const double kappa = banks.erosion;
     parallel_for(w.y0, w.y1, 16, [=, &factor](std::int64_t yb, std::int64_t ye) {
-        for (std::int64_t y = yb; y < ye; ++y)
-            for (int x = w.x0; x < w.x1; ++x) {
-                const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
-                const int out = dir[i];
-                rp[i] = lp[i] = 0.0;
-                if (out < 0 || !(incised[i] > 0.0)) continue;
-                const double amount = kappa * factor(area[i]) * incised[i];
-                // The main donor: the neighbour sending its water here that drains the most
-                // (ties: the lowest direction code, the same on any tiling).
-                int in = -1;
-                double best = -1.0;
-                for (int k = 0; k < 8; ++k) {
-                    const int nx = x + kDx[k], ny = int(y) + kDy[k];
-                    if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
-                    const std::size_t d = std::size_t(ny) * std::size_t(W) + std::size_t(nx);
-                    if (dir[d] == (k + 4) % 8 && area[d] > best) best = area[d], in = dir[d];
-                }
-                // The right bank lies at out + 90°, the left at out − 90°; the outer bank is the one on
-                // the side the water comes from (a positive dot product with the incoming direction).
-                double w0 = 0.5;
-                if (in >= 0) {
-                    const int t = turn(in, out);
-                    if (t > 0) {
-                        const double b = std::min(1.0, 0.5 * t);
-                        const int s0 = (out + 2) % 8;
-                        const bool outer0 = kDx[s0] * kDx[in] + kDy[s0] * kDy[in] > 0;
-                        w0 = outer0 ? 0.5 * (1.0 + b) : 0.5 * (1.0 - b);
-                    }
-                }
-                rp[i] = amount * w0;
-                lp[i] = amount * (1.0 - w0);
+        for (std::int64_t y = yb; y < ye; ++y) {
+            if (y == 0 || y + 1 == H) {
+                for (int x = w.x0; x < w.x1; ++x)
+                    push_one<false>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
+                continue;
             }
+            const int xb = std::max(w.x0, 1), xe = std::min(w.x1, W - 1);
+            for (int x = w.x0; x < std::min(xb, w.x1); ++x)
+                push_one<false>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
+            for (int x = xb; x < xe; ++x) push_one<true>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
+            for (int x = std::max(xe, w.x0); x < w.x1; ++x)
+                push_one<false>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
+        }
     });
 }
 
@@ -116,32 +174,21 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
     double* const row_volume = out + std::size_t(cw) * std::size_t(ch);
     const std::int64_t off[4] = {1, W, -1, -std::int64_t(W)};  // the edge neighbours, codes 0, 2, 4, 6
     parallel_for(w.y0, w.y1, 16, [=](std::int64_t yb, std::int64_t ye) {
-        for (std::int64_t y = yb; y < ye; ++y)
-            for (int x = w.x0; x < w.x1; ++x) {
-                const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
-                double& o = out[std::size_t(y - w.y0) * std::size_t(cw) + std::size_t(x - w.x0)];
-                const double hl = heights[l];
-                o = hl;
-                if (outlet && outlet[l]) continue;
-                const bool inner = x > 0 && y > 0 && x + 1 < W && y + 1 < H;
-                double drop = 0.0, strongest = 0.0, floor = 0.0;
-                for (int e = 0; e < 4; ++e) {  // banks are the rivers' edge neighbours
-                    const int k = 2 * e;
-                    if (!inner) {
-                        const int nx = x + kDx[k], ny = int(y) + kDy[k];
-                        if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
-                    }
-                    const std::size_t i = std::size_t(std::int64_t(l) + off[e]);
-                    const int d = dir[i];
-                    if (d < 0) continue;
-                    const int back = (e + 2) % 4;  // the direction from the river cell i to this bank, halved
-                    const double p = right[i] * kShares.right[d][back] + left[i] * kShares.left[d][back];
-                    if (!(p > 0.0)) continue;
-                    drop += p;
-                    if (p > strongest) strongest = p, floor = heights[i] + rise;
-                }
-                if (drop > 0.0 && hl > floor) o = std::max(floor, hl - drop);
+        for (std::int64_t y = yb; y < ye; ++y) {
+            double* const o = out + std::size_t(y - w.y0) * std::size_t(cw);  // o[x - w.x0]: cell x of row y
+            if (y == 0 || y + 1 == H) {
+                for (int x = w.x0; x < w.x1; ++x)
+                    o[x - w.x0] = lower_one<false>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
+                continue;
             }
+            const int xb = std::max(w.x0, 1), xe = std::min(w.x1, W - 1);
+            for (int x = w.x0; x < std::min(xb, w.x1); ++x)
+                o[x - w.x0] = lower_one<false>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
+            for (int x = xb; x < xe; ++x)
+                o[x - w.x0] = lower_one<true>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
+            for (int x = std::max(xe, w.x0); x < w.x1; ++x)
+                o[x - w.x0] = lower_one<false>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
+        }
     });
     // Write back and sum the volume row by row (each row's sum in a fixed order, then the rows in order).
     parallel_for(w.y0, w.y1, 16, [=](std::int64_t yb, std::int64_t ye) {

@@ -33,6 +33,7 @@
 // tile with a halo of one cell computes its own cells exactly (tiled.cpp).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -50,7 +51,14 @@ struct Banks {
 class BankAreaFactor {
 public:
     BankAreaFactor(const Banks& banks, double cell);
-    double operator()(double area) const;
+    double operator()(double area) const {
+        const double c = area * inv_a0_;
+        if (c < double(table_.size() - 1)) {
+            const auto ci = std::size_t(c + 0.5);
+            if (double(ci) * a0_ == area) return table_[ci];
+        }
+        return -std::expm1(-area * inv_ab_);
+    }
 
 private:
     std::vector<double> table_;

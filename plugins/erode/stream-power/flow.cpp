@@ -98,15 +98,6 @@ double FlowRouter::distance(std::int64_t i) const {
     return (d == 1 || d == -1 || d == width_ || d == -width_) ? cell_ : cell_ * kSqrt2;
 }
 
-int FlowRouter::direction(std::int64_t i) const {
-    const std::int64_t d = std::int64_t(receiver_[std::size_t(i)]) - i;
-    if (d == 0) return -1;
-    // Receivers are neighbours, so the index offset alone names the direction (no division per cell).
-    for (int k = 0; k < 8; ++k)
-        if (std::int64_t(kDy[k]) * width_ + kDx[k] == d) return k;
-    return -1;
-}
-
 /// Steepest-descent direction (0–7, kDx/kDy order; −1: no lower neighbour) of
 /// the inner cells x = 1 … W−2 of one inner row, as doubles: a loop without
 /// branches or integer lanes, which the compiler turns into vector blends (the

@@ -153,7 +153,17 @@ public:
     /// Distance to the receiver, metres (0 for an outlet).
     double distance(std::int64_t i) const;
     /// D8 direction code of the receiver (kDx/kDy), −1 for an outlet.
-    int direction(std::int64_t i) const;
+    int direction(std::int64_t i) const {
+        const std::int64_t d = std::int64_t(receiver_[std::size_t(i)]) - i;
+        // Receivers are neighbours, so the index offset alone names the direction, without a division:
+        // the row step dy is the offset's sign beyond ±1 (offsets W−1 … W+1 lie below, −W−1 … −W+1
+        // above), dx the rest.
+        static constexpr std::int8_t kCode[3][3] = {{5, 6, 7}, {4, -1, 0}, {3, 2, 1}};  // [dy + 1][dx + 1]
+        const std::int64_t dy = std::int64_t(d > 1) - std::int64_t(d < -1);
+        const std::int64_t dx = d - dy * width_;
+        if (dx < -1 || dx > 1) return -1;
+        return kCode[dy + 1][dx + 1];
+    }
     /// Stack positions that cut it into groups of whole outlet basins (first 0, last size()):
     /// each group can be solved on its own thread, in stack order, with the same result.
     const std::vector<std::int64_t>& chunks() const { return chunks_; }
