@@ -102,9 +102,10 @@ void expect_inside_the_bands(const std::string& spec_name, const std::string& ex
         EXPECT_GE(v, b.low) << info.key << " (" << spec_name << " " << extra << ")";
         EXPECT_LE(v, b.high) << info.key << " (" << spec_name << " " << extra << ")";
     }
-    // The gorges the rivers cut in the debris have slumped to 40° (a 25 m drop a cell): no slot one cell wide
-    // deeper than 40 m. Before the pipelines' `banks` pass they reached 142 m.
-    EXPECT_LE(deepest_slot(h, kSide), 40.0) << spec_name << " " << extra;
+    // The rivers have cut their banks, the steepest debris has slumped to 40° (a 25 m drop a cell) and the
+    // soil has crept over it: no slot one cell wide deeper than 32 m (28.4 m on six seeds since stop 43, the
+    // soil settling after the slump; 38 m before, with the slump last; 142 m before the slump).
+    EXPECT_LE(deepest_slot(h, kSide), 32.0) << spec_name << " " << extra;
 }
 
 class DefaultPipeline : public testing::TestWithParam<int> {};
