@@ -4,9 +4,8 @@
 // rivers grow valley floors and give the same bits on one and two threads.
 #include "banks.hpp"
 #include "flow.hpp"
+#include "noise_terrain.hpp"
 #include "stream_power.hpp"
-
-#include <orogen/random.hpp>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -172,12 +171,7 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 3.0) << k;
 }
 
-std::vector<double> noise(int w, int h, std::uint64_t seed, double amplitude) {
-    std::vector<double> v(std::size_t(w) * std::size_t(h));
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) v[std::size_t(y) * w + x] = amplitude * random::uniform(seed, x, y);
-    return v;
-}
+using test::noise;
 
 /// Mean height of the two cells across each river (A ≥ 40 cells, flowing along an axis) above the river.
 double mean_bank_rise(const Model& model, int w, int h) {

@@ -3,6 +3,7 @@
 // knickpoint of the kinematic wave, depression handling (every cell drains to
 // an outlet, no loops, the outlet's area is the map's), and determinism.
 #include "basin_join.hpp"
+#include "noise_terrain.hpp"
 #include "stream_power.hpp"
 
 #include <orogen/random.hpp>
@@ -25,12 +26,7 @@ namespace {
 using namespace orogen;
 using namespace orogen::stream_power;
 
-std::vector<double> noise(int w, int h, std::uint64_t seed, double amplitude) {
-    std::vector<double> v(std::size_t(w) * std::size_t(h));
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) v[std::size_t(y) * w + x] = amplitude * random::uniform(seed, x, y);
-    return v;
-}
+using test::noise;
 
 /// Least-squares slope and intercept of y on x.
 std::pair<double, double> fit(const std::vector<double>& x, const std::vector<double>& y) {
