@@ -18,7 +18,13 @@ channels, not flats):
   crests;
 - channel curvature: the mean Laplacian curvature (1/km) of the samples whose
   D8 drainage area exceeds 1 km² (a V notch at 30 m: 30-40 /km; a valley with a
-  floor or a rounded bottom: less).
+  floor or a rounded bottom: less);
+- valley width: across the same channel samples (along the axis, x or y, on
+  which the central difference is the smaller: across the river, for one that
+  runs along the other axis), the median height of the two samples d cells to
+  either side above the river, for d = 1 … 4; the width (m) at which that
+  median section stands 10 m above the river, interpolated linearly (walls at
+  30° from the river itself: 35 m; a valley floor widens it).
 
 They are measured here rather than in `orogen analyze` because they are still
 being judged: the first and last depend on the DEM's vertical resolution, the
@@ -115,7 +121,29 @@ def figures(path, z, cell):
         "slope change °": float(np.median(change[counted])),
         "curvature skewness": float(skew),
         "channel curvature /km": float(np.mean(lap[channel]) * 1000.0) if channel.any() else float("nan"),
+        "valley width m": valley_width(z, cell, channel),
     }
+
+
+def valley_width(z, cell, channel, rise=10.0, reach=4):
+    """Width (m) at which the median cross-section of the channel samples stands `rise` m above the river."""
+    rows, cols = z.shape
+    ys, xs = np.nonzero(channel)
+    ys, xs = ys + 1, xs + 1  # `channel` covers the inner samples
+    keep = (ys >= reach) & (xs >= reach) & (ys < rows - reach) & (xs < cols - reach)
+    ys, xs = ys[keep], xs[keep]
+    if ys.size == 0:
+        return float("nan")
+    across_x = np.abs(z[ys, xs + 1] - z[ys, xs - 1]) <= np.abs(z[ys + 1, xs] - z[ys - 1, xs])
+    section = [0.0]
+    for d in range(1, reach + 1):
+        side = np.where(across_x, (z[ys, xs - d] + z[ys, xs + d]) / 2.0, (z[ys - d, xs] + z[ys + d, xs]) / 2.0)
+        section.append(float(np.nanmedian(side - z[ys, xs])))
+    for d in range(1, reach + 1):
+        if section[d] >= rise:
+            below, above = section[d - 1], section[d]
+            return 2.0 * cell * (d - 1 + (rise - below) / (above - below))
+    return float("nan")  # wider than the reach: the section stays below `rise`
 
 
 def main():

@@ -25,9 +25,10 @@ def grid(n=201):
 
 def test_a_plane_has_no_slope_change_and_no_channel(tmp_path):
     x, y = grid()
-    planar, change, skew, channel = measure(tmp_path, np.tan(np.radians(20.0)) * y)
+    planar, change, skew, channel, width = measure(tmp_path, np.tan(np.radians(20.0)) * y)
     assert change < 1e-3
     assert np.isnan(channel)  # every cell drains straight down the plane: none gathers 1 km²
+    assert np.isnan(width)  # and so has no valley to measure
 
 
 def test_a_v_valley_has_a_notchs_curvature_in_its_channel(tmp_path):
@@ -37,10 +38,25 @@ def test_a_v_valley_has_a_notchs_curvature_in_its_channel(tmp_path):
     x, y = grid()
     mid = x[0, 100]
     z = np.abs(x - mid) * np.tan(np.radians(30.0)) + y * np.tan(np.radians(8.0))
-    planar, change, skew, channel = measure(tmp_path, z)
+    planar, change, skew, channel, width = measure(tmp_path, z)
     assert abs(channel - 2000.0 * np.tan(np.radians(30.0)) / CELL) < 0.5
     assert skew > 5.0
     assert planar > 95.0  # every wall cell is flat in curvature
+
+
+def test_a_v_valley_is_as_wide_as_its_walls_make_it_10_m_up(tmp_path):
+    # Walls at angle a rise 30 m·tan a a cell from the river: 10 m up, the valley is 2·10 m / tan a wide
+    # (34.6 m at 30°, 74.6 m at 15°); the section is linear, so the interpolation is exact. The floor
+    # falls 8° along y, across the axis the width is measured on.
+    x, y = grid()
+    mid = x[0, 100]
+    for angle in (30.0, 15.0):
+        z = np.abs(x - mid) * np.tan(np.radians(angle)) + y * np.tan(np.radians(8.0))
+        width = measure(tmp_path, z)[4]
+        assert abs(width - 20.0 / np.tan(np.radians(angle))) < 0.01, angle
+    # The same valley along x: the width is measured across it, on the other axis.
+    z = np.abs(y - mid) * np.tan(np.radians(30.0)) + x * np.tan(np.radians(8.0))
+    assert abs(measure(tmp_path, z)[4] - 20.0 / np.tan(np.radians(30.0))) < 0.01
 
 
 def test_bad_input_says_what_is_wrong_and_exits_2(tmp_path):
