@@ -101,8 +101,7 @@ inline void push_one(double kappa, const BankAreaFactor& factor, int W, int H, i
 }
 
 /// One cell's new height (lower_banks). `Inner` as in push_one: its four edge neighbours are read
-/// without bounds checks and summed without branches (a root's row of shares is zero, and adding a
-/// zero push changes no sum).
+/// without bounds checks; a root's row of shares is zero.
 template <bool Inner>
 inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* dir, const double* right,
                         const double* left, const std::uint8_t* outlet, double rise, const double* heights,
@@ -110,7 +109,10 @@ inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* 
     const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
     const double hl = heights[l];
     if (outlet && outlet[l]) return hl;
-    double drop = 0.0, strongest = 0.0, floor = 0.0;
+    // Written so that nothing waits on a comparison (which neighbour pushes hardest is unpredictable): the
+    // strongest push is the maximum, its river the first (lowest e) that pushes that much; a neighbour off
+    // the window pushes nothing (and adding a zero changes no sum).
+    double p[4] = {}, f[4] = {};
     for (int e = 0; e < 4; ++e) {  // banks are the rivers' edge neighbours
         if (!Inner) {
             const int nx = x + kDx[2 * e], ny = int(y) + kDy[2 * e];
@@ -119,12 +121,15 @@ inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* 
         const std::size_t i = std::size_t(std::int64_t(l) + off[e]);
         const int d = dir[i] + 1;
         const int back = (e + 2) % 4;  // the direction from the river cell i to this bank, halved
-        const double p = right[i] * kShares.right[d][back] + left[i] * kShares.left[d][back];
-        drop += p;
-        const double f = heights[i] + rise;
-        floor = p > strongest ? f : floor;
-        strongest = p > strongest ? p : strongest;
+        p[e] = right[i] * kShares.right[d][back] + left[i] * kShares.left[d][back];
+        f[e] = heights[i] + rise;
     }
+    const double drop = ((p[0] + p[1]) + p[2]) + p[3];
+    const double strongest = std::max(std::max(std::max(p[0], p[1]), p[2]), p[3]);
+    double floor = f[3];
+    floor = p[2] == strongest ? f[2] : floor;
+    floor = p[1] == strongest ? f[1] : floor;
+    floor = p[0] == strongest ? f[0] : floor;
     return drop > 0.0 && hl > floor ? std::max(floor, hl - drop) : hl;
 }
 
