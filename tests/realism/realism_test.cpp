@@ -195,17 +195,16 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
     ASSERT_TRUE(read_terrain(dir / "terrain.r32", h, GetParam().side));
     const auto mine = orogen::analysis::measure({h.data(), GetParam().side, GetParam().side, GetParam().cell});
     std::string nearest;
-    double best = 1e300;
+    double best = 1e300, to_namesake = 1e300;
     for (std::size_t i = 0; i < refs.size(); ++i) {
         const auto d = orogen::analysis::distance(mine, ref_figures[i], bands);
         ASSERT_GT(d.used, 10u) << refs[i].name;
         std::printf("%s: %s at %.2f\n", GetParam().pipeline, refs[i].name.c_str(), d.value);
         if (d.value < best) best = d.value, nearest = refs[i].name;
+        if (refs[i].name == GetParam().namesake) to_namesake = d.value;
     }
     EXPECT_EQ(nearest, GetParam().namesake);
-    for (std::size_t i = 0; i < refs.size(); ++i)
-        if (refs[i].name == GetParam().namesake)
-            EXPECT_LE(orogen::analysis::distance(mine, ref_figures[i], bands).value, GetParam().within);
+    EXPECT_LE(to_namesake, GetParam().within);
 }
 
 INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 namespace orogen::stream_power {
 
@@ -72,8 +73,7 @@ constexpr RightShare make_right_share() {
 constexpr RightShare kRightShare = make_right_share();
 
 /// One cell's right and left pushes (bank_pushes). `Inner`: the cell is not on the window's edge, so
-/// its eight neighbours are read without bounds checks and the main donor is chosen without branches
-/// (which donor drains the most is unpredictable); the same arithmetic and ties either way.
+/// its eight neighbours are read without bounds checks; the same arithmetic and ties either way.
 template <bool Inner>
 inline void push_one(double kappa, const BankAreaFactor& factor, int W, int H, int x, std::int64_t y,
                      const std::int8_t* dir, const double* area, const double* incised, double* rp, double* lp) {
@@ -133,6 +133,20 @@ inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* 
     return drop > 0.0 && hl > floor ? std::max(floor, hl - drop) : hl;
 }
 
+/// Calls fn(x, inner) for each computed cell x of row y of the window, `inner` a std::bool_constant: true
+/// for the cells off the window's edge (all eight neighbours inside it), false for the edge ones.
+template <class Fn>
+inline void each_cell_of_row(const BankWindow& w, std::int64_t y, Fn&& fn) {
+    if (y == 0 || y + 1 == w.height) {
+        for (int x = w.x0; x < w.x1; ++x) fn(x, std::false_type{});
+        return;
+    }
+    const int xb = std::max(w.x0, 1), xe = std::min(w.x1, w.width - 1);
+    for (int x = w.x0; x < std::min(xb, w.x1); ++x) fn(x, std::false_type{});
+    for (int x = xb; x < xe; ++x) fn(x, std::true_type{});
+    for (int x = std::max(xe, w.x0); x < w.x1; ++x) fn(x, std::false_type{});
+}
+
 }  // namespace
 
 BankAreaFactor::BankAreaFactor(const Banks& banks, double cell)
@@ -153,19 +167,10 @@ void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWin
     const int W = w.width, H = w.height;
     const double kappa = banks.erosion;
     parallel_for(w.y0, w.y1, 16, [=, &factor](std::int64_t yb, std::int64_t ye) {
-        for (std::int64_t y = yb; y < ye; ++y) {
-            if (y == 0 || y + 1 == H) {
-                for (int x = w.x0; x < w.x1; ++x)
-                    push_one<false>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
-                continue;
-            }
-            const int xb = std::max(w.x0, 1), xe = std::min(w.x1, W - 1);
-            for (int x = w.x0; x < std::min(xb, w.x1); ++x)
-                push_one<false>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
-            for (int x = xb; x < xe; ++x) push_one<true>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
-            for (int x = std::max(xe, w.x0); x < w.x1; ++x)
-                push_one<false>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
-        }
+        for (std::int64_t y = yb; y < ye; ++y)
+            each_cell_of_row(w, y, [&](int x, auto inner) {
+                push_one<decltype(inner)::value>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
+            });
     });
 }
 
@@ -181,18 +186,10 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
     parallel_for(w.y0, w.y1, 16, [=](std::int64_t yb, std::int64_t ye) {
         for (std::int64_t y = yb; y < ye; ++y) {
             double* const o = out + std::size_t(y - w.y0) * std::size_t(cw);  // o[x - w.x0]: cell x of row y
-            if (y == 0 || y + 1 == H) {
-                for (int x = w.x0; x < w.x1; ++x)
-                    o[x - w.x0] = lower_one<false>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
-                continue;
-            }
-            const int xb = std::max(w.x0, 1), xe = std::min(w.x1, W - 1);
-            for (int x = w.x0; x < std::min(xb, w.x1); ++x)
-                o[x - w.x0] = lower_one<false>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
-            for (int x = xb; x < xe; ++x)
-                o[x - w.x0] = lower_one<true>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
-            for (int x = std::max(xe, w.x0); x < w.x1; ++x)
-                o[x - w.x0] = lower_one<false>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
+            each_cell_of_row(w, y, [&](int x, auto inner) {
+                o[x - w.x0] =
+                    lower_one<decltype(inner)::value>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
+            });
         }
     });
     // Write back and sum the volume row by row (each row's sum in a fixed order, then the rows in order).
