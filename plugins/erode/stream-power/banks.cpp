@@ -100,29 +100,77 @@ inline void push_one(double kappa, const BankAreaFactor& factor, int W, int H, i
     lp[i] = amount * (1.0 - w0);
 }
 
-/// One cell's new height (lower_banks). `Inner` as in push_one: its four edge neighbours are read
-/// without bounds checks; a root's row of shares is zero.
+/// What lower_one needs besides the cell: the window's arrays and the floor's rise over one cell.
+struct LowerInputs {
+    int W, H;
+    const std::int8_t* dir;
+    const double *right, *left, *area;
+    const std::uint8_t* outlet;
+    double rise, wide_area;
+    const double* heights;
+    std::int64_t off[8];  // the neighbours by direction code
+    BankRelay* relay;  // null: no relay
+};
+
+/// Whether neighbour (x + dx, y + dy) lies in the window.
+inline bool inside(int W, int H, int x, std::int64_t y, int k) {
+    const int nx = x + kDx[k];
+    const std::int64_t ny = y + kDy[k];
+    return nx >= 0 && ny >= 0 && nx < W && ny < H;
+}
+
+/// A bank this close to its floor (m) counts as down to it (the river lowers it again at each step).
+constexpr double kAtFloor = 0.5;
+
+/// The push a settled cell l (new height `h`) passes on to the cell beyond it (lower_banks with a relay):
+/// each large river (area ≥ wide_area) that has l straight across its flow, on its right or left at
+/// distance r (1 or √2 cells), and whose cell l is down to the floor there (h ≤ river + rise·r + kAtFloor),
+/// passes its whole push on that side onward, to the cell 2·r from it, which it may lower to its own height
+/// plus rise·2r. The strongest such push goes on (ties: the lowest direction code).
 template <bool Inner>
-inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* dir, const double* right,
-                        const double* left, const std::uint8_t* outlet, double rise, const double* heights,
-                        const std::int64_t* off) {
-    const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
-    const double hl = heights[l];
-    if (outlet && outlet[l]) return hl;
+inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t l, double h) {
+    double best = 0.0, floor = 0.0;
+    int out = -1;
+    for (int k = 0; k < 8; ++k) {
+        if (!Inner && !inside(in.W, in.H, x, y, k)) continue;
+        const std::size_t i = std::size_t(std::int64_t(l) + in.off[k]);
+        const int d = in.dir[i];
+        const int from_river = (k + 4) % 8;  // the direction from river i to this cell
+        if (d < 0 || !(in.area[i] >= in.wide_area)) continue;
+        const double push = from_river == (d + 2) % 8 ? in.right[i] : from_river == (d + 6) % 8 ? in.left[i] : 0.0;
+        const double r = (k & 1) ? kSqrt2 : 1.0;
+        if (push > best && h <= in.heights[i] + in.rise * r + kAtFloor) {
+            best = push;
+            floor = in.heights[i] + 2.0 * in.rise * r;
+            out = from_river;
+        }
+    }
+    in.relay->push[l] = best;
+    in.relay->floor[l] = floor;
+    in.relay->out[l] = std::int8_t(out);
+}
+
+/// One cell's new height (lower_banks). `Inner` as in push_one: its neighbours are read without bounds
+/// checks; a root's row of shares is zero (a neighbour off the window pushes nothing, and adding a zero
+/// changes no sum). `Relay`: also what this cell passes on (relay_one).
+template <bool Inner, bool Relay>
+inline double lower_one(const LowerInputs& in, int x, std::int64_t y) {
+    const std::size_t l = std::size_t(y) * std::size_t(in.W) + std::size_t(x);
+    const double hl = in.heights[l];
+    if (in.outlet && in.outlet[l]) {
+        if constexpr (Relay) in.relay->out[l] = -1;
+        return hl;
+    }
     // Written so that nothing waits on a comparison (which neighbour pushes hardest is unpredictable): the
-    // strongest push is the maximum, its river the first (lowest e) that pushes that much; a neighbour off
-    // the window pushes nothing (and adding a zero changes no sum).
+    // strongest push is the maximum, its river the first (lowest e) that pushes that much.
     double p[4] = {}, f[4] = {};
     for (int e = 0; e < 4; ++e) {  // banks are the rivers' edge neighbours
-        if (!Inner) {
-            const int nx = x + kDx[2 * e], ny = int(y) + kDy[2 * e];
-            if (nx < 0 || ny < 0 || nx >= W || ny >= H) continue;
-        }
-        const std::size_t i = std::size_t(std::int64_t(l) + off[e]);
-        const int d = dir[i] + 1;
+        if (!Inner && !inside(in.W, in.H, x, y, 2 * e)) continue;
+        const std::size_t i = std::size_t(std::int64_t(l) + in.off[2 * e]);
+        const int d = in.dir[i] + 1;
         const int back = (e + 2) % 4;  // the direction from the river cell i to this bank, halved
-        p[e] = right[i] * kShares.right[d][back] + left[i] * kShares.left[d][back];
-        f[e] = heights[i] + rise;
+        p[e] = in.right[i] * kShares.right[d][back] + in.left[i] * kShares.left[d][back];
+        f[e] = in.heights[i] + in.rise;
     }
     const double drop = ((p[0] + p[1]) + p[2]) + p[3];
     const double strongest = std::max(std::max(std::max(p[0], p[1]), p[2]), p[3]);
@@ -130,7 +178,26 @@ inline double lower_one(int W, int H, int x, std::int64_t y, const std::int8_t* 
     floor = p[2] == strongest ? f[2] : floor;
     floor = p[1] == strongest ? f[1] : floor;
     floor = p[0] == strongest ? f[0] : floor;
-    return drop > 0.0 && hl > floor ? std::max(floor, hl - drop) : hl;
+    const double h = drop > 0.0 && hl > floor ? std::max(floor, hl - drop) : hl;
+    if constexpr (Relay) relay_one<Inner>(in, x, y, l, h);
+    return h;
+}
+
+/// One cell's new height (lower_relayed): the lowest that any neighbour passing a push on towards it
+/// brings it to, not below that push's floor.
+template <bool Inner>
+inline double relayed_one(const BankRelay& relay, const std::uint8_t* outlet, int W, int H, int x, std::int64_t y,
+                          const double* heights, const std::int64_t* off) {
+    const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
+    const double hl = heights[l];
+    if (outlet && outlet[l]) return hl;
+    double h = hl;
+    for (int k = 0; k < 8; ++k) {
+        if (!Inner && !inside(W, H, x, y, k)) continue;
+        const std::size_t j = std::size_t(std::int64_t(l) + off[k]);
+        if (relay.out[j] == (k + 4) % 8) h = std::min(h, std::max(relay.floor[j], hl - relay.push[j]));
+    }
+    return h;
 }
 
 /// Calls fn(x, inner) for each computed cell x of row y of the window, `inner` a std::bool_constant: true
@@ -174,25 +241,22 @@ void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWin
     });
 }
 
-double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
-                   const double* left, const std::uint8_t* outlet, double cell, double* heights,
-                   std::vector<double>& scratch) {
-    const double rise = cell * banks.floor_slope;
-    const int W = w.width, H = w.height, cw = w.x1 - w.x0, ch = std::max(0, w.y1 - w.y0);
+namespace {
+
+/// Computes each computed cell's new height into `scratch` with cell(x, y, inner), then writes them back
+/// and returns the volume removed (m³): each row's sum in a fixed order, then the rows in order.
+template <class Cell>
+double lower_rows(const BankWindow& w, double cell, double* heights, std::vector<double>& scratch, Cell&& cell_at) {
+    const int W = w.width, cw = w.x1 - w.x0, ch = std::max(0, w.y1 - w.y0);
     scratch.resize(std::size_t(cw) * std::size_t(ch) + std::size_t(ch));  // new heights, then each row's volume
     double* const out = scratch.data();
     double* const row_volume = out + std::size_t(cw) * std::size_t(ch);
-    const std::int64_t off[4] = {1, W, -1, -std::int64_t(W)};  // the edge neighbours, codes 0, 2, 4, 6
-    parallel_for(w.y0, w.y1, 16, [=](std::int64_t yb, std::int64_t ye) {
+    parallel_for(w.y0, w.y1, 16, [=, &w, &cell_at](std::int64_t yb, std::int64_t ye) {
         for (std::int64_t y = yb; y < ye; ++y) {
             double* const o = out + std::size_t(y - w.y0) * std::size_t(cw);  // o[x - w.x0]: cell x of row y
-            each_cell_of_row(w, y, [&](int x, auto inner) {
-                o[x - w.x0] =
-                    lower_one<decltype(inner)::value>(W, H, x, y, dir, right, left, outlet, rise, heights, off);
-            });
+            each_cell_of_row(w, y, [&](int x, auto inner) { o[x - w.x0] = cell_at(x, y, inner); });
         }
     });
-    // Write back and sum the volume row by row (each row's sum in a fixed order, then the rows in order).
     parallel_for(w.y0, w.y1, 16, [=](std::int64_t yb, std::int64_t ye) {
         for (std::int64_t y = yb; y < ye; ++y) {
             double v = 0.0;
@@ -208,6 +272,43 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
     double removed = 0.0;
     for (int r = 0; r < ch; ++r) removed += row_volume[r];
     return removed * cell * cell;
+}
+
+}  // namespace
+
+double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
+                   const double* left, const double* area, const std::uint8_t* outlet, double cell, double* heights,
+                   std::vector<double>& scratch, BankRelay* relay) {
+    const std::int64_t W = w.width;
+    LowerInputs in{w.width,
+                   w.height,
+                   dir,
+                   right,
+                   left,
+                   area,
+                   outlet,
+                   cell * banks.floor_slope,
+                   banks.wide_area,
+                   heights,
+                   {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1},
+                   banks.wide() ? relay : nullptr};
+    if (!in.relay)
+        return lower_rows(w, cell, heights, scratch, [&in](int x, std::int64_t y, auto inner) {
+            return lower_one<decltype(inner)::value, false>(in, x, y);
+        });
+    in.relay->size_to(std::size_t(w.width) * std::size_t(w.height));
+    return lower_rows(w, cell, heights, scratch, [&in](int x, std::int64_t y, auto inner) {
+        return lower_one<decltype(inner)::value, true>(in, x, y);
+    });
+}
+
+double lower_relayed(const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet, double cell,
+                     double* heights, std::vector<double>& scratch) {
+    const std::int64_t W = w.width;
+    const std::int64_t off[8] = {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1};
+    return lower_rows(w, cell, heights, scratch, [&](int x, std::int64_t y, auto inner) {
+        return relayed_one<decltype(inner)::value>(relay, outlet, w.width, w.height, x, y, heights, off);
+    });
 }
 
 }  // namespace orogen::stream_power

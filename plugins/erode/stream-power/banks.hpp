@@ -28,7 +28,20 @@
 // plus the floor slope over one cell, and outlets stay. What falls in leaves with the river (detachment-limited, as
 // the incision).
 //
-// Both passes read only the heights after the incision and write separate
+// A large river (draining more than A_w, banks.wide_area) pushes on past
+// a bank it has cut down: where the cell straight across its flow, r = 1
+// cell away (√2 across a diagonal flow), is within half a metre of its
+// floor (the river plus the floor slope over r), the river's whole push on
+// that side falls on the next cell out, 2r away, which stops at the river
+// plus the floor slope over 2r. Its valley floor is then about five cells
+// wide rather than three, as real floors widen downstream (10 m above
+// rivers draining 1 km², real 30 m DEMs' valleys are 90–150 m wide;
+// tools/texture_figures.py). The cell across the river finds the push it
+// passes on as it settles (lower_banks) and the cell beyond reads it from
+// its neighbour (lower_relayed): a reach of two cells with a halo of one,
+// and one more exchange between.
+//
+// Each pass reads only the heights before it and writes separate
 // arrays, so the result does not depend on the order or the threads, and a
 // tile with a halo of one cell computes its own cells exactly (tiled.cpp).
 #pragma once
@@ -43,7 +56,22 @@ struct Banks {
     double erosion = 0.0;  ///< κ, dimensionless (0: banks stand)
     double area = 1e6;  ///< A_b, m²
     double floor_slope = 0.0;  ///< tan of the angle at which a lowered bank still rises from its river
+    double wide_area = 0.0;  ///< A_w, m²: rivers draining more push on through a bank at its floor (0: none)
     bool any() const { return erosion > 0.0; }
+    bool wide() const { return any() && wide_area > 0.0; }
+};
+
+/// What each settled bank passes on to the cell beyond it (window-indexed): `push` (m) towards its
+/// neighbour at direction code `out` (−1: nothing), which it may lower to `floor` (m) and no further.
+struct BankRelay {
+    std::vector<double> push, floor;
+    std::vector<std::int8_t> out;
+    void size_to(std::size_t n) {
+        if (push.size() == n && floor.size() == n && out.size() == n) return;
+        push.assign(n, 0.0);
+        floor.assign(n, 0.0);
+        out.assign(n, -1);
+    }
 };
 
 /// 1 − e^(−A/A_b) for a drainage area A (m²): from a table when A is a whole number of cells below
@@ -86,9 +114,18 @@ void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWin
 
 /// Second pass: lowers each computed cell by what its neighbours push on it,
 /// not below the one pushing hardest plus banks.floor_slope over one cell; `outlet` cells (window-indexed, or null)
-/// stay. Returns the volume removed over the computed cells, m³.
+/// stay. With banks.wide() and a `relay` (sized to the window), also fills it for the computed cells: a
+/// cell straight across a river draining at least banks.wide_area (`area`), left within half a metre of
+/// its floor, passes that river's push on that side onward (banks.hpp). Returns the volume removed over
+/// the computed cells, m³.
 double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
-                   const double* left, const std::uint8_t* outlet, double cell, double* heights,
-                   std::vector<double>& scratch);
+                   const double* left, const double* area, const std::uint8_t* outlet, double cell, double* heights,
+                   std::vector<double>& scratch, BankRelay* relay = nullptr);
+
+/// Third pass (banks.wide()): lowers each computed cell to the lowest that a neighbour passing a push
+/// on towards it brings it (`relay` as lower_banks filled it, a tile's halo exchanged), not below that
+/// push's floor; outlets stay. Returns the volume removed, m³.
+double lower_relayed(const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet, double cell,
+                     double* heights, std::vector<double>& scratch);
 
 }  // namespace orogen::stream_power

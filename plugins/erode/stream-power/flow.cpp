@@ -12,11 +12,7 @@
 
 namespace orogen::stream_power {
 
-namespace {
-
-constexpr double kSqrt2 = 1.4142135623730951;
-
-}  // namespace
+namespace {}  // namespace
 
 std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t v) {
     while (parent[std::size_t(v)] != v) {

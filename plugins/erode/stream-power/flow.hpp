@@ -50,6 +50,7 @@ enum class Depressions {
 /// D8 neighbour k: 0 east, 1 south-east, 2 south, 3 south-west, 4 west, 5 north-west, 6 north, 7 north-east.
 inline constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
 inline constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
+inline constexpr double kSqrt2 = 1.4142135623730951;  ///< a diagonal step, in cells
 
 /// Steepest-descent direction of the cells x = 1 … W−2 of a row `c` (W
 /// heights) between rows `up` (north) and `dn` (south), into dir_out[x] as a

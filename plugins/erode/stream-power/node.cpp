@@ -105,6 +105,7 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.banks.area = ctx.real("bank_area");
     constexpr double rad = std::numbers::pi / 180.0;
     s.banks.floor_slope = std::tan(ctx.real("bank_floor_slope") * rad);
+    s.banks.wide_area = ctx.real("bank_wide_area");
     s.rock.angle = ctx.real("landslide_angle") * rad;
     s.rock.thickness = ctx.real("bed_thickness");
     s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
@@ -498,7 +499,7 @@ void check(CheckContext& ctx) {
     if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("landslide_block_spread",
                   "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
-    for (const char* bank : {"bank_area", "bank_floor_slope"})
+    for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area"})
         if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0))
             ctx.error(bank, std::string(bank) + " shapes the rivers' bank erosion; give bank_erosion > 0 as well");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
@@ -702,6 +703,13 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("a bank the river has cut down still rises from the river at this angle: the valley "
                           "floor slopes gently to its river, as the aprons along a mountain valley's foot do "
                           "(0 = dead flat floors, which hold pits)"),
+                Param::real("bank_wide_area", 0.0)
+                    .min(0.0)
+                    .max(1e12)
+                    .unit("m²")
+                    .help("rivers draining more than this keep floors five cells wide rather than three: a bank cut "
+                          "down to its floor passes the river's push on to the cell beyond it, as real valley floors "
+                          "widen downstream (3e5 = from a third of a km²); 0 = three cells everywhere"),
                 Param::integer("substeps", 1)
                     .min(1)
                     .max(1000)

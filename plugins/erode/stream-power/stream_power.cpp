@@ -13,7 +13,6 @@ namespace orogen::stream_power {
 
 namespace {
 
-constexpr double kSqrt2 = 1.4142135623730951;
 /// Deposition: iterations in which a cell may start incising again; after them the set of
 /// incising cells only shrinks, so the solve ends.
 constexpr int kFlips = 20;
@@ -194,8 +193,9 @@ void Model::erode_banks() {
     const BankWindow w{width_, height_, 0, 0, width_, height_};
     bank_pushes(settings_.banks, *bank_factor_, w, bank_dir_.data(), flow_.area().data(), bank_before_.data(),
                 bank_right_, bank_left_);
-    lower_banks(settings_.banks, w, bank_dir_.data(), bank_right_.data(), bank_left_.data(), flow_.outlets().data(),
-                cell_, h_.data(), bank_scratch_);
+    lower_banks(settings_.banks, w, bank_dir_.data(), bank_right_.data(), bank_left_.data(), flow_.area().data(),
+                flow_.outlets().data(), cell_, h_.data(), bank_scratch_, &bank_relay_);
+    if (settings_.banks.wide()) lower_relayed(w, bank_relay_, flow_.outlets().data(), cell_, h_.data(), bank_scratch_);
 }
 
 void Model::glacial_factors(double dt) {

@@ -21,8 +21,6 @@ namespace orogen::stream_power {
 
 namespace {
 
-constexpr double kSqrt2 = 1.4142135623730951;
-
 // Messages between the ranks: arrays of plain records, back to back.
 template <typename T>
 void put(std::string& out, const std::vector<T>& v) {
@@ -780,8 +778,16 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
                 bank_left_);
     double* second[] = {bank_right_.data(), bank_left_.data()};
     joined([&] { return tiles_.exchange(std::span<double* const>(second)); });
-    lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_outlet_.data(),
-                cell_, bank_h_.data(), bank_scratch_);
+    lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_area_.data(),
+                bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_, &bank_relay_);
+    if (settings_.banks.wide()) {  // what the halo's banks pass on
+        bank_relay_out_.resize(gn);
+        for (std::size_t g = 0; g < gn; ++g) bank_relay_out_[g] = bank_relay_.out[g];
+        double* third[] = {bank_relay_.push.data(), bank_relay_.floor.data(), bank_relay_out_.data()};
+        joined([&] { return tiles_.exchange(std::span<double* const>(third)); });
+        for (std::size_t g = 0; g < gn; ++g) bank_relay_.out[g] = std::int8_t(bank_relay_out_[g]);
+        lower_relayed(w, bank_relay_, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_);
+    }
     for (int y = 0; y < own_.height; ++y)
         for (int x = 0; x < own_.width; ++x)
             h_[std::size_t(y) * std::size_t(own_.width) + std::size_t(x)] =

@@ -120,7 +120,8 @@ private:
     void join_on_rank0(ResolveState& st);
     void apply_joined(ResolveState& st, double* h);
     void accumulate();
-    /// Banks (banks.hpp) after an incision from heights `before`: two halo exchanges, the same bits as Model.
+    /// Banks (banks.hpp) after an incision from heights `before`: two halo exchanges (three with
+    /// banks.wide()), the same bits as Model.
     void erode_banks(const std::vector<double>& before);
     /// Solve `v` down the rivers: f(l, v_receiver) sets v[l] for every cell but the roots, receivers first.
     void propagate(std::vector<double>& v, const std::function<void(std::size_t, double)>& f);
@@ -172,6 +173,8 @@ private:
     std::vector<std::int8_t> bank_code_;
     std::vector<std::uint8_t> bank_outlet_;
     std::optional<BankAreaFactor> bank_factor_;  // 1 − e^(−A/A_b), built at the first step
+    BankRelay bank_relay_;  // what a bank down to its floor passes on (banks.wide()), the halo's exchanged
+    std::vector<double> bank_relay_out_;  // bank_relay_.out as doubles, for the exchange
     std::vector<double> pow_table_;
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::int64_t pits_ = 0;

@@ -54,7 +54,7 @@ TEST(Banks, AStraightRiverLowersEachBankByHalfItsShare) {
     EXPECT_DOUBLE_EQ(v.left[at(1, 2)], 3.0);
     EXPECT_EQ(v.right[at(4, 2)], 0.0);  // the root drains nowhere: no push
     const double removed =
-        lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+        lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(), v.scratch);
     for (int x = 0; x < kW; ++x) {
         const double bank = x + 1 < kW ? 97.0 : 100.0;  // beside the root nothing pushes
         EXPECT_DOUBLE_EQ(v.heights[at(x, 1)], bank) << x;
@@ -87,7 +87,7 @@ TEST(Banks, ABankStopsAboveItsRiverAtTheFloorSlopeAndOutletsStay) {
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     std::vector<std::uint8_t> outlet(kW * kH, 0);
     outlet[at(0, 3)] = 1;
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), outlet.data(), 30.0, v.heights.data(), v.scratch);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), outlet.data(), 30.0, v.heights.data(), v.scratch);
     EXPECT_DOUBLE_EQ(v.heights[at(1, 1)], 3.0);
     EXPECT_DOUBLE_EQ(v.heights[at(2, 1)], 2.0);
     EXPECT_DOUBLE_EQ(v.heights[at(3, 1)], 3.0);
@@ -159,7 +159,7 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     b.erosion = 4.0;  // 4 m a side, 2 m on each flanking cell
     b.area = 1e4;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(), v.scratch);
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 98.0) << k;
     // The diagonal neighbours lie √2 cells off the river's line (the receiver and the donor on it): untouched.
     for (int k = 1; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 100.0) << k;
@@ -167,24 +167,107 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     b.erosion = 400.0;
     b.floor_slope = 0.1;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(), v.scratch);
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 3.0) << k;
+}
+
+/// The straight river with each bank already at its floor (3 m above the river: floor slope 0.1 over
+/// 30 m), the rows beyond 50 m up; then the three passes with a relay for rivers over `wide_area`.
+Window wide_river(double erosion, double wide_area, double bank = 3.0) {
+    Window v = straight_river();
+    for (int x = 0; x < kW; ++x) {
+        v.heights[at(x, 1)] = v.heights[at(x, 3)] = bank;
+        v.heights[at(x, 0)] = v.heights[at(x, 4)] = 50.0;
+    }
+    Banks b;
+    b.erosion = erosion;
+    b.area = 1e4;
+    b.floor_slope = 0.1;
+    b.wide_area = wide_area;
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    BankRelay relay;
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
+                v.scratch, &relay);
+    if (b.wide()) lower_relayed(v.w, relay, nullptr, 30.0, v.heights.data(), v.scratch);
+    return v;
+}
+
+TEST(Banks, ALargeRiverPushesOnPastABankAtItsFloor) {
+    // κ = 1, lowered 2 m: 1 m on each side. The banks cannot go lower; the cells beyond take the push.
+    Window v = wide_river(1.0, 1e6);
+    for (int x = 0; x + 1 < kW; ++x) {
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 1)], 3.0) << x;
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 3)], 3.0) << x;
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 0)], 49.0) << x;
+        EXPECT_DOUBLE_EQ(v.heights[at(x, 4)], 49.0) << x;
+    }
+    EXPECT_DOUBLE_EQ(v.heights[at(4, 0)], 50.0);  // beside the root nothing pushes
+    // A strong push stops at the river plus the floor slope over two cells.
+    v = wide_river(100.0, 1e6);
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 0)], 6.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 4)], 6.0);
+}
+
+TEST(Banks, OnlyLargeRiversAndBanksDownToTheirFloorPushOn) {
+    Window v = wide_river(1.0, 2e9);  // the river drains 1e9 m²: too small to widen
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 0)], 50.0);
+    v = wide_river(1.0, 0.0);  // no relay at all
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 0)], 50.0);
+    v = wide_river(1.0, 1e6, 3.4);  // a bank 0.4 m above its floor (within half a metre) counts as down
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 1)], 3.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 0)], 49.0);
+    v = wide_river(1.0, 1e6, 10.0);  // a bank well above it still shields the cell beyond
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 1)], 9.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(1, 0)], 50.0);
+}
+
+TEST(Banks, ADiagonalRiverPushesOnAcrossItsFlowAndOutletsStay) {
+    // A river down the diagonal, flowing south-east (code 1), its cells 0 m; all else 100 m but the cells
+    // straight across it from its centre, (1, 3) and (3, 1), down to their floor (0.1·30·√2 m).
+    Window v;
+    for (int k = 0; k < kW; ++k) {
+        v.dir[at(k, k)] = k + 1 < kW ? 1 : -1;
+        v.area[at(k, k)] = 1e9;
+        v.incised[at(k, k)] = 2.0;
+        v.heights[at(k, k)] = 0.0;
+    }
+    const double rise = 0.1 * 30.0 * std::sqrt(2.0);
+    v.heights[at(1, 3)] = v.heights[at(3, 1)] = rise;
+    Banks b;
+    b.erosion = 1.0;
+    b.area = 1e4;
+    b.floor_slope = 0.1;
+    b.wide_area = 1e6;
+    bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
+    BankRelay relay;
+    std::vector<std::uint8_t> outlet(kW * kH, 0);
+    outlet[at(4, 0)] = 1;
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), outlet.data(), 30.0,
+                v.heights.data(), v.scratch, &relay);
+    EXPECT_EQ(relay.out[at(1, 3)], 3);  // on the river's right, onward to the south-west
+    EXPECT_EQ(relay.out[at(3, 1)], 7);  // on its left, onward to the north-east
+    EXPECT_DOUBLE_EQ(relay.push[at(1, 3)], 1.0);  // the river's whole push on that side
+    EXPECT_DOUBLE_EQ(relay.floor[at(1, 3)], 2.0 * rise);
+    lower_relayed(v.w, relay, outlet.data(), 30.0, v.heights.data(), v.scratch);
+    EXPECT_DOUBLE_EQ(v.heights[at(0, 4)], 99.0);
+    EXPECT_DOUBLE_EQ(v.heights[at(4, 0)], 100.0);  // an outlet
 }
 
 using test::noise;
 
-/// Mean height of the two cells across each river (A ≥ 40 cells, flowing along an axis) above the river.
-double mean_bank_rise(const Model& model, int w, int h) {
+/// Mean height of the two cells `reach` cells across each river (A ≥ 40 cells, flowing along an axis)
+/// above the river.
+double mean_bank_rise(const Model& model, int w, int h, int reach = 1) {
     double sum = 0.0;
     int count = 0;
-    for (int y = 1; y + 1 < h; ++y)
-        for (int x = 1; x + 1 < w; ++x) {
+    for (int y = reach; y + reach < h; ++y)
+        for (int x = reach; x + reach < w; ++x) {
             const std::int64_t i = std::int64_t(y) * w + x;
             if (model.flow().area()[std::size_t(i)] < 40 * 900.0) continue;
             const int d = model.flow().direction(i);
             if (d != 0 && d != 2 && d != 4 && d != 6) continue;
-            const std::int64_t a = i + kDy[(d + 2) % 8] * w + kDx[(d + 2) % 8];
-            const std::int64_t c = i + kDy[(d + 6) % 8] * w + kDx[(d + 6) % 8];
+            const std::int64_t a = i + reach * (kDy[(d + 2) % 8] * w + kDx[(d + 2) % 8]);
+            const std::int64_t c = i + reach * (kDy[(d + 6) % 8] * w + kDx[(d + 6) % 8]);
             sum += 0.5 * (model.heights()[std::size_t(a)] + model.heights()[std::size_t(c)]) -
                 model.heights()[std::size_t(i)];
             ++count;
@@ -218,6 +301,38 @@ TEST(Banks, RiversGrowValleyFloorsAndTheBitsHoldOnTwoThreads) {
     for (int t = 0; t < 2; ++t) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
         s.banks.erosion = 4.0;
+        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        model.run(3e5, 2e4);
+        threads[t] = model.heights();
+    }
+    EXPECT_EQ(0, std::memcmp(threads[0].data(), threads[1].data(), threads[0].size() * sizeof(double)));
+}
+
+TEST(Banks, LargeRiversWidenTheirFloorsAndTheBitsHoldOnTwoThreads) {
+    const int w = 129, h = 97;
+    Settings s;
+    s.erodibility = 2e-5;
+    s.area_exponent = 0.5;
+    s.diffusivity = 0.0;
+    s.open = {true, true, false, false};
+    s.rock.angle = 35.0 * M_PI / 180.0;
+    s.banks.erosion = 4.0;
+    s.banks.area = 1e4;
+    s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
+    // The mean rise two cells across the rivers draining more than 40 cells.
+    double rise2[2] = {0.0, 0.0};
+    for (int wide = 0; wide < 2; ++wide) {
+        s.banks.wide_area = wide ? 2e4 : 0.0;
+        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        model.run(1.2e6, 2e4);
+        model.route_only();
+        rise2[wide] = mean_bank_rise(model, w, h, 2);
+    }
+    EXPECT_GT(rise2[0], 10.0) << rise2[1];  // three-cell floors: two cells out is the valley's side
+    EXPECT_LT(rise2[1], 0.6 * rise2[0]);  // 0.46 of it; 0.77 when the push goes astray
+    std::vector<double> threads[2];
+    for (int t = 0; t < 2; ++t) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
         Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
         model.run(3e5, 2e4);
         threads[t] = model.heights();
