@@ -53,6 +53,7 @@ void BM_stream_power_step(benchmark::State& state) {
     s.deposition = double(state.range(4));  // G of Yuan et al. (2019); 0: detachment-limited
     s.banks.erosion = double(state.range(5));  // rivers cut their banks (banks.hpp); 0: none
     s.banks.area = 3e4;
+    s.banks.wide_area = state.range(6) ? 3e5 : 0.0;  // floors five cells wide along rivers draining 0.3 km²
     s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
     Model model(n, n, 30.0, dome(n), std::vector<double>(std::size_t(n) * n, 1e-3), s);
     for (int i = 0; i < 3; ++i) model.step(1e4);
@@ -67,15 +68,16 @@ void BM_stream_power_step(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * std::int64_t(n) * n);
 }
 BENCHMARK(BM_stream_power_step)
-    ->ArgNames({"n", "threads", "diffusion", "mfd", "G", "banks"})
-    ->Args({1025, 1, 1, 0, 0, 0})
-    ->Args({1025, 2, 1, 0, 0, 0})
-    ->Args({1025, 2, 0, 0, 0, 0})
-    ->Args({1025, 2, 1, 1, 0, 0})
-    ->Args({1025, 1, 1, 0, 1, 0})
-    ->Args({1025, 2, 1, 0, 1, 0})
-    ->Args({1025, 2, 1, 0, 0, 4})
-    ->Args({4097, 2, 1, 0, 0, 0})
+    ->ArgNames({"n", "threads", "diffusion", "mfd", "G", "banks", "wide"})
+    ->Args({1025, 1, 1, 0, 0, 0, 0})
+    ->Args({1025, 2, 1, 0, 0, 0, 0})
+    ->Args({1025, 2, 0, 0, 0, 0, 0})
+    ->Args({1025, 2, 1, 1, 0, 0, 0})
+    ->Args({1025, 1, 1, 0, 1, 0, 0})
+    ->Args({1025, 2, 1, 0, 1, 0, 0})
+    ->Args({1025, 2, 1, 0, 0, 4, 0})
+    ->Args({1025, 2, 1, 0, 0, 4, 1})
+    ->Args({4097, 2, 1, 0, 0, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
