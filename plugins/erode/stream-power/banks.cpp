@@ -136,7 +136,8 @@ inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t 
         const std::size_t i = std::size_t(std::int64_t(l) + in.off[k]);
         const int d = in.dir[i];
         const int from_river = (k + 4) % 8;  // the direction from river i to this cell
-        if (d < 0 || !(in.area[i] >= in.wide_area)) continue;
+        // Few neighbours are large rivers: that test first (it seldom passes, so it is well predicted).
+        if (!(in.area[i] >= in.wide_area) || d < 0) continue;
         const double push = from_river == (d + 2) % 8 ? in.right[i] : from_river == (d + 6) % 8 ? in.left[i] : 0.0;
         const double r = (k & 1) ? kSqrt2 : 1.0;
         if (push > best && h <= in.heights[i] + in.rise * r + kAtFloor) {
@@ -145,9 +146,11 @@ inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t 
             out = from_river;
         }
     }
-    in.relay->push[l] = best;
-    in.relay->floor[l] = floor;
     in.relay->out[l] = std::int8_t(out);
+    if (out >= 0) {  // lower_relayed reads push and floor only where out points somewhere
+        in.relay->push[l] = best;
+        in.relay->floor[l] = floor;
+    }
 }
 
 /// One cell's new height (lower_banks). `Inner` as in push_one: its neighbours are read without bounds
