@@ -222,6 +222,8 @@ s7 = erode:stream-power(p, p.timelapse, years=5e4, dt=1.5e4, uplift_history_year
 s8 = erode:stream-power(d, years=6e4, dt=1e4, uplift=3, diffusivity=0.01, landslide_angle=28, bed_thickness=30, bed_dip=25, bed_dip_toward=60, bed_angle_spread=8, bed_erodibility_contrast=4, bed_fold_amplitude=60, bed_fold_wavelength=900, bed_thickness_spread=0.7, bed_fault_spacing=600, bed_fault_throw=50, landslide_block_spread=0.6, bed_facies_length=400, bed_facies_share=0.7)
 s9 = erode:stream-power(p, p.timelapse, years=5e4, dt=2.5e4, uplift_history_years=4e4, substeps=3, uplift=1, diffusivity=0.05, channel_area=2e4, landslide_angle=30, bank_erosion=4, bank_area=1e4)
 s10 = erode:stream-power(d, years=6e4, dt=1e4, uplift=2, diffusivity=0.01, channel_area=1e4, bank_erosion=6, bank_area=1e4, bank_wide_area=3e4, open="we")
+s11 = erode:stream-power(d, years=4e4, dt=1e4, uplift=2, diffusivity=0.01, rain=orographic, wind_from=290, rain_resolution=150, open="ns")
+s12 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, rain=orographic, wind_from=60, rain_resolution=30, channel_area=1e4)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
 export:video(r, path="s1.mpg", fps=25, quality=0)
 export:vtk(s1, path="s1.vti")
@@ -234,13 +236,15 @@ export:vtk(s7, path="s7.vti")
 export:vtk(s8, path="s8.vti")
 export:vtk(s9, path="s9.vti")
 export:vtk(s10, path="s10.vti")
+export:vtk(s11, path="s11.vti")
+export:vtk(s12, path="s12.vti")
 )";
 
 class StreamPowerSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(StreamPowerSeam, StreamPowerEqualsOneProcess) {
     expect_same_outputs(kStreamPowerSpec,
                         {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti", "s7.vti", "s8.vti",
-                         "s9.vti", "s10.vti"},
+                         "s9.vti", "s10.vti", "s11.vti", "s12.vti"},
                         GetParam());
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, StreamPowerSeam, kErosionCases, kCaseName);

@@ -148,42 +148,65 @@ std::vector<double> orographic_rain_coarse(const double* heights, int width, int
     return out;
 }
 
-void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
-                            double resolution, std::vector<double>& out) {
+CoarseRainGrid coarse_rain_grid(int width, int height, double cell, const OrographicRain& rain, double resolution) {
     check(rain, width, height, cell);
     if (!(resolution > 0.0) || !std::isfinite(resolution))
         throw std::invalid_argument("orographic rain: the resolution must be a positive number of metres");
-    const int f = std::max(1, int(std::min(resolution / cell, 1e6)));
-    const int cw = (width + f - 1) / f, ch = (height + f - 1) / f;
-    // Block means (a partial block at the east or south edge averages the cells it has).
-    std::vector<double> coarse(std::size_t(cw) * std::size_t(ch), 0.0);
-    parallel_for(0, ch, 4, [&](std::int64_t Y0, std::int64_t Y1) {
-        for (auto Y = int(Y0); Y < int(Y1); ++Y)
-            for (int X = 0; X < cw; ++X) {
+    CoarseRainGrid g;
+    g.width = width;
+    g.height = height;
+    g.cell = cell;
+    g.factor = std::max(1, int(std::min(resolution / cell, 1e6)));
+    g.coarse_width = (width + g.factor - 1) / g.factor;
+    g.coarse_height = (height + g.factor - 1) / g.factor;
+    return g;
+}
+
+void add_block_sums(const CoarseRainGrid& g, const double* heights, int x0, int y0, int w, int h,
+                    std::vector<double>& sums) {
+    const int f = g.factor, cw = g.coarse_width;
+    // Heights in whole 2^-10 m when a block holds several cells, so that every partial sum is a whole
+    // number (exact below 2^53: blocks of 10^6 cells of 8 km) and any split adds up to the same bits.
+    const double scale = f == 1 ? 1.0 : 1024.0;
+    const int Y0 = y0 / f, Y1 = (y0 + h + f - 1) / f;
+    parallel_for(Y0, Y1, 4, [&](std::int64_t b0, std::int64_t b1) {
+        for (auto Y = int(b0); Y < int(b1); ++Y)
+            for (int X = x0 / f; X < (x0 + w + f - 1) / f; ++X) {
                 double sum = 0.0;
-                int count = 0;
-                for (int y = Y * f; y < std::min(height, (Y + 1) * f); ++y)
-                    for (int x = X * f; x < std::min(width, (X + 1) * f); ++x, ++count)
-                        sum += heights[std::size_t(y) * std::size_t(width) + std::size_t(x)];
-                coarse[std::size_t(Y) * std::size_t(cw) + std::size_t(X)] = sum / count;
+                for (int y = std::max(y0, Y * f); y < std::min(y0 + h, (Y + 1) * f); ++y)
+                    for (int x = std::max(x0, X * f); x < std::min(x0 + w, (X + 1) * f); ++x) {
+                        const double v = heights[std::size_t(y - y0) * std::size_t(w) + std::size_t(x - x0)];
+                        sum += f == 1 ? v : std::nearbyint(v * scale);
+                    }
+                sums[std::size_t(Y) * std::size_t(cw) + std::size_t(X)] += sum;
             }
     });
-    // A non-finite height makes its block's mean non-finite: name the height, not the block.
-    for (std::size_t b = 0; b < coarse.size(); ++b)
-        if (!std::isfinite(coarse[b]))
-            for (std::size_t j = 0; j < std::size_t(width) * std::size_t(height); ++j)
-                if (!std::isfinite(heights[j]))
-                    throw std::invalid_argument("orographic rain: height " + std::to_string(j) +
-                                                " is not a finite number");
-    const double coarse_cell = cell * f;
+}
+
+std::vector<double> coarse_rain(const CoarseRainGrid& g, const OrographicRain& rain, std::vector<double> sums) {
+    const int f = g.factor, cw = g.coarse_width, ch = g.coarse_height;
+    const double scale = f == 1 ? 1.0 : 1024.0;
+    for (int Y = 0; Y < ch; ++Y)  // block means (a partial block at the east or south edge has fewer cells)
+        for (int X = 0; X < cw; ++X) {
+            const int count = (std::min(g.height, (Y + 1) * f) - Y * f) * (std::min(g.width, (X + 1) * f) - X * f);
+            double& v = sums[std::size_t(Y) * std::size_t(cw) + std::size_t(X)];
+            v = v / (scale * count);
+            if (!std::isfinite(v))
+                throw std::invalid_argument("orographic rain: a height in block (" + std::to_string(X) + ", " +
+                                            std::to_string(Y) + ") of " + std::to_string(f) + " x " +
+                                            std::to_string(f) + " cells is not a finite number");
+        }
+    const double coarse_cell = g.cell * f;
     const double wind_length = rain.wind_speed * (rain.condensation_time + rain.fallout_time);
     const int padding =
         std::clamp(int(std::ceil(kPaddingWindLengths * wind_length / coarse_cell)), 1, std::max(cw, ch));
-    std::vector<double> r = orographic_rain(coarse.data(), cw, ch, coarse_cell, rain, padding);
-    if (f == 1) {
-        out = std::move(r);
-        return;
-    }
+    return orographic_rain(sums.data(), cw, ch, coarse_cell, rain, padding);
+}
+
+void interpolate_rain(const CoarseRainGrid& g, const std::vector<double>& coarse, int x0, int y0, int w, int h,
+                      std::vector<double>& out) {
+    const int f = g.factor, cw = g.coarse_width, ch = g.coarse_height;
+    out.resize(std::size_t(w) * std::size_t(h));
     // Bilinear between the coarse cells' centres (held at the edges); each column's pair of coarse
     // columns and weight computed once.
     struct Axis {
@@ -191,27 +214,43 @@ void orographic_rain_coarse(const double* heights, int width, int height, double
         double t;
     };
     auto axis = [f](int i, int n) {
-        const double g = std::clamp((i + 0.5) / f - 0.5, 0.0, double(n - 1));
-        const int i0 = int(g);
-        return Axis{i0, std::min(i0 + 1, n - 1), g - i0};
+        const double c = std::clamp((i + 0.5) / f - 0.5, 0.0, double(n - 1));
+        const int i0 = int(c);
+        return Axis{i0, std::min(i0 + 1, n - 1), c - i0};
     };
-    std::vector<Axis> columns(static_cast<std::size_t>(width));
-    for (int x = 0; x < width; ++x) columns[std::size_t(x)] = axis(x, cw);
-    out.resize(std::size_t(width) * std::size_t(height));
-    parallel_for(0, height, 16, [&](std::int64_t y0, std::int64_t y1) {
+    std::vector<Axis> columns(static_cast<std::size_t>(w));
+    for (int x = 0; x < w; ++x) columns[std::size_t(x)] = axis(x0 + x, cw);
+    parallel_for(0, h, 16, [&](std::int64_t r0, std::int64_t r1) {
         std::vector<double> across(static_cast<std::size_t>(cw));  // the row's rain between its two coarse rows
-        for (auto y = int(y0); y < int(y1); ++y) {
-            const Axis a = axis(y, ch);
-            const double* top = r.data() + std::size_t(a.i0) * std::size_t(cw);
-            const double* bottom = r.data() + std::size_t(a.i1) * std::size_t(cw);
+        for (auto y = int(r0); y < int(r1); ++y) {
+            const Axis a = axis(y0 + y, ch);
+            const double* top = coarse.data() + std::size_t(a.i0) * std::size_t(cw);
+            const double* bottom = coarse.data() + std::size_t(a.i1) * std::size_t(cw);
             for (int X = 0; X < cw; ++X) across[std::size_t(X)] = top[X] + (bottom[X] - top[X]) * a.t;
-            double* row = out.data() + std::size_t(y) * std::size_t(width);
-            for (int x = 0; x < width; ++x) {
+            double* row = out.data() + std::size_t(y) * std::size_t(w);
+            for (int x = 0; x < w; ++x) {
                 const Axis& c = columns[std::size_t(x)];
                 row[x] = across[std::size_t(c.i0)] + (across[std::size_t(c.i1)] - across[std::size_t(c.i0)]) * c.t;
             }
         }
     });
+}
+
+void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
+                            double resolution, std::vector<double>& out) {
+    const CoarseRainGrid g = coarse_rain_grid(width, height, cell, rain, resolution);
+    // A non-finite height: name it, not its block.
+    for (std::size_t j = 0; j < std::size_t(width) * std::size_t(height); ++j)
+        if (!std::isfinite(heights[j]))
+            throw std::invalid_argument("orographic rain: height " + std::to_string(j) + " is not a finite number");
+    std::vector<double> sums(std::size_t(g.coarse_width) * std::size_t(g.coarse_height), 0.0);
+    add_block_sums(g, heights, 0, 0, width, height, sums);
+    std::vector<double> r = coarse_rain(g, rain, std::move(sums));
+    if (g.factor == 1) {
+        out = std::move(r);
+        return;
+    }
+    interpolate_rain(g, r, 0, 0, width, height, out);
 }
 
 }  // namespace orogen::climate

@@ -353,8 +353,8 @@ void write_layers(NodeContext& ctx, Heightmap& hm, Engine& engine, std::int64_t 
         GridView q = hm.layer("ice_flux", 0.0f);
         for (std::size_t i = 0; i < n && i < ice.size(); ++i) q.data[i] = float(ice[i]);
     }
-    if (ctx.text("rain") == "orographic" && engine.whole) {  // orographic rain never tiles either
-        const std::vector<double> rain = engine.whole->rain();
+    if (ctx.text("rain") == "orographic") {
+        const std::vector<double> rain = engine.tiled ? engine.tiled->rain() : engine.whole->rain();
         GridView r = hm.layer("rain", 0.0f);
         for (std::size_t i = 0; i < n && i < rain.size(); ++i) r.data[i] = float(rain[i]);
     }
@@ -844,7 +844,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("where the rain falls: uniform, or orographic (Smith & Barstad 2004): a steady moist "
                           "wind rains on the windward slopes and leaves a dry lee, recomputed each step over the "
                           "growing relief; a cell counts rain/rain_background of its area, so `erodibility` is for "
-                          "the background rain. Adds the layer rain (m/yr). Not tiled"),
+                          "the background rain. Adds the layer rain (m/yr)"),
                 Param::real("rain_background", 1.0)
                     .min(0.0, true)
                     .max(20.0)

@@ -105,13 +105,13 @@ void Model::update_rain() {
     const double inv = 1.0 / settings_.rain.background;
     double* w = rain_weight_.data();
     parallel_for(0, std::int64_t(rain_weight_.size()), 1 << 16, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i) w[i] *= inv;
+        for (std::int64_t i = b; i < e; ++i) w[i] = rain_weight(w[i], inv);
     });
 }
 
 std::vector<double> Model::rain() const {
     std::vector<double> r(rain_weight_);
-    for (double& v : r) v *= settings_.rain.background;
+    for (double& v : r) v *= settings_.rain.background;  // the rain as the drainage area weighed it
     return r;
 }
 

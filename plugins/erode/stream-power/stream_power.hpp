@@ -50,6 +50,14 @@
 
 namespace orogen::stream_power {
 
+/// A cell's rain over the background rain, as the drainage area weighs it: in whole 2^-20, so that
+/// areas summed in any order (a tiled run's tiles) are exact and the same bits (a grid of 2^32 cells
+/// at 1000 times the background stays below 2^53 units).
+inline double rain_weight(double rain, double inv_background) {
+    constexpr double unit = 1048576.0;  // 2^20
+    return std::nearbyint(rain * inv_background * unit) / unit;
+}
+
 struct Settings {
     double erodibility = 2e-5;  ///< K, m^(1−2m)/yr (n = 1)
     double area_exponent = 0.45;  ///< m

@@ -5,6 +5,8 @@
 
 #include "basin_join.hpp"
 
+#include <orogen/climate/orographic_rain.hpp>
+
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -90,7 +92,6 @@ std::string untiled_because(const Settings& s) {
     if (s.mfd_exponent > 0.0) return "routing=mfd is not tiled yet";
     if (s.deposition > 0.0) return "deposition > 0 is not tiled yet";
     if (s.glaciers.any()) return "glaciers are not tiled yet";
-    if (s.orographic_rain) return "rain=orographic is not tiled yet";
     return "";
 }
 
@@ -531,10 +532,12 @@ void TiledModel::apply_joined(ResolveState& st, double* h) {
 }
 
 void TiledModel::accumulate() {
-    // Cells upstream, as whole numbers (exact in any order: the whole grid's bits).
+    // Cells upstream, as whole numbers, or sums of whole 2^-20 with the rain's weights (exact in any
+    // order: the whole grid's bits).
     std::vector<Inflow> inflows;
     auto count = [&] {
-        std::fill(count_.begin(), count_.end(), 1.0);
+        if (rain_weight_.empty()) std::fill(count_.begin(), count_.end(), 1.0);
+        else std::copy(rain_weight_.begin(), rain_weight_.end(), count_.begin());
         for (const Inflow& f : inflows) {
             if (const std::int64_t l = local_of(f.cell); l >= 0) count_[std::size_t(l)] += f.count;
         }
@@ -664,7 +667,28 @@ void TiledModel::run(double years, double dt, const std::function<void(std::int6
     }
 }
 
+void TiledModel::update_rain() {
+    // Model::update_rain over the tiles: each adds its heights to the blocks' whole sums, the ranks' sums
+    // are added (exactly: whole numbers), and each takes the coarse rain and interpolates its own cells.
+    const climate::CoarseRainGrid g =
+        climate::coarse_rain_grid(W_, H_, cell_, settings_.rain, settings_.rain_resolution);
+    std::vector<double> sums(std::size_t(g.coarse_width) * std::size_t(g.coarse_height), 0.0);
+    climate::add_block_sums(g, h_.data(), own_.x0, own_.y0, own_.width, own_.height, sums);
+    joined([&] { tiles_.reduce(std::span<double>(sums), Tiling::Reduce::sum); });
+    const std::vector<double> coarse = climate::coarse_rain(g, settings_.rain, std::move(sums));
+    climate::interpolate_rain(g, coarse, own_.x0, own_.y0, own_.width, own_.height, rain_weight_);
+    const double inv = 1.0 / settings_.rain.background;
+    for (double& w : rain_weight_) w = rain_weight(w, inv);
+}
+
+std::vector<double> TiledModel::rain() const {
+    std::vector<double> r(rain_weight_);
+    for (double& v : r) v *= settings_.rain.background;
+    return r;
+}
+
 void TiledModel::route_only() {
+    if (settings_.orographic_rain && rain_weight_.empty()) update_rain();
     std::vector<double> copy = h_;  // routing may fill lakes: keep the model's heights as they are
     route(copy.data());
     accumulate();
@@ -701,7 +725,8 @@ std::int64_t TiledModel::step(double dt) {
     const double t_start = time_;
     uplift(t_start, t_start + sub, sub);
     time_ += dt;
-    // 2. Routing, depressions, drainage area.
+    // 2. The rain on the uplifted relief; routing, depressions, drainage area (weighted by the rain).
+    if (settings_.orographic_rain) update_rain();
     route(h_.data());
     accumulate();
     const std::int64_t pits = pits_;

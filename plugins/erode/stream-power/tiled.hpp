@@ -87,6 +87,8 @@ public:
     const std::vector<double>& area() const { return area_; }
     /// D8 code of each cell's receiver (kDx/kDy), −1 for an outlet.
     int direction(std::size_t l) const { return dir_[l]; }
+    /// With orographic rain, the rain (m/yr) on each cell of the tile in the last step, as Model::rain().
+    std::vector<double> rain() const;
     /// χ (m) of every cell of the tile for reference area a0 (m²), as Model::chi. Collective.
     std::vector<double> chi(double a0 = 1.0);
     /// Pits found on the whole grid by the last routing.
@@ -120,6 +122,7 @@ private:
     void join_on_rank0(ResolveState& st);
     void apply_joined(ResolveState& st, double* h);
     void accumulate();
+    void update_rain();  // orographic rain over the current heights (collective), and each cell's weight
     /// Banks (banks.hpp) after an incision from heights `before`: two halo exchanges (three with
     /// banks.wide()), the same bits as Model.
     void erode_banks(const std::vector<double>& before);
@@ -167,6 +170,7 @@ private:
     std::vector<double> grown_h_, grown_v_, grown_done_, grown_label_;  // over ghosted() (halo 1)
     std::vector<std::int64_t> label_;  // resolve_pits: each cell's basin (its pit or outlet)
     std::vector<double> count_, area_;  // cells upstream (with itself), m²
+    std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
     // Banks: the heights before the incision (own), and over ghosted() the area, direction, lowering,
     // heights and pushes the two passes read, each cell's direction as a code, outlets, scratch.
     std::vector<double> bank_before_, bank_area_, bank_dir_, bank_e_, bank_h_, bank_right_, bank_left_, bank_scratch_;

@@ -247,6 +247,60 @@ TEST(OrographicRain, TheSameBitsOnOneAndTwoThreads) {
     EXPECT_EQ(runs[0], runs[1]);
 }
 
+TEST(OrographicRain, TilesAddingTheirBlocksGetTheWholeGridsBits) {
+    // A 101 x 77 grid in blocks of 4 cells, cut into three windows whose edges cross blocks; their sums
+    // added in two orders, each window's rain interpolated on its own: the whole grid's, bit for bit.
+    const int w = 101, h = 77;
+    const double cell = 90.0;
+    std::vector<double> z(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            z[std::size_t(y) * w + x] = 1500.0 * std::exp(-((x - 50.0) * (x - 50.0) + (y - 30.0) * (y - 30.0)) / 300.0) +
+                0.1234567 * x - 0.0087 * y * y;
+    OrographicRain r;
+    r.wind_from = 300.0;
+    const auto whole = orogen::climate::orographic_rain_coarse(z.data(), w, h, cell, r, 360.0);
+    const auto g = orogen::climate::coarse_rain_grid(w, h, cell, r, 360.0);
+    ASSERT_EQ(g.factor, 4);
+    struct Win {
+        int x0, y0, w, h;
+    };
+    const Win wins[] = {{0, 0, 47, 77}, {47, 0, 54, 30}, {47, 30, 54, 47}};
+    auto cut = [&](const Win& v) {
+        std::vector<double> out(std::size_t(v.w) * v.h);
+        for (int y = 0; y < v.h; ++y)
+            for (int x = 0; x < v.w; ++x) out[std::size_t(y) * v.w + x] = z[std::size_t(v.y0 + y) * w + v.x0 + x];
+        return out;
+    };
+    for (const int order : {0, 1}) {
+        std::vector<double> sums(std::size_t(g.coarse_width) * g.coarse_height, 0.0);
+        for (int k = 0; k < 3; ++k) {
+            const Win& v = wins[order ? 2 - k : k];
+            const auto part = cut(v);
+            orogen::climate::add_block_sums(g, part.data(), v.x0, v.y0, v.w, v.h, sums);
+        }
+        const auto coarse = orogen::climate::coarse_rain(g, r, sums);
+        for (const Win& v : wins) {
+            std::vector<double> mine;
+            orogen::climate::interpolate_rain(g, coarse, v.x0, v.y0, v.w, v.h, mine);
+            for (int y = 0; y < v.h; ++y)
+                for (int x = 0; x < v.w; ++x)
+                    ASSERT_EQ(mine[std::size_t(y) * v.w + x], whole[std::size_t(v.y0 + y) * w + v.x0 + x])
+                        << "order " << order << " at " << v.x0 + x << ", " << v.y0 + y;
+        }
+    }
+    // A non-finite height names its block.
+    z[std::size_t(40) * w + 9] = std::nan("");
+    std::vector<double> sums(std::size_t(g.coarse_width) * g.coarse_height, 0.0);
+    orogen::climate::add_block_sums(g, z.data(), 0, 0, w, h, sums);
+    try {
+        orogen::climate::coarse_rain(g, r, sums);
+        FAIL() << "a NaN height was taken";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("block (2, 10)"), std::string::npos) << e.what();
+    }
+}
+
 TEST(OrographicRain, BadInputIsRefusedSayingWhat) {
     std::vector<double> h(16 * 16, 100.0);
     OrographicRain r;

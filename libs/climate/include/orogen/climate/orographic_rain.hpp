@@ -67,6 +67,31 @@ std::vector<double> orographic_rain_coarse(const double* heights, int width, int
 void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
                             double resolution, std::vector<double>& out);
 
+/// orographic_rain_coarse in parts, for a caller that holds the grid in tiles (a run split across
+/// processes): each tile adds its heights to the blocks' sums, the sums are added up (in any order:
+/// they are whole numbers), and each tile takes the coarse rain from them and interpolates its cells.
+/// The same bits as orographic_rain_coarse, whatever the split.
+struct CoarseRainGrid {
+    int width = 0, height = 0;  ///< the fine grid, cells
+    double cell = 0.0;  ///< its cell, m
+    int factor = 1;  ///< cells per block side
+    int coarse_width = 0, coarse_height = 0;  ///< blocks
+};
+/// The blocks for a width × height grid at `resolution` metres. Throws std::invalid_argument on a bad
+/// size, setting or resolution.
+CoarseRainGrid coarse_rain_grid(int width, int height, double cell, const OrographicRain& rain, double resolution);
+/// Adds the heights of the w × h window at (x0, y0) of the grid (row-major, `heights` the window's own)
+/// to `sums` (coarse_width × coarse_height, zeroed before the first window), in units that make every
+/// sum a whole number: 2^-10 m when a block holds several cells, metres when it holds one.
+void add_block_sums(const CoarseRainGrid& g, const double* heights, int x0, int y0, int w, int h,
+                    std::vector<double>& sums);
+/// The rain (m/yr) on the coarse grid from the blocks' whole sums. Throws std::invalid_argument naming
+/// the block if a sum is not finite.
+std::vector<double> coarse_rain(const CoarseRainGrid& g, const OrographicRain& rain, std::vector<double> sums);
+/// The coarse rain interpolated bilinearly onto the w × h window at (x0, y0) (`out` resized to it).
+void interpolate_rain(const CoarseRainGrid& g, const std::vector<double>& coarse, int x0, int y0, int w, int h,
+                      std::vector<double>& out);
+
 /// The wind's components: east (x) and south (down the rows, y), m/s.
 struct Wind {
     double east, south;
