@@ -275,69 +275,63 @@ double mean_bank_rise(const Model& model, int w, int h, int reach = 1) {
     return count ? sum / count : 0.0;
 }
 
-TEST(Banks, RiversGrowValleyFloorsAndTheBitsHoldOnTwoThreads) {
-    const int w = 129, h = 97;
-    Settings s;
-    s.erodibility = 2e-5;
-    s.area_exponent = 0.5;
-    s.diffusivity = 0.0;
-    s.open = {true, true, false, false};
-    s.rock.angle = 35.0 * M_PI / 180.0;  // landslides hold the walls: without banks, V notches
-    double rise[2] = {0.0, 0.0};
-    for (int with = 0; with < 2; ++with) {
-        s.banks.erosion = with ? 4.0 : 0.0;
-        s.banks.area = 1e4;
-        s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
-        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
-        model.run(1.2e6, 2e4);
-        model.route_only();
-        rise[with] = mean_bank_rise(model, w, h);
-    }
-    // Without banks the cells across a river stand near the landslide angle above it (tan 35° × 30 m = 21 m);
-    // with them the rivers keep a floor beside them.
-    EXPECT_GT(rise[0], 10.0) << rise[1];
-    EXPECT_LT(rise[1], 0.3 * rise[0]);
-    std::vector<double> threads[2];
-    for (int t = 0; t < 2; ++t) {
-        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
-        s.banks.erosion = 4.0;
-        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
-        model.run(3e5, 2e4);
-        threads[t] = model.heights();
-    }
-    EXPECT_EQ(0, std::memcmp(threads[0].data(), threads[1].data(), threads[0].size() * sizeof(double)));
-}
+constexpr int kValleyW = 129, kValleyH = 97;
 
-TEST(Banks, LargeRiversWidenTheirFloorsAndTheBitsHoldOnTwoThreads) {
-    const int w = 129, h = 97;
+/// Rivers cutting a noisy surface whose walls landslides hold at 35° (without banks: V notches), with
+/// banks at κ = 4 from 1e4 m², 1° floors, when `banks`.
+Settings valley_settings(bool banks) {
     Settings s;
     s.erodibility = 2e-5;
     s.area_exponent = 0.5;
     s.diffusivity = 0.0;
     s.open = {true, true, false, false};
     s.rock.angle = 35.0 * M_PI / 180.0;
-    s.banks.erosion = 4.0;
+    s.banks.erosion = banks ? 4.0 : 0.0;
     s.banks.area = 1e4;
     s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
-    // The mean rise two cells across the rivers draining more than 40 cells.
-    double rise2[2] = {0.0, 0.0};
-    for (int wide = 0; wide < 2; ++wide) {
-        s.banks.wide_area = wide ? 2e4 : 0.0;
-        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
-        model.run(1.2e6, 2e4);
-        model.route_only();
-        rise2[wide] = mean_bank_rise(model, w, h, 2);
-    }
-    EXPECT_GT(rise2[0], 10.0) << rise2[1];  // three-cell floors: two cells out is the valley's side
-    EXPECT_LT(rise2[1], 0.6 * rise2[0]);  // 0.46 of it; 0.77 when the push goes astray
+    return s;
+}
+
+/// After 1.2 Myr, the mean rise `reach` cells across the rivers (mean_bank_rise).
+double rise_after_run(const Settings& s, int reach) {
+    Model model(kValleyW, kValleyH, 30.0, noise(kValleyW, kValleyH, 11, 50.0),
+                std::vector<double>(std::size_t(kValleyW) * kValleyH, 1e-3), s);
+    model.run(1.2e6, 2e4);
+    model.route_only();
+    return mean_bank_rise(model, kValleyW, kValleyH, reach);
+}
+
+/// 0.3 Myr on one thread and on two give the same bits.
+void expect_the_same_bits_on_two_threads(const Settings& s) {
     std::vector<double> threads[2];
     for (int t = 0; t < 2; ++t) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
-        Model model(w, h, 30.0, noise(w, h, 11, 50.0), std::vector<double>(std::size_t(w) * h, 1e-3), s);
+        Model model(kValleyW, kValleyH, 30.0, noise(kValleyW, kValleyH, 11, 50.0),
+                    std::vector<double>(std::size_t(kValleyW) * kValleyH, 1e-3), s);
         model.run(3e5, 2e4);
         threads[t] = model.heights();
     }
     EXPECT_EQ(0, std::memcmp(threads[0].data(), threads[1].data(), threads[0].size() * sizeof(double)));
+}
+
+TEST(Banks, RiversGrowValleyFloorsAndTheBitsHoldOnTwoThreads) {
+    const double without = rise_after_run(valley_settings(false), 1), with = rise_after_run(valley_settings(true), 1);
+    // Without banks the cells across a river stand near the landslide angle above it (tan 35° × 30 m = 21 m);
+    // with them the rivers keep a floor beside them.
+    EXPECT_GT(without, 10.0) << with;
+    EXPECT_LT(with, 0.3 * without);
+    expect_the_same_bits_on_two_threads(valley_settings(true));
+}
+
+TEST(Banks, LargeRiversWidenTheirFloorsAndTheBitsHoldOnTwoThreads) {
+    // The mean rise two cells across the rivers draining more than 40 cells.
+    Settings s = valley_settings(true);
+    const double three = rise_after_run(s, 2);
+    s.banks.wide_area = 2e4;
+    const double five = rise_after_run(s, 2);
+    EXPECT_GT(three, 10.0) << five;  // three-cell floors: two cells out is the valley's side
+    EXPECT_LT(five, 0.6 * three);  // 0.46 of it; 0.77 when the push goes astray
+    expect_the_same_bits_on_two_threads(s);
 }
 
 }  // namespace
