@@ -106,7 +106,7 @@ struct LowerInputs {
     const std::int8_t* dir;
     const double *right, *left, *area;
     const std::uint8_t* outlet;
-    double rise, wide_area;
+    double rise, wide_area, wider_area;  // wider_area 0: no third cell
     const double* heights;
     std::int64_t off[8];  // the neighbours by direction code
     BankRelay* relay;  // null: no relay
@@ -131,6 +131,7 @@ template <bool Inner>
 inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t l, double h) {
     double best = 0.0, floor = 0.0;
     int out = -1;
+    bool onward = false;
     for (int k = 0; k < 8; ++k) {
         if (!Inner && !inside(in.W, in.H, x, y, k)) continue;
         const std::size_t i = std::size_t(std::int64_t(l) + in.off[k]);
@@ -144,12 +145,14 @@ inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t 
             best = push;
             floor = in.heights[i] + 2.0 * in.rise * r;
             out = from_river;
+            onward = in.wider_area > 0.0 && in.area[i] >= in.wider_area;
         }
     }
     in.relay->out[l] = std::int8_t(out);
-    if (out >= 0) {  // lower_relayed reads push and floor only where out points somewhere
+    if (out >= 0) {  // lower_relayed reads the rest only where out points somewhere
         in.relay->push[l] = best;
         in.relay->floor[l] = floor;
+        in.relay->onward[l] = onward;
     }
 }
 
@@ -187,18 +190,37 @@ inline double lower_one(const LowerInputs& in, int x, std::int64_t y) {
 }
 
 /// One cell's new height (lower_relayed): the lowest that any neighbour passing a push on towards it
-/// brings it to, not below that push's floor.
-template <bool Inner>
+/// brings it to, not below that push's floor. With `next`, a cell so lowered to within kAtFloor of that
+/// floor by a push marked onward passes it on once more, straight on (its floor rising by the floor
+/// slope over one more step, `rise` over one cell).
+template <bool Inner, bool Next>
 inline double relayed_one(const BankRelay& relay, const std::uint8_t* outlet, int W, int H, int x, std::int64_t y,
-                          const double* heights, const std::int64_t* off) {
+                          const double* heights, const std::int64_t* off, double rise, BankRelay* next) {
     const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
     const double hl = heights[l];
+    if constexpr (Next) next->out[l] = -1;
     if (outlet && outlet[l]) return hl;
     double h = hl;
+    std::int64_t from = -1;  // the neighbour whose push brought the cell lowest (ties: the lowest code)
     for (int k = 0; k < 8; ++k) {
         if (!Inner && !inside(W, H, x, y, k)) continue;
         const std::size_t j = std::size_t(std::int64_t(l) + off[k]);
-        if (relay.out[j] == (k + 4) % 8) h = std::min(h, std::max(relay.floor[j], hl - relay.push[j]));
+        if (relay.out[j] != (k + 4) % 8) continue;
+        const double v = std::max(relay.floor[j], hl - relay.push[j]);
+        if (v < h) {
+            h = v;
+            from = std::int64_t(j);
+        }
+    }
+    if constexpr (Next) {
+        const auto j = std::size_t(from);
+        if (from >= 0 && relay.onward[j] && h <= relay.floor[j] + kAtFloor) {
+            const int out = relay.out[j];
+            next->out[l] = std::int8_t(out);
+            next->push[l] = relay.push[j];
+            next->floor[l] = relay.floor[j] + rise * ((out & 1) ? kSqrt2 : 1.0);
+            next->onward[l] = 0;
+        }
     }
     return h;
 }
@@ -292,6 +314,7 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
                    outlet,
                    cell * banks.floor_slope,
                    banks.wide_area,
+                   banks.wider() ? banks.wider_area : 0.0,
                    heights,
                    {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1},
                    banks.wide() ? relay : nullptr};
@@ -305,12 +328,20 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
     });
 }
 
-double lower_relayed(const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet, double cell,
-                     double* heights, std::vector<double>& scratch) {
+double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet,
+                     double cell, double* heights, std::vector<double>& scratch, BankRelay* next) {
     const std::int64_t W = w.width;
     const std::int64_t off[8] = {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1};
+    const double rise = cell * banks.floor_slope;
+    if (!next)
+        return lower_rows(w, cell, heights, scratch, [&](int x, std::int64_t y, auto inner) {
+            return relayed_one<decltype(inner)::value, false>(relay, outlet, w.width, w.height, x, y, heights, off,
+                                                              rise, nullptr);
+        });
+    next->size_to(std::size_t(w.width) * std::size_t(w.height));
     return lower_rows(w, cell, heights, scratch, [&](int x, std::int64_t y, auto inner) {
-        return relayed_one<decltype(inner)::value>(relay, outlet, w.width, w.height, x, y, heights, off);
+        return relayed_one<decltype(inner)::value, true>(relay, outlet, w.width, w.height, x, y, heights, off, rise,
+                                                         next);
     });
 }
 

@@ -39,7 +39,10 @@
 // tools/texture_figures.py). The cell across the river finds the push it
 // passes on as it settles (lower_banks) and the cell beyond reads it from
 // its neighbour (lower_relayed): a reach of two cells with a halo of one,
-// and one more exchange between.
+// and one more exchange between. Rivers draining more than
+// banks.wider_area push on once more, through the second cell to a third
+// (3r away, the floor slope over 3r): floors seven cells wide, with a
+// fourth pass and exchange.
 //
 // Each pass reads only the heights before it and writes separate
 // arrays, so the result does not depend on the order or the threads, and a
@@ -57,20 +60,24 @@ struct Banks {
     double area = 1e6;  ///< A_b, m²
     double floor_slope = 0.0;  ///< tan of the angle at which a lowered bank still rises from its river
     double wide_area = 0.0;  ///< A_w, m²: rivers draining more push on through a bank at its floor (0: none)
+    double wider_area = 0.0;  ///< m²: rivers draining more (and A_w) push on through the next cell too (0: none)
     bool any() const { return erosion > 0.0; }
     bool wide() const { return any() && wide_area > 0.0; }
+    bool wider() const { return wide() && wider_area > 0.0; }
 };
 
 /// What each settled bank passes on to the cell beyond it (window-indexed): `push` (m) towards its
-/// neighbour at direction code `out` (−1: nothing), which it may lower to `floor` (m) and no further.
+/// neighbour at direction code `out` (−1: nothing), which it may lower to `floor` (m) and no further, and
+/// which passes it on once more (`onward`, from a river draining banks.wider_area) if it gets down to it.
 struct BankRelay {
     std::vector<double> push, floor;
-    std::vector<std::int8_t> out;
+    std::vector<std::int8_t> out, onward;
     void size_to(std::size_t n) {
-        if (push.size() == n && floor.size() == n && out.size() == n) return;
+        if (push.size() == n && floor.size() == n && out.size() == n && onward.size() == n) return;
         push.assign(n, 0.0);
         floor.assign(n, 0.0);
         out.assign(n, -1);
+        onward.assign(n, 0);
     }
 };
 
@@ -124,8 +131,10 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
 
 /// Third pass (banks.wide()): lowers each computed cell to the lowest that a neighbour passing a push
 /// on towards it brings it (`relay` as lower_banks filled it, a tile's halo exchanged), not below that
-/// push's floor; outlets stay. Returns the volume removed, m³.
-double lower_relayed(const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet, double cell,
-                     double* heights, std::vector<double>& scratch);
+/// push's floor; outlets stay. With `next` (banks.wider(); sized to the window), also fills it: a cell
+/// brought within half a metre of the floor by a push marked onward passes it on, straight on, its floor
+/// one step higher (a fourth pass, lower_relayed again on `next`). Returns the volume removed, m³.
+double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet,
+                     double cell, double* heights, std::vector<double>& scratch, BankRelay* next = nullptr);
 
 }  // namespace orogen::stream_power

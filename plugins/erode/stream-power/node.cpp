@@ -106,6 +106,7 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     constexpr double rad = std::numbers::pi / 180.0;
     s.banks.floor_slope = std::tan(ctx.real("bank_floor_slope") * rad);
     s.banks.wide_area = ctx.real("bank_wide_area");
+    s.banks.wider_area = ctx.real("bank_wider_area");
     s.rock.angle = ctx.real("landslide_angle") * rad;
     s.rock.thickness = ctx.real("bed_thickness");
     s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
@@ -499,9 +500,18 @@ void check(CheckContext& ctx) {
     if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("landslide_block_spread",
                   "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
-    for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area"})
+    for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area", "bank_wider_area"})
         if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0))
             ctx.error(bank, std::string(bank) + " shapes the rivers' bank erosion; give bank_erosion > 0 as well");
+    if (ctx.real("bank_wider_area") > 0.0 && ctx.real("bank_erosion") > 0.0) {
+        if (!(ctx.real("bank_wide_area") > 0.0))
+            ctx.error("bank_wider_area",
+                      "bank_wider_area widens the floors bank_wide_area makes; give bank_wide_area as well");
+        else if (ctx.real("bank_wider_area") < ctx.real("bank_wide_area"))
+            ctx.error("bank_wider_area",
+                      "bank_wider_area is smaller than bank_wide_area: the seven-cell floors start where the "
+                      "five-cell ones do at the earliest; give bank_wider_area >= bank_wide_area");
+    }
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
@@ -710,6 +720,13 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("rivers draining more than this keep floors five cells wide rather than three: a bank cut "
                           "down to its floor passes the river's push on to the cell beyond it, as real valley floors "
                           "widen downstream (3e5 = from a third of a km²); 0 = three cells everywhere"),
+                Param::real("bank_wider_area", 0.0)
+                    .min(0.0)
+                    .max(1e12)
+                    .unit("m²")
+                    .help("rivers draining more than this (and bank_wide_area) keep floors seven cells wide: the "
+                          "cell beyond the bank, once down to its floor, passes the push on once more (1e6 = from "
+                          "a km²); 0 = five cells at most"),
                 Param::integer("substeps", 1)
                     .min(1)
                     .max(1000)

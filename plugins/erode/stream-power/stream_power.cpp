@@ -195,7 +195,11 @@ void Model::erode_banks() {
                 bank_right_, bank_left_);
     lower_banks(settings_.banks, w, bank_dir_.data(), bank_right_.data(), bank_left_.data(), flow_.area().data(),
                 flow_.outlets().data(), cell_, h_.data(), bank_scratch_, &bank_relay_);
-    if (settings_.banks.wide()) lower_relayed(w, bank_relay_, flow_.outlets().data(), cell_, h_.data(), bank_scratch_);
+    if (!settings_.banks.wide()) return;
+    const Banks& b = settings_.banks;
+    lower_relayed(b, w, bank_relay_, flow_.outlets().data(), cell_, h_.data(), bank_scratch_,
+                  b.wider() ? &bank_relay2_ : nullptr);
+    if (b.wider()) lower_relayed(b, w, bank_relay2_, flow_.outlets().data(), cell_, h_.data(), bank_scratch_);
 }
 
 void Model::glacial_factors(double dt) {

@@ -774,6 +774,20 @@ std::int64_t TiledModel::step(double dt) {
     return pits;
 }
 
+void TiledModel::relay_across(BankRelay& relay, std::size_t gn) {
+    // The direction and the onward mark in one double each cell: out + 8·onward, or −1.
+    bank_relay_out_.resize(gn);
+    for (std::size_t g = 0; g < gn; ++g)
+        bank_relay_out_[g] = relay.out[g] < 0 ? -1.0 : double(relay.out[g] + 8 * relay.onward[g]);
+    double* arrays[] = {relay.push.data(), relay.floor.data(), bank_relay_out_.data()};
+    joined([&] { return tiles_.exchange(std::span<double* const>(arrays)); });
+    for (std::size_t g = 0; g < gn; ++g) {
+        const int v = int(bank_relay_out_[g]);
+        relay.out[g] = std::int8_t(v < 0 ? -1 : v % 8);
+        relay.onward[g] = std::int8_t(v < 0 ? 0 : v / 8);
+    }
+}
+
 void TiledModel::erode_banks(const std::vector<double>& before) {
     const int gw = grown_.width, gh = grown_.height;
     const int ox = own_.x0 - grown_.x0, oy = own_.y0 - grown_.y0;
@@ -805,13 +819,15 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
     joined([&] { return tiles_.exchange(std::span<double* const>(second)); });
     lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_area_.data(),
                 bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_, &bank_relay_);
-    if (settings_.banks.wide()) {  // what the halo's banks pass on
-        bank_relay_out_.resize(gn);
-        for (std::size_t g = 0; g < gn; ++g) bank_relay_out_[g] = bank_relay_.out[g];
-        double* third[] = {bank_relay_.push.data(), bank_relay_.floor.data(), bank_relay_out_.data()};
-        joined([&] { return tiles_.exchange(std::span<double* const>(third)); });
-        for (std::size_t g = 0; g < gn; ++g) bank_relay_.out[g] = std::int8_t(bank_relay_out_[g]);
-        lower_relayed(w, bank_relay_, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_);
+    if (settings_.banks.wide()) {  // what the halo's banks pass on (and the second cells out, if wider)
+        const bool wider = settings_.banks.wider();
+        relay_across(bank_relay_, gn);
+        lower_relayed(settings_.banks, w, bank_relay_, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_,
+                      wider ? &bank_relay2_ : nullptr);
+        if (wider) {
+            relay_across(bank_relay2_, gn);
+            lower_relayed(settings_.banks, w, bank_relay2_, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_);
+        }
     }
     for (int y = 0; y < own_.height; ++y)
         for (int x = 0; x < own_.width; ++x)

@@ -124,8 +124,9 @@ private:
     void accumulate();
     void update_rain();  // orographic rain over the current heights (collective), and each cell's weight
     /// Banks (banks.hpp) after an incision from heights `before`: two halo exchanges (three with
-    /// banks.wide()), the same bits as Model.
+    /// banks.wide(), four with banks.wider()), the same bits as Model.
     void erode_banks(const std::vector<double>& before);
+    void relay_across(BankRelay& relay, std::size_t gn);  // fills the halo of what the banks pass on
     /// Solve `v` down the rivers: f(l, v_receiver) sets v[l] for every cell but the roots, receivers first.
     void propagate(std::vector<double>& v, const std::function<void(std::size_t, double)>& f);
     bool outlet_at(std::int64_t g) const;
@@ -178,6 +179,7 @@ private:
     std::vector<std::uint8_t> bank_outlet_;
     std::optional<BankAreaFactor> bank_factor_;  // 1 − e^(−A/A_b), built at the first step
     BankRelay bank_relay_;  // what a bank down to its floor passes on (banks.wide()), the halo's exchanged
+    BankRelay bank_relay2_;  // what the second cells out pass on (banks.wider())
     std::vector<double> bank_relay_out_;  // bank_relay_.out as doubles, for the exchange
     std::vector<double> pow_table_;
     std::unique_ptr<diffusion::Solver> diffusion_;

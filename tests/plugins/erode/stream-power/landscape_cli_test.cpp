@@ -170,7 +170,9 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "n = erode:stream-power(base, bed_thickness=50, bed_facies_share=0.3)\n"
                   "o = erode:stream-power(base, bank_floor_slope=2)\n"
                   "p = erode:stream-power(base, bank_erosion=11)\n"
-                  "q = erode:stream-power(base, bank_wide_area=1e5)\n");
+                  "q = erode:stream-power(base, bank_wide_area=1e5)\n"
+                  "r = erode:stream-power(base, bank_erosion=4, bank_wider_area=1e6)\n"
+                  "s = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e6, bank_wider_area=1e5)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -204,6 +206,9 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:19:43: error: 'bank_erosion' of erode:stream-power is 11, out of range [0, 10]",
              "rock.orogen:20:45: error: erode:stream-power: bank_wide_area shapes the rivers' bank erosion; give "
              "bank_erosion > 0 as well",
+             "rock.orogen:21:62: error: erode:stream-power: bank_wider_area widens the floors bank_wide_area "
+             "makes; give bank_wide_area as well",
+             "rock.orogen:22:82: error: erode:stream-power: bank_wider_area is smaller than bank_wide_area",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
