@@ -151,8 +151,8 @@ void expect_inside_the_bands(const std::string& spec_name, const std::string& ex
     // soil has crept over it: no slot one cell wide deeper than 32 m (28.4 m on six seeds since stop 43, the
     // soil settling after the slump; 38 m before, with the slump last; 142 m before the slump).
     EXPECT_LE(deepest_slot(h, kSide), 32.0) << spec_name << " " << extra;
-    // Floors five cells wide along the rivers draining 0.3 km² (bank_wide_area): the valley bottoms'
-    // curvature 15.1–18.4 /km on six seeds (19.5–22.7 with floors three cells wide; real 8–16).
+    // Floors five cells wide along the rivers draining 0.3 km², seven from 1 km²: the valley bottoms.
+    // curvature 13.6–15.3 /km on six seeds (15.1–18.4 with five-cell floors, 19.5–22.7 with three; real 8–16).
     const double curvature = channel_curvature(h, kSide, 30.0);
     testing::Test::RecordProperty("channel_curvature", std::to_string(curvature));
     EXPECT_LE(curvature, 19.5) << spec_name << " " << extra;
