@@ -239,12 +239,14 @@ void interpolate_rain(const CoarseRainGrid& g, const std::vector<double>& coarse
 void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
                             double resolution, std::vector<double>& out) {
     const CoarseRainGrid g = coarse_rain_grid(width, height, cell, rain, resolution);
-    // A non-finite height: name it, not its block.
-    for (std::size_t j = 0; j < std::size_t(width) * std::size_t(height); ++j)
-        if (!std::isfinite(heights[j]))
-            throw std::invalid_argument("orographic rain: height " + std::to_string(j) + " is not a finite number");
     std::vector<double> sums(std::size_t(g.coarse_width) * std::size_t(g.coarse_height), 0.0);
     add_block_sums(g, heights, 0, 0, width, height, sums);
+    // A non-finite height makes its block's sum non-finite: then look for it, and name it, not its block
+    // (the whole grid is searched only then, not every call).
+    if (!std::all_of(sums.begin(), sums.end(), [](double v) { return std::isfinite(v); }))
+        for (std::size_t j = 0; j < std::size_t(width) * std::size_t(height); ++j)
+            if (!std::isfinite(heights[j]))
+                throw std::invalid_argument("orographic rain: height " + std::to_string(j) + " is not a finite number");
     std::vector<double> r = coarse_rain(g, rain, std::move(sums));
     if (g.factor == 1) {
         out = std::move(r);

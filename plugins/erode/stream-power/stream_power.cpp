@@ -102,18 +102,10 @@ void Model::update_rain() {
     // Only the weights are kept (rain() multiplies back): one array of the grid's size, reused each step.
     climate::orographic_rain_coarse(h_.data(), width_, height_, cell_, settings_.rain, settings_.rain_resolution,
                                     rain_weight_);
-    const double inv = 1.0 / settings_.rain.background;
-    double* w = rain_weight_.data();
-    parallel_for(0, std::int64_t(rain_weight_.size()), 1 << 16, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i) w[i] = rain_weight(w[i], inv);
-    });
+    rain_to_weights(rain_weight_, settings_.rain.background);
 }
 
-std::vector<double> Model::rain() const {
-    std::vector<double> r(rain_weight_);
-    for (double& v : r) v *= settings_.rain.background;  // the rain as the drainage area weighed it
-    return r;
-}
+std::vector<double> Model::rain() const { return weights_to_rain(rain_weight_, settings_.rain.background); }
 
 std::int64_t Model::step(double dt) {
     const std::size_t n = h_.size();

@@ -57,6 +57,15 @@ inline double rain_weight(double rain, double inv_background) {
     constexpr double unit = 1048576.0;  // 2^20
     return std::nearbyint(rain * inv_background * unit) / unit;
 }
+/// The rain (m/yr) in place turned into each cell's weight (rain_weight), and back (as weighed).
+inline void rain_to_weights(std::vector<double>& rain, double background) {
+    const double inv = 1.0 / background;
+    for (double& v : rain) v = rain_weight(v, inv);
+}
+inline std::vector<double> weights_to_rain(std::vector<double> weights, double background) {
+    for (double& v : weights) v *= background;
+    return weights;
+}
 
 struct Settings {
     double erodibility = 2e-5;  ///< K, m^(1−2m)/yr (n = 1)

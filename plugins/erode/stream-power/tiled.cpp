@@ -677,15 +677,10 @@ void TiledModel::update_rain() {
     joined([&] { tiles_.reduce(std::span<double>(sums), Tiling::Reduce::sum); });
     const std::vector<double> coarse = climate::coarse_rain(g, settings_.rain, std::move(sums));
     climate::interpolate_rain(g, coarse, own_.x0, own_.y0, own_.width, own_.height, rain_weight_);
-    const double inv = 1.0 / settings_.rain.background;
-    for (double& w : rain_weight_) w = rain_weight(w, inv);
+    rain_to_weights(rain_weight_, settings_.rain.background);
 }
 
-std::vector<double> TiledModel::rain() const {
-    std::vector<double> r(rain_weight_);
-    for (double& v : r) v *= settings_.rain.background;
-    return r;
-}
+std::vector<double> TiledModel::rain() const { return weights_to_rain(rain_weight_, settings_.rain.background); }
 
 void TiledModel::route_only() {
     if (settings_.orographic_rain && rain_weight_.empty()) update_rain();
