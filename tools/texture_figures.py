@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Texture figures that `orogen analyze` does not report yet (docs/realism.md).
+"""Texture figures that `orogen analyze` does not report (docs/realism.md).
 
     tools/texture_figures.py FILE [FILE ...]
 
@@ -26,9 +26,13 @@ channels, not flats):
   median section stands 10 m above the river, interpolated linearly (walls at
   30° from the river itself: 35 m; a valley floor widens it).
 
-They are measured here rather than in `orogen analyze` because they are still
-being judged: the first and last depend on the DEM's vertical resolution, the
-second counts the DEM's own noise.
+The first three are measured here rather than in `orogen analyze` because they
+are still being judged: the first depends on the DEM's vertical resolution, the
+second counts the DEM's own noise. The last two are `orogen analyze` figures
+since stop 45 (`channel_curvature`, `valley_width`), measured there on the
+whole network: the D8 here runs on the unfilled heights, so every pit stops the
+drainage area and they see only the channels above the first pit (about half,
+none draining more than ~10 km²). They stay here to compare with earlier notes.
 """
 import argparse
 import os

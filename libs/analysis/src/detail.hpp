@@ -36,5 +36,7 @@ void measure_relief(const Terrain& t, const Options& o, Figures& f);
 void measure_curvature(const Terrain& t, Figures& f);
 void measure_spectrum(const Terrain& t, Figures& f);
 void measure_drainage(const Terrain& t, const Options& o, Figures& f);
+/// Channel curvature and valley width, over the cells draining more than o.channel_area (m², `area`).
+void measure_valleys(const Terrain& t, const Options& o, std::span<const double> area, Figures& f);
 
 }  // namespace orogen::analysis::detail

@@ -2,7 +2,7 @@
 // (Barnes, Lehman & Mulla 2014) from every edge sample (and every sample beside a hole), D8 steepest
 // descent on the filled heights (O'Callaghan & Mark 1984), drainage area accumulated from the highest
 // cell down. On it: concavity θ and steepness k_sn (slope–area), Hack's exponent, drainage density,
-// the network's share, hillslope length and channel sinuosity.
+// the network's share, hillslope length and channel sinuosity; the valleys along the channels (valleys.cpp).
 #include "detail.hpp"
 
 #include <algorithm>
@@ -124,7 +124,8 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
             ") is too small to route water over (needs at least 3x3)";
         for (FigureId id :
              {FigureId::concavity, FigureId::steepness, FigureId::hack_exponent, FigureId::drainage_density,
-              FigureId::network_share, FigureId::hillslope_length, FigureId::channel_sinuosity})
+              FigureId::network_share, FigureId::hillslope_length, FigureId::channel_sinuosity,
+              FigureId::channel_curvature, FigureId::valley_width, FigureId::valley_widening})
             f[id].why_not = why;
         return;
     }
@@ -139,6 +140,7 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
         area[std::size_t(j)] += area[i];
         length[std::size_t(j)] = std::max(length[std::size_t(j)], length[i] + r.distance[i]);
     }
+    measure_valleys(t, o, area, f);
 
     // Slope–area over the channel cells (terrain_stats.py: A > 1 km² and S > 1e-4).
     std::vector<double> ca, cs, cl, la, ls, ll;

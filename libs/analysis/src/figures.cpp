@@ -78,6 +78,27 @@ constexpr FigureInfo table[] = {
      "mean over the channel cells (A > 1 km²) of the D8 flow length along the next 1 km of flow path over the "
      "straight distance between its ends (D8 reads a straight channel as 1.00–1.08, by its direction)",
      "Mueller 1968, Ann. Assoc. Am. Geogr. 58:371; Schumm 1963, Geol. Soc. Am. Bull. 74:1089", 3},
+    {channel_curvature, "channel_curvature", "channel curv.", "1/km",
+     "mean Laplacian curvature (5-point stencil) of the channel cells (A > 1 km² on the routing of the "
+     "concavity) that slope more than 6° by central differences: how sharp the valley bottoms are (a V of "
+     "30° walls at 30 m: 38 /km; a floor or a rounded bottom: less)",
+     "Zevenbergen & Thorne 1987, Earth Surf. Proc. Landf. 12:47; Lashermes, Foufoula-Georgiou & Dietrich "
+     "2007, Geophys. Res. Lett. 34:L23S04 (valley bottoms by curvature)",
+     1},
+    {valley_width, "valley_width", "valley width", "m",
+     "twice the distance at which the median cross-section of those channel cells stands 10 m above the "
+     "river (linear between samples); each section runs along x or y, whichever the central difference "
+     "changes less on (across the river), and averages the two sides d = 1 … 8 samples out",
+     "Montgomery & Gran 2001, Water Resour. Res. 37:1841 (width downstream); Whipple 2004, Annu. Rev. "
+     "Earth Planet. Sci. 32:151",
+     0},
+    {valley_widening, "valley_widening", "widening b", "",
+     "slope of the least-squares line of ln W against ln A, W the valley width as above over the channel "
+     "cells in each quarter decade of drainage area A with 30 cells or more (at least 3 such bins): how "
+     "fast valleys widen downstream (W ∝ A^b)",
+     "Montgomery & Gran 2001, Water Resour. Res. 37:1841; Leopold & Maddock 1953, USGS Prof. Pap. 252 "
+     "(hydraulic geometry)",
+     2},
 };
 static_assert(std::size(table) == figure_count, "one row per FigureId");
 

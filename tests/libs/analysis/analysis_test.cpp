@@ -1,6 +1,7 @@
 // orogen_analysis on surfaces whose figures are known: a plane's slope, a cone's hypsometric integral
 // of 1/3, spectral surfaces of prescribed β, rivers at stream-power steady state (θ = m/n,
-// k_s = (U/K)^(1/n)), pits, local relief, nodata and terrains too small for a figure; the FFT
+// k_s = (U/K)^(1/n)), pits, local relief, valleys of known sections, nodata and terrains too small for a
+// figure; the FFT
 // against the naive DFT; the same bits for any thread count.
 #include <orogen/analysis/compare.hpp>
 #include <orogen/analysis/fft.hpp>
@@ -255,6 +256,86 @@ TEST(Figures, AWindingChannelIsSinuousAndAStraightOneIsNot) {
     const Figures line = measure({straight.data(), w, h, 100.0});
     ASSERT_TRUE(line[channel_sinuosity].ok()) << line[channel_sinuosity].why_not;
     EXPECT_NEAR(line[channel_sinuosity].value, 1.0, 1e-12);
+}
+
+// ----------------------------------------------------------------- valleys
+
+/// A straight valley running south down the middle column of a w × h grid (30 m cells), falling `fall` m/m
+/// (steeper than 6°, so its cells count), its cross-section `rise(d, y)` metres d ≥ 0 cells from the river.
+/// Its sides drain straight across into the river: the river at row y drains rows 0 … y.
+std::vector<float> valley(int w, int h, double fall, auto&& rise) {
+    return field(w, h, [&](int x, int y) { return 4000.0 - 30.0 * fall * y + rise(std::abs(x - w / 2), y); });
+}
+
+TEST(Figures, AVValleyHasTheWidthAndCurvatureOfItsWalls) {
+    // Walls at 30°: 10 m above the river at 10 / tan 30° = 17.3 m to either side (34.6 m across), the
+    // Laplacian at the river 2·tan 30° / 30 m (38.5 /km), the same width at every drainage area.
+    const int w = 201, h = 401;
+    const double wall = std::tan(30.0 / degrees);
+    const auto z = valley(w, h, 0.15, [&](int d, int) { return 30.0 * wall * d; });
+    const Figures f = measure({z.data(), w, h, 30.0});
+    ASSERT_TRUE(f[channel_curvature].ok()) << f[channel_curvature].why_not;
+    EXPECT_NEAR(f[channel_curvature].value, 2.0 * wall / 30.0 * 1000.0, 0.01);
+    ASSERT_TRUE(f[valley_width].ok()) << f[valley_width].why_not;
+    EXPECT_NEAR(f[valley_width].value, 2.0 * 10.0 / wall, 1e-3);
+    ASSERT_EQ(f.valley_section.size(), 9u);
+    EXPECT_NEAR(f.valley_section[4], 4 * 30.0 * wall, 1e-3);
+    ASSERT_TRUE(f[valley_widening].ok()) << f[valley_widening].why_not;
+    EXPECT_NEAR(f[valley_widening].value, 0.0, 1e-6);
+    EXPECT_GE(f.valley_widths.x.size(), 3u);
+}
+
+TEST(Figures, AValleyWidthInterpolatesBetweenSamplesAtTheRiseAsked) {
+    // Lower walls at 20° to 3 cells out, then 40°: 50 m above the river (Options::valley_rise) at
+    // 3 + (50 − 32.8) / 25.2 cells, linear between the samples as the section is.
+    const int w = 201, h = 401;
+    const double lower = 30.0 * std::tan(20.0 / degrees), upper = 30.0 * std::tan(40.0 / degrees);
+    const auto z = valley(w, h, 0.11, [&](int d, int) { return d <= 3 ? lower * d : 3 * lower + upper * (d - 3); });
+    Options o;
+    o.valley_rise = 50.0;
+    const Figures f = measure({z.data(), w, h, 30.0}, o);
+    ASSERT_TRUE(f[valley_width].ok()) << f[valley_width].why_not;
+    EXPECT_NEAR(f[valley_width].value, 2.0 * 30.0 * (3.0 + (50.0 - 3.0 * lower) / upper), 1e-3);
+    // The default rise (10 m) falls on the lower walls.
+    EXPECT_NEAR(measure({z.data(), w, h, 30.0})[valley_width].value, 2.0 * 30.0 * 10.0 / lower, 1e-3);
+}
+
+TEST(Figures, AValleyWideningDownstreamAsAPowerOfAreaGivesItsExponent) {
+    // Walls gentler downstream, tan α ∝ A^−0.2 with A = (y + 1)·w·cell² the river's drainage area at
+    // row y: the width 2·10 m / tan α grows as A^0.2. A narrow grid, so that the walls, gentler a row
+    // down, drain straight across (A is the rows' count) rather than down-valley first.
+    const int w = 41, h = 2001;
+    const double b = 0.2, a0 = 1e6;
+    auto tan_wall = [&](int y) { return std::min(1.0, std::pow((y + 1) * w * 900.0 / a0, -b)); };
+    const auto z = valley(w, h, 0.15, [&](int d, int y) { return 30.0 * tan_wall(y) * d; });
+    const Figures f = measure({z.data(), w, h, 30.0});
+    ASSERT_TRUE(f[valley_widening].ok()) << f[valley_widening].why_not;
+    EXPECT_NEAR(f[valley_widening].value, b, 0.02);
+    ASSERT_GE(f.valley_widths.x.size(), 3u);
+    for (std::size_t k = 1; k < f.valley_widths.y.size(); ++k)
+        EXPECT_GT(f.valley_widths.y[k], f.valley_widths.y[k - 1]) << "wider downstream";
+}
+
+TEST(Figures, ValleyFiguresSayWhyTheyCannotBeMeasured) {
+    // Rivers on a gentle plane (under 6°): no channel cell to measure.
+    const int w = 201, h = 401;
+    const auto gentle = valley(w, h, 0.05, [](int d, int) { return 0.5 * d; });
+    const Figures f = measure({gentle.data(), w, h, 30.0});
+    EXPECT_EQ(f[channel_curvature].why_not, "no channel cell (draining more than 1 km²) slopes more than 6°");
+    EXPECT_EQ(f[valley_width].why_not, f[channel_curvature].why_not);
+    // 8 cells out the walls stand 160 m above the river: asked for the width 200 m up, wider than the reach.
+    const auto broad = valley(w, h, 0.15, [](int d, int) { return 20.0 * d; });
+    Options high;
+    high.valley_rise = 200.0;
+    const Figures g = measure({broad.data(), w, h, 30.0}, high);
+    EXPECT_TRUE(g[channel_curvature].ok());
+    EXPECT_EQ(g[valley_width].why_not,
+              "the valleys are wider than 480 m: 240 m from the river they stand 160.0 m above it");
+    // A valley too short to have three quarter decades of area with 30 channel cells each.
+    const auto short_valley = valley(201, 40, 0.15, [](int d, int) { return 20.0 * d; });
+    const Figures s = measure({short_valley.data(), 201, 40, 30.0});
+    EXPECT_TRUE(s[valley_width].ok()) << s[valley_width].why_not;
+    EXPECT_NE(s[valley_widening].why_not.find("the fit needs 3"), std::string::npos) << s[valley_widening].why_not;
 }
 
 #ifdef OROGEN_HAVE_STREAM_POWER

@@ -81,7 +81,7 @@ TEST(AnalyzeCli, ComparesWithReferencesAndNamesTheNearest) {
     EXPECT_NE(r.out.find("references"), std::string::npos);
     EXPECT_TRUE(std::regex_search(r.out, std::regex("median slope .* OUT +in\\n"))) << r.out;
     EXPECT_NE(r.out.find("resembles most"), std::string::npos);
-    EXPECT_NE(r.out.find("  morocco_rif_27m: morocco_rif_27m-2 (0.00 over 17 figures)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("  morocco_rif_27m: morocco_rif_27m-2 (0.00 over 20 figures)"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("  dome: morocco_rif_27m-2 ("), std::string::npos) << r.out;
     const std::string json = slurp(dir / "out/analysis.json");
     EXPECT_NE(json.find("\"inside_references\": false"), std::string::npos);
