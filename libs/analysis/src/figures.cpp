@@ -86,9 +86,10 @@ constexpr FigureInfo table[] = {
      "2007, Geophys. Res. Lett. 34:L23S04 (valley bottoms by curvature)",
      1},
     {valley_width, "valley_width", "valley width", "m",
-     "twice the distance at which the median cross-section of those channel cells stands 10 m above the "
-     "river (linear between samples); each section runs along x or y, whichever the central difference "
-     "changes less on (across the river), and averages the two sides d = 1 … 8 samples out",
+     "twice the distance at which the median cross-section of the channel cells (A > 1 km², any slope: "
+     "floodplains count) stands 10 m above the river (linear between samples); each section runs along x "
+     "or y, whichever the central difference changes less on (across the river), and averages the two "
+     "sides d = 1 … 8 samples out",
      "Montgomery & Gran 2001, Water Resour. Res. 37:1841 (width downstream); Whipple 2004, Annu. Rev. "
      "Earth Planet. Sci. 32:151",
      0},

@@ -1,9 +1,9 @@
 // Figures of the valley bottoms along the channels (cells draining more than Options::channel_area, on
-// the drainage routing of drainage.cpp) that slope more than Options::valley_min_slope by central
-// differences (the channels among hillslopes, not the flats of floodplains, lakes and filled pits):
-// channel curvature, the mean Laplacian there (how sharp the bottoms are); valley width, where their
-// median cross-section stands Options::valley_rise above the river; and how fast that width grows with
-// the drainage area. tools/texture_figures.py measured the first two first, with D8 on the unfilled
+// the drainage routing of drainage.cpp): channel curvature, the mean Laplacian of those that slope more
+// than Options::valley_min_slope by central differences (the channels among hillslopes: the flats of
+// floodplains and lakes would dilute how sharp the bottoms are); valley width, where the median
+// cross-section of all of them stands Options::valley_rise above the river (the floodplains count:
+// they are the widest floors); and how fast that width grows with the drainage area. tools/texture_figures.py measured the first two first, with D8 on the unfilled
 // heights: every pit stopped the area there, so it saw only the channels above the first pit, about
 // half of them and none draining more than ~10 km² (the widest valleys).
 #include "detail.hpp"
@@ -72,9 +72,10 @@ void measure_valleys(const Terrain& t, const Options& o, std::span<const double>
             if (!t.valid[i] || !(area[i] > o.channel_area)) continue;
             if (!t.valid[i - 1] || !t.valid[i + 1] || !t.valid[i - w] || !t.valid[i + w]) continue;
             const double gx = (t.z[i + 1] - t.z[i - 1]) / (2.0 * t.cell), gy = (t.z[i + w] - t.z[i - w]) / (2.0 * t.cell);
-            if (!(std::hypot(gx, gy) > steep)) continue;
-            curvature += (t.z[i - 1] + t.z[i + 1] + t.z[i - w] + t.z[i + w] - 4.0 * t.z[i]) / c2;  // 1/m
-            ++channels;
+            if (std::hypot(gx, gy) > steep) {
+                curvature += (t.z[i - 1] + t.z[i + 1] + t.z[i - w] + t.z[i + w] - 4.0 * t.z[i]) / c2;  // 1/m
+                ++channels;
+            }
             // Across the river: along the axis on which the heights change less.
             const bool across_x = std::abs(gx) <= std::abs(gy);
             if (across_x ? x < reach || x + reach >= t.width : y < reach || y + reach >= t.height) continue;
@@ -85,17 +86,17 @@ void measure_valleys(const Terrain& t, const Options& o, std::span<const double>
             if (whole) sections.push_back({i, across_x, area[i]});
         }
     char text[160];
-    std::snprintf(text, sizeof text, "no channel cell (draining more than %g km²) slopes more than %s",
-                  o.channel_area / 1e6, degrees(o.valley_min_slope).c_str());
     if (channels == 0) {
-        for (FigureId id : {FigureId::channel_curvature, FigureId::valley_width, FigureId::valley_widening})
-            f[id].why_not = text;
-        return;
+        std::snprintf(text, sizeof text, "no channel cell (draining more than %g km²) slopes more than %s",
+                      o.channel_area / 1e6, degrees(o.valley_min_slope).c_str());
+        f[FigureId::channel_curvature].why_not = text;
+    } else {
+        f[FigureId::channel_curvature].value = 1000.0 * curvature / double(channels);  // 1/m → 1/km
     }
-    f[FigureId::channel_curvature].value = 1000.0 * curvature / double(channels);  // 1/m → 1/km
     if (sections.empty()) {
-        std::snprintf(text, sizeof text, "no sloping channel cell has %d measured samples on both sides across it",
-                      reach);
+        std::snprintf(text, sizeof text,
+                      "no channel cell (draining more than %g km²) has %d measured samples on both sides across it",
+                      o.channel_area / 1e6, reach);
         f[FigureId::valley_width].why_not = text;
         f[FigureId::valley_widening].why_not = text;
         return;

@@ -317,12 +317,14 @@ TEST(Figures, AValleyWideningDownstreamAsAPowerOfAreaGivesItsExponent) {
 }
 
 TEST(Figures, ValleyFiguresSayWhyTheyCannotBeMeasured) {
-    // Rivers on a gentle plane (under 6°): no channel cell to measure.
+    // A valley falling 5 % (under 6°): no channel cell for the curvature, but its width is measured (a
+    // floodplain's counts), 10 m up at 10 / 3 cells from the river.
     const int w = 201, h = 401;
-    const auto gentle = valley(w, h, 0.05, [](int d, int) { return 0.5 * d; });
+    const auto gentle = valley(w, h, 0.05, [](int d, int) { return 3.0 * d; });
     const Figures f = measure({gentle.data(), w, h, 30.0});
     EXPECT_EQ(f[channel_curvature].why_not, "no channel cell (draining more than 1 km²) slopes more than 6°");
-    EXPECT_EQ(f[valley_width].why_not, f[channel_curvature].why_not);
+    ASSERT_TRUE(f[valley_width].ok()) << f[valley_width].why_not;
+    EXPECT_NEAR(f[valley_width].value, 2.0 * 30.0 * 10.0 / 3.0, 1e-3);
     // 8 cells out the walls stand 160 m above the river: asked for the width 200 m up, wider than the reach.
     const auto broad = valley(w, h, 0.15, [](int d, int) { return 20.0 * d; });
     Options high;
@@ -332,6 +334,10 @@ TEST(Figures, ValleyFiguresSayWhyTheyCannotBeMeasured) {
     EXPECT_EQ(g[valley_width].why_not,
               "the valleys are wider than 480 m: 240 m from the river they stand 160.0 m above it");
     // A valley too short to have three quarter decades of area with 30 channel cells each.
+    // (And one narrower than its reach: no section at all.)
+    const auto narrow = valley(15, 401, 0.15, [](int d, int) { return 20.0 * d; });
+    EXPECT_EQ(measure({narrow.data(), 15, 401, 30.0})[valley_width].why_not,
+              "no channel cell (draining more than 1 km²) has 8 measured samples on both sides across it");
     const auto short_valley = valley(201, 40, 0.15, [](int d, int) { return 20.0 * d; });
     const Figures s = measure({short_valley.data(), 201, 40, 30.0});
     EXPECT_TRUE(s[valley_width].ok()) << s[valley_width].why_not;

@@ -49,8 +49,8 @@ struct Options {
         1e5;  ///< m²: drainage area above which a cell is on the drainage network (density, hillslopes)
     double relief_radius = 1000.0;  ///< m: half-width of the square window of the local relief
     double sinuosity_reach = 1000.0;  ///< m: length of flow path over which a channel's sinuosity is taken
-    /// °: channel cells at least this steep (central differences) have their valley bottom measured
-    /// (channels among hillslopes, not the flats of floodplains, lakes and filled pits)
+    /// °: channel cells at least this steep (central differences) enter the channel curvature (channels
+    /// among hillslopes, not the flats of floodplains, lakes and filled pits)
     double valley_min_slope = 6.0;
     double valley_rise = 10.0;  ///< m: the valley's width is taken this high above the river
     int valley_reach = 8;  ///< samples: how far to either side of the river its cross-section is taken
@@ -149,7 +149,7 @@ struct Figures {
     LogBins hack;
     LineFit hack_fit;
     /// The valleys' median cross-section: height (m) above the river d = 0 … valley_reach samples to either
-    /// side, over the channel cells of the valley width (empty when there are none).
+    /// side, over the channel cells (A > channel_area, any slope; empty when there are none).
     std::vector<double> valley_section;
     /// Valley width against drainage area: the width (m, as the figure) over the channel cells in each
     /// quarter decade of A (m²) with 30 cells or more; y is the width, not a mean.
