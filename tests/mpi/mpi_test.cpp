@@ -221,7 +221,7 @@ p  = tectonics:plates(d, plates=4, steps=120, cones=30, height=60, timelapse_eve
 s7 = erode:stream-power(p, p.timelapse, years=5e4, dt=1.5e4, uplift_history_years=4e4, uplift_smoothing=60, diffusivity=0.01, uplift_edge_taper=400)
 s8 = erode:stream-power(d, years=6e4, dt=1e4, uplift=3, diffusivity=0.01, landslide_angle=28, bed_thickness=30, bed_dip=25, bed_dip_toward=60, bed_angle_spread=8, bed_erodibility_contrast=4, bed_fold_amplitude=60, bed_fold_wavelength=900, bed_thickness_spread=0.7, bed_fault_spacing=600, bed_fault_throw=50, landslide_block_spread=0.6, bed_facies_length=400, bed_facies_share=0.7)
 s9 = erode:stream-power(p, p.timelapse, years=5e4, dt=2.5e4, uplift_history_years=4e4, substeps=3, uplift=1, diffusivity=0.05, channel_area=2e4, landslide_angle=30, bank_erosion=4, bank_area=1e4)
-s10 = erode:stream-power(d, years=6e4, dt=1e4, uplift=2, diffusivity=0.01, channel_area=1e4, bank_erosion=6, bank_area=1e4, bank_wide_area=3e4, bank_wider_area=6e4, open="we")
+s10 = erode:stream-power(d, years=6e4, dt=1e4, uplift=2, diffusivity=0.01, channel_area=1e4, bank_erosion=6, bank_area=1e4, bank_wide_area=3e4, bank_wider_area=6e4, bank_widest_floor=11, open="we")
 s11 = erode:stream-power(d, years=4e4, dt=1e4, uplift=2, diffusivity=0.01, rain=orographic, wind_from=290, rain_resolution=150, open="ns")
 s12 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, rain=orographic, wind_from=60, rain_resolution=30, channel_area=1e4)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)

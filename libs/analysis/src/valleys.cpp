@@ -71,7 +71,8 @@ void measure_valleys(const Terrain& t, const Options& o, std::span<const double>
             const std::size_t i = t.at(x, y);
             if (!t.valid[i] || !(area[i] > o.channel_area)) continue;
             if (!t.valid[i - 1] || !t.valid[i + 1] || !t.valid[i - w] || !t.valid[i + w]) continue;
-            const double gx = (t.z[i + 1] - t.z[i - 1]) / (2.0 * t.cell), gy = (t.z[i + w] - t.z[i - w]) / (2.0 * t.cell);
+            const double gx = (t.z[i + 1] - t.z[i - 1]) / (2.0 * t.cell),
+                         gy = (t.z[i + w] - t.z[i - w]) / (2.0 * t.cell);
             if (std::hypot(gx, gy) > steep) {
                 curvature += (t.z[i - 1] + t.z[i + 1] + t.z[i - w] + t.z[i + w] - 4.0 * t.z[i]) / c2;  // 1/m
                 ++channels;
@@ -104,7 +105,8 @@ void measure_valleys(const Terrain& t, const Options& o, std::span<const double>
     f.valley_section = valley_section(t, sections, reach);
     f[FigureId::valley_width].value = width_at_rise(f.valley_section, t.cell, o.valley_rise);
     if (std::isnan(f[FigureId::valley_width].value)) {
-        std::snprintf(text, sizeof text, "the valleys are wider than %g m: %g m from the river they stand %.1f m above it",
+        std::snprintf(text, sizeof text,
+                      "the valleys are wider than %g m: %g m from the river they stand %.1f m above it",
                       2.0 * reach * t.cell, reach * t.cell, f.valley_section.back());
         f[FigureId::valley_width].why_not = text;
     }

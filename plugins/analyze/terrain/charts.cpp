@@ -256,32 +256,32 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
                                    return s;
                                },
                                "linespoints pt 7 ps 0.6")});
-    pending.push_back({{stem + "-valley-width.png", "Valley width against drainage area"},
-                       header("Valley width 10 m above the river against drainage area; lines: W = c A^b",
-                              "drainage area A (m²)", "valley width W (m)") +
-                           "set logscale xy\n" +
-                           plot(
-                               terrains, "vw",
-                               [](const Terrain& t) {
-                                   Series s{{}, t.name};
-                                   const auto& f = t.figures;
-                                   if (!f[FigureId::valley_widening].ok()) return s;
-                                   s.title +=
-                                       ": b " + number(std::round(f[FigureId::valley_widening].value * 100) / 100);
-                                   for (std::size_t b = 0; b < f.valley_widths.x.size(); ++b)
-                                       s.points.emplace_back(f.valley_widths.x[b], f.valley_widths.y[b]);
-                                   return s;
-                               },
-                               "points pt 7 ps 0.8",
-                               [](const Terrain& t) {
-                                   std::vector<std::pair<double, double>> line;
-                                   const auto& f = t.figures;
-                                   if (!f[FigureId::valley_widening].ok()) return line;
-                                   for (double a : {f.valley_widths.x.front(), f.valley_widths.x.back()})
-                                       line.emplace_back(a, std::exp(f.valley_widths_fit.intercept +
-                                                                     f.valley_widths_fit.slope * std::log(a)));
-                                   return line;
-                               })});
+    pending.push_back(
+        {{stem + "-valley-width.png", "Valley width against drainage area"},
+         header("Valley width 10 m above the river against drainage area; lines: W = c A^b", "drainage area A (m²)",
+                "valley width W (m)") +
+             "set logscale xy\n" +
+             plot(
+                 terrains, "vw",
+                 [](const Terrain& t) {
+                     Series s{{}, t.name};
+                     const auto& f = t.figures;
+                     if (!f[FigureId::valley_widening].ok()) return s;
+                     s.title += ": b " + number(std::round(f[FigureId::valley_widening].value * 100) / 100);
+                     for (std::size_t b = 0; b < f.valley_widths.x.size(); ++b)
+                         s.points.emplace_back(f.valley_widths.x[b], f.valley_widths.y[b]);
+                     return s;
+                 },
+                 "points pt 7 ps 0.8",
+                 [](const Terrain& t) {
+                     std::vector<std::pair<double, double>> line;
+                     const auto& f = t.figures;
+                     if (!f[FigureId::valley_widening].ok()) return line;
+                     for (double a : {f.valley_widths.x.front(), f.valley_widths.x.back()})
+                         line.emplace_back(
+                             a, std::exp(f.valley_widths_fit.intercept + f.valley_widths_fit.slope * std::log(a)));
+                     return line;
+                 })});
 
     ChartsWritten written;
     std::vector<std::unique_ptr<AtomicFile>> files;

@@ -106,7 +106,8 @@ struct LowerInputs {
     const std::int8_t* dir;
     const double *right, *left, *area;
     const std::uint8_t* outlet;
-    double rise, wide_area, wider_area;  // wider_area 0: no third cell
+    const Banks* banks;
+    double rise;
     const double* heights;
     std::int64_t off[8];  // the neighbours by direction code
     BankRelay* relay;  // null: no relay
@@ -131,28 +132,29 @@ template <bool Inner>
 inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t l, double h) {
     double best = 0.0, floor = 0.0;
     int out = -1;
-    bool onward = false;
+    int onward = 0;
     for (int k = 0; k < 8; ++k) {
         if (!Inner && !inside(in.W, in.H, x, y, k)) continue;
         const std::size_t i = std::size_t(std::int64_t(l) + in.off[k]);
         const int d = in.dir[i];
         const int from_river = (k + 4) % 8;  // the direction from river i to this cell
         // Few neighbours are large rivers: that test first (it seldom passes, so it is well predicted).
-        if (!(in.area[i] >= in.wide_area) || d < 0) continue;
+        if (!(in.area[i] >= in.banks->wide_area) || d < 0) continue;
         const double push = from_river == (d + 2) % 8 ? in.right[i] : from_river == (d + 6) % 8 ? in.left[i] : 0.0;
         const double r = (k & 1) ? kSqrt2 : 1.0;
         if (push > best && h <= in.heights[i] + in.rise * r + kAtFloor) {
             best = push;
             floor = in.heights[i] + 2.0 * in.rise * r;
             out = from_river;
-            onward = in.wider_area > 0.0 && in.area[i] >= in.wider_area;
+            onward = 0;
+            while (onward < in.banks->onward_passes() && in.area[i] >= in.banks->onward_area(onward + 1)) ++onward;
         }
     }
     in.relay->out[l] = std::int8_t(out);
     if (out >= 0) {  // lower_relayed reads the rest only where out points somewhere
         in.relay->push[l] = best;
         in.relay->floor[l] = floor;
-        in.relay->onward[l] = onward;
+        in.relay->onward[l] = std::int8_t(onward);
     }
 }
 
@@ -191,8 +193,8 @@ inline double lower_one(const LowerInputs& in, int x, std::int64_t y) {
 
 /// One cell's new height (lower_relayed): the lowest that any neighbour passing a push on towards it
 /// brings it to, not below that push's floor. With `next`, a cell so lowered to within kAtFloor of that
-/// floor by a push marked onward passes it on once more, straight on (its floor rising by the floor
-/// slope over one more step, `rise` over one cell).
+/// floor by a push with passes onward left passes it on once more, straight on (its floor rising by the
+/// floor slope over one more step, `rise` over one cell), with one pass fewer left.
 template <bool Inner, bool Next>
 inline double relayed_one(const BankRelay& relay, const std::uint8_t* outlet, int W, int H, int x, std::int64_t y,
                           const double* heights, const std::int64_t* off, double rise, BankRelay* next) {
@@ -214,12 +216,12 @@ inline double relayed_one(const BankRelay& relay, const std::uint8_t* outlet, in
     }
     if constexpr (Next) {
         const auto j = std::size_t(from);
-        if (from >= 0 && relay.onward[j] && h <= relay.floor[j] + kAtFloor) {
+        if (from >= 0 && relay.onward[j] > 0 && h <= relay.floor[j] + kAtFloor) {
             const int out = relay.out[j];
             next->out[l] = std::int8_t(out);
             next->push[l] = relay.push[j];
             next->floor[l] = relay.floor[j] + rise * ((out & 1) ? kSqrt2 : 1.0);
-            next->onward[l] = 0;
+            next->onward[l] = std::int8_t(relay.onward[j] - 1);
         }
     }
     return h;
@@ -312,9 +314,8 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
                    left,
                    area,
                    outlet,
+                   &banks,
                    cell * banks.floor_slope,
-                   banks.wide_area,
-                   banks.wider() ? banks.wider_area : 0.0,
                    heights,
                    {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1},
                    banks.wide() ? relay : nullptr};

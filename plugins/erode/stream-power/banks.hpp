@@ -42,7 +42,12 @@
 // and one more exchange between. Rivers draining more than
 // banks.wider_area push on once more, through the second cell to a third
 // (3r away, the floor slope over 3r): floors seven cells wide, with a
-// fourth pass and exchange.
+// fourth pass and exchange. With banks.widest_floor, larger rivers push on
+// further still, two cells more each time the drainage area grows by
+// wider_area / wide_area (nine cells from wider_area²/wide_area, …), a
+// pass and an exchange each: real floors keep widening downstream (10 m
+// above the rivers, the valleys of the Kahurangi DEM are about 130 m wide
+// at 1 km² and 300–400 m at 100 km²: `orogen analyze`'s valley widening).
 //
 // Each pass reads only the heights before it and writes separate
 // arrays, so the result does not depend on the order or the threads, and a
@@ -61,14 +66,22 @@ struct Banks {
     double floor_slope = 0.0;  ///< tan of the angle at which a lowered bank still rises from its river
     double wide_area = 0.0;  ///< A_w, m²: rivers draining more push on through a bank at its floor (0: none)
     double wider_area = 0.0;  ///< m²: rivers draining more (and A_w) push on through the next cell too (0: none)
+    /// cells: floors widen on past seven cells, two cells more each time the drainage area grows by
+    /// wider_area / wide_area, up to this many (odd; 0 or 7: seven at most)
+    int widest_floor = 0;
     bool any() const { return erosion > 0.0; }
     bool wide() const { return any() && wide_area > 0.0; }
     bool wider() const { return wide() && wider_area > 0.0; }
+    /// The relay passes after the first: 0 (floors five cells wide at most), 1 (seven), 2 (nine), …
+    int onward_passes() const { return !wider() ? 0 : widest_floor > 7 ? (widest_floor - 5) / 2 : 1; }
+    /// The drainage area (m²) from which a river's push travels k passes onward (k ≥ 1): its floor 5 + 2k
+    /// cells wide.
+    double onward_area(int k) const { return wider_area * std::pow(wider_area / wide_area, double(k - 1)); }
 };
 
 /// What each settled bank passes on to the cell beyond it (window-indexed): `push` (m) towards its
 /// neighbour at direction code `out` (−1: nothing), which it may lower to `floor` (m) and no further, and
-/// which passes it on once more (`onward`, from a river draining banks.wider_area) if it gets down to it.
+/// which passes it on `onward` more times (a river draining banks.onward_area(k): k) if it gets down to it.
 struct BankRelay {
     std::vector<double> push, floor;
     std::vector<std::int8_t> out, onward;
@@ -132,8 +145,9 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
 /// Third pass (banks.wide()): lowers each computed cell to the lowest that a neighbour passing a push
 /// on towards it brings it (`relay` as lower_banks filled it, a tile's halo exchanged), not below that
 /// push's floor; outlets stay. With `next` (banks.wider(); sized to the window), also fills it: a cell
-/// brought within half a metre of the floor by a push marked onward passes it on, straight on, its floor
-/// one step higher (a fourth pass, lower_relayed again on `next`). Returns the volume removed, m³.
+/// brought within half a metre of the floor by a push with passes onward left passes it on, straight on,
+/// its floor one step higher, one pass fewer left (the next pass, lower_relayed again on `next`). Returns
+/// the volume removed, m³.
 double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet,
                      double cell, double* heights, std::vector<double>& scratch, BankRelay* next = nullptr);
 

@@ -107,6 +107,7 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.banks.floor_slope = std::tan(ctx.real("bank_floor_slope") * rad);
     s.banks.wide_area = ctx.real("bank_wide_area");
     s.banks.wider_area = ctx.real("bank_wider_area");
+    s.banks.widest_floor = int(ctx.integer("bank_widest_floor"));
     s.rock.angle = ctx.real("landslide_angle") * rad;
     s.rock.thickness = ctx.real("bed_thickness");
     s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
@@ -500,7 +501,7 @@ void check(CheckContext& ctx) {
     if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("landslide_block_spread",
                   "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
-    for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area", "bank_wider_area"})
+    for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area", "bank_wider_area", "bank_widest_floor"})
         if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0))
             ctx.error(bank, std::string(bank) + " shapes the rivers' bank erosion; give bank_erosion > 0 as well");
     if (ctx.real("bank_wider_area") > 0.0 && ctx.real("bank_erosion") > 0.0) {
@@ -511,6 +512,17 @@ void check(CheckContext& ctx) {
             ctx.error("bank_wider_area",
                       "bank_wider_area is smaller than bank_wide_area: the seven-cell floors start where the "
                       "five-cell ones do at the earliest; give bank_wider_area >= bank_wide_area");
+    }
+    if (const auto widest = ctx.integer("bank_widest_floor"); widest > 0 && ctx.real("bank_erosion") > 0.0) {
+        if (widest % 2 == 0 || widest < 7)
+            ctx.error("bank_widest_floor",
+                      "bank_widest_floor is " + std::to_string(widest) +
+                          ": floors are an odd number of cells wide, the river in the middle, and seven or more "
+                          "(bank_wider_area makes seven); give 7, 9, 11, …");
+        else if (!(ctx.real("bank_wider_area") > ctx.real("bank_wide_area") && ctx.real("bank_wide_area") > 0.0))
+            ctx.error("bank_widest_floor",
+                      "bank_widest_floor widens the floors past seven cells each time the drainage area grows by "
+                      "bank_wider_area / bank_wide_area; give bank_wider_area > bank_wide_area > 0");
     }
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
@@ -727,6 +739,14 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("rivers draining more than this (and bank_wide_area) keep floors seven cells wide: the "
                           "cell beyond the bank, once down to its floor, passes the push on once more (1e6 = from "
                           "a km²); 0 = five cells at most"),
+                Param::integer("bank_widest_floor", 0)
+                    .min(0)
+                    .max(31)
+                    .unit("cells")
+                    .help("floors keep widening past seven cells, two cells more each time the drainage area grows "
+                          "by bank_wider_area / bank_wide_area (9 from 3.3 km², 11 from 11 km² with 3e5 and 1e6), "
+                          "up to this many, as real floors widen all the way downstream; each two cells cost a "
+                          "pass; 0 = seven at most"),
                 Param::integer("substeps", 1)
                     .min(1)
                     .max(1000)

@@ -189,9 +189,12 @@ void Model::erode_banks() {
                 flow_.outlets().data(), cell_, h_.data(), bank_scratch_, &bank_relay_);
     if (!settings_.banks.wide()) return;
     const Banks& b = settings_.banks;
-    lower_relayed(b, w, bank_relay_, flow_.outlets().data(), cell_, h_.data(), bank_scratch_,
-                  b.wider() ? &bank_relay2_ : nullptr);
-    if (b.wider()) lower_relayed(b, w, bank_relay2_, flow_.outlets().data(), cell_, h_.data(), bank_scratch_);
+    // Each pass lowers the cells the last one pushes on to and, but for the last, fills the other relay
+    // with what they pass on in turn.
+    BankRelay *relay = &bank_relay_, *next = &bank_relay2_;
+    for (int pass = 0; pass <= b.onward_passes(); ++pass, std::swap(relay, next))
+        lower_relayed(b, w, *relay, flow_.outlets().data(), cell_, h_.data(), bank_scratch_,
+                      pass < b.onward_passes() ? next : nullptr);
 }
 
 void Model::glacial_factors(double dt) {

@@ -770,7 +770,7 @@ std::int64_t TiledModel::step(double dt) {
 }
 
 void TiledModel::relay_across(BankRelay& relay, std::size_t gn) {
-    // The direction and the onward mark in one double each cell: out + 8·onward, or −1.
+    // The direction and the passes onward left in one double each cell: out + 8·onward, or −1.
     bank_relay_out_.resize(gn);
     for (std::size_t g = 0; g < gn; ++g)
         bank_relay_out_[g] = relay.out[g] < 0 ? -1.0 : double(relay.out[g] + 8 * relay.onward[g]);
@@ -814,14 +814,13 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
     joined([&] { return tiles_.exchange(std::span<double* const>(second)); });
     lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_area_.data(),
                 bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_, &bank_relay_);
-    if (settings_.banks.wide()) {  // what the halo's banks pass on (and the second cells out, if wider)
-        const bool wider = settings_.banks.wider();
-        relay_across(bank_relay_, gn);
-        lower_relayed(settings_.banks, w, bank_relay_, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_,
-                      wider ? &bank_relay2_ : nullptr);
-        if (wider) {
-            relay_across(bank_relay2_, gn);
-            lower_relayed(settings_.banks, w, bank_relay2_, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_);
+    if (settings_.banks.wide()) {  // what the halo's banks pass on, pass after pass (as Model::erode_banks)
+        const int passes = settings_.banks.onward_passes();
+        BankRelay *relay = &bank_relay_, *next = &bank_relay2_;
+        for (int pass = 0; pass <= passes; ++pass, std::swap(relay, next)) {
+            relay_across(*relay, gn);
+            lower_relayed(settings_.banks, w, *relay, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_,
+                          pass < passes ? next : nullptr);
         }
     }
     for (int y = 0; y < own_.height; ++y)

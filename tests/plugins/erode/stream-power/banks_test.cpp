@@ -347,4 +347,21 @@ TEST(Banks, TheLargestRiversWidenTheirFloorsOnceMore) {
     expect_the_same_bits_on_two_threads(s);
 }
 
+TEST(Banks, FloorsKeepWideningDownstreamToTheWidestAsked) {
+    // The mean rise four cells across the rivers draining more than 40 cells: floors seven cells wide
+    // (from 3e4 m²), then nine from 4.5e4 m² and eleven from 6.75e4 m² (the area growing by 3e4 / 2e4 a
+    // step) with bank_widest_floor = 11.
+    Settings s = valley_settings(true);
+    s.banks.wide_area = 2e4;
+    s.banks.wider_area = 3e4;
+    const double seven = rise_after_run(s, 4);
+    s.banks.widest_floor = 11;
+    EXPECT_EQ(s.banks.onward_passes(), 3);
+    EXPECT_DOUBLE_EQ(s.banks.onward_area(2), 4.5e4);
+    const double eleven = rise_after_run(s, 4);
+    EXPECT_GT(seven, 10.0) << eleven;
+    EXPECT_LT(eleven, 0.75 * seven);
+    expect_the_same_bits_on_two_threads(s);
+}
+
 }  // namespace

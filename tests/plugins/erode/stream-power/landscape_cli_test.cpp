@@ -172,7 +172,10 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "p = erode:stream-power(base, bank_erosion=11)\n"
                   "q = erode:stream-power(base, bank_wide_area=1e5)\n"
                   "r = erode:stream-power(base, bank_erosion=4, bank_wider_area=1e6)\n"
-                  "s = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e6, bank_wider_area=1e5)\n");
+                  "s = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e6, bank_wider_area=1e5)\n"
+                  "t = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e5, bank_wider_area=1e6, "
+                  "bank_widest_floor=10)\n"
+                  "u = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e5, bank_widest_floor=11)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -209,6 +212,11 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:21:62: error: erode:stream-power: bank_wider_area widens the floors bank_wide_area "
              "makes; give bank_wide_area as well",
              "rock.orogen:22:82: error: erode:stream-power: bank_wider_area is smaller than bank_wide_area",
+             "rock.orogen:23:105: error: erode:stream-power: bank_widest_floor is 10: floors are an odd number of "
+             "cells wide",
+             "rock.orogen:24:84: error: erode:stream-power: bank_widest_floor widens the floors past seven cells "
+             "each time the drainage area grows by bank_wider_area / bank_wide_area; give bank_wider_area > "
+             "bank_wide_area > 0",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
