@@ -111,10 +111,10 @@ void expect_inside_the_bands(const std::string& spec_name, const std::string& ex
     // soil settling after the slump; 38 m before, with the slump last; 142 m before the slump).
     EXPECT_LE(deepest_slot(h, kSide), 32.0) << spec_name << " " << extra;
     // The valley bottoms (stop 45's figures, measured on the whole network): the real 27–30 m ranges'
-    // channel curvature is 7.1–16.8 /km, their valleys 115–167 m wide 10 m above rivers draining more than
-    // 1 km², widening downstream as A^0.06–0.22. The default is at the band's sharp, narrow end (15.8–17.6
-    // /km, 105–115 m on six seeds) and its valleys barely widen (b 0.02–0.04: docs/realism.md, what is
-    // left); floors three cells wide gave 21.7 /km and 88 m (seed 42), one cell wide 25+ /km.
+    // channel curvature is 7.1–16.8 /km, their valleys 146–188 m wide 10 m above rivers draining more than
+    // 1 km², widening downstream as A^0.00–0.28. The default is at the band's sharp end (15.8–17.6 /km on
+    // six seeds) and its valleys narrower (112–127 m): its floors do not widen with the river
+    // (docs/realism.md, the valleys); floors three cells wide gave 21.7 /km and 96 m (seed 42).
     for (const auto& [figure, low, high] : {std::tuple{FigureId::channel_curvature, 0.0, 19.0},
                                             std::tuple{FigureId::valley_width, 100.0, 400.0}}) {
         const auto& info = orogen::analysis::info(figure);
@@ -225,9 +225,9 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
-                         // Seed 42's distances over the 20 figures since stop 45 (17 before): Himalaya 1.08
-                         // (0.84), Rif 0.95 (0.75), Raukumara 0.70 (0.65), Kahurangi 0.84 (0.50), Mont Blanc
-                         // 1.12 with its banks (2.09 without, nearest the Andes).
+                         // Seed 42's distances over the 20 figures since stop 45 (17 before): Himalaya 1.17
+                         // (0.84), Rif 0.89 (0.75), Raukumara 0.79 (0.65), Kahurangi 0.84 (0.50), Mont Blanc
+                         // 1.15 with its banks (1.68 without, nearest the Andes).
                          testing::Values(Preset{"himalaya", "himalaya_baspa_30m", 1.3}, Preset{"rif", "morocco_rif_27m", 1.15},
                                          Preset{"raukumara", "nz_raukumara_30m", 0.85},
                                          Preset{"kahurangi", "nz_kahurangi_30m", 1.0},
