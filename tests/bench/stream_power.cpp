@@ -53,7 +53,11 @@ void BM_stream_power_step(benchmark::State& state) {
     s.deposition = double(state.range(4));  // G of Yuan et al. (2019); 0: detachment-limited
     s.banks.erosion = double(state.range(5));  // rivers cut their banks (banks.hpp); 0: none
     s.banks.area = 3e4;
-    s.banks.wide_area = state.range(6) ? 3e5 : 0.0;  // floors five cells wide along rivers draining 0.3 km²
+    // wide 1: floors five cells wide along rivers draining 0.3 km²; 2: and seven from 1 km²; 3: and on to fifteen
+    // (bank_widest_floor, pipelines/kahurangi.orogen's)
+    s.banks.wide_area = state.range(6) ? 3e5 : 0.0;
+    s.banks.wider_area = state.range(6) >= 2 ? 1e6 : 0.0;
+    s.banks.widest_floor = state.range(6) >= 3 ? 15 : 0;
     s.banks.floor_slope = std::tan(1.0 * M_PI / 180.0);
     Model model(n, n, 30.0, dome(n), std::vector<double>(std::size_t(n) * n, 1e-3), s);
     for (int i = 0; i < 3; ++i) model.step(1e4);
@@ -77,6 +81,8 @@ BENCHMARK(BM_stream_power_step)
     ->Args({1025, 2, 1, 0, 1, 0, 0})
     ->Args({1025, 2, 1, 0, 0, 4, 0})
     ->Args({1025, 2, 1, 0, 0, 4, 1})
+    ->Args({1025, 2, 1, 0, 0, 4, 2})
+    ->Args({1025, 2, 1, 0, 0, 4, 3})
     ->Args({4097, 2, 1, 0, 0, 0, 0})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

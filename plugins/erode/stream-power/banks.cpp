@@ -106,7 +106,9 @@ struct LowerInputs {
     const std::int8_t* dir;
     const double *right, *left, *area;
     const std::uint8_t* outlet;
-    const Banks* banks;
+    double wide_area;  // m²: rivers draining this much pass their push on
+    int passes;  // banks.onward_passes()
+    double onward_area[16];  // banks.onward_area(k + 1), k < passes: from a river draining this much, k + 1 more
     double rise;
     const double* heights;
     std::int64_t off[8];  // the neighbours by direction code
@@ -139,7 +141,7 @@ inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t 
         const int d = in.dir[i];
         const int from_river = (k + 4) % 8;  // the direction from river i to this cell
         // Few neighbours are large rivers: that test first (it seldom passes, so it is well predicted).
-        if (!(in.area[i] >= in.banks->wide_area) || d < 0) continue;
+        if (!(in.area[i] >= in.wide_area) || d < 0) continue;
         const double push = from_river == (d + 2) % 8 ? in.right[i] : from_river == (d + 6) % 8 ? in.left[i] : 0.0;
         const double r = (k & 1) ? kSqrt2 : 1.0;
         if (push > best && h <= in.heights[i] + in.rise * r + kAtFloor) {
@@ -147,7 +149,7 @@ inline void relay_one(const LowerInputs& in, int x, std::int64_t y, std::size_t 
             floor = in.heights[i] + 2.0 * in.rise * r;
             out = from_river;
             onward = 0;
-            while (onward < in.banks->onward_passes() && in.area[i] >= in.banks->onward_area(onward + 1)) ++onward;
+            while (onward < in.passes && in.area[i] >= in.onward_area[onward]) ++onward;
         }
     }
     in.relay->out[l] = std::int8_t(out);
@@ -314,11 +316,14 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
                    left,
                    area,
                    outlet,
-                   &banks,
+                   banks.wide_area,
+                   std::min(banks.onward_passes(), 16),
+                   {},
                    cell * banks.floor_slope,
                    heights,
                    {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1},
                    banks.wide() ? relay : nullptr};
+    for (int k = 0; k < in.passes; ++k) in.onward_area[k] = banks.onward_area(k + 1);
     if (!in.relay)
         return lower_rows(w, cell, heights, scratch, [&in](int x, std::int64_t y, auto inner) {
             return lower_one<decltype(inner)::value, false>(in, x, y);
@@ -330,20 +335,55 @@ double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* d
 }
 
 double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& relay, const std::uint8_t* outlet,
-                     double cell, double* heights, std::vector<double>& scratch, BankRelay* next) {
+                     double cell, double* heights, BankRelay* next) {
     const std::int64_t W = w.width;
     const std::int64_t off[8] = {1, W + 1, W, W - 1, -1, -W - 1, -W, -W + 1};
     const double rise = cell * banks.floor_slope;
-    if (!next)
-        return lower_rows(w, cell, heights, scratch, [&](int x, std::int64_t y, auto inner) {
-            return relayed_one<decltype(inner)::value, false>(relay, outlet, w.width, w.height, x, y, heights, off,
-                                                              rise, nullptr);
-        });
-    next->size_to(std::size_t(w.width) * std::size_t(w.height));
-    return lower_rows(w, cell, heights, scratch, [&](int x, std::int64_t y, auto inner) {
-        return relayed_one<decltype(inner)::value, true>(relay, outlet, w.width, w.height, x, y, heights, off, rise,
-                                                         next);
+    if (next) {
+        next->size_to(std::size_t(w.width) * std::size_t(w.height));
+        std::fill(next->out.begin(), next->out.end(), std::int8_t(-1));  // what no cell passes on
+    }
+    // Only the cells a relay points at can change (few: the large rivers' banks, fewer each pass), so they
+    // are found from the relay rather than by visiting every cell: each cell of the window and its
+    // one-cell ring (a tile's halo) that passes something on names its target, kept if it is computed
+    // here. Row by row in parallel, then in index order, each target once; each reads only its own height
+    // and the relay, so the targets are independent and the heights the same bits as a visit of every cell.
+    const int ya = std::max(0, w.y0 - 1), yb = std::min(w.height, w.y1 + 1);
+    const int xa = std::max(0, w.x0 - 1), xb = std::min(w.width, w.x1 + 1);
+    std::vector<std::vector<std::size_t>> rows(std::size_t(std::max(0, yb - ya)));
+    parallel_for(ya, yb, 16, [&](std::int64_t y0, std::int64_t y1) {
+        for (std::int64_t y = y0; y < y1; ++y) {
+            auto& list = rows[std::size_t(y - ya)];
+            for (int x = xa; x < xb; ++x) {
+                const std::size_t j = std::size_t(y) * std::size_t(W) + std::size_t(x);
+                const int out = relay.out[j];
+                if (out < 0) continue;
+                const int tx = x + kDx[out];
+                const std::int64_t ty = y + kDy[out];
+                if (tx < w.x0 || tx >= w.x1 || ty < w.y0 || ty >= w.y1) continue;
+                list.push_back(std::size_t(std::int64_t(j) + off[out]));
+            }
+        }
     });
+    std::vector<std::size_t> targets;
+    for (const auto& list : rows) targets.insert(targets.end(), list.begin(), list.end());
+    std::sort(targets.begin(), targets.end());
+    targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+    double removed = 0.0;
+    for (const std::size_t l : targets) {
+        const int x = int(l % std::size_t(W));
+        const std::int64_t y = std::int64_t(l / std::size_t(W));
+        const bool inner = x > 0 && y > 0 && x + 1 < w.width && y + 1 < w.height;
+        const double before = heights[l];
+        const double h = inner
+            ? (next ? relayed_one<true, true>(relay, outlet, w.width, w.height, x, y, heights, off, rise, next)
+                    : relayed_one<true, false>(relay, outlet, w.width, w.height, x, y, heights, off, rise, nullptr))
+            : (next ? relayed_one<false, true>(relay, outlet, w.width, w.height, x, y, heights, off, rise, next)
+                    : relayed_one<false, false>(relay, outlet, w.width, w.height, x, y, heights, off, rise, nullptr));
+        heights[l] = h;
+        removed += before - h;
+    }
+    return removed * cell * cell;
 }
 
 }  // namespace orogen::stream_power

@@ -741,7 +741,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                           "a km²); 0 = five cells at most"),
                 Param::integer("bank_widest_floor", 0)
                     .min(0)
-                    .max(31)
+                    .max(35)
                     .unit("cells")
                     .help("floors keep widening past seven cells, two cells more each time the drainage area grows "
                           "by bank_wider_area / bank_wide_area (9 from 3.3 km², 11 from 11 km² with 3e5 and 1e6), "

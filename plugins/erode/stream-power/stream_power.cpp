@@ -193,7 +193,7 @@ void Model::erode_banks() {
     // with what they pass on in turn.
     BankRelay *relay = &bank_relay_, *next = &bank_relay2_;
     for (int pass = 0; pass <= b.onward_passes(); ++pass, std::swap(relay, next))
-        lower_relayed(b, w, *relay, flow_.outlets().data(), cell_, h_.data(), bank_scratch_,
+        lower_relayed(b, w, *relay, flow_.outlets().data(), cell_, h_.data(),
                       pass < b.onward_passes() ? next : nullptr);
 }
 

@@ -819,7 +819,7 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
         BankRelay *relay = &bank_relay_, *next = &bank_relay2_;
         for (int pass = 0; pass <= passes; ++pass, std::swap(relay, next)) {
             relay_across(*relay, gn);
-            lower_relayed(settings_.banks, w, *relay, bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_,
+            lower_relayed(settings_.banks, w, *relay, bank_outlet_.data(), cell_, bank_h_.data(),
                           pass < passes ? next : nullptr);
         }
     }

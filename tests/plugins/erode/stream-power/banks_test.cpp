@@ -188,7 +188,7 @@ Window wide_river(double erosion, double wide_area, double bank = 3.0) {
     BankRelay relay;
     lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
                 v.scratch, &relay);
-    if (b.wide()) lower_relayed(b, v.w, relay, nullptr, 30.0, v.heights.data(), v.scratch);
+    if (b.wide()) lower_relayed(b, v.w, relay, nullptr, 30.0, v.heights.data());
     return v;
 }
 
@@ -248,7 +248,7 @@ TEST(Banks, ADiagonalRiverPushesOnAcrossItsFlowAndOutletsStay) {
     EXPECT_EQ(relay.out[at(3, 1)], 7);  // on its left, onward to the north-east
     EXPECT_DOUBLE_EQ(relay.push[at(1, 3)], 1.0);  // the river's whole push on that side
     EXPECT_DOUBLE_EQ(relay.floor[at(1, 3)], 2.0 * rise);
-    lower_relayed(b, v.w, relay, outlet.data(), 30.0, v.heights.data(), v.scratch);
+    lower_relayed(b, v.w, relay, outlet.data(), 30.0, v.heights.data());
     EXPECT_DOUBLE_EQ(v.heights[at(0, 4)], 99.0);
     EXPECT_DOUBLE_EQ(v.heights[at(4, 0)], 100.0);  // an outlet
 }
