@@ -56,6 +56,22 @@ struct Series {
     std::string title;
 };
 
+/// The points of log-binned chart data.
+std::vector<std::pair<double, double>> binned(const analysis::LogBins& bins) {
+    std::vector<std::pair<double, double>> points;
+    for (std::size_t b = 0; b < bins.x.size(); ++b) points.emplace_back(bins.x[b], bins.y[b]);
+    return points;
+}
+
+/// A fit of ln y against ln x drawn across the bins' range of x (nothing without bins).
+std::vector<std::pair<double, double>> fitted(const analysis::LogBins& bins, const analysis::LineFit& fit) {
+    std::vector<std::pair<double, double>> line;
+    if (bins.x.empty()) return line;
+    for (double x : {bins.x.front(), bins.x.back()})
+        line.emplace_back(x, std::exp(fit.intercept + fit.slope * std::log(x)));
+    return line;
+}
+
 /// `plot` over datablocks, one per terrain with data; empty if none has any.
 std::string plot(const std::vector<Terrain>& terrains, const std::string& name,
                  const std::function<Series(const Terrain&)>& series, const std::string& with,
@@ -197,20 +213,14 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
                                    if (!f[FigureId::concavity].ok()) return s;
                                    s.title += ": θ " + number(std::round(f[FigureId::concavity].value * 100) / 100) +
                                        ", k_sn " + number(std::round(f[FigureId::steepness].value));
-                                   for (std::size_t b = 0; b < f.slope_area.x.size(); ++b)
-                                       s.points.emplace_back(f.slope_area.x[b], f.slope_area.y[b]);
+                                   s.points = binned(f.slope_area);
                                    return s;
                                },
                                "points pt 7 ps 0.8",
                                [](const Terrain& t) {
-                                   std::vector<std::pair<double, double>> line;
                                    const auto& f = t.figures;
-                                   if (!f[FigureId::concavity].ok() || f.slope_area.x.empty()) return line;
-                                   for (double a : {f.slope_area.x.front(), f.slope_area.x.back()})
-                                       line.emplace_back(
-                                           a,
-                                           std::exp(f.slope_area_fit.intercept + f.slope_area_fit.slope * std::log(a)));
-                                   return line;
+                                   return f[FigureId::concavity].ok() ? fitted(f.slope_area, f.slope_area_fit)
+                                                                      : std::vector<std::pair<double, double>>{};
                                })});
     pending.push_back({{stem + "-hack.png", "Hack's law"},
                        header("Hack's law L = c A^h (channel cells, log-binned; lines: the fits)",
@@ -223,23 +233,18 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
                                    const auto& f = t.figures;
                                    if (!f[FigureId::hack_exponent].ok()) return s;
                                    s.title += ": h " + number(std::round(f[FigureId::hack_exponent].value * 100) / 100);
-                                   for (std::size_t b = 0; b < f.hack.x.size(); ++b)
-                                       s.points.emplace_back(f.hack.x[b], f.hack.y[b]);
+                                   s.points = binned(f.hack);
                                    return s;
                                },
                                "points pt 7 ps 0.8",
                                [](const Terrain& t) {
-                                   std::vector<std::pair<double, double>> line;
                                    const auto& f = t.figures;
-                                   if (!f[FigureId::hack_exponent].ok() || f.hack.x.empty()) return line;
-                                   for (double a : {f.hack.x.front(), f.hack.x.back()})
-                                       line.emplace_back(
-                                           a, std::exp(f.hack_fit.intercept + f.hack_fit.slope * std::log(a)));
-                                   return line;
+                                   return f[FigureId::hack_exponent].ok() ? fitted(f.hack, f.hack_fit)
+                                                                          : std::vector<std::pair<double, double>>{};
                                })});
 
     pending.push_back({{stem + "-valley-section.png", "Valley cross-section"},
-                       header("Median valley cross-section across the channels (A > 1 km², slope > 6°)",
+                       header("Median valley cross-section across the channels (A > 1 km²)",
                               "distance from the river (m)", "height above the river (m)") +
                            "set yrange [0:*]\n" +
                            plot(
@@ -256,32 +261,28 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
                                    return s;
                                },
                                "linespoints pt 7 ps 0.6")});
-    pending.push_back(
-        {{stem + "-valley-width.png", "Valley width against drainage area"},
-         header("Valley width 10 m above the river against drainage area; lines: W = c A^b", "drainage area A (m²)",
-                "valley width W (m)") +
-             "set logscale xy\n" +
-             plot(
-                 terrains, "vw",
-                 [](const Terrain& t) {
-                     Series s{{}, t.name};
-                     const auto& f = t.figures;
-                     if (!f[FigureId::valley_widening].ok()) return s;
-                     s.title += ": b " + number(std::round(f[FigureId::valley_widening].value * 100) / 100);
-                     for (std::size_t b = 0; b < f.valley_widths.x.size(); ++b)
-                         s.points.emplace_back(f.valley_widths.x[b], f.valley_widths.y[b]);
-                     return s;
-                 },
-                 "points pt 7 ps 0.8",
-                 [](const Terrain& t) {
-                     std::vector<std::pair<double, double>> line;
-                     const auto& f = t.figures;
-                     if (!f[FigureId::valley_widening].ok()) return line;
-                     for (double a : {f.valley_widths.x.front(), f.valley_widths.x.back()})
-                         line.emplace_back(
-                             a, std::exp(f.valley_widths_fit.intercept + f.valley_widths_fit.slope * std::log(a)));
-                     return line;
-                 })});
+    pending.push_back({{stem + "-valley-width.png", "Valley width against drainage area"},
+                       header("Valley width 10 m above the river against drainage area; lines: W = c A^b",
+                              "drainage area A (m²)", "valley width W (m)") +
+                           "set logscale xy\n" +
+                           plot(
+                               terrains, "vw",
+                               [](const Terrain& t) {
+                                   Series s{{}, t.name};
+                                   const auto& f = t.figures;
+                                   if (!f[FigureId::valley_widening].ok()) return s;
+                                   s.title +=
+                                       ": b " + number(std::round(f[FigureId::valley_widening].value * 100) / 100);
+                                   s.points = binned(f.valley_widths);
+                                   return s;
+                               },
+                               "points pt 7 ps 0.8",
+                               [](const Terrain& t) {
+                                   const auto& f = t.figures;
+                                   return f[FigureId::valley_widening].ok()
+                                       ? fitted(f.valley_widths, f.valley_widths_fit)
+                                       : std::vector<std::pair<double, double>>{};
+                               })});
 
     ChartsWritten written;
     std::vector<std::unique_ptr<AtomicFile>> files;
