@@ -191,7 +191,7 @@ INSTANTIATE_TEST_SUITE_P(Ranks, DiffusionSeam, kErosionCases, kCaseName);
 /// relief full of pits (filled, then routed across with n = 1.5), uplift from
 /// a layer spread across the seams, hillslope diffusion, chi, every side
 /// closed with the lowest cell of the whole grid as the one outlet, and a
-/// time-lapse; then routing=mfd, which is not tiled and runs on rank 0;
+/// time-lapse; then routing=mfd and (s13) floodplains, which are not tiled and run on rank 0;
 /// rough diamond-square relief with a hundred lakes a step, most of them
 /// settled on their own tile (closed basins) and the rest by rank 0; and
 /// uplift from the plates' time-lapse (a series on rank 0, each interval's
@@ -224,6 +224,7 @@ s9 = erode:stream-power(p, p.timelapse, years=5e4, dt=2.5e4, uplift_history_year
 s10 = erode:stream-power(d, years=6e4, dt=1e4, uplift=2, diffusivity=0.01, channel_area=1e4, bank_erosion=6, bank_area=1e4, bank_wide_area=3e4, bank_wider_area=6e4, bank_widest_floor=11, open="we")
 s11 = erode:stream-power(d, years=4e4, dt=1e4, uplift=2, diffusivity=0.01, rain=orographic, wind_from=290, rain_resolution=150, open="ns")
 s12 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, rain=orographic, wind_from=60, rain_resolution=30, channel_area=1e4)
+s13 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, channel_area=1e4, floodplain_area=5e4, floodplain_width=30)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
 export:video(r, path="s1.mpg", fps=25, quality=0)
 export:vtk(s1, path="s1.vti")
@@ -238,13 +239,14 @@ export:vtk(s9, path="s9.vti")
 export:vtk(s10, path="s10.vti")
 export:vtk(s11, path="s11.vti")
 export:vtk(s12, path="s12.vti")
+export:vtk(s13, path="s13.vti")
 )";
 
 class StreamPowerSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(StreamPowerSeam, StreamPowerEqualsOneProcess) {
     expect_same_outputs(kStreamPowerSpec,
                         {"s1.mpg", "s1.vti", "s2.vti", "s3.vti", "s4.r32", "s5.vti", "s6.vti", "s7.vti", "s8.vti",
-                         "s9.vti", "s10.vti", "s11.vti", "s12.vti"},
+                         "s9.vti", "s10.vti", "s11.vti", "s12.vti", "s13.vti"},
                         GetParam());
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, StreamPowerSeam, kErosionCases, kCaseName);

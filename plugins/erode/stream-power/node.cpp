@@ -108,6 +108,10 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.banks.wide_area = ctx.real("bank_wide_area");
     s.banks.wider_area = ctx.real("bank_wider_area");
     s.banks.widest_floor = int(ctx.integer("bank_widest_floor"));
+    s.floodplain.area = ctx.real("floodplain_area");
+    s.floodplain.width = ctx.real("floodplain_width");
+    s.floodplain.exponent = ctx.real("floodplain_exponent");
+    s.floodplain.slope = std::tan(ctx.real("floodplain_slope") * rad);
     s.rock.angle = ctx.real("landslide_angle") * rad;
     s.rock.thickness = ctx.real("bed_thickness");
     s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
@@ -524,6 +528,9 @@ void check(CheckContext& ctx) {
                       "bank_widest_floor widens the floors past seven cells each time the drainage area grows by "
                       "bank_wider_area / bank_wide_area; give bank_wider_area > bank_wide_area > 0");
     }
+    for (const char* fp : {"floodplain_width", "floodplain_exponent", "floodplain_slope"})
+        if (ctx.given(fp) && !(ctx.real("floodplain_area") > 0.0))
+            ctx.error(fp, std::string(fp) + " shapes the rivers' floodplains; give floodplain_area (m²) as well");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
@@ -623,7 +630,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
             "U-shaped troughs; rain=orographic weights the drainage area by the rain a moist wind leaves on the "
             "relief (Smith & Barstad 2004). The same "
             "result on any number of threads, and under mpirun on any number of tiles (routing=d8, deposition=0, no "
-            "glaciers, uniform rain; other settings run on rank 0). Adds the layers drainage (upstream area, m^2: draw "
+            "glaciers or floodplains, uniform rain; other settings run on rank 0). Adds the layers drainage (upstream "
+            "area, m^2: draw "
             "rivers where it exceeds ~1 km^2), flow_direction (D8 code of the receiver: 0 east, 1 south-east, ... 7 "
             "north-east; -1 "
             "outlet), eroded (the surface's change by erosion and deposition, m: negative where rock was removed; "
@@ -747,6 +755,30 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                           "by bank_wider_area / bank_wide_area (9 from 3.3 km², 11 from 11 km² with 3e5 and 1e6), "
                           "up to this many, as real floors widen all the way downstream; each two cells cost a "
                           "pass; 0 = seven at most"),
+                Param::real("floodplain_area", 0.0)
+                    .min(0.0)
+                    .max(1e12)
+                    .unit("m²")
+                    .help("rivers draining more than this have floodplains: each step every cell within the "
+                          "half-width floodplain_width·(A/floodplain_area)^floodplain_exponent of such a river is "
+                          "lowered to its nearest one plus floodplain_slope over the distance (never raised), as "
+                          "large rivers plane their valley floors (3e6 = from 3 km²; not tiled: runs on rank 0); "
+                          "0 = none"),
+                Param::real("floodplain_width", 30.0)
+                    .min(0.0, true)
+                    .max(1e5)
+                    .unit("m")
+                    .help("the floodplain's half-width for a river draining floodplain_area"),
+                Param::real("floodplain_exponent", 0.5)
+                    .min(0.0)
+                    .max(1.0)
+                    .help("how fast floodplains widen downstream: half-width ∝ A^floodplain_exponent (real 30 m "
+                          "valleys widen as A^0.2-0.3 10 m above their rivers)"),
+                Param::real("floodplain_slope", 2.0)
+                    .min(0.0)
+                    .max(30.0)
+                    .unit("°")
+                    .help("a floodplain rises from its river at this angle (0 = dead flat, which holds pits)"),
                 Param::integer("substeps", 1)
                     .min(1)
                     .max(1000)
@@ -928,17 +960,20 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(0.1)
                     .unit("kg/m³")
                     .help("rain=orographic: C_w, water condensed per metre of lift (0.004-0.01; warm air more)"),
-                Param::real("rain_resolution", 250.0)
-                    .min(1.0)
-                    .max(1e5)
-                    .unit("m")
-                    .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
-                          "below a few km)"),
-                Param::string("open", "nesw")
-                    .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
-                          "level. none: the lowest cell is the one outlet"),
-                Param::string("base_level", "edge")
-                    .help("height of the outlets: edge (they keep the input's heights) or metres, e.g. \"0\""),
+                Param::
+                    real("rain_resolution", 250.0)
+                        .min(1.0)
+                        .max(1e5)
+                        .unit("m")
+                        .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
+                              "below a few km)"),
+                Param::
+                    string("open", "nesw")
+                        .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
+                              "level. none: the lowest cell is the one outlet"),
+                Param::
+                    string("base_level", "edge")
+                        .help("height of the outlets: edge (they keep the input's heights) or metres, e.g. \"0\""),
                 Param::
                     choice("depressions", {"fill", "route"}, "fill")
                         .help("pits: fill (lakes fill to their spill level: sediment) or route (water crosses them, "
@@ -969,6 +1004,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                 s.deposition = std::get<double>(p.at("deposition"));
                 if (std::get<bool>(p.at("glaciers"))) s.glaciers.balance_gradient = 1.0;
                 s.orographic_rain = std::get<std::string>(p.at("rain")) == "orographic";
+                s.floodplain.area = std::get<double>(p.at("floodplain_area"));
                 return stream_power::untiled_because(s);
             },
     });

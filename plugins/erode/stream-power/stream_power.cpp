@@ -158,6 +158,12 @@ std::int64_t Model::step(double dt) {
         if (settings_.deposition > 0.0) incise_with_deposition(sub);
         else incise(sub);
         if (settings_.banks.any()) erode_banks();
+        if (settings_.floodplain.any()) {
+            floodplain_dir_.resize(n);
+            for (std::size_t i = 0; i < n; ++i) floodplain_dir_[i] = std::int8_t(flow_.direction(std::int64_t(i)));
+            carve_floodplains(settings_.floodplain, width_, height_, cell_, floodplain_dir_.data(), flow_.area().data(),
+                              flow_.outlets().data(), h, floodplain_nearest_, floodplain_floor_);
+        }
         if (settings_.glaciers.any())
             carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
         // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).

@@ -30,6 +30,7 @@
 #pragma once
 
 #include "banks.hpp"
+#include "floodplain.hpp"
 #include "flow.hpp"
 #include "glaciers.hpp"
 #include "rock.hpp"
@@ -105,6 +106,9 @@ struct Settings {
     /// lowers the two cells across its flow by a share of its own lowering, the outer bank of a bend
     /// the most (lateral erosion, Langston & Tucker 2018).
     Banks banks;
+    /// Floodplains (floodplain.hpp): with floodplain.any(), after the banks every cell within a large
+    /// river's floodplain half-width W(A) is lowered to its nearest such river plus a gentle slope. Not tiled.
+    Floodplain floodplain;
     /// Valley glaciers (glaciers.hpp): with glaciers.any(), ice gathers above the ELA, flows down the
     /// flow graph, erodes K_g·Q^m_g·S^n in the same implicit sweep as the rivers and carves U-shaped
     /// troughs. Detachment-limited only (deposition = 0), and not tiled.
@@ -219,6 +223,8 @@ private:
     std::optional<BankAreaFactor> bank_factor_;  // banks: 1 − e^(−A/A_b), built at the first step
     BankRelay bank_relay_;  // banks: what a bank down to its floor passes on (banks.wide())
     BankRelay bank_relay2_;  // banks: what the second cell out passes on (banks.wider())
+    std::vector<double> floodplain_nearest_, floodplain_floor_;  // floodplains: scratch
+    std::vector<std::int8_t> floodplain_dir_;  // floodplains: each cell's direction to its receiver
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
     double time_ = 0.0, sediment_out_ = 0.0;

@@ -92,6 +92,7 @@ std::string untiled_because(const Settings& s) {
     if (s.mfd_exponent > 0.0) return "routing=mfd is not tiled yet";
     if (s.deposition > 0.0) return "deposition > 0 is not tiled yet";
     if (s.glaciers.any()) return "glaciers are not tiled yet";
+    if (s.floodplain.any()) return "floodplains are not tiled yet";
     return "";
 }
 

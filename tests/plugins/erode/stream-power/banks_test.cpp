@@ -3,6 +3,7 @@
 // the main donor, a diagonal river), the floor a bank stops at, outlets; and in the model, that
 // rivers grow valley floors and give the same bits on one and two threads.
 #include "banks.hpp"
+#include "floodplain.hpp"
 #include "flow.hpp"
 #include "noise_terrain.hpp"
 #include "stream_power.hpp"
@@ -361,6 +362,85 @@ TEST(Banks, FloorsKeepWideningDownstreamToTheWidestAsked) {
     const double eleven = rise_after_run(s, 4);
     EXPECT_GT(seven, 10.0) << eleven;
     EXPECT_LT(eleven, 0.75 * seven);
+    expect_the_same_bits_on_two_threads(s);
+}
+
+// ------------------------------------------------------------- floodplains
+
+/// A flat 21 × 11 grid 100 m high with a river along row 5 flowing east (code 0), falling 1 m a cell
+/// from 50 m, each of its cells draining `area` m² (other cells: no receiver).
+struct RiverRow {
+    int w = 21, h = 11;
+    std::vector<double> heights, area;
+    std::vector<std::int8_t> dir;
+    explicit RiverRow(double a) : heights(std::size_t(w) * h, 100.0), area(heights.size(), 900.0), dir(heights.size(), -1) {
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(5) * w + x;
+            heights[i] = 50.0 - x;
+            area[i] = a;
+            dir[i] = x + 1 < w ? 0 : -1;
+        }
+    }
+    double at(int x, int y) const { return heights[std::size_t(y) * w + x]; }
+};
+
+TEST(Floodplain, CellsWithinTheHalfWidthFallToTheirNearestRiverPlusTheSlope) {
+    // Half-width 30 m · (4e6 / 1e6)^0.5 = 60 m: two cells of 30 m each side, rising 0.5 m a cell.
+    RiverRow r(4e6);
+    const Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
+    std::vector<double> nearest, floor;
+    const double removed = carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), nullptr,
+                                             r.heights.data(), nearest, floor);
+    for (int x = 0; x + 1 < r.w; ++x) {  // the last cell is a root: its floodplain is none
+        EXPECT_DOUBLE_EQ(r.at(x, 5), 50.0 - x) << "the river stays";
+        for (int d : {1, 2}) {
+            EXPECT_DOUBLE_EQ(r.at(x, 5 - d), 50.0 - x + 0.5 * d) << x << " " << d;
+            EXPECT_DOUBLE_EQ(r.at(x, 5 + d), 50.0 - x + 0.5 * d) << x << " " << d;
+        }
+        EXPECT_DOUBLE_EQ(r.at(x, 2), 100.0) << "beyond the half-width";
+    }
+    EXPECT_GT(removed, 0.0);
+    // A river draining less than floodplain_area has none.
+    RiverRow small(0.9e6);
+    carve_floodplains(fp, small.w, small.h, 30.0, small.dir.data(), small.area.data(), nullptr, small.heights.data(),
+                      nearest, floor);
+    EXPECT_DOUBLE_EQ(small.at(3, 4), 100.0);
+}
+
+TEST(Floodplain, TheNearestRiverSetsACellNotTheLowestAndOutletsStay) {
+    // The river runs east along row 5, then back west along row 8 much lower (a meander's two arms, 3
+    // cells apart). Row 6 is nearer the upper arm: it must stand above it (no cutoff), although the lower
+    // arm's floodplain reaches it too.
+    RiverRow r(9e6);  // half-width 90 m: three cells
+    for (int x = 0; x < r.w; ++x) {
+        const std::size_t i = std::size_t(8) * r.w + x;
+        r.heights[i] = 10.0 + x;
+        r.area[i] = 9e6;
+        r.dir[i] = x > 0 ? 4 : -1;  // west
+    }
+    std::vector<std::uint8_t> outlet(r.heights.size(), 0);
+    outlet[std::size_t(6) * r.w + 10] = 1;
+    const Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
+    std::vector<double> nearest, floor;
+    carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), outlet.data(), r.heights.data(), nearest,
+                      floor);
+    for (int x = 1; x + 1 < r.w; ++x) {
+        if (x == 10) continue;
+        EXPECT_DOUBLE_EQ(r.at(x, 6), 50.0 - x + 0.5) << x << ": the upper arm's floor, not the lower arm's";
+        EXPECT_DOUBLE_EQ(r.at(x, 7), 10.0 + x + 0.5) << x << ": the lower arm's";
+    }
+    EXPECT_DOUBLE_EQ(r.at(10, 6), 100.0) << "an outlet stays";
+}
+
+TEST(Floodplain, LargeRiversKeepWideFloorsAndTheBitsHoldOnTwoThreads) {
+    // The mean rise three cells across the rivers draining more than 40 cells, with floodplains from
+    // 3.6e4 m² (40 cells) 30 m wide there, against the banks alone.
+    Settings s = valley_settings(true);
+    const double banks = rise_after_run(s, 3);
+    s.floodplain = {3.6e4, 30.0, 0.5, std::tan(1.0 * M_PI / 180.0)};
+    const double plains = rise_after_run(s, 3);
+    EXPECT_GT(banks, 10.0) << plains;
+    EXPECT_LT(plains, 0.5 * banks);
     expect_the_same_bits_on_two_threads(s);
 }
 

@@ -175,7 +175,8 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
                   "s = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e6, bank_wider_area=1e5)\n"
                   "t = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e5, bank_wider_area=1e6, "
                   "bank_widest_floor=10)\n"
-                  "u = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e5, bank_widest_floor=11)\n");
+                  "u = erode:stream-power(base, bank_erosion=4, bank_wide_area=1e5, bank_widest_floor=11)\n"
+                  "v = erode:stream-power(base, floodplain_exponent=0.3)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2);
     for (const char* want : {
@@ -217,6 +218,8 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
              "rock.orogen:24:84: error: erode:stream-power: bank_widest_floor widens the floors past seven cells "
              "each time the drainage area grows by bank_wider_area / bank_wide_area; give bank_wider_area > "
              "bank_wide_area > 0",
+             "rock.orogen:25:50: error: erode:stream-power: floodplain_exponent shapes the rivers' floodplains; "
+             "give floodplain_area (m²) as well",
          })
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }

@@ -1,0 +1,49 @@
+// floodplain.hpp — the flat floors of large rivers' valleys.
+//
+// Real valleys widen downstream: 10 m above rivers draining 1 km² those of
+// the 30 m reference DEMs are 100–130 m wide, above rivers draining 100 km²
+// 300–400 m, their floors nearly flat for three to five cells to either side
+// (`orogen analyze`'s valley width against drainage area, W ∝ A^0.2–0.3;
+// docs/realism.md). A river that migrates across its valley planes the floor
+// and its floods spread sediment over it; the banks (banks.hpp) cut only the
+// cells next to each step's river, and each step's soil creep refills the
+// cells beyond.
+//
+// Each step, every cell within the floodplain's half-width
+//
+//     W(A) = width · (A / area)^exponent   (m)
+//
+// of a river cell draining A ≥ area (one that drains somewhere) is lowered,
+// never raised, to that river plus the floor slope over the distance d:
+// h ← min(h, h_river + slope · d). Of the rivers whose floodplain reaches a
+// cell, its nearest one sets it (ties: the lower index), not the lowest: a
+// cell inside a bend then never falls below the bend's own river, so the
+// floor keeps the river's course rather than cutting it off. Outlets stay.
+//
+// Serial, in index order: a river cell's floodplain reaches W/cell cells,
+// up to ten at 300 km² with the default pipeline's numbers, more than a
+// tile's halo of one, so a tiled run takes the whole grid on rank 0
+// (untiled_because).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace orogen::stream_power {
+
+struct Floodplain {
+    double area = 0.0;  ///< m²: rivers draining more have floodplains (0: none)
+    double width = 30.0;  ///< m: the half-width W at `area`
+    double exponent = 0.5;  ///< W ∝ A^exponent
+    double slope = 0.0;  ///< tan of the angle at which the floor rises from its river
+    bool any() const { return area > 0.0; }
+};
+
+/// Lowers the `width` × `height` grid's `heights` (m, row-major) to the floodplains of its rivers (above):
+/// `dir` the D8 direction code of each cell's receiver (−1: none), `area` its drainage area (m²), `outlet`
+/// (or null) the cells that stay. `nearest` and `floor` are scratch (resized). Returns the volume removed, m³.
+double carve_floodplains(const Floodplain& fp, int width, int height, double cell, const std::int8_t* dir,
+                         const double* area, const std::uint8_t* outlet, double* heights, std::vector<double>& nearest,
+                         std::vector<double>& floor);
+
+}  // namespace orogen::stream_power
