@@ -960,13 +960,12 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(0.1)
                     .unit("kg/m³")
                     .help("rain=orographic: C_w, water condensed per metre of lift (0.004-0.01; warm air more)"),
-                Param::
-                    real("rain_resolution", 250.0)
-                        .min(1.0)
-                        .max(1e5)
-                        .unit("m")
-                        .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
-                              "below a few km)"),
+                Param::real("rain_resolution", 250.0)
+                    .min(1.0)
+                    .max(1e5)
+                    .unit("m")
+                    .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
+                          "below a few km)"),
                 Param::
                     string("open", "nesw")
                         .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "
