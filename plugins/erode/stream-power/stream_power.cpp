@@ -159,9 +159,11 @@ std::int64_t Model::step(double dt) {
         else incise(sub);
         if (settings_.banks.any()) erode_banks();
         if (settings_.floodplain.any()) {
-            floodplain_dir_.resize(n);
-            for (std::size_t i = 0; i < n; ++i) floodplain_dir_[i] = std::int8_t(flow_.direction(std::int64_t(i)));
-            carve_floodplains(settings_.floodplain, width_, height_, cell_, floodplain_dir_.data(), flow_.area().data(),
+            if (!settings_.banks.any()) {  // erode_banks fills the directions when the banks run
+                bank_dir_.resize(n);
+                for (std::size_t i = 0; i < n; ++i) bank_dir_[i] = std::int8_t(flow_.direction(std::int64_t(i)));
+            }
+            carve_floodplains(settings_.floodplain, width_, height_, cell_, bank_dir_.data(), flow_.area().data(),
                               flow_.outlets().data(), h, floodplain_nearest_, floodplain_floor_);
         }
         if (settings_.glaciers.any())

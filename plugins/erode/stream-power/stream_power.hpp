@@ -219,12 +219,12 @@ private:
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::vector<double> bank_before_, bank_right_, bank_left_,
         bank_scratch_;  // banks: heights before the incision, pushes
-    std::vector<std::int8_t> bank_dir_;  // banks: each cell's direction to its receiver (kDx/kDy), −1 at a root
+    std::vector<std::int8_t>
+        bank_dir_;  // banks, floodplains: each cell's direction to its receiver (kDx/kDy), −1 at a root
     std::optional<BankAreaFactor> bank_factor_;  // banks: 1 − e^(−A/A_b), built at the first step
     BankRelay bank_relay_;  // banks: what a bank down to its floor passes on (banks.wide())
     BankRelay bank_relay2_;  // banks: what the second cell out passes on (banks.wider())
     std::vector<double> floodplain_nearest_, floodplain_floor_;  // floodplains: scratch
-    std::vector<std::int8_t> floodplain_dir_;  // floodplains: each cell's direction to its receiver
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
     double time_ = 0.0, sediment_out_ = 0.0;
