@@ -54,6 +54,8 @@
 // tile with a halo of one cell computes its own cells exactly (tiled.cpp).
 #pragma once
 
+#include "onset.hpp"
+
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -95,7 +97,7 @@ struct BankRelay {
 };
 
 /// 1 − e^(−A/A_b) for a drainage area A (m²): from a table when A is a whole number of cells below
-/// 2^16 (as the incision's A^m: most cells drain few cells), else computed. Built once per model.
+/// 2^16 (as the incision's A^m: most cells drain few cells), else onset(). Built once per model.
 class BankAreaFactor {
 public:
     BankAreaFactor(const Banks& banks, double cell);
@@ -105,7 +107,7 @@ public:
             const auto ci = std::size_t(c + 0.5);
             if (double(ci) * a0_ == area) return table_[ci];
         }
-        return -std::expm1(-area * inv_ab_);
+        return onset(area * inv_ab_);  // not a whole number of cells (rain-weighted areas)
     }
 
 private:

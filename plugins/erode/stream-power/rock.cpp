@@ -281,14 +281,21 @@ void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0,
 }
 
 void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
-             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors) {
+             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors,
+             RockMemo* memo) {
     const bool layered = beds.layered();
     const bool blocky = beds.angle > 0.0 && beds.block_spread > 0.0;
     const bool vary_slope = (layered && beds.angle > 0.0 && beds.angle_spread > 0.0) || blocky;
     const bool vary_k = layered && beds.erodibility_contrast != 1.0;
+    // The memo holds for these arrays only if they already hold a value for every cell it names.
+    const bool recall = memo && memo->key.size() == count && slopes.size() == (vary_slope ? count : 0) &&
+        factors.size() == (vary_k ? count : 0);
     slopes.resize(vary_slope ? count : 0);
     factors.resize(vary_k ? count : 0);
     if (!vary_slope && !vary_k) return;
+    constexpr std::int64_t kNoKey = std::numeric_limits<std::int64_t>::min();  // never recalled
+    if (memo && !recall) memo->key.assign(count, kNoKey);
+    std::int64_t* const keys = memo ? memo->key.data() : nullptr;
     // A bed's strength is one of kStrengths classes: the slopes and factors come from a table (a tan and
     // a pow per class, not per cell and step).
     constexpr int kStrengths = Beds::kStrengths;
@@ -308,11 +315,24 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
     std::vector<double> base;
     std::vector<int> klass;
     if (layered) {
+        // The range of q, by blocks on every thread (min and max: the same whatever the order).
+        constexpr std::int64_t kBlock = 1 << 16;
+        const std::int64_t blocks = (std::int64_t(count) + kBlock - 1) / kBlock;
+        std::vector<double> block_lo(static_cast<std::size_t>(blocks)), block_hi(static_cast<std::size_t>(blocks));
+        parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+            for (std::int64_t b = b0; b < b1; ++b) {
+                double l = std::numeric_limits<double>::infinity(), h = -l;
+                const std::size_t e = std::min(count, std::size_t((b + 1) * kBlock));
+                for (std::size_t i = std::size_t(b * kBlock); i < e; ++i) {
+                    const double q = (heights[i] - uplifted[i]) + offsets[i];
+                    l = std::min(l, q), h = std::max(h, q);
+                }
+                block_lo[std::size_t(b)] = l, block_hi[std::size_t(b)] = h;
+            }
+        });
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (std::size_t i = 0; i < count; ++i) {
-            const double q = (heights[i] - uplifted[i]) + offsets[i];
-            lo = std::min(lo, q), hi = std::max(hi, q);
-        }
+        for (std::int64_t b = 0; b < blocks; ++b)
+            lo = std::min(lo, block_lo[std::size_t(b)]), hi = std::max(hi, block_hi[std::size_t(b)]);
         if (lo <= hi && (hi - lo) / thickness < double(kMaxBeds)) {
             first = static_cast<std::int64_t>(std::floor(lo / thickness)) - 1;
             const std::int64_t beds_in = static_cast<std::int64_t>(std::floor(hi / thickness)) + 2 - first + 1;
@@ -358,18 +378,46 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
     parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) {
         for (std::int64_t i = b; i < e; ++i) {
             const double zeta = heights[i] - uplifted[i];
-            int k = kStrengths / 2;
+            // The cell's bed (from the table when it lies in it: bed_at's answer) and block slice.
+            const double q = layered ? zeta + offsets[i] : 0.0;
+            std::int64_t bed = 0;
+            bool tabled = false;
+            std::size_t j = 0;
             if (layered) {
-                const double q = zeta + offsets[i];
-                // In the table, unless its facies have no table of corners; otherwise (a height outside the
-                // table, many corners) the cell's bed and facies are drawn directly.
-                const double bed = std::floor(q / thickness);
-                if (bed > double(first) && bed < double(last) && (facies || !beds.facies())) {
-                    std::size_t j = std::size_t(static_cast<std::int64_t>(bed) - first);
+                const double index = std::floor(q / thickness);
+                tabled = index > double(first) && index < double(last) && (facies || !beds.facies());
+                if (tabled) {
+                    j = std::size_t(static_cast<std::int64_t>(index) - first);
                     if (uneven) {
                         if (q < base[j]) --j;
                         else if (q >= base[j + 1]) ++j;
                     }
+                    bed = first + std::int64_t(j);
+                } else {
+                    bed = beds.bed_at(q);
+                }
+            }
+            double slice = 0.0;
+            std::int64_t block_key = 0;
+            if (blocky) {
+                slice = std::floor(zeta / cell);
+                block_key = std::abs(slice) < 0x1p62 ? static_cast<std::int64_t>(slice) : 0;
+            }
+            if (keys) {
+                // Bed and slice packed in one key when each fits 32 bits (and the height is finite).
+                constexpr std::int64_t kFits = std::int64_t(1) << 31;
+                const bool fits = std::isfinite(zeta) && std::isfinite(q) && bed > -kFits && bed < kFits &&
+                    block_key > -kFits && block_key < kFits;
+                const std::int64_t key =
+                    fits ? std::int64_t((std::uint64_t(bed) << 32) | std::uint64_t(std::uint32_t(block_key))) : kNoKey;
+                if (recall && key != kNoKey && keys[i] == key) continue;  // the same rock as last time
+                keys[i] = key;
+            }
+            int k = kStrengths / 2;
+            if (layered) {
+                // In the table, unless its facies have no table of corners; otherwise (a height outside the
+                // table, many corners) the cell's bed and facies are drawn directly.
+                if (tabled) {
                     k = klass[j];
                     if (facies) {
                         const LatticeAt& u = column_at[std::size_t(i % width)];
@@ -387,10 +435,8 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
             if (vary_slope) {
                 double slope = slope_of[k];
                 if (blocky) {
-                    const double slice = std::floor(zeta / cell);
-                    const std::int64_t key = std::abs(slice) < 0x1p62 ? static_cast<std::int64_t>(slice) : 0;
                     const double u = random::uniform(block_seed, std::uint64_t(x0 + int(i % width)),
-                                                     std::uint64_t(y0 + int(i / width)), std::uint64_t(key));
+                                                     std::uint64_t(y0 + int(i / width)), std::uint64_t(block_key));
                     slope = std::min(slope * (1.0 + beds.block_spread * u), steepest);
                 }
                 slopes[std::size_t(i)] = slope;

@@ -111,11 +111,20 @@ struct Beds {
 void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0, double cell,
                  std::vector<double>& offsets);
 
+/// What rock_at found in each cell last time: the bed and the cell-deep slice of rock height it showed.
+/// A cell still in both shows the same rock, so its slope and factor are kept rather than drawn again
+/// (most cells, most steps: a river cuts through a 150 m bed in many steps). Kept by the caller between
+/// calls on the same block, with the same `slopes` and `factors`.
+struct RockMemo {
+    std::vector<std::int64_t> key;
+};
+
 /// Each cell's landslide slope (tan) and erodibility factor, from its height, the uplift it received and
 /// its bed_offsets (all `count` values) of a width-`width` block whose first cell is (x0, y0) of the grid,
 /// cells `cell` metres apart (the joint blocks are a cell wide and deep). `slopes` / `factors` are resized;
-/// either is left empty when it would be uniform.
+/// either is left empty when it would be uniform. With a `memo` (see RockMemo) the same values, sooner.
 void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
-             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors);
+             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors,
+             RockMemo* memo = nullptr);
 
 }  // namespace orogen::stream_power

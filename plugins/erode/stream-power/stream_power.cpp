@@ -152,7 +152,8 @@ std::int64_t Model::step(double dt) {
         }
         // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
         if (bed_offset_.empty()) bed_offsets(settings_.rock, n, width_, 0, 0, cell_, bed_offset_);
-        rock_at(settings_.rock, h, uplifted_.data(), bed_offset_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_);
+        rock_at(settings_.rock, h, uplifted_.data(), bed_offset_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_,
+                &rock_memo_);
         if (settings_.glaciers.any()) glacial_factors(sub);
         if (settings_.banks.any()) bank_before_.assign(h_.begin(), h_.end());
         if (settings_.deposition > 0.0) incise_with_deposition(sub);

@@ -215,6 +215,7 @@ private:
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
+    RockMemo rock_memo_;  // the bed and slice each cell showed (rock_at)
     threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::vector<double> bank_before_, bank_right_, bank_left_,
@@ -255,12 +256,15 @@ inline double channel_area_power(double a, double m, double inv_ac) {
 }
 
 /// A^m·(1 − e^(−A/A_c)) for a drainage area `a` (m²): table[c] is the value for c
-/// whole cells of a0 m² (inv_a0 = 1/a0), else channel_area_power().
+/// whole cells of a0 m² (inv_a0 = 1/a0); other areas below the table's last (rain-weighted ones) with
+/// onset() for the factor; channel_area_power() for the largest.
 inline double area_power(double a, const double* table, double inv_a0, double a0, double m, double inv_ac) {
     const double c = a * inv_a0;
     if (c < double(kPowTable - 1)) {
         const auto ci = std::int64_t(c + 0.5);
-        return double(ci) * a0 == a ? table[ci] : channel_area_power(a, m, inv_ac);
+        if (double(ci) * a0 == a) return table[ci];
+        const double am = std::pow(a, m);
+        return inv_ac > 0.0 ? am * onset(a * inv_ac) : am;
     }
     return channel_area_power(a, m, inv_ac);
 }

@@ -739,7 +739,7 @@ std::int64_t TiledModel::step(double dt) {
         // shows.
         if (bed_offset_.empty()) bed_offsets(settings_.rock, n, own_.width, own_.x0, own_.y0, cell_, bed_offset_);
         rock_at(settings_.rock, h_.data(), uplifted_.data(), bed_offset_.data(), n, own_.width, own_.x0, own_.y0, cell_,
-                rock_slopes_, rock_k_);
+                rock_slopes_, rock_k_, &rock_memo_);
         const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
         const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
         const double c1 = K * sub / std::pow(cell_, ns), c2 = K * sub / std::pow(cell_ * kSqrt2, ns);

@@ -152,6 +152,7 @@ private:
     double cell_;
     Settings settings_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
+    RockMemo rock_memo_;  // the bed and slice each cell showed (rock_at)
     threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::int64_t sink_ = -1;  // every side closed: the outlet (whole-grid index)

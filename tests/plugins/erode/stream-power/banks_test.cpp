@@ -44,6 +44,32 @@ Window straight_river() {
     return v;
 }
 
+TEST(Onset, OneMinusExpWithinItsBoundEverywhereAndOneBeyondReach) {
+    // onset(x) = 1 − e^(−x) to within (2^−12)²/8 = 7.5e-9 (linear between exact values); the worst error
+    // lies between nodes where the curvature is largest (near 0); 1 exactly from 38 on; never decreasing.
+    double worst = 0.0, last = 0.0;
+    for (double x = 0.0; x < 45.0; x += 0.000137) {
+        const double v = onset(x), exact = -std::expm1(-x);
+        worst = std::max(worst, std::abs(v - exact));
+        ASSERT_GE(v, last) << "x " << x;
+        last = v;
+    }
+    EXPECT_LT(worst, 7.5e-9);
+    EXPECT_GT(worst, 1e-9) << "interpolated, not exact: the bound is what the test checks";
+    EXPECT_EQ(onset(38.0), 1.0);
+    EXPECT_EQ(onset(1e300), 1.0);
+    EXPECT_EQ(onset(0.0), 0.0);
+    EXPECT_EQ(onset(0.5), -std::expm1(-0.5)) << "a node is the exact value";
+    EXPECT_TRUE(std::isnan(onset(std::nan(""))));
+    // The banks' factor: whole cells from its own table (exact), other areas through onset.
+    Banks banks;
+    banks.erosion = 4.0;
+    banks.area = 3e4;
+    const BankAreaFactor factor(banks, 30.0);
+    EXPECT_EQ(factor(900.0 * 7), -std::expm1(-7.0 * 900.0 * (1.0 / 3e4)));
+    EXPECT_NEAR(factor(900.0 * 7.3), -std::expm1(-900.0 * 7.3 / 3e4), 7.5e-9);
+}
+
 TEST(Banks, AStraightRiverLowersEachBankByHalfItsShare) {
     Window v = straight_river();
     Banks b;
@@ -54,8 +80,8 @@ TEST(Banks, AStraightRiverLowersEachBankByHalfItsShare) {
     EXPECT_DOUBLE_EQ(v.right[at(1, 2)], 3.0);
     EXPECT_DOUBLE_EQ(v.left[at(1, 2)], 3.0);
     EXPECT_EQ(v.right[at(4, 2)], 0.0);  // the root drains nowhere: no push
-    const double removed =
-        lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    const double removed = lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr,
+                                       30.0, v.heights.data(), v.scratch);
     for (int x = 0; x < kW; ++x) {
         const double bank = x + 1 < kW ? 97.0 : 100.0;  // beside the root nothing pushes
         EXPECT_DOUBLE_EQ(v.heights[at(x, 1)], bank) << x;
@@ -73,7 +99,8 @@ TEST(Banks, ASmallStreamBarelyPushes) {
     b.erosion = 3.0;
     b.area = 1e5;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    EXPECT_NEAR(v.right[at(1, 2)], 3.0 * -std::expm1(-1e3 / 1e5), 1e-15);
+    // 1e3 m² is not a whole number of 30 m cells: the factor comes from onset(), within 7.5e-9.
+    EXPECT_NEAR(v.right[at(1, 2)], 3.0 * -std::expm1(-1e3 / 1e5), 3.0 * 7.5e-9);
 }
 
 TEST(Banks, ABankStopsAboveItsRiverAtTheFloorSlopeAndOutletsStay) {
@@ -88,7 +115,8 @@ TEST(Banks, ABankStopsAboveItsRiverAtTheFloorSlopeAndOutletsStay) {
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     std::vector<std::uint8_t> outlet(kW * kH, 0);
     outlet[at(0, 3)] = 1;
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), outlet.data(), 30.0, v.heights.data(), v.scratch);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), outlet.data(), 30.0,
+                v.heights.data(), v.scratch);
     EXPECT_DOUBLE_EQ(v.heights[at(1, 1)], 3.0);
     EXPECT_DOUBLE_EQ(v.heights[at(2, 1)], 2.0);
     EXPECT_DOUBLE_EQ(v.heights[at(3, 1)], 3.0);
@@ -160,7 +188,8 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     b.erosion = 4.0;  // 4 m a side, 2 m on each flanking cell
     b.area = 1e4;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
+                v.scratch);
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 98.0) << k;
     // The diagonal neighbours lie √2 cells off the river's line (the receiver and the donor on it): untouched.
     for (int k = 1; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 100.0) << k;
@@ -168,7 +197,8 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     b.erosion = 400.0;
     b.floor_slope = 0.1;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(), v.scratch);
+    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
+                v.scratch);
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 3.0) << k;
 }
 
@@ -373,7 +403,8 @@ struct RiverRow {
     int w = 21, h = 11;
     std::vector<double> heights, area;
     std::vector<std::int8_t> dir;
-    explicit RiverRow(double a) : heights(std::size_t(w) * h, 100.0), area(heights.size(), 900.0), dir(heights.size(), -1) {
+    explicit RiverRow(double a)
+        : heights(std::size_t(w) * h, 100.0), area(heights.size(), 900.0), dir(heights.size(), -1) {
         for (int x = 0; x < w; ++x) {
             const std::size_t i = std::size_t(5) * w + x;
             heights[i] = 50.0 - x;
@@ -389,8 +420,8 @@ TEST(Floodplain, CellsWithinTheHalfWidthFallToTheirNearestRiverPlusTheSlope) {
     RiverRow r(4e6);
     const Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
     std::vector<double> nearest, floor;
-    const double removed = carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), nullptr,
-                                             r.heights.data(), nearest, floor);
+    const double removed =
+        carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), nullptr, r.heights.data(), nearest, floor);
     for (int x = 0; x + 1 < r.w; ++x) {  // the last cell is a root: its floodplain is none
         EXPECT_DOUBLE_EQ(r.at(x, 5), 50.0 - x) << "the river stays";
         for (int d : {1, 2}) {
@@ -422,8 +453,7 @@ TEST(Floodplain, TheNearestRiverSetsACellNotTheLowestAndOutletsStay) {
     outlet[std::size_t(6) * r.w + 10] = 1;
     const Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
     std::vector<double> nearest, floor;
-    carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), outlet.data(), r.heights.data(), nearest,
-                      floor);
+    carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), outlet.data(), r.heights.data(), nearest, floor);
     for (int x = 1; x + 1 < r.w; ++x) {
         if (x == 10) continue;
         EXPECT_DOUBLE_EQ(r.at(x, 6), 50.0 - x + 0.5) << x << ": the upper arm's floor, not the lower arm's";

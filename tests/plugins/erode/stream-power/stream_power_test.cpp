@@ -504,6 +504,57 @@ TEST(Beds, JointBlocksStandUpToTheSpreadSteeperThanTheirBedAndTileAlike) {
     }
 }
 
+TEST(Beds, ARememberedRockIsTheRockDrawnAfresh) {
+    // With a RockMemo a cell still in last call's bed and block slice keeps its slope and factor; every
+    // call must give what a call without one gives, as the heights fall through beds and slices at
+    // different rates (some by a bed a call, some by less than a slice), for even and uneven beds, facies
+    // with and without their table of corners, a height that turns NaN and back, and a memo handed empty
+    // arrays.
+    struct Case {
+        double thickness, spread, facies;
+    };
+    for (const auto [thickness, spread, facies] : {Case{40.0, 0.0, 0.0}, Case{40.0, 0.9, 0.0}, Case{40.0, 0.9, 700.0},
+                                                   Case{4.0, 0.5, 100.0}, Case{0.0, 0.0, 0.0}}) {
+        Beds beds;
+        beds.thickness = thickness;
+        beds.thickness_spread = spread;
+        beds.facies_length = facies;
+        beds.facies_share = 0.6;
+        beds.dip_slope = 0.2;
+        beds.angle = 0.6;
+        beds.angle_spread = thickness > 0.0 ? 0.3 : 0.0;
+        beds.erodibility_contrast = 4.0;
+        beds.block_spread = 0.5;
+        beds.seed = 11;
+        const int width = 50, height = 40;
+        const std::size_t n = std::size_t(width * height);
+        std::vector<double> heights(n), uplifted(n), offsets, slopes, factors, fresh_slopes, fresh_factors;
+        for (std::size_t i = 0; i < n; ++i) {
+            heights[i] = 1200.0 * std::sin(0.21 * double(i)) + 0.7 * double(i);
+            uplifted[i] = 50.0 + 0.02 * double(i);
+        }
+        bed_offsets(beds, n, width, 3, 7, 30.0, offsets);
+        RockMemo memo;
+        for (int call = 0; call < 12; ++call) {
+            for (std::size_t i = 0; i < n; ++i) heights[i] -= double(i % 7) * (i % 3 == 0 ? 9.0 : 0.4);
+            heights[29] = call == 4 ? std::numeric_limits<double>::quiet_NaN() : 100.0 - call;
+            if (call == 8) slopes.clear(), factors.clear();  // arrays the memo did not fill: drawn afresh
+            rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 3, 7, 30.0, slopes, factors,
+                    &memo);
+            rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 3, 7, 30.0, fresh_slopes,
+                    fresh_factors);
+            ASSERT_EQ(slopes.size(), fresh_slopes.size());
+            ASSERT_EQ(factors.size(), fresh_factors.size());
+            for (std::size_t i = 0; i < n; ++i) {
+                if (i == 29 && call == 4) continue;
+                ASSERT_EQ(slopes[i], fresh_slopes[i]) << "call " << call << ", cell " << i << ", " << thickness;
+                if (!factors.empty())
+                    ASSERT_EQ(factors[i], fresh_factors[i]) << "call " << call << ", cell " << i << ", " << thickness;
+            }
+        }
+    }
+}
+
 TEST(Beds, StrongBedsStandSteeperThanWeakOnes) {
     // Flat-lying beds 60 m thick under a rising block: after the run, hillslopes in strong rock are steeper
     // than in weak rock (their landslide angle is higher, their rivers slower).
