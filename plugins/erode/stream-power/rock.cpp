@@ -403,18 +403,22 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
                 slice = std::floor(zeta / cell);
                 block_key = std::abs(slice) < 0x1p62 ? static_cast<std::int64_t>(slice) : 0;
             }
-            if (keys) {
-                // Bed and slice packed in one key when each fits 32 bits (and the height is finite).
-                constexpr std::int64_t kFits = std::int64_t(1) << 31;
-                const bool fits = std::isfinite(zeta) && std::isfinite(q) && bed > -kFits && bed < kFits &&
-                    block_key > -kFits && block_key < kFits;
-                const std::int64_t key =
-                    fits ? std::int64_t((std::uint64_t(bed) << 32) | std::uint64_t(std::uint32_t(block_key))) : kNoKey;
-                if (recall && key != kNoKey && keys[i] == key) continue;  // the same rock as last time
-                keys[i] = key;
-            }
+            // The memo's key: the bed (32 bits), the block slice (24) and the bed's class here (8), when
+            // the bed and slice fit and the height is finite. The same bed keeps its class (its facies do
+            // not change with height); a new slice draws only its block again.
+            static_assert(Beds::kStrengths <= 256, "a class in the key's 8 bits");
+            constexpr std::int64_t kBedFits = std::int64_t(1) << 31, kSliceFits = std::int64_t(1) << 23;
+            const bool keyed = keys && std::isfinite(zeta) && std::isfinite(q) && bed > -kBedFits && bed < kBedFits &&
+                block_key > -kSliceFits && block_key < kSliceFits;
+            const std::uint64_t place =
+                keyed ? (std::uint64_t(bed) << 32) | (std::uint64_t(std::uint32_t(block_key) & 0xffffffu) << 8) : 0;
+            const bool same_bed =
+                keyed && recall && keys[i] != kNoKey && (std::uint64_t(keys[i]) >> 32) == (place >> 32);
+            if (same_bed && (std::uint64_t(keys[i]) & ~std::uint64_t(0xff)) == place) continue;  // the same rock
             int k = kStrengths / 2;
-            if (layered) {
+            if (same_bed) {
+                k = int(std::uint64_t(keys[i]) & 0xffu);
+            } else if (layered) {
                 // In the table, unless its facies have no table of corners; otherwise (a height outside the
                 // table, many corners) the cell's bed and facies are drawn directly.
                 if (tabled) {
@@ -432,6 +436,7 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
                     k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
                 }
             }
+            if (keys) keys[i] = keyed ? std::int64_t(place | std::uint64_t(k)) : kNoKey;
             if (vary_slope) {
                 double slope = slope_of[k];
                 if (blocky) {

@@ -111,10 +111,11 @@ struct Beds {
 void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0, double cell,
                  std::vector<double>& offsets);
 
-/// What rock_at found in each cell last time: the bed and the cell-deep slice of rock height it showed.
-/// A cell still in both shows the same rock, so its slope and factor are kept rather than drawn again
-/// (most cells, most steps: a river cuts through a 150 m bed in many steps). Kept by the caller between
-/// calls on the same block, with the same `slopes` and `factors`.
+/// What rock_at found in each cell last time: the bed, the cell-deep slice of rock height and the bed's
+/// strength class there. A cell still in both shows the same rock, so its slope and factor are kept; one
+/// in the same bed but a new slice keeps its class (its facies are drawn once per bed) and draws only its
+/// joint block (a river cuts through a 150 m bed in many steps, through a 30 m slice in one or two). Kept
+/// by the caller between calls on the same block, with the same `slopes` and `factors`.
 struct RockMemo {
     std::vector<std::int64_t> key;
 };
