@@ -257,13 +257,13 @@ inline double channel_area_power(double a, double m, double inv_ac) {
 
 /// A^m·(1 − e^(−A/A_c)) for a drainage area `a` (m²): table[c] is the value for c
 /// whole cells of a0 m² (inv_a0 = 1/a0); other areas below the table's last (rain-weighted ones) with
-/// onset() for the factor; channel_area_power() for the largest.
+/// onset() for the factor (and sqrt for m = 1/2); channel_area_power() for the largest.
 inline double area_power(double a, const double* table, double inv_a0, double a0, double m, double inv_ac) {
     const double c = a * inv_a0;
     if (c < double(kPowTable - 1)) {
         const auto ci = std::int64_t(c + 0.5);
         if (double(ci) * a0 == a) return table[ci];
-        const double am = std::pow(a, m);
+        const double am = m == 0.5 ? std::sqrt(a) : std::pow(a, m);  // sqrt: a pow's time in a tenth
         return inv_ac > 0.0 ? am * onset(a * inv_ac) : am;
     }
     return channel_area_power(a, m, inv_ac);
