@@ -1,9 +1,12 @@
 // The floodplains of large rivers (floodplain.hpp).
 #include "floodplain.hpp"
 
+#include "flow.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace orogen::stream_power {
 
@@ -19,6 +22,12 @@ double carve_floodplains(const Floodplain& fp, int width, int height, double cel
         for (int x = 0; x < width; ++x) {
             const std::size_t i = std::size_t(y) * std::size_t(width) + std::size_t(x);
             if (dir[i] < 0 || !(area[i] >= fp.area)) continue;
+            if (fp.max_slope > 0.0) {  // a steep reach (a gorge) planes no floor
+                const int k = dir[i];
+                const std::size_t r = std::size_t(y + kDy[k]) * std::size_t(width) + std::size_t(x + kDx[k]);
+                const double run = cell * ((k & 1) ? std::numbers::sqrt2 : 1.0);
+                if (heights[i] - heights[r] > fp.max_slope * run) continue;
+            }
             const double reach = reach_at_area * std::pow(area[i] / fp.area, fp.exponent);
             const int r = int(reach);
             for (int dy = -r; dy <= r; ++dy) {

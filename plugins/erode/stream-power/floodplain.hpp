@@ -13,7 +13,8 @@
 //
 //     W(A) = width · (A / area)^exponent   (m)
 //
-// of a river cell draining A ≥ area (one that drains somewhere) is lowered,
+// of a river cell draining A ≥ area (one that drains somewhere, and, with a
+// max_slope, no steeper than that to its receiver) is lowered,
 // never raised, to that river plus the floor slope over the distance d:
 // h ← min(h, h_river + slope · d). Of the rivers whose floodplain reaches a
 // cell, its nearest one sets it (ties: the lower index), not the lowest: a
@@ -36,6 +37,9 @@ struct Floodplain {
     double width = 30.0;  ///< m: the half-width W at `area`
     double exponent = 0.5;  ///< W ∝ A^exponent
     double slope = 0.0;  ///< tan of the angle at which the floor rises from its river
+    /// tan: only rivers no steeper than this (to their receiver) plane a floodplain (0: every river). Real
+    /// floodplains lie along gentle reaches; a steep river in a gorge has none.
+    double max_slope = 0.0;
     bool any() const { return area > 0.0; }
 };
 

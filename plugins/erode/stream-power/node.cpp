@@ -112,6 +112,7 @@ stream_power::Settings settings_of(NodeContext& ctx) {
     s.floodplain.width = ctx.real("floodplain_width");
     s.floodplain.exponent = ctx.real("floodplain_exponent");
     s.floodplain.slope = std::tan(ctx.real("floodplain_slope") * rad);
+    s.floodplain.max_slope = std::tan(ctx.real("floodplain_max_slope") * rad);
     s.rock.angle = ctx.real("landslide_angle") * rad;
     s.rock.thickness = ctx.real("bed_thickness");
     s.rock.dip_slope = std::tan(ctx.real("bed_dip") * rad);
@@ -528,7 +529,7 @@ void check(CheckContext& ctx) {
                       "bank_widest_floor widens the floors past seven cells each time the drainage area grows by "
                       "bank_wider_area / bank_wide_area; give bank_wider_area > bank_wide_area > 0");
     }
-    for (const char* fp : {"floodplain_width", "floodplain_exponent", "floodplain_slope"})
+    for (const char* fp : {"floodplain_width", "floodplain_exponent", "floodplain_slope", "floodplain_max_slope"})
         if (ctx.given(fp) && !(ctx.real("floodplain_area") > 0.0))
             ctx.error(fp, std::string(fp) + " shapes the rivers' floodplains; give floodplain_area (m²) as well");
     if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
@@ -779,6 +780,12 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(30.0)
                     .unit("°")
                     .help("a floodplain rises from its river at this angle (0 = dead flat, which holds pits)"),
+                Param::real("floodplain_max_slope", 0.0)
+                    .min(0.0)
+                    .max(60.0)
+                    .unit("°")
+                    .help("only rivers no steeper than this (to their receiver) plane a floodplain, as real ones "
+                          "lie along gentle reaches and none in gorges (2.3 = a 4 % gradient); 0 = every river"),
                 Param::integer("substeps", 1)
                     .min(1)
                     .max(1000)
@@ -955,17 +962,19 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .max(2e4)
                     .unit("m")
                     .help("rain=orographic: H_w, the water vapour's scale height (1-4 km)"),
-                Param::real("uplift_sensitivity", 0.0083)
-                    .min(0.0)
-                    .max(0.1)
-                    .unit("kg/m³")
-                    .help("rain=orographic: C_w, water condensed per metre of lift (0.004-0.01; warm air more)"),
-                Param::real("rain_resolution", 250.0)
-                    .min(1.0)
-                    .max(1e5)
-                    .unit("m")
-                    .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
-                          "below a few km)"),
+                Param::
+                    real("uplift_sensitivity", 0.0083)
+                        .min(0.0)
+                        .max(0.1)
+                        .unit("kg/m³")
+                        .help("rain=orographic: C_w, water condensed per metre of lift (0.004-0.01; warm air more)"),
+                Param::
+                    real("rain_resolution", 250.0)
+                        .min(1.0)
+                        .max(1e5)
+                        .unit("m")
+                        .help("rain=orographic: the grid the rain is computed on (whole cells; the theory smooths "
+                              "below a few km)"),
                 Param::
                     string("open", "nesw")
                         .help("sides water leaves by (letters n e s w, all or none); their vertices are held at base "

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <vector>
 
 namespace {
@@ -436,6 +437,33 @@ TEST(Floodplain, CellsWithinTheHalfWidthFallToTheirNearestRiverPlusTheSlope) {
     carve_floodplains(fp, small.w, small.h, 30.0, small.dir.data(), small.area.data(), nullptr, small.heights.data(),
                       nearest, floor);
     EXPECT_DOUBLE_EQ(small.at(3, 4), 100.0);
+}
+
+TEST(Floodplain, OnlyReachesGentlerThanTheMaxSlopePlaneAFloor) {
+    // The river falls 4 m a cell (13 %, a gorge) to x = 10, then 1 m a cell (3.3 %). With a max slope of
+    // 3° (5.2 %) only the gentle reach planes a floor: two cells each side from x = 10 on, none along the
+    // gorge beyond that reach (x ≤ 7). The cell at x = 10 drops 1 m to its receiver: gentle, its floor kept.
+    RiverRow r(4e6);
+    for (int x = 0; x < r.w; ++x) r.heights[std::size_t(5) * r.w + x] = x < 10 ? 70.0 - 4.0 * x : 40.0 - (x - 10);
+    Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
+    fp.max_slope = std::tan(3.0 * std::numbers::pi / 180.0);
+    std::vector<double> nearest, floor;
+    carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), nullptr, r.heights.data(), nearest, floor);
+    for (int x = 0; x <= 7; ++x)
+        for (int y : {3, 4, 6, 7}) EXPECT_DOUBLE_EQ(r.at(x, y), 100.0) << "gorge: " << x << " " << y;
+    for (int x = 10; x + 1 < r.w; ++x) {
+        const double river = 40.0 - (x - 10);
+        EXPECT_DOUBLE_EQ(r.at(x, 4), river + 0.5) << x;
+        EXPECT_DOUBLE_EQ(r.at(x, 7), river + 1.0) << x;
+    }
+    // Without a max slope the gorge planes its floor too.
+    RiverRow every(4e6);
+    for (int x = 0; x < every.w; ++x)
+        every.heights[std::size_t(5) * every.w + x] = x < 10 ? 70.0 - 4.0 * x : 40.0 - (x - 10);
+    fp.max_slope = 0.0;
+    carve_floodplains(fp, every.w, every.h, 30.0, every.dir.data(), every.area.data(), nullptr, every.heights.data(),
+                      nearest, floor);
+    EXPECT_DOUBLE_EQ(every.at(3, 4), 70.0 - 12.0 + 0.5);
 }
 
 TEST(Floodplain, TheNearestRiverSetsACellNotTheLowestAndOutletsStay) {
