@@ -84,7 +84,7 @@ double wavenumber(std::size_t i, std::size_t n, double spacing) {
 }
 
 /// Smith & Barstad's transfer function: P̂/ĥ, in mm/s per metre of terrain.
-std::complex<double> transfer(double k, double l, const Wind& wind, const OrographicRain& r) {
+std::complex<double> transfer_at(double k, double l, const Wind& wind, const OrographicRain& r) {
     const double sigma = wind.east * k + wind.south * l;  // intrinsic frequency, 1/s
     if (sigma == 0.0) return {0.0, 0.0};  // ridges along the wind lift nothing
     const double s2 = sigma * sigma, n2 = r.moist_stability * r.moist_stability, k2 = k * k + l * l;
@@ -109,7 +109,7 @@ Wind wind_components(const OrographicRain& rain) {
 }
 
 std::vector<double> orographic_rain(const double* heights, int width, int height, double cell,
-                                    const OrographicRain& rain, int padding) {
+                                    const OrographicRain& rain, int padding, RainTransfer* transfer) {
     check(rain, width, height, cell);
     const std::size_t n = std::size_t(width) * std::size_t(height);
     double lowest = heights[0];
@@ -122,11 +122,22 @@ std::vector<double> orographic_rain(const double* heights, int width, int height
     std::vector<std::complex<double>> t = padded_terrain(heights, width, height, nx, ny, lowest);
     analysis::fft2(t, nx, ny);
     const Wind wind = wind_components(rain);
+    RainTransfer own;
+    RainTransfer& kept = transfer ? *transfer : own;
+    if (kept.nx != nx || kept.ny != ny || kept.cell != cell || !(kept.rain == rain) || kept.values.size() != nx * ny) {
+        kept.values.resize(nx * ny);
+        parallel_for(0, std::int64_t(ny), 16, [&](std::int64_t y0, std::int64_t y1) {
+            for (auto y = std::size_t(y0); y < std::size_t(y1); ++y) {
+                const double l = wavenumber(y, ny, cell);
+                for (std::size_t x = 0; x < nx; ++x)
+                    kept.values[y * nx + x] = transfer_at(wavenumber(x, nx, cell), l, wind, rain);
+            }
+        });
+        kept.nx = nx, kept.ny = ny, kept.cell = cell, kept.rain = rain;
+    }
+    const std::complex<double>* const by = kept.values.data();
     parallel_for(0, std::int64_t(ny), 16, [&](std::int64_t y0, std::int64_t y1) {
-        for (auto y = std::size_t(y0); y < std::size_t(y1); ++y) {
-            const double l = wavenumber(y, ny, cell);
-            for (std::size_t x = 0; x < nx; ++x) t[y * nx + x] *= transfer(wavenumber(x, nx, cell), l, wind, rain);
-        }
+        for (auto i = std::size_t(y0) * nx; i < std::size_t(y1) * nx; ++i) t[i] *= by[i];
     });
     analysis::fft2(t, nx, ny, true);
     // A share f of the year the moist wind rains P_0 + P_orographic (mm/s, here as m/yr), cut at zero in
@@ -183,7 +194,8 @@ void add_block_sums(const CoarseRainGrid& g, const double* heights, int x0, int 
     });
 }
 
-std::vector<double> coarse_rain(const CoarseRainGrid& g, const OrographicRain& rain, std::vector<double> sums) {
+std::vector<double> coarse_rain(const CoarseRainGrid& g, const OrographicRain& rain, std::vector<double> sums,
+                                RainTransfer* transfer) {
     const int f = g.factor, cw = g.coarse_width, ch = g.coarse_height;
     const double scale = f == 1 ? 1.0 : 1024.0;
     for (int Y = 0; Y < ch; ++Y)  // block means (a partial block at the east or south edge has fewer cells)
@@ -200,7 +212,7 @@ std::vector<double> coarse_rain(const CoarseRainGrid& g, const OrographicRain& r
     const double wind_length = rain.wind_speed * (rain.condensation_time + rain.fallout_time);
     const int padding =
         std::clamp(int(std::ceil(kPaddingWindLengths * wind_length / coarse_cell)), 1, std::max(cw, ch));
-    return orographic_rain(sums.data(), cw, ch, coarse_cell, rain, padding);
+    return orographic_rain(sums.data(), cw, ch, coarse_cell, rain, padding, transfer);
 }
 
 void interpolate_rain(const CoarseRainGrid& g, const std::vector<double>& coarse, int x0, int y0, int w, int h,
@@ -237,7 +249,7 @@ void interpolate_rain(const CoarseRainGrid& g, const std::vector<double>& coarse
 }
 
 void orographic_rain_coarse(const double* heights, int width, int height, double cell, const OrographicRain& rain,
-                            double resolution, std::vector<double>& out) {
+                            double resolution, std::vector<double>& out, RainTransfer* transfer) {
     const CoarseRainGrid g = coarse_rain_grid(width, height, cell, rain, resolution);
     std::vector<double> sums(std::size_t(g.coarse_width) * std::size_t(g.coarse_height), 0.0);
     add_block_sums(g, heights, 0, 0, width, height, sums);
@@ -247,7 +259,7 @@ void orographic_rain_coarse(const double* heights, int width, int height, double
         for (std::size_t j = 0; j < std::size_t(width) * std::size_t(height); ++j)
             if (!std::isfinite(heights[j]))
                 throw std::invalid_argument("orographic rain: height " + std::to_string(j) + " is not a finite number");
-    std::vector<double> r = coarse_rain(g, rain, std::move(sums));
+    std::vector<double> r = coarse_rain(g, rain, std::move(sums), transfer);
     if (g.factor == 1) {
         out = std::move(r);
         return;

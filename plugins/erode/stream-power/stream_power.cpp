@@ -101,7 +101,7 @@ void Model::accumulate(const double* routed) {
 void Model::update_rain() {
     // Only the weights are kept (rain() multiplies back): one array of the grid's size, reused each step.
     climate::orographic_rain_coarse(h_.data(), width_, height_, cell_, settings_.rain, settings_.rain_resolution,
-                                    rain_weight_);
+                                    rain_weight_, &rain_transfer_);
     rain_to_weights(rain_weight_, settings_.rain.background);
 }
 

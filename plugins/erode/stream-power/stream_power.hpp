@@ -228,6 +228,7 @@ private:
     std::vector<double> floodplain_nearest_, floodplain_floor_;  // floodplains: scratch
     std::vector<double> ice_, ice_f_;  // glaciers: each cell's ice flux (m³/yr) and its K_g·dt·Q^m_g/L^n
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
+    climate::RainTransfer rain_transfer_;  // the rain's transfer function, the same every step
     double time_ = 0.0, sediment_out_ = 0.0;
     UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);  // the interval whose rate is in history_rate_

@@ -676,7 +676,7 @@ void TiledModel::update_rain() {
     std::vector<double> sums(std::size_t(g.coarse_width) * std::size_t(g.coarse_height), 0.0);
     climate::add_block_sums(g, h_.data(), own_.x0, own_.y0, own_.width, own_.height, sums);
     joined([&] { tiles_.reduce(std::span<double>(sums), Tiling::Reduce::sum); });
-    const std::vector<double> coarse = climate::coarse_rain(g, settings_.rain, std::move(sums));
+    const std::vector<double> coarse = climate::coarse_rain(g, settings_.rain, std::move(sums), &rain_transfer_);
     climate::interpolate_rain(g, coarse, own_.x0, own_.y0, own_.width, own_.height, rain_weight_);
     rain_to_weights(rain_weight_, settings_.rain.background);
 }

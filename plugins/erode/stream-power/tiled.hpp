@@ -173,6 +173,7 @@ private:
     std::vector<std::int64_t> label_;  // resolve_pits: each cell's basin (its pit or outlet)
     std::vector<double> count_, area_;  // cells upstream (with itself), m²
     std::vector<double> rain_weight_;  // orographic rain over the background rain, by cell
+    climate::RainTransfer rain_transfer_;  // the rain's transfer function, the same every step
     // Banks: the heights before the incision (own), and over ghosted() the area, direction, lowering,
     // heights and pushes the two passes read, each cell's direction as a code, outlets, scratch.
     std::vector<double> bank_before_, bank_area_, bank_dir_, bank_e_, bank_h_, bank_right_, bank_left_, bank_scratch_;

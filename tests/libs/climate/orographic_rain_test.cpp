@@ -247,6 +247,30 @@ TEST(OrographicRain, TheSameBitsOnOneAndTwoThreads) {
     EXPECT_EQ(runs[0], runs[1]);
 }
 
+TEST(OrographicRain, AKeptTransferGivesTheSameBitsAndFollowsItsSettings) {
+    // A RainTransfer kept across calls: the same bits as none, for other heights, another wind, another
+    // grid (each made afresh when it does not fit), and back again.
+    const auto a = hill(300, 90.0, 2000.0, 5000.0), b = hill(300, 90.0, 1200.0, 3000.0);
+    const auto c = hill(200, 90.0, 1500.0, 4000.0);
+    OrographicRain west, north;
+    north.wind_from = 0.0;
+    orogen::climate::RainTransfer kept;
+    struct Call {
+        const std::vector<double>* h;
+        int side;
+        const OrographicRain* rain;
+    };
+    for (const Call& call : {Call{&a, 300, &west}, Call{&b, 300, &west}, Call{&b, 300, &north}, Call{&c, 200, &north},
+                             Call{&a, 300, &west}}) {
+        std::vector<double> with, without;
+        orogen::climate::orographic_rain_coarse(call.h->data(), call.side, call.side, 90.0, *call.rain, 250.0, with,
+                                                &kept);
+        orogen::climate::orographic_rain_coarse(call.h->data(), call.side, call.side, 90.0, *call.rain, 250.0, without);
+        ASSERT_EQ(with, without) << call.side << " " << call.rain->wind_from;
+        EXPECT_EQ(kept.rain, *call.rain);
+    }
+}
+
 TEST(OrographicRain, TilesAddingTheirBlocksGetTheWholeGridsBits) {
     // A 101 x 77 grid in blocks of 4 cells, cut into three windows whose edges cross blocks; their sums
     // added in two orders, each window's rain interpolated on its own: the whole grid's, bit for bit.
@@ -255,8 +279,9 @@ TEST(OrographicRain, TilesAddingTheirBlocksGetTheWholeGridsBits) {
     std::vector<double> z(std::size_t(w) * h);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            z[std::size_t(y) * w + x] = 1500.0 * std::exp(-((x - 50.0) * (x - 50.0) + (y - 30.0) * (y - 30.0)) / 300.0) +
-                0.1234567 * x - 0.0087 * y * y;
+            z[std::size_t(y) * w + x] =
+                1500.0 * std::exp(-((x - 50.0) * (x - 50.0) + (y - 30.0) * (y - 30.0)) / 300.0) + 0.1234567 * x -
+                0.0087 * y * y;
     OrographicRain r;
     r.wind_from = 300.0;
     const auto whole = orogen::climate::orographic_rain_coarse(z.data(), w, h, cell, r, 360.0);
