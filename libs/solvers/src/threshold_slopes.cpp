@@ -259,30 +259,22 @@ void check_slope(double cell, const Slopes& slopes) {
 /// a fixed size summed in their order: the same bits on any number of threads (a serial pass over the grid
 /// was 2 % of a landslide-limited stream-power run).
 void account(const double* before, const double* after, std::size_t count, double* removed, Result& result) {
-    constexpr std::int64_t kBlock = 1 << 16;
-    const std::int64_t blocks = (std::int64_t(count) + kBlock - 1) / kBlock;
-    std::vector<std::int64_t> lowered(static_cast<std::size_t>(blocks), 0);
-    std::vector<double> dropped(static_cast<std::size_t>(blocks), 0.0);
-    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
-        for (std::int64_t b = b0; b < b1; ++b) {
-            std::int64_t n = 0;
-            double sum = 0.0;
-            const std::size_t end = std::min(count, std::size_t((b + 1) * kBlock));
-            for (std::size_t i = std::size_t(b * kBlock); i < end; ++i) {
-                const double drop = before[i] - after[i];
-                if (drop > 0.0) {
-                    ++n;
-                    sum += drop;
-                    if (removed) removed[i] += drop;
-                }
+    std::atomic<std::int64_t> lowered{0};  // a count: the same in any order
+    result.removed += parallel_sum(0, std::int64_t(count), 1 << 16, [&](std::int64_t b, std::int64_t e) {
+        std::int64_t n = 0;
+        double sum = 0.0;
+        for (auto i = std::size_t(b); i < std::size_t(e); ++i) {
+            const double drop = before[i] - after[i];
+            if (drop > 0.0) {
+                ++n;
+                sum += drop;
+                if (removed) removed[i] += drop;
             }
-            lowered[std::size_t(b)] = n, dropped[std::size_t(b)] = sum;
         }
+        lowered += n;
+        return sum;
     });
-    for (std::int64_t b = 0; b < blocks; ++b) {
-        result.lowered += lowered[std::size_t(b)];
-        result.removed += dropped[std::size_t(b)];
-    }
+    result.lowered += lowered.load();
 }
 
 }  // namespace

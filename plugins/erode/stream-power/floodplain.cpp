@@ -24,9 +24,9 @@ double carve_floodplains(const Floodplain& fp, int width, int height, double cel
             if (dir[i] < 0 || !(area[i] >= fp.area)) continue;
             if (fp.max_slope > 0.0) {  // a steep reach (a gorge) planes no floor
                 const int k = dir[i];
-                const std::size_t r = std::size_t(y + kDy[k]) * std::size_t(width) + std::size_t(x + kDx[k]);
+                const std::size_t to = std::size_t(y + kDy[k]) * std::size_t(width) + std::size_t(x + kDx[k]);
                 const double run = cell * ((k & 1) ? std::numbers::sqrt2 : 1.0);
-                if (heights[i] - heights[r] > fp.max_slope * run) continue;
+                if (heights[i] - heights[to] > fp.max_slope * run) continue;
             }
             const double reach = reach_at_area * std::pow(area[i] / fp.area, fp.exponent);
             const int r = int(reach);
