@@ -191,7 +191,7 @@ INSTANTIATE_TEST_SUITE_P(Ranks, DiffusionSeam, kErosionCases, kCaseName);
 /// relief full of pits (filled, then routed across with n = 1.5), uplift from
 /// a layer spread across the seams, hillslope diffusion, chi, every side
 /// closed with the lowest cell of the whole grid as the one outlet, and a
-/// time-lapse; then routing=mfd and (s13) floodplains, which are not tiled and run on rank 0;
+/// time-lapse; then routing=mfd (not tiled: on rank 0) and (s13) floodplains reaching across the seams;
 /// rough diamond-square relief with a hundred lakes a step, most of them
 /// settled on their own tile (closed basins) and the rest by rank 0; and
 /// uplift from the plates' time-lapse (a series on rank 0, each interval's
@@ -224,7 +224,7 @@ s9 = erode:stream-power(p, p.timelapse, years=5e4, dt=2.5e4, uplift_history_year
 s10 = erode:stream-power(d, years=6e4, dt=1e4, uplift=2, diffusivity=0.01, channel_area=1e4, bank_erosion=6, bank_area=1e4, bank_wide_area=3e4, bank_wider_area=6e4, bank_widest_floor=11, open="we")
 s11 = erode:stream-power(d, years=4e4, dt=1e4, uplift=2, diffusivity=0.01, rain=orographic, wind_from=290, rain_resolution=150, open="ns")
 s12 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, rain=orographic, wind_from=60, rain_resolution=30, channel_area=1e4)
-s13 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, channel_area=1e4, floodplain_area=5e4, floodplain_width=30)
+s13 = erode:stream-power(d, years=2e4, dt=1e4, uplift=2, channel_area=1e4, floodplain_area=5e4, floodplain_width=90, floodplain_max_slope=20)
 r = render:terrain(s1.timelapse, width=194, height=122, exaggeration=2)
 export:video(r, path="s1.mpg", fps=25, quality=0)
 export:vtk(s1, path="s1.vti")
@@ -269,6 +269,7 @@ TEST(Mpi, StreamPowerSettingsThatDoNotTileRunOnRankZeroAndSaySo) {
     EXPECT_NE(r.err.find("rank 0 of 2, up to "), std::string::npos) << r.err;
     EXPECT_EQ(r.out.find("'s1' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("'s7' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;  // uplift_history tiles
+    EXPECT_EQ(r.out.find("'s13' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;  // floodplains tile
 }
 
 /// The lines "NODE: suspended sediment X m, ..." of a run's output, in order.

@@ -21,13 +21,17 @@
 // cell inside a bend then never falls below the bend's own river, so the
 // floor keeps the river's course rather than cutting it off. Outlets stay.
 //
-// Serial, in index order: a river cell's floodplain reaches W/cell cells,
-// up to ten at 300 km² with the default pipeline's numbers, more than a
-// tile's halo of one, so a tiled run takes the whole grid on rank 0
-// (untiled_because).
+// In three parts, so that a tiled run gives the same bits: the rivers that
+// plane a floor (floodplain_source, cell by cell), each river's reach stamped
+// in index order (stamp_floodplains, over any window of the grid) and the
+// cells lowered (lower_to_floodplains). A river's floodplain reaches W/cell
+// cells, up to ten at 300 km² with the default pipeline's numbers, more than
+// a tile's halo of one: the tiles share their rivers (a few per cent of the
+// cells) and each stamps its own window (TiledModel::plane_floodplains).
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace orogen::stream_power {
@@ -42,6 +46,36 @@ struct Floodplain {
     double max_slope = 0.0;
     bool any() const { return area > 0.0; }
 };
+
+/// A river cell that planes a floodplain: its index in the whole grid, its height (m) before any cell is
+/// lowered, and how far its floodplain reaches (cells, W/cell).
+struct FloodplainSource {
+    std::int64_t index;
+    double height;
+    double reach;
+};
+
+/// Whether a cell planes a floodplain: `dir` its D8 receiver's code (−1: none), `area` its drainage area (m²),
+/// `h` and `h_receiver` its and its receiver's heights (m). If so, sets `reach` (cells).
+bool floodplain_source(const Floodplain& fp, double cell, int dir, double area, double h, double h_receiver,
+                       double& reach);
+
+/// A rectangle of the grid (vertices): the window a tile stamps and lowers.
+struct FloodplainWindow {
+    int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
+/// For each cell of `window` (row-major in it), the distance (cells) to the nearest of `sources` (in
+/// increasing index order of a `grid_width`-wide grid) whose floodplain reaches it, strictly nearer winning
+/// (ties: the lower index), and that river's height: `nearest` (∞ where none reaches) and `floor`, resized.
+void stamp_floodplains(std::span<const FloodplainSource> sources, int grid_width, FloodplainWindow window,
+                       std::vector<double>& nearest, std::vector<double>& floor);
+
+/// Lowers, never raises, each of the `n` cells of `heights` that a floodplain reaches (not a river, not an
+/// outlet when `outlet` is given) to its river's height plus the floor's rise over the distance. Returns the
+/// volume removed, m³.
+double lower_to_floodplains(const Floodplain& fp, double cell, std::size_t n, const std::vector<double>& nearest,
+                            const std::vector<double>& floor, const std::uint8_t* outlet, double* heights);
 
 /// Lowers the `width` × `height` grid's `heights` (m, row-major) to the floodplains of its rivers (above):
 /// `dir` the D8 direction code of each cell's receiver (−1: none), `area` its drainage area (m²), `outlet`

@@ -763,7 +763,7 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .help("rivers draining more than this have floodplains: each step every cell within the "
                           "half-width floodplain_width·(A/floodplain_area)^floodplain_exponent of such a river is "
                           "lowered to its nearest one plus floodplain_slope over the distance (never raised), as "
-                          "large rivers plane their valley floors (3e6 = from 3 km²; not tiled: runs on rank 0); "
+                          "large rivers plane their valley floors (3e6 = from 3 km²); "
                           "0 = none"),
                 Param::real("floodplain_width", 30.0)
                     .min(0.0, true)

@@ -92,7 +92,6 @@ std::string untiled_because(const Settings& s) {
     if (s.mfd_exponent > 0.0) return "routing=mfd is not tiled yet";
     if (s.deposition > 0.0) return "deposition > 0 is not tiled yet";
     if (s.glaciers.any()) return "glaciers are not tiled yet";
-    if (s.floodplain.any()) return "floodplains are not tiled yet";
     return "";
 }
 
@@ -760,6 +759,7 @@ std::int64_t TiledModel::step(double dt) {
             }
         });
         if (settings_.banks.any()) erode_banks(bank_before_);
+        if (settings_.floodplain.any()) plane_floodplains();
         // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
         if (settings_.rock.angle > 0.0)
             threshold::limit_slopes(
@@ -828,6 +828,44 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
         for (int x = 0; x < own_.width; ++x)
             h_[std::size_t(y) * std::size_t(own_.width) + std::size_t(x)] =
                 bank_h_[std::size_t(y + oy) * std::size_t(gw) + std::size_t(x + ox)];
+}
+
+void TiledModel::plane_floodplains() {
+    // The receivers of the tile's edge cells lie in the halo.
+    tiles_.ghosted_copy(h_.data(), floodplain_grown_);
+    double* grown[] = {floodplain_grown_.data()};
+    joined([&] { return tiles_.exchange(std::span<double* const>(grown)); });
+    const int gw = grown_.width;
+    const int ox = own_.x0 - grown_.x0, oy = own_.y0 - grown_.y0;
+    floodplain_mine_.clear();
+    for (int y = 0; y < own_.height; ++y)
+        for (int x = 0; x < own_.width; ++x) {
+            const std::size_t l = std::size_t(y) * std::size_t(own_.width) + std::size_t(x);
+            const int k = dir_[l];
+            const double receiver = k < 0
+                ? 0.0
+                : floodplain_grown_[std::size_t(y + oy + kDy[k]) * std::size_t(gw) + std::size_t(x + ox + kDx[k])];
+            double reach = 0.0;
+            if (floodplain_source(settings_.floodplain, cell_, k, area_[l], h_[l], receiver, reach))
+                floodplain_mine_.push_back({global(l), h_[l], reach});
+        }
+    // Every tile's rivers, in the whole grid's index order (the order Model stamps them in: the same
+    // nearest river for every cell, ties included).
+    std::string bytes;
+    put(bytes, floodplain_mine_);
+    const auto all = joined([&] { return tiles_.gather(bytes, Tiling::Gather::to_every_rank); });
+    floodplain_all_.clear();
+    for (const auto& b : all) {
+        std::size_t at = 0;
+        const auto theirs = take<FloodplainSource>(b, at);
+        floodplain_all_.insert(floodplain_all_.end(), theirs.begin(), theirs.end());
+    }
+    std::sort(floodplain_all_.begin(), floodplain_all_.end(),
+              [](const FloodplainSource& a, const FloodplainSource& b) { return a.index < b.index; });
+    stamp_floodplains(floodplain_all_, W_, {own_.x0, own_.y0, own_.width, own_.height}, floodplain_nearest_,
+                      floodplain_floor_);
+    lower_to_floodplains(settings_.floodplain, cell_, h_.size(), floodplain_nearest_, floodplain_floor_, outlet_.data(),
+                         h_.data());
 }
 
 std::vector<double> TiledModel::chi(double a0) {

@@ -127,6 +127,9 @@ private:
     /// banks.wide(), four with banks.wider()), the same bits as Model.
     void erode_banks(const std::vector<double>& before);
     void relay_across(BankRelay& relay, std::size_t gn);  // fills the halo of what the banks pass on
+    /// Floodplains (floodplain.hpp): a halo exchange for the receivers' heights, every tile's rivers that
+    /// plane a floor gathered on every rank (in index order), each tile stamping and lowering its own cells.
+    void plane_floodplains();
     /// Solve `v` down the rivers: f(l, v_receiver) sets v[l] for every cell but the roots, receivers first.
     void propagate(std::vector<double>& v, const std::function<void(std::size_t, double)>& f);
     bool outlet_at(std::int64_t g) const;
@@ -183,6 +186,10 @@ private:
     BankRelay bank_relay_;  // what a bank down to its floor passes on (banks.wide()), the halo's exchanged
     BankRelay bank_relay2_;  // what the second cells out pass on (banks.wider())
     std::vector<double> bank_relay_out_;  // bank_relay_.out as doubles, for the exchange
+    // Floodplains: the heights over ghosted(), the rivers that plane a floor (the tile's, then every
+    // tile's), and each cell's nearest river and its height.
+    std::vector<double> floodplain_grown_, floodplain_nearest_, floodplain_floor_;
+    std::vector<FloodplainSource> floodplain_mine_, floodplain_all_;
     std::vector<double> pow_table_;
     std::unique_ptr<diffusion::Solver> diffusion_;
     std::int64_t pits_ = 0;
