@@ -11,7 +11,9 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstring>
 #include <numbers>
 #include <vector>
@@ -415,6 +417,53 @@ struct RiverRow {
     }
     double at(int x, int y) const { return heights[std::size_t(y) * w + x]; }
 };
+
+TEST(Floodplain, EveryWindowAndThreadCountStampsTheNearestRiverTiesToTheLowerIndex) {
+    // 300 rivers with reaches up to 12 cells over a 70 × 90 grid, several at the same distance from
+    // some cells: against a brute force over every river for every cell, on the whole grid (bands of
+    // rows on two threads and on one) and on three windows that cut it as tiles would.
+    const int w = 70, h = 90;
+    std::vector<FloodplainSource> sources;
+    std::uint64_t state = 12345;
+    auto next = [&] { return (state = state * 6364136223846793005ULL + 1442695040888963407ULL) >> 33; };
+    std::vector<std::int64_t> cells;
+    for (int k = 0; k < 300; ++k) cells.push_back(std::int64_t(next() % std::uint64_t(w * h)));
+    std::sort(cells.begin(), cells.end());
+    cells.erase(std::unique(cells.begin(), cells.end()), cells.end());
+    for (const std::int64_t c : cells) sources.push_back({c, double(next() % 1000), double(next() % 1300) / 100.0});
+    std::vector<double> want_near(std::size_t(w) * h, std::numeric_limits<double>::infinity()),
+        want_floor(want_near.size());
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (const FloodplainSource& s : sources) {
+                const double d = std::hypot(double(x - s.index % w), double(y - s.index / w));
+                const std::size_t j = std::size_t(y) * w + x;
+                if (d <= s.reach && d < want_near[j]) {
+                    want_near[j] = d;
+                    want_floor[j] = s.height;
+                }
+            }
+    for (const int threads : {2, 1}) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        std::vector<double> nearest, floor;
+        stamp_floodplains(sources, w, {0, 0, w, h}, nearest, floor);
+        for (std::size_t j = 0; j < want_near.size(); ++j) {
+            ASSERT_EQ(nearest[j], want_near[j]) << "cell " << j << " on " << threads << " threads";
+            if (std::isfinite(want_near[j])) ASSERT_EQ(floor[j], want_floor[j]) << "cell " << j;
+        }
+        for (const FloodplainWindow win :
+             {FloodplainWindow{0, 0, 35, 45}, FloodplainWindow{35, 0, 35, 90}, FloodplainWindow{0, 45, 35, 45}}) {
+            stamp_floodplains(sources, w, win, nearest, floor);
+            for (int y = 0; y < win.height; ++y)
+                for (int x = 0; x < win.width; ++x) {
+                    const std::size_t j = std::size_t(win.y0 + y) * w + std::size_t(win.x0 + x);
+                    const std::size_t l = std::size_t(y) * std::size_t(win.width) + std::size_t(x);
+                    ASSERT_EQ(nearest[l], want_near[j]) << "window cell " << x << "," << y;
+                    if (std::isfinite(want_near[j])) ASSERT_EQ(floor[l], want_floor[j]);
+                }
+        }
+    }
+}
 
 TEST(Floodplain, CellsWithinTheHalfWidthFallToTheirNearestRiverPlusTheSlope) {
     // Half-width 30 m · (4e6 / 1e6)^0.5 = 60 m: two cells of 30 m each side, rising 0.5 m a cell.
