@@ -23,8 +23,8 @@
 //
 // In three parts, so that a tiled run gives the same bits: the rivers that
 // plane a floor (floodplain_source, cell by cell), each river's reach stamped
-// in index order (stamp_floodplains, over any window of the grid) and the
-// cells lowered (lower_to_floodplains). A river's floodplain reaches W/cell
+// in index order (stamp_floodplains, over any window of the grid, by bands
+// of rows on every thread) and the cells lowered (lower_to_floodplains). A river's floodplain reaches W/cell
 // cells, up to ten at 300 km² with the default pipeline's numbers, more than
 // a tile's halo of one: the tiles share their rivers (a few per cent of the
 // cells) and each stamps its own window (TiledModel::plane_floodplains).
