@@ -31,6 +31,9 @@ class TwoRanks final : public Tiling {
 public:
     explicit TwoRanks(std::string other) : Tiling(two_tiles(), 0, 1), other_(std::move(other)) {}
     std::vector<std::string> gather(std::string_view bytes, Gather) override { return {std::string(bytes), other_}; }
+    std::vector<std::string> send_to_ranks(std::span<const std::string> to_rank) override {
+        return {to_rank.front(), other_};
+    }
     void share_from_rank0(std::string&) override {}
     std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap*) override { return nullptr; }
     std::vector<float> fetch_samples(const float*, AxisSamples, AxisSamples) override { return {}; }

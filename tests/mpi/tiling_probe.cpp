@@ -2,9 +2,9 @@
 // under mpiexec on one split: `tiling_probe ROWSxCOLS WIDTH HEIGHT`. Each rank
 // fills its owned tile with a known function of GLOBAL coordinates, then the
 // halo exchange (ghost widths 1-3, several grids at once, float, double and
-// int64), reduce, carry, fetch_samples, scatter and gather must give every
-// cell exactly that function (or its known sum). The first wrong cell is
-// printed (rank, x, y, got, want) and the probe exits 1; a usage error exits 2.
+// int64), reduce, carry, fetch_samples, scatter, gather, ranks_meeting and
+// send_to_ranks must give every cell exactly that function (or its known
+// sum). The first wrong cell is printed (rank, x, y, got, want) and the probe exits 1; a usage error exits 2.
 #include "tiles/mpi_comm.hpp"
 #include "tiles/tiles.hpp"
 
@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <memory>
 #include <span>
@@ -170,6 +171,44 @@ void check_moving(Tiling& tiling, orogen::TiledRun& run) {
                         value_at<float>(x, y, 2));
 }
 
+/// ranks_meeting() against every tile's rectangle, and send_to_ranks(): rank s sends rank d a message of
+/// (s·7 + d) % 5 values (none at all for some pairs, so only some travel), each a known function of (s, d, i),
+/// and every rank must get exactly those, from every rank, in rank order (its own message to itself included).
+void check_routing(Tiling& tiling) {
+    const int r = tiling.rank(), n = tiling.ranks(), w = tiling.grid_width(), h = tiling.grid_height();
+    for (const TileRect probe :
+         {TileRect{-3, -3, 5, 5}, TileRect{w / 2 - 2, h / 2 - 3, 4, 7}, TileRect{0, 0, w, h},
+          TileRect{w - 1, h - 1, 9, 9}, TileRect{w, 0, 4, 4}, TileRect{3, 2, 0, 5}, TileRect{r, r, 2 * r + 1, 3}}) {
+        std::vector<int> want;
+        for (int k = 0; k < n; ++k) {
+            const TileRect t = tiling.tile(k);
+            const int x0 = std::max({probe.x0, t.x0, 0}), x1 = std::min({probe.x1(), t.x1(), w});
+            const int y0 = std::max({probe.y0, t.y0, 0}), y1 = std::min({probe.y1(), t.y1(), h});
+            if (x0 < x1 && y0 < y1) want.push_back(k);
+        }
+        expect_true(r, "ranks_meeting lists the tiles a rectangle meets", tiling.ranks_meeting(probe) == want);
+    }
+    auto count = [](int from, int to) { return (from * 7 + to) % 5; };
+    auto value = [](int from, int to, int i) { return std::int64_t(from) * 1000003 + to * 1009 + i; };
+    std::vector<std::string> out(static_cast<std::size_t>(n));
+    for (int d = 0; d < n; ++d)
+        for (int i = 0; i < count(r, d); ++i) {
+            const std::int64_t v = value(r, d, i);
+            out[std::size_t(d)].append(reinterpret_cast<const char*>(&v), sizeof v);
+        }
+    const std::vector<std::string> in = tiling.send_to_ranks(out);
+    expect_true(r, "send_to_ranks returns one message per rank", in.size() == std::size_t(n));
+    for (int s = 0; s < n && failures == 0 && in.size() == std::size_t(n); ++s) {
+        const std::string& got = in[std::size_t(s)];
+        expect_true(r, "send_to_ranks message size", got.size() == std::size_t(count(s, r)) * sizeof(std::int64_t));
+        for (int i = 0; i < count(s, r) && failures == 0; ++i) {
+            std::int64_t v = 0;
+            std::memcpy(&v, got.data() + std::size_t(i) * sizeof v, sizeof v);
+            expect_cell(r, "send_to_ranks (x = sender, y = value index)", s, i, v, value(s, r, i));
+        }
+    }
+}
+
 int probe(int rows, int cols, int width, int height, int rank) {
     orogen::TiledRun run(orogen::split_grid(width, height, rows, cols), rank);
     for (int halo = 1; halo <= 3; ++halo) {
@@ -183,6 +222,7 @@ int probe(int rows, int cols, int width, int height, int rank) {
     check_reduce(tiling);
     check_carry(tiling);
     check_moving(tiling, run);
+    check_routing(tiling);
     // Every rank learns whether any failed, so the exit codes agree.
     return run.agree(failures ? 1 : 0);
 }

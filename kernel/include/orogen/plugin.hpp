@@ -33,7 +33,8 @@
 /// 7: Tiling in the shape of PETSc's DMDA (orogen/tiles.hpp): the ghost width is the node's tile_halo,
 ///    ghosted grids and one typed exchange, typed reductions with an operator, gather() to rank 0 or to
 ///    every rank, TiledFields for a grid eroder's tiled loop; six virtual primitives instead of twenty.
-#define OROGEN_PLUGIN_API_VERSION 7
+/// 8: Tiling::send_to_ranks (a seventh primitive: bytes to chosen ranks only) and Tiling::ranks_meeting.
+#define OROGEN_PLUGIN_API_VERSION 8
 
 namespace orogen {
 

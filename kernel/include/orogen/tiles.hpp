@@ -13,7 +13,7 @@
 // The shape is PETSc's DMDA: the layout (the split, this rank's corners and
 // its ghosted corners), the ghost width declared once (tile_halo), ghosted
 // grids with one exchange for any number of them and any value type, and
-// typed reductions with an operator. Everything is built over six virtual
+// typed reductions with an operator. Everything is built over seven virtual
 // primitives the kernel implements; no MPI header appears here. A tiled grid
 // eroder's loop (grow, exchange, step, check, copy back) is TiledFields below.
 #pragma once
@@ -103,6 +103,10 @@ public:
     TileRect tile(int rank) const { return split_.tile(rank); }
     /// The rank whose tile holds vertex (x, y) of the whole grid.
     int rank_at(int x, int y) const;
+    /// The ranks whose tiles hold a vertex of `rect` (clipped to the grid), in
+    /// rank order; none when it lies outside the grid. With send_to_ranks():
+    /// what reaches a few cells beyond its own tile goes to those tiles only.
+    std::vector<int> ranks_meeting(TileRect rect) const;
     /// Whether this tile is the eastmost of its row of tiles.
     bool eastmost() const { return owned().x1() == grid_width(); }
 
@@ -157,6 +161,13 @@ public:
     /// elsewhere) or on every rank. With share_from_rank0(): rank 0 solves
     /// what the tiles sent and hands every rank the answer.
     virtual std::vector<std::string> gather(std::string_view bytes, Gather where) = 0;
+    /// Collective: `to_rank[r]` (ranks() of them, most of them empty as a
+    /// rule) goes to rank r; returns what every rank sent this one, in rank
+    /// order (its own to itself included). Only the non-empty ones travel,
+    /// after one all-to-all of their sizes: for what each tile needs from its
+    /// near neighbours only, however many ranks run (a river's floodplain
+    /// reaching across a seam), where gather() would send everything to all.
+    virtual std::vector<std::string> send_to_ranks(std::span<const std::string> to_rank) = 0;
     /// Collective: rank 0's `bytes` on every rank (others' are replaced).
     virtual void share_from_rank0(std::string& bytes) = 0;
     /// Collective: rank 0's whole-grid heightmap `whole` (its heights and

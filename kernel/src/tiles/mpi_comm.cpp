@@ -42,6 +42,20 @@ void check(int rc, const char* what) {
     MPI_Error_string(rc, text, &len);
     throw Error(std::string("MPI ") + what + " failed: " + std::string(text, std::size_t(len)));
 }
+
+// Posts `bytes` at `data` to (sending) or from `peer` as non-blocking pieces of at most kPiece, appended to
+// `requests`; an empty message is one empty piece, as the peer posts one empty receive.
+void post_pieces(std::vector<MPI_Request>& requests, char* data, std::size_t bytes, int peer, bool sending, int tag) {
+    std::size_t done = 0;
+    do {
+        const std::size_t n = std::min(kPiece, bytes - done);
+        requests.emplace_back();
+        if (sending)
+            check(MPI_Isend(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()), "MPI_Isend");
+        else check(MPI_Irecv(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()), "MPI_Irecv");
+        done += n;
+    } while (done < bytes);
+}
 }  // namespace
 
 Session::Session(int& argc, char**& argv) {
@@ -86,27 +100,47 @@ std::vector<std::string> allgather(std::string_view bytes) {
     return parts;
 }
 
+std::vector<std::string> alltoall(std::span<const std::string> to_rank, int tag) {
+    int size = 1, rank = 0;
+    MPI_Comm_size(MPI_COMM_WORLD, &size);
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    if (to_rank.size() != std::size_t(size)) throw Error("internal error: alltoall needs one message per rank");
+    const auto n = static_cast<std::size_t>(size);
+    std::vector<unsigned long long> sizes_out(n), sizes_in(n);
+    for (int r = 0; r < size; ++r) sizes_out[std::size_t(r)] = to_rank[std::size_t(r)].size();
+    check(MPI_Alltoall(sizes_out.data(), 1, MPI_UNSIGNED_LONG_LONG, sizes_in.data(), 1, MPI_UNSIGNED_LONG_LONG,
+                       MPI_COMM_WORLD),
+          "MPI_Alltoall");
+    std::vector<std::string> from_rank(n);
+    std::vector<MPI_Request> requests;
+    for (int r = 0; r < size; ++r) {
+        const std::size_t k = std::size_t(r);
+        if (r == rank) {
+            from_rank[k] = to_rank[k];
+            continue;
+        }
+        if (sizes_in[k] == 0) continue;
+        from_rank[k].resize(std::size_t(sizes_in[k]));
+        post_pieces(requests, from_rank[k].data(), from_rank[k].size(), r, false, tag);
+    }
+    for (int r = 0; r < size; ++r) {
+        const std::size_t k = std::size_t(r);
+        if (r != rank && sizes_out[k] != 0)
+            post_pieces(requests, const_cast<char*>(to_rank[k].data()), to_rank[k].size(), r, true, tag);
+    }
+    if (!requests.empty())
+        check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
+    return from_rank;
+}
+
 void sendrecv(const void* send_data, std::size_t send_bytes, int to, void* recv_data, std::size_t recv_bytes, int from,
               int tag) {
     // Non-blocking pieces, all posted, then waited for: the message to `to` and the one from `from` may
     // differ in size (export:tiles' fetch), and MPI matches the pieces of one sender and tag in order.
     std::vector<MPI_Request> requests;
-    auto post = [&](char* data, std::size_t bytes, int peer, bool sending) {
-        std::size_t done = 0;
-        do {  // one empty message for an empty one: the peer posts one empty receive
-            const std::size_t n = std::min(kPiece, bytes - done);
-            requests.emplace_back();
-            if (sending)
-                check(MPI_Isend(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()),
-                      "MPI_Isend");
-            else
-                check(MPI_Irecv(data + done, int(n), MPI_BYTE, peer, tag, MPI_COMM_WORLD, &requests.back()),
-                      "MPI_Irecv");
-            done += n;
-        } while (done < bytes);
-    };
-    if (from >= 0) post(static_cast<char*>(recv_data), recv_bytes, from, false);
-    if (to >= 0) post(const_cast<char*>(static_cast<const char*>(send_data)), send_bytes, to, true);
+    if (from >= 0) post_pieces(requests, static_cast<char*>(recv_data), recv_bytes, from, false, tag);
+    if (to >= 0)
+        post_pieces(requests, const_cast<char*>(static_cast<const char*>(send_data)), send_bytes, to, true, tag);
     if (!requests.empty())
         check(MPI_Waitall(int(requests.size()), requests.data(), MPI_STATUSES_IGNORE), "MPI_Waitall");
 }
@@ -159,6 +193,9 @@ Session::~Session() = default;
 void max_all(int*, int) {}
 void allgather(const int* send, int count, int* recv) { std::copy(send, send + count, recv); }
 std::vector<std::string> allgather(std::string_view bytes) { return {std::string(bytes)}; }
+std::vector<std::string> alltoall(std::span<const std::string> to_rank, int) {
+    return {to_rank.empty() ? std::string() : to_rank.front()};
+}
 void sendrecv(const void*, std::size_t, int to, void*, std::size_t, int from, int) {
     if (to >= 0 || from >= 0) unavailable();
 }

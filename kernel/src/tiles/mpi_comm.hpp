@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -43,6 +44,9 @@ void max_all(int* values, int count);
 void allgather(const int* send, int count, int* recv);
 /// Every rank's `bytes` (any size, each below 2 GiB), in rank order, on every rank.
 std::vector<std::string> allgather(std::string_view bytes);
+/// `to_rank[r]` (one per rank) to rank r; returns what each rank sent this one, in rank order. The sizes
+/// go first (one all-to-all), then only the non-empty messages, all posted at once, with `tag`.
+std::vector<std::string> alltoall(std::span<const std::string> to_rank, int tag);
 /// Send `send` to rank `to` and receive `recv` from rank `from` at once; -1 for
 /// either means no such neighbour (nothing sent or received). The two sizes
 /// may differ; `from` must send exactly `recv_bytes` with the same tag.

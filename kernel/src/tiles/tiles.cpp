@@ -30,6 +30,23 @@ int Tiling::rank_at(int x, int y) const {
                 std::to_string(grid_width()) + "x" + std::to_string(grid_height()) + " grid");
 }
 
+std::vector<int> Tiling::ranks_meeting(TileRect rect) const {
+    // The split is a lattice of cuts: the columns and rows of tiles the rectangle spans, found by bisection.
+    const int x0 = std::max(rect.x0, 0), y0 = std::max(rect.y0, 0);
+    const int x1 = std::min(rect.x1(), grid_width()), y1 = std::min(rect.y1(), grid_height());
+    if (x0 >= x1 || y0 >= y1) return {};
+    const auto& xs = split_.xs;
+    const auto& ys = split_.ys;
+    const int c0 = int(std::upper_bound(xs.begin(), xs.end(), x0) - xs.begin()) - 1;
+    const int c1 = int(std::upper_bound(xs.begin(), xs.end(), x1 - 1) - xs.begin()) - 1;
+    const int r0 = int(std::upper_bound(ys.begin(), ys.end(), y0) - ys.begin()) - 1;
+    const int r1 = int(std::upper_bound(ys.begin(), ys.end(), y1 - 1) - ys.begin()) - 1;
+    std::vector<int> out;
+    for (int r = r0; r <= r1; ++r)
+        for (int c = c0; c <= c1; ++c) out.push_back(r * split_.cols + c);
+    return out;
+}
+
 void Tiling::exchange(std::span<const GridView> grids) {
     const TileRect g = ghosted();
     std::vector<void*> data;
@@ -248,7 +265,7 @@ int TiledRun::agree(int exit_code, int* reporter) {
 namespace {
 
 constexpr int kTagWest = 11, kTagEast = 12, kTagNorth = 13, kTagSouth = 14, kTagCarry = 15, kTagTile = 20,
-              kTagFetch = 21, kTagText = 22;
+              kTagFetch = 21, kTagText = 22, kTagRoute = 23;
 
 /// Copy the rectangle (x, y, w, h) of `grid` (row length `stride`) into `out`, or back with `to_grid`.
 template <typename T>
@@ -325,6 +342,15 @@ std::vector<std::string> NodeTiling::gather(std::string_view bytes, Gather where
     agree_or_throw();
     if (where == Gather::to_rank0) return run_.gather_text(std::string(bytes));
     return mpi::allgather(bytes);
+}
+
+std::vector<std::string> NodeTiling::send_to_ranks(std::span<const std::string> to_rank) {
+    if (to_rank.size() != std::size_t(ranks()))
+        throw Error("internal error: send_to_ranks() takes " + std::to_string(ranks()) +
+                    " messages, one per rank, not " + std::to_string(to_rank.size()));
+    agree_or_throw();
+    if (ranks() == 1) return {to_rank.front()};
+    return mpi::alltoall(to_rank, kTagRoute);
 }
 
 void NodeTiling::share_from_rank0(std::string& bytes) {

@@ -91,6 +91,7 @@ public:
     NodeTiling(TiledRun& run, int halo) : Tiling(run.split(), run.rank(), halo), run_(run) {}
 
     std::vector<std::string> gather(std::string_view bytes, Gather where) override;
+    std::vector<std::string> send_to_ranks(std::span<const std::string> to_rank) override;
     void share_from_rank0(std::string& bytes) override;
     std::shared_ptr<Heightmap> scatter_from_rank0(const Heightmap* whole) override;
     std::vector<float> fetch_samples(const float* mine, AxisSamples columns, AxisSamples rows) override;

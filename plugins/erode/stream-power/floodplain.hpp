@@ -26,8 +26,9 @@
 // in index order (stamp_floodplains, over any window of the grid, by bands
 // of rows on every thread) and the cells lowered (lower_to_floodplains). A river's floodplain reaches W/cell
 // cells, up to ten at 300 km² with the default pipeline's numbers, more than
-// a tile's halo of one: the tiles share their rivers (a few per cent of the
-// cells) and each stamps its own window (TiledModel::plane_floodplains).
+// a tile's halo of one: each tile sends its rivers (a few per cent of its
+// cells) to the tiles their floodplains reach into, and each stamps its own
+// window (TiledModel::plane_floodplains).
 #pragma once
 
 #include <cstdint>

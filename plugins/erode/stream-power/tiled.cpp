@@ -849,13 +849,22 @@ void TiledModel::plane_floodplains() {
             if (floodplain_source(settings_.floodplain, cell_, k, area_[l], h_[l], receiver, reach))
                 floodplain_mine_.push_back({global(l), h_[l], reach});
         }
-    // Every tile's rivers, in the whole grid's index order (the order Model stamps them in: the same
-    // nearest river for every cell, ties included).
-    std::string bytes;
-    put(bytes, floodplain_mine_);
-    const auto all = joined([&] { return tiles_.gather(bytes, Tiling::Gather::to_every_rank); });
+    // Each river goes to the tiles its floodplain reaches into (its own included), a few at most; every tile
+    // stamps those in the whole grid's index order (the order Model stamps them in: the same nearest river
+    // for every cell, ties included, as any river that can reach one of its cells is among them).
+    std::vector<std::vector<FloodplainSource>> to_rank(std::size_t(tiles_.ranks()));
+    for (const FloodplainSource& s : floodplain_mine_) {
+        const int r = int(s.reach), x = int(s.index % W_), y = int(s.index / W_);
+        for (int rank : tiles_.ranks_meeting({x - r, y - r, 2 * r + 1, 2 * r + 1}))
+            to_rank[std::size_t(rank)].push_back(s);
+    }
+    std::vector<std::string> bytes(to_rank.size());
+    for (std::size_t k = 0; k < to_rank.size(); ++k)
+        if (!to_rank[k].empty()) put(bytes[k], to_rank[k]);  // nothing travels to a tile out of every reach
+    const auto all = joined([&] { return tiles_.send_to_ranks(bytes); });
     floodplain_all_.clear();
     for (const auto& b : all) {
+        if (b.empty()) continue;
         std::size_t at = 0;
         const auto theirs = take<FloodplainSource>(b, at);
         floodplain_all_.insert(floodplain_all_.end(), theirs.begin(), theirs.end());
