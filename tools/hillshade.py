@@ -5,7 +5,8 @@
 
 FILE is a square float32 .r32 (orogen's RAW, metres) or any raster GDAL opens
 (python3-gdal). The first N × N samples (default 600) of each are shaded with
-central differences at M metres a cell (default 30).
+central differences at M metres a cell (default 30). Drawn with matplotlib
+(python3-matplotlib: a tool for the docs, so tools/setup.sh leaves it out).
 """
 import argparse
 
@@ -42,7 +43,10 @@ def main():
     p.add_argument("--size", type=int, default=600)
     p.add_argument("--cell", type=float, default=30.0)
     a = p.parse_args()
-    import matplotlib
+    try:
+        import matplotlib
+    except ImportError:
+        raise SystemExit("hillshade.py draws with matplotlib: apt-get install python3-matplotlib")
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
