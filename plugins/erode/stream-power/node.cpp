@@ -476,19 +476,22 @@ void check(CheckContext& ctx) {
         ctx.error("routing",
                   "multiple flow directions need filled lakes (water crossing an unfilled lake would "
                   "flow back into it); use depressions=fill or routing=d8");
-    if (ctx.text("routing") != "mfd" && ctx.given("mfd_exponent"))
+    if (ctx.text("routing") != "mfd" && ctx.given("mfd_exponent") && !ctx.given("routing"))
         ctx.error("mfd_exponent", "mfd_exponent weights multiple flow directions; give routing=mfd as well");
     if (ctx.real("dt") > ctx.real("years"))
         ctx.error("dt", "the time step is longer than the run (years); give dt <= years");
     // The beds' parameters describe beds: without a thickness there are none, and a spread of landslide
-    // angles needs landslides.
-    if (!(ctx.real("bed_thickness") > 0.0))
+    // angles needs landslides. A shaping parameter without its process is an error only where the process's
+    // switch is not given at all (forgotten); a switch given as off (`--set range.floodplain_area=0` on a spec
+    // that shapes floodplains) turns the process off on purpose, its shaping parameters then unused.
+    if (!(ctx.real("bed_thickness") > 0.0) && !ctx.given("bed_thickness"))
         for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast",
                               "bed_fold_amplitude", "bed_fold_wavelength", "bed_thickness_spread", "bed_fault_spacing",
                               "bed_fault_throw", "bed_facies_length", "bed_facies_share"})
             if (ctx.given(p))
                 ctx.error(p, std::string(p) + " describes the rock's beds; give bed_thickness (m) as well");
-    if ((ctx.real("bed_fault_spacing") > 0.0) != (ctx.real("bed_fault_throw") > 0.0))
+    if ((ctx.real("bed_fault_spacing") > 0.0) != (ctx.real("bed_fault_throw") > 0.0) &&
+        !ctx.given(ctx.real("bed_fault_spacing") > 0.0 ? "bed_fault_throw" : "bed_fault_spacing"))
         ctx.error(ctx.real("bed_fault_spacing") > 0.0 ? "bed_fault_spacing" : "bed_fault_throw",
                   "faults need both a spacing and a throw; give bed_fault_spacing (m) and bed_fault_throw (m)");
     if (const double spacing = ctx.real("bed_fault_spacing"); spacing > 0.0 && spacing < 100.0)
@@ -499,15 +502,16 @@ void check(CheckContext& ctx) {
         ctx.error("bed_facies_length",
                   "facies changing within less than 100 m would speckle the beds cell by cell; give "
                   "bed_facies_length >= 100 (m), or 0 for beds of one strength each");
-    if (ctx.given("bed_facies_share") && !(ctx.real("bed_facies_length") > 0.0))
+    if (ctx.given("bed_facies_share") && !(ctx.real("bed_facies_length") > 0.0) && !ctx.given("bed_facies_length"))
         ctx.error("bed_facies_share",
                   "bed_facies_share sets how much the facies change a bed's strength; give bed_facies_length (m) "
                   "as well");
-    if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0))
+    if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0) &&
+        !ctx.given("landslide_angle"))
         ctx.error("landslide_block_spread",
                   "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
     for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area", "bank_wider_area", "bank_widest_floor"})
-        if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0))
+        if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0) && !ctx.given("bank_erosion"))
             ctx.error(bank, std::string(bank) + " shapes the rivers' bank erosion; give bank_erosion > 0 as well");
     if (ctx.real("bank_wider_area") > 0.0 && ctx.real("bank_erosion") > 0.0) {
         if (!(ctx.real("bank_wide_area") > 0.0))
@@ -530,9 +534,9 @@ void check(CheckContext& ctx) {
                       "bank_wider_area / bank_wide_area; give bank_wider_area > bank_wide_area > 0");
     }
     for (const char* fp : {"floodplain_width", "floodplain_exponent", "floodplain_slope", "floodplain_max_slope"})
-        if (ctx.given(fp) && !(ctx.real("floodplain_area") > 0.0))
+        if (ctx.given(fp) && !(ctx.real("floodplain_area") > 0.0) && !ctx.given("floodplain_area"))
             ctx.error(fp, std::string(fp) + " shapes the rivers' floodplains; give floodplain_area (m²) as well");
-    if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0))
+    if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0) && !ctx.given("landslide_angle"))
         ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
     if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
         a > 0.0 && (a - spread < 5.0 || a + spread > 80.0))
@@ -593,12 +597,12 @@ void check(CheckContext& ctx) {
     if (ctx.flag("glaciers")) ctx.output().layers.insert("ice_flux");
     if (ctx.flag("glaciers") && ctx.real("deposition") > 0.0)
         ctx.error("glaciers", "glaciers erode detachment-limited for now; give deposition=0 or glaciers=false");
-    if (!ctx.flag("glaciers"))
+    if (!ctx.flag("glaciers") && !ctx.given("glaciers"))
         for (const char* p : {"ela", "ice_balance_gradient", "ice_max_balance", "ice_erodibility", "ice_flux_exponent",
                               "glacier_half_width", "glacier_min_flux", "trough_wall_angle"})
             if (ctx.given(p)) ctx.error(p, std::string(p) + " describes glaciers; give glaciers=true as well");
     if (ctx.text("rain") == "orographic") ctx.output().layers.insert("rain");
-    else
+    else if (!ctx.given("rain"))
         for (const char* p : kRainParams)
             if (ctx.given(p))
                 ctx.error(p, std::string(p) + " describes orographic rain; give rain=\"orographic\" as well");

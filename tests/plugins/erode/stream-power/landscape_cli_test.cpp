@@ -224,6 +224,46 @@ TEST(LandscapeCli, RockAndGlacierParametersAreCheckedBeforeTheRun) {
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
 }
 
+TEST(LandscapeCli, AProcessTurnedOffOnPurposeKeepsItsShapingParametersUnused) {
+    // `make demo`'s spec shapes its floodplains, banks, beds, faults and landslides; turning one off from the
+    // command line (its switch given as 0) must check and run, its shaping parameters then unused, where
+    // the same parameters without their switch at all are errors (the test above).
+    const std::string spec = q(std::string(OROGEN_SOURCE_DIR) + "/pipelines/default.orogen");
+    for (const char* off : {"range.floodplain_area=0", "range.bank_erosion=0", "range.bed_thickness=0",
+                            "range.bed_fault_throw=0", "range.bed_fault_spacing=0", "range.landslide_angle=0"}) {
+        const RunResult r = run_orogen("check " + spec + " --set " + off);
+        EXPECT_EQ(r.exit_code, 0) << off << "\n" << r.err;
+    }
+    TempDir dir;
+    const auto switched = dir.write("off.orogen",
+                                    "orogen 1\n"
+                                    "grid 65 cell=30\n"
+                                    "base = generate:shape(kind=pyramid, height=300)\n"
+                                    "a = erode:stream-power(base, glaciers=false, ela=2000)\n"
+                                    "b = erode:stream-power(base, rain=uniform, wind_from=200)\n"
+                                    "c = erode:stream-power(base, routing=d8, mfd_exponent=2)\n"
+                                    "d = erode:stream-power(base, bed_thickness=50, bed_facies_length=0, "
+                                    "bed_facies_share=0.3)\n");
+    const RunResult checked = run_orogen("check " + q(switched));
+    EXPECT_EQ(checked.exit_code, 0) << checked.err;
+    // ... and the run is the one without the process: floodplains off on a small spec that shapes them.
+    const auto small = dir.write("fp.orogen",
+                                 "orogen 1\n"
+                                 "grid 129 cell=30\n"
+                                 "base = generate:diamond-square(roughness=0.5, amplitude=300)\n"
+                                 "a = erode:stream-power(base, years=1e5, dt=2e4, floodplain_area=1e5, "
+                                 "floodplain_width=60, floodplain_max_slope=10)\n"
+                                 "b = erode:stream-power(base, years=1e5, dt=2e4)\n"
+                                 "export:raw(a, path=\"a.r32\")\n"
+                                 "export:raw(b, path=\"b.r32\")\n");
+    const RunResult with = run_orogen("run " + q(small) + " --out " + q(dir / "with"));
+    ASSERT_EQ(with.exit_code, 0) << with.err;
+    const RunResult without = run_orogen("run " + q(small) + " --set a.floodplain_area=0 --out " + q(dir / "without"));
+    ASSERT_EQ(without.exit_code, 0) << without.err;
+    EXPECT_NE(slurp(dir / "with" / "a.r32"), slurp(dir / "with" / "b.r32"));  // floodplains change it
+    EXPECT_EQ(slurp(dir / "without" / "a.r32"), slurp(dir / "without" / "b.r32"));  // and off, nothing
+}
+
 TEST(LandscapeCli, RainAndUpliftTaperParametersAreCheckedBeforeTheRun) {
     TempDir dir;
     const auto spec = dir.write("rain.orogen",
