@@ -228,13 +228,20 @@ TEST(LandscapeCli, AProcessTurnedOffOnPurposeKeepsItsShapingParametersUnused) {
     // `make demo`'s spec shapes its floodplains, banks, beds, faults and landslides; turning one off from the
     // command line (its switch given as 0) must check and run, its shaping parameters then unused, where
     // the same parameters without their switch at all are errors (the test above).
-    const std::string spec = q(std::string(OROGEN_SOURCE_DIR) + "/pipelines/default.orogen");
+    // The terrain part of the spec only, up to its first output: the render and video plugins it ends with
+    // are not built in every configuration (the ThreadSanitizer build leaves them out).
+    TempDir dir;
+    const std::string demo = slurp(std::string(OROGEN_SOURCE_DIR) + "/pipelines/default.orogen");
+    const std::size_t outputs = demo.find("\nexport:");
+    ASSERT_NE(outputs, std::string::npos);
+    ASSERT_NE(demo.find("floodplain_area="), std::string::npos);  // still the spec that shapes them all
+    const std::string spec =
+        q(dir.write("demo.orogen", demo.substr(0, outputs + 1) + "export:raw(soil, path=\"t.r32\")\n"));
     for (const char* off : {"range.floodplain_area=0", "range.bank_erosion=0", "range.bed_thickness=0",
                             "range.bed_fault_throw=0", "range.bed_fault_spacing=0", "range.landslide_angle=0"}) {
         const RunResult r = run_orogen("check " + spec + " --set " + off);
         EXPECT_EQ(r.exit_code, 0) << off << "\n" << r.err;
     }
-    TempDir dir;
     const auto switched = dir.write("off.orogen",
                                     "orogen 1\n"
                                     "grid 65 cell=30\n"
