@@ -869,7 +869,8 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
                     .unit("m")
                     .help("beds whose facies change along them: each bed's strength drifts over about this "
                           "distance, so cliff bands fade into benches along their outcrop and weak beds stiffen "
-                          "(a few km; 0 = each bed one strength across the map)"),
+                          "(300 m in make demo: cliff bands break into knobs and gaps; a few km: they fade "
+                          "along their outcrop; 0 = each bed one strength across the map)"),
                 Param::real("bed_facies_share", 0.5)
                     .min(0.0)
                     .max(1.0)

@@ -363,11 +363,15 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
     if (facies) {
         corner.resize(base.size() * std::size_t(a_count * b_count));
         const std::uint64_t s = random::hash(beds.seed, kFaciesSalt);
-        for (std::size_t j = 0; j < base.size(); ++j)
-            for (std::int64_t bb = 0; bb < b_count; ++bb)
+        // Each corner is its own draw: the rows of corners (a bed's row bb) in parallel, the same bits.
+        parallel_for(0, std::int64_t(base.size()) * b_count, 16, [&](std::int64_t r0, std::int64_t r1) {
+            for (std::int64_t r = r0; r < r1; ++r) {
+                const std::int64_t j = r / b_count, bb = r % b_count;
                 for (std::int64_t a = 0; a < a_count; ++a)
-                    corner[(j * std::size_t(b_count) + std::size_t(bb)) * std::size_t(a_count) + std::size_t(a)] =
-                        facies_node(s, first + std::int64_t(j), a_lo + a, b_lo + bb);
+                    corner[std::size_t(r) * std::size_t(a_count) + std::size_t(a)] =
+                        facies_node(s, first + j, a_lo + a, b_lo + bb);
+            }
+        });
     }
     const bool uneven = beds.thickness_spread > 0.0;
     const std::int64_t last = first + std::int64_t(base.size()) - 1;

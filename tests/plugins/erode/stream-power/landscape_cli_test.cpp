@@ -238,7 +238,8 @@ TEST(LandscapeCli, AProcessTurnedOffOnPurposeKeepsItsShapingParametersUnused) {
     const std::string spec =
         q(dir.write("demo.orogen", demo.substr(0, outputs + 1) + "export:raw(soil, path=\"t.r32\")\n"));
     for (const char* off : {"range.floodplain_area=0", "range.bank_erosion=0", "range.bed_thickness=0",
-                            "range.bed_fault_throw=0", "range.bed_fault_spacing=0", "range.landslide_angle=0"}) {
+                            "range.bed_fault_throw=0", "range.bed_fault_spacing=0", "range.landslide_angle=0",
+                            "range.bed_facies_length=0"}) {
         const RunResult r = run_orogen("check " + spec + " --set " + off);
         EXPECT_EQ(r.exit_code, 0) << off << "\n" << r.err;
     }
