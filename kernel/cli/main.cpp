@@ -323,22 +323,37 @@ std::string tiles_problem(const Args& args, int ranks) {
 std::optional<Plan> check_spec_text(const std::string& path, std::string text, const PluginSet& plugins,
                                     const Args& args);
 
+/// Under mpirun every rank checks the same spec and reaches the same verdict, but rank 0 alone says why.
+/// A rank that left at once with exit code 2 would make mpirun end the others, rank 0 perhaps before it
+/// had written its message (seen under load: the exit code right, the message missing). So the ranks meet
+/// here after rank 0 has written it; failed on any rank is failed on all. One collective on every path.
+bool failed_on_any_rank(bool failed) {
+    if (!g_mpi) return failed;
+    std::fflush(stderr);
+    int any = failed ? 1 : 0;
+    mpi::max_all(&any, 1);
+    return any != 0;
+}
+
+/// Whether this process prints what the ranks agree on: the only one, or rank 0 under mpirun.
+bool speaks_for_all() { return !g_mpi || g_mpi->rank == 0; }
+
 std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins, const Args& args) {
     std::error_code ec;
+    std::string problem, text;
     if (!fs::exists(path, ec)) {
-        std::fprintf(stderr, "orogen: error: cannot read spec %s: no such file\n", path.c_str());
-        return std::nullopt;
+        problem = "cannot read spec " + path + ": no such file";
+    } else if (fs::is_directory(path, ec)) {
+        problem = "cannot read spec " + path + ": it is a folder; give a .orogen file";
+    } else {
+        try {
+            const auto bytes = read_file(path);
+            text.assign(bytes.begin(), bytes.end());
+        } catch (const std::exception& e) { problem = e.what(); }
     }
-    if (fs::is_directory(path, ec)) {
-        std::fprintf(stderr, "orogen: error: cannot read spec %s: it is a folder; give a .orogen file\n", path.c_str());
-        return std::nullopt;
-    }
-    std::string text;
-    try {
-        const auto bytes = read_file(path);
-        text.assign(bytes.begin(), bytes.end());
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "orogen: error: %s\n", e.what());
+    if (!problem.empty()) {
+        if (speaks_for_all()) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
+        failed_on_any_rank(true);
         return std::nullopt;
     }
     return check_spec_text(path, std::move(text), plugins, args);
@@ -351,9 +366,12 @@ std::optional<Plan> check_spec_text(const std::string& path, std::string text, c
     spec::Diagnostics diags;
     spec::Spec parsed = spec::parse(source, diags);
     if (diags.has_errors()) {  // syntax first: semantic errors on a broken tree would be noise
-        std::fputs(diags.format().c_str(), stderr);
-        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
-                     path.c_str());
+        if (speaks_for_all()) {
+            std::fputs(diags.format().c_str(), stderr);
+            std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
+                         path.c_str());
+        }
+        failed_on_any_rank(true);
         return std::nullopt;
     }
     CheckOptions options;
@@ -378,13 +396,13 @@ std::optional<Plan> check_spec_text(const std::string& path, std::string text, c
         check_tiled(plan, tiled_split(plan, args), tiled, diags);
     }
     // Under mpirun every rank checks the same plan; rank 0 alone prints.
-    if (g_mpi && g_mpi->rank != 0) return diags.has_errors() ? std::nullopt : std::optional<Plan>(std::move(plan));
-    if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
-    if (diags.has_errors()) {
-        std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
-                     path.c_str());
-        return std::nullopt;
+    if (speaks_for_all()) {
+        if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
+        if (diags.has_errors())
+            std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
+                         path.c_str());
     }
+    if (failed_on_any_rank(diags.has_errors())) return std::nullopt;
     return plan;
 }
 
@@ -659,6 +677,7 @@ int main(int argc, char** argv) {
         g_mpi = MpiRun{mpi_session->rank(), mpi_session->size()};
         if (const std::string problem = tiles_problem(args, g_mpi->size); !problem.empty()) {
             if (g_mpi->rank == 0) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
+            failed_on_any_rank(true);
             return exit_bad_input;
         }
     } else if (args.tiles) {

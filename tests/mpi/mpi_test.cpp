@@ -324,6 +324,31 @@ TEST(Mpi, TilesNarrowerThanPipeOrHydraulicHalosAreRefusedAtTheNode) {
     EXPECT_FALSE(fs::exists(dir / "o" / "h.r32"));
 }
 
+TEST(Mpi, ASpecErrorIsSaidOnceByRankZeroBeforeAnyRankLeaves) {
+    // Every rank reaches the same verdict; rank 0 alone says why, and the ranks meet before leaving, so
+    // mpirun does not end rank 0 before its message is out (it once did under load: exit 2, no message).
+    TempDir dir;
+    const auto count = [](const std::string& text, const std::string& what) {
+        std::size_t n = 0;
+        for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+        return n;
+    };
+    const auto broken = dir.write("broken.orogen", "orogen 1\ngrid 33\nf = generate:fault(\n");
+    const RunResult syntax = run_mpi(3, "check " + q(broken));
+    EXPECT_EQ(syntax.exit_code, 2);
+    EXPECT_EQ(count(syntax.err, "broken.orogen:3:19: error: this '(' of the call to generate:fault is never closed"),
+              1u)
+        << syntax.err;
+    const RunResult missing = run_mpi(3, "run " + q(dir / "missing.orogen") + " --out " + q(dir / "o"));
+    EXPECT_EQ(missing.exit_code, 2);
+    EXPECT_EQ(count(missing.err, "missing.orogen: no such file"), 1u) << missing.err;
+    for (int i = 0; i < 4; ++i) {  // a check error found by every rank, said once each time
+        const RunResult r = run_mpi(4, "check " + q(broken));
+        EXPECT_EQ(count(r.err, "1 error in"), 1u) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "o"));
+}
+
 TEST(Mpi, TimelapseOfATiledNodeThatDoesNotGatherItIsRefused) {
     // A plugin's tiled node without tiled_timelapse (every node of orogen's own gathers its frames).
     TempDir dir;
