@@ -214,12 +214,13 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
-                         // Seed 42's distances over the 20 figures since stop 45 (17 before): Himalaya 1.17
-                         // (0.84), Rif 0.52 with its floodplains since stop 47 (0.89 before them; 0.75),
+                         // Seed 42's distances over the 20 figures since stop 45 (17 before): Himalaya 1.10 with
+                         // facies and floors to eleven cells since stop 49 (1.17 before; 0.84), Rif 0.52 with its
+                         // floodplains since stop 47 (0.89 before them; 0.75),
                          // Raukumara 0.73 with facies every 300 m since stop 49 (0.79 before; 0.65), Kahurangi
                          // 0.65 (0.67 with stop 48's facies over 3 km; 0.50), Mont Blanc 1.15 with its banks (1.68
                          // without, nearest the Andes).
-                         testing::Values(Preset{"himalaya", "himalaya_baspa_30m", 1.3}, Preset{"rif", "morocco_rif_27m", 0.65},
+                         testing::Values(Preset{"himalaya", "himalaya_baspa_30m", 1.2}, Preset{"rif", "morocco_rif_27m", 0.65},
                                          Preset{"raukumara", "nz_raukumara_30m", 0.8},
                                          Preset{"kahurangi", "nz_kahurangi_30m", 0.8},
                                          Preset{"montblanc", "alps_montblanc_93m", 1.35, 769, 90.0,
