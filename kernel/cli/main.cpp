@@ -410,7 +410,7 @@ int cmd_check(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() != 1) return usage_error("check needs one spec file");
     auto plan = load_spec(args.positional[0], plugins, args);
     if (!plan) return exit_bad_input;
-    if (g_mpi && g_mpi->rank != 0) return exit_ok;
+    if (!speaks_for_all()) return exit_ok;
     // The grid's defaults are said, not left to be discovered: no grid line is 513 x 513, no cell= is 1 m.
     std::printf("%s: ok (%zu node%s, grid %dx%d%s, cell %g m%s, seed %llu)\n", args.positional[0].c_str(),
                 plan->nodes.size(), plan->nodes.size() == 1 ? "" : "s", plan->grid.width, plan->grid.height,
@@ -433,7 +433,7 @@ int cmd_run(const Args& args, const PluginSet& plugins) {
 int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugins, bool summary) {
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
-    const bool speaks = !g_mpi || g_mpi->rank == 0;  // under mpirun, rank 0 shows progress and the summary
+    const bool speaks = speaks_for_all();  // under mpirun, rank 0 shows progress and the summary
     ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, args.quiet || !speaks);
     std::optional<TiledRun> tiled;
     if (g_mpi) tiled.emplace(tiled_split(*plan, args), g_mpi->rank);
@@ -676,7 +676,7 @@ int main(int argc, char** argv) {
         }
         g_mpi = MpiRun{mpi_session->rank(), mpi_session->size()};
         if (const std::string problem = tiles_problem(args, g_mpi->size); !problem.empty()) {
-            if (g_mpi->rank == 0) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
+            if (speaks_for_all()) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
             failed_on_any_rank(true);
             return exit_bad_input;
         }
