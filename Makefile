@@ -41,7 +41,7 @@ TSAN_BUILD ?= build-tsan
 # the cache's parallel copies and hashes, and the kernel tests that run specs on several threads. Not here: the
 # render passes, export:video and export:paraview (their threads are llvmpipe's, FFmpeg's and ParaView's, not
 # instrumented) — CI's ASan phase covers their code (ASAN_CI).
-TSAN_ONLY  ?= ^/plugins/(erode|generate|tectonics|import)/[^/]+$$|^/plugins/export/(png|raw|gltf|vdb|vtk|geotiff|exr|maps|tiles)$$|^/tests/plugins/(erode|generate|tectonics)/[^/]+$$|^/tests/plugins/export/(png|raw|gltf|vdb|geotiff|exr|maps|tiles)$$|^/tests/(cache|kernel)$$|^/tests/libs/(analysis|climate|formats|mesh|relief|solvers)$$
+TSAN_ONLY  ?= ^/plugins/(erode|generate|tectonics|import|process)/[^/]+$$|^/plugins/export/(png|raw|gltf|vdb|vtk|geotiff|exr|maps|tiles)$$|^/tests/plugins/(erode|generate|tectonics)/[^/]+$$|^/tests/plugins/export/(png|raw|gltf|vdb|geotiff|exr|maps|tiles)$$|^/tests/(cache|kernel)$$|^/tests/libs/(analysis|climate|formats|mesh|relief|solvers)$$
 # Tests TSan gains nothing from, left to the other phases (they were half of the TSan phase's test time):
 # check-time diagnostics, which run no thread (the kernel's run under ASan+UBSan in asan-ci, the plugins'
 # in the release suite), and the long physics validations (dam break, hydrostatics, experiment 4.1, the

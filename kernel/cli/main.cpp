@@ -56,7 +56,7 @@ const char* usage_text =
     "                                                  against real DEMs: a table, DIR/analysis.json, charts,\n"
     "                                                  renderings and DIR/README.md (default DIR: analysis/;\n"
     "                                                  docs/analysis.md)\n"
-    "  orogen list [KIND]                              the nodes the loaded plugins provide\n"
+    "  orogen list [KIND]                              the nodes (and processes) the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
     "  orogen version                                  kernel, plugin API and plugin versions\n"
     "  orogen cache info [--cache DIR] [--cache-size SIZE]   what the cache folder holds: entries, size, limit,\n"
@@ -522,10 +522,10 @@ int cmd_list(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() > 1) return usage_error("list takes at most one kind");
     const std::string kind = args.positional.empty() ? "" : args.positional[0];
     static const std::vector<std::string> kinds = {"generate", "erode",  "tectonics", "render",
-                                                   "export",   "import", "analyze"};
+                                                   "export",   "import", "analyze",   "process"};
     if (!kind.empty() && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) {
-        std::string msg =
-            "unknown kind '" + kind + "' (kinds: generate, erode, tectonics, render, export, import, analyze)";
+        std::string msg = "unknown kind '" + kind +
+            "' (kinds: generate, erode, tectonics, render, export, import, analyze; and process)";
         const std::string guess = spec::closest(kind, kinds);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
@@ -534,6 +534,12 @@ int cmd_list(const Args& args, const PluginSet& plugins) {
     for (const auto* n : plugins.registry().nodes()) {
         if (!kind.empty() && n->kind != kind) continue;
         std::printf("%-26s %s\n", n->qualified_name().c_str(), n->summary.c_str());
+    }
+    const auto processes = plugins.registry().processes();
+    if ((kind.empty() || kind == "process") && !processes.empty()) {
+        std::printf("%sprocesses (a loop node's body, one a line: erode:evolve(...) { uplift() flow() ... }):\n",
+                    kind.empty() ? "\n" : "");
+        for (const auto* p : processes) std::printf("  %-24s %s\n", p->name.c_str(), p->summary.c_str());
     }
     return exit_ok;
 }
@@ -559,16 +565,62 @@ std::string value_text(const ParamValue& v, const Param& p) {
     return s.str();
 }
 
+void print_params(const std::vector<Param>& params) {
+    std::printf("\nparameters:%s\n", params.empty() ? " none" : "");
+    for (const auto& p : params) {
+        const std::string type = std::string(to_string(p.type));
+        std::string range;
+        if (p.minimum || p.maximum) {
+            range = std::string(p.minimum ? (p.minimum_exclusive ? "(" : "[") : "(") +
+                (p.minimum ? value_text(*p.minimum, p) : "-inf") + ", " +
+                (p.maximum ? value_text(*p.maximum, p) : "inf") + (p.maximum ? (p.maximum_exclusive ? ")" : "]") : ")");
+        }
+        std::printf("  %-16s %-12s default %-12s%s%s\n", p.name.c_str(), type.c_str(),
+                    value_text(p.default_value, p).c_str(), range.empty() ? "" : ("  range " + range).c_str(),
+                    p.unit_text.empty() ? "" : ("  unit " + p.unit_text).c_str());
+        if (p.type == ParamType::choice) {
+            std::string options;
+            for (const auto& c : p.choices) options += (options.empty() ? "" : ", ") + c;
+            std::printf("      one of: %s\n", options.c_str());
+        }
+        if (!p.help_text.empty()) std::printf("      %s\n", p.help_text.c_str());
+    }
+}
+
+int help_process(const ProcessDescriptor& p, const PluginSet& plugins) {
+    std::printf("process %s — %s\n", p.name.c_str(), p.summary.c_str());
+    if (!p.description.empty()) std::printf("\n%s\n", p.description.c_str());
+    std::printf("\nruns: %s%s\n",
+                p.cadence == Cadence::once_per_step ? "once a step (on its first sub-step)" : "every sub-step",
+                p.tile_halo >= 0 ? ("; tiled, halo " + std::to_string(p.tile_halo)).c_str() : "; not tiled");
+    std::printf("fields:\n");
+    for (const auto& f : p.fields)
+        std::printf("  %-17s %-20s%s%s\n", std::string(to_string(f.access)).c_str(),
+                    f.field == kFlowGraph ? "flow (the flow graph)" : f.field.c_str(),
+                    f.unit.empty() ? "" : ("  " + f.unit).c_str(), f.help.empty() ? "" : ("  — " + f.help).c_str());
+    if (!p.adds_layers.empty()) {
+        std::string layers;
+        for (const auto& l : p.adds_layers) layers += (layers.empty() ? "" : ", ") + l;
+        std::printf("adds layers: %s\n", layers.c_str());
+    }
+    print_params(p.params);
+    std::printf("\nprovided by %s\n", plugins.registry().provider(p.name).c_str());
+    return exit_ok;
+}
+
 int cmd_help(const Args& args, const PluginSet& plugins) {
     if (args.positional.size() != 1) return usage_error("help needs a node, e.g. `orogen help generate:fault`");
     const std::string& name = args.positional[0];
     const NodeDescriptor* n = plugins.registry().find(name);
     if (!n) {
+        const std::string bare = name.rfind("process:", 0) == 0 ? name.substr(8) : name;
+        if (const ProcessDescriptor* p = plugins.registry().find_process(bare)) return help_process(*p, plugins);
         std::vector<std::string> names;
         for (const auto* d : plugins.registry().nodes()) {
             names.push_back(d->qualified_name());
             if (d->name == name) n = d;  // `orogen help fault` is fine too
         }
+        for (const auto* p : plugins.registry().processes()) names.push_back(p->name);
         if (!n) {
             std::string msg = "unknown node '" + name + "'";
             const std::string guess = spec::closest(name, names);
@@ -597,25 +649,8 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
     for (const auto& s : n->side_outputs)
         std::printf("side value: NAME.%s (%s)%s\n", s.name.c_str(), describe_type(s.type, s.series).c_str(),
                     s.help.empty() ? "" : (" — " + s.help).c_str());
-    std::printf("\nparameters:%s\n", n->params.empty() ? " none" : "");
-    for (const auto& p : n->params) {
-        const std::string type = std::string(to_string(p.type));
-        std::string range;
-        if (p.minimum || p.maximum) {
-            range = std::string(p.minimum ? (p.minimum_exclusive ? "(" : "[") : "(") +
-                (p.minimum ? value_text(*p.minimum, p) : "-inf") + ", " +
-                (p.maximum ? value_text(*p.maximum, p) : "inf") + (p.maximum ? (p.maximum_exclusive ? ")" : "]") : ")");
-        }
-        std::printf("  %-16s %-12s default %-12s%s%s\n", p.name.c_str(), type.c_str(),
-                    value_text(p.default_value, p).c_str(), range.empty() ? "" : ("  range " + range).c_str(),
-                    p.unit_text.empty() ? "" : ("  unit " + p.unit_text).c_str());
-        if (p.type == ParamType::choice) {
-            std::string options;
-            for (const auto& c : p.choices) options += (options.empty() ? "" : ", ") + c;
-            std::printf("      one of: %s\n", options.c_str());
-        }
-        if (!p.help_text.empty()) std::printf("      %s\n", p.help_text.c_str());
-    }
+    if (n->processes) std::printf("body: processes in braces after the call, one a line (`orogen list process`)\n");
+    print_params(n->params);
     std::printf("\nprovided by %s\n", plugins.registry().provider(n->qualified_name()).c_str());
     return exit_ok;
 }

@@ -1,5 +1,5 @@
-// bench-links: TBB::tbb
-// One step of the stream-power landscape model (orogen::stream_power::Model::step:
+// bench-links: TBB::tbb orogen_landscape
+// One step of the stream-power landscape model (orogen::landscape::Model::step:
 // uplift, D8 routing, pit resolution, drainage area (D8, or multiple flow
 // directions with mfd:1), implicit diffusion, implicit incision, and with banks:4 the rivers cutting
 // their banks) at 1025² and 4097², and its parts. Targets (2 cores): one step
@@ -13,7 +13,7 @@
 //    inside, K = 2e-4, m = 0.4, n = 1, D = 0.01 m²/yr, dt = 2e4 yr, the
 //    average over the first `steps` steps from the noise (the first step
 //    resolves about a third of the cells as pits).
-#include "stream_power.hpp"
+#include <orogen/landscape/stream_power.hpp>
 
 #include <orogen/random.hpp>
 
@@ -27,7 +27,7 @@
 namespace {
 
 using namespace orogen;
-using namespace orogen::stream_power;
+using namespace orogen::landscape;
 
 std::vector<double> dome(int n) {
     std::vector<double> h(std::size_t(n) * n);

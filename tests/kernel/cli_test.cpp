@@ -230,13 +230,14 @@ TEST(Cli, ListHelpAndVersionDescribeThePlugins) {
     EXPECT_TRUE(std::regex_search(r.out, std::regex("\n  generate-fault +0\\.1\\.0 +.*orogen_generate_fault\\.so\n")));
 }
 
-// Every plugin's id is `kind-name`, the folder plugins/<kind>/<name> it is built
+// Every plugin's id is `kind-name` (a process plugin's `process-name`), the folder plugins/<kind>/<name> it is built
 // from (its library is orogen_<kind>_<name>.so, with '_' for '-').
 TEST(Cli, EveryPluginIdIsKindDashName) {
     auto r = run_orogen("version");
     ASSERT_EQ(r.exit_code, 0);
     const std::regex line("^  (\\S+) +\\S+ +\\S*/orogen_([a-z0-9_]+)\\.so$");
-    const std::regex pattern("^(generate|erode|tectonics|render|export|import|analyze)-[a-z0-9]+(-[a-z0-9]+)*$");
+    const std::regex pattern(
+        "^(generate|erode|tectonics|render|export|import|analyze|process)-[a-z0-9]+(-[a-z0-9]+)*$");
     std::istringstream in(r.out);
     std::string l;
     int plugins = 0;

@@ -35,6 +35,8 @@
 
 namespace orogen {
 
+struct ProcessCall;  // orogen/process.hpp: a process of a loop node's body, checked
+
 // ---------------------------------------------------------------- parameters
 
 enum class ParamType { integer, real, boolean, string, choice, point, points, path };
@@ -204,6 +206,14 @@ public:
         return nullptr;
     }
 
+    /// For a node that takes processes (NodeDescriptor::processes): the body's processes, checked (plugin API 9).
+    virtual const std::vector<ProcessCall>& processes() const;
+    /// Report an error at parameter `param` of the body's process `index` (at its call if empty).
+    virtual void process_error(std::size_t index, std::string_view param, std::string message) {
+        (void)index;
+        error(param, std::move(message));
+    }
+
     /// True if heightmap input `i` has layer `name` (or may have it: its layers
     /// are not known before the run). Otherwise reports at `param`
     /// "no layer 'NAME' on the input (the input's layers are: a, b); HINT" and returns false.
@@ -267,6 +277,10 @@ public:
     /// sample if `data` holds a NaN or infinity.
     void check_finite(std::span<const float> data, std::string_view what, std::int64_t step) const;
 
+    /// For a node that takes processes (NodeDescriptor::processes): the body's processes, in the spec's
+    /// order, checked and with every parameter filled in (plugin API 9). Empty for other nodes.
+    virtual const std::vector<ProcessCall>& processes() const;
+
     /// In a tiled (MPI) run, for a node with tile_halo >= 0: the split, this
     /// rank's tile and the halo exchange (orogen/tiles.hpp). nullptr otherwise:
     /// the node then sees the whole grid, as always.
@@ -320,6 +334,10 @@ struct NodeDescriptor {
     /// Optional cross-parameter and input checks, run at check time.
     std::function<void(CheckContext&)> check;
     std::function<NodeOutputs(NodeContext&)> run;
+    /// A node that runs a loop whose body the spec gives as processes in braces after the call
+    /// (orogen/process.hpp): `NAME = erode:evolve(...) { uplift(...) flow() ... }` (plugin API 9).
+    /// The kernel checks the body against the registered processes and the fields they declare.
+    bool processes = false;
     /// Whether its result may come from the cache (plugin API 3).
     CachePolicy cache = CachePolicy::store;
     /// A tiled node (tile_halo >= 0) that records its time-lapse under mpirun

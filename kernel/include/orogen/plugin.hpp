@@ -16,6 +16,7 @@
 #pragma once
 
 #include <orogen/node.hpp>
+#include <orogen/process.hpp>
 
 #include <cstdint>
 #include <functional>
@@ -34,7 +35,9 @@
 ///    ghosted grids and one typed exchange, typed reductions with an operator, gather() to rank 0 or to
 ///    every rank, TiledFields for a grid eroder's tiled loop; six virtual primitives instead of twenty.
 /// 8: Tiling::send_to_ranks (a seventh primitive: bytes to chosen ranks only) and Tiling::ranks_meeting.
-#define OROGEN_PLUGIN_API_VERSION 8
+/// 9: processes (orogen/process.hpp): Registry::add(ProcessDescriptor), NodeDescriptor::processes,
+///    NodeContext::processes() and CheckContext::processes().
+#define OROGEN_PLUGIN_API_VERSION 9
 
 namespace orogen {
 
@@ -50,10 +53,16 @@ public:
     /// error names both plugins' files); the first one stays.
     void add(NodeDescriptor node);
 
+    /// Add a process (a part of a loop node's body). A second process with the same name is refused.
+    void add(ProcessDescriptor process);
+
     const NodeDescriptor* find(std::string_view qualified_name) const;
+    const ProcessDescriptor* find_process(std::string_view name) const;
+    /// All processes, sorted by name.
+    std::vector<const ProcessDescriptor*> processes() const;
     /// All nodes, sorted by kind then name.
     std::vector<const NodeDescriptor*> nodes() const;
-    /// The file of the plugin that registered `qualified_name` ("" if built in).
+    /// The file of the plugin that registered `qualified_name` ("" if built in); for a process, its name.
     std::string provider(std::string_view qualified_name) const;
 
     /// Set by the loader while a plugin's callback runs.

@@ -40,6 +40,10 @@ Hasher& Hasher::text(std::string_view s) {
     return bytes(s.data(), s.size());
 }
 
+namespace {
+void hash_params(Hasher& h, const std::map<std::string, ParamValue, std::less<>>& params);
+}  // namespace
+
 Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std::optional<Digest>>& inputs,
                 std::string_view plugin_name, std::string_view plugin_version, std::string_view plugin_identity,
                 std::uint64_t seed) {
@@ -53,8 +57,25 @@ Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std
     h.u64(seed);
     h.u64(std::uint64_t(plan.grid.width)).u64(std::uint64_t(plan.grid.height)).f64(plan.grid.cell);
     h.u64(std::uint64_t(std::int64_t(node.mapped_input) + 1));
-    h.u64(node.params.size());
-    for (const auto& [name, value] : node.params) {
+    hash_params(h, node.params);
+    // A loop node's body: each process's name, label and parameters, in order.
+    h.u64(node.processes.size());
+    for (const auto& process : node.processes) {
+        h.text(process.process->name).text(process.label);
+        hash_params(h, process.params);
+    }
+    h.u64(inputs.size());
+    for (const auto& in : inputs) {
+        h.u64(in ? 1 : 0);
+        if (in) h.digest(*in);
+    }
+    return h.finish();
+}
+
+namespace {
+void hash_params(Hasher& h, const std::map<std::string, ParamValue, std::less<>>& params) {
+    h.u64(params.size());
+    for (const auto& [name, value] : params) {
         h.text(name).u64(value.index());
         std::visit(
             [&](const auto& x) {
@@ -72,15 +93,8 @@ Digest node_key(const Plan& plan, const PlannedNode& node, const std::vector<std
             },
             value);
     }
-    h.u64(inputs.size());
-    for (const auto& in : inputs) {
-        h.u64(in ? 1 : 0);
-        if (in) h.digest(*in);
-    }
-    return h.finish();
 }
 
-namespace {
 struct FoundBinary {
     const void* address = nullptr;
     bool found = false;

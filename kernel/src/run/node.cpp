@@ -1,5 +1,6 @@
 #include <orogen/error.hpp>
 #include <orogen/node.hpp>
+#include <orogen/process.hpp>
 #include <orogen/tiles.hpp>
 
 #include <algorithm>
@@ -172,6 +173,56 @@ std::vector<std::string> split_names(std::string_view text) {
         start = comma + 1;
     }
     return names;
+}
+
+}  // namespace orogen
+
+// ------------------------------------------------------------------ processes (orogen/process.hpp)
+
+namespace orogen {
+
+namespace {
+const std::vector<ProcessCall>& no_processes() {
+    static const std::vector<ProcessCall> none;
+    return none;
+}
+}  // namespace
+
+const std::vector<ProcessCall>& NodeContext::processes() const { return no_processes(); }
+const std::vector<ProcessCall>& CheckContext::processes() const { return no_processes(); }
+
+std::string_view to_string(FieldAccess access) {
+    switch (access) {
+        case FieldAccess::reads: return "reads";
+        case FieldAccess::reads_if_present: return "reads if present";
+        case FieldAccess::writes: return "writes";
+        case FieldAccess::adds: return "adds to";
+        case FieldAccess::updates: return "updates";
+    }
+    return "uses";
+}
+
+double FlowGraph::distance(std::int64_t i) const {
+    const std::int64_t d = std::int64_t(receivers[std::size_t(i)]) - i;
+    if (d == 0) return 0.0;
+    return (d == 1 || d == -1 || d == width || d == -width) ? cell : cell * 1.4142135623730951;
+}
+
+int FlowGraph::direction(std::int64_t i) const {
+    const std::int64_t d = std::int64_t(receivers[std::size_t(i)]) - i;
+    static constexpr std::int8_t kCode[3][3] = {{5, 6, 7}, {4, -1, 0}, {3, 2, 1}};  // [dy + 1][dx + 1]
+    const std::int64_t dy = std::int64_t(d > 1) - std::int64_t(d < -1);
+    const std::int64_t dx = d - dy * width;
+    if (dx < -1 || dx > 1) return -1;
+    return kCode[dy + 1][dx + 1];
+}
+
+const ParamValue& ProcessCheckContext::param(std::string_view p) const {
+    const auto& params = call().params;
+    auto it = params.find(p);
+    if (it == params.end())
+        throw Error("internal error: process '" + call().label + "' has no parameter '" + std::string(p) + "'");
+    return it->second;
 }
 
 }  // namespace orogen

@@ -40,6 +40,7 @@ public:
     const std::string& label() const override { return node_.label; }
     std::uint64_t seed() const override { return seed_; }
     const GridSpec& grid() const override { return plan_.grid; }
+    const std::vector<ProcessCall>& processes() const override { return node_.processes; }
     const ParamValue& param(std::string_view name) const override {
         auto it = node_.params.find(name);
         if (it == node_.params.end())

@@ -5,10 +5,12 @@
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/process.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -216,6 +218,15 @@ public:
         ++errors_;
     }
     ValueInfo& output() override { return output_; }
+    const std::vector<ProcessCall>& processes() const override { return node_.processes; }
+    void process_error(std::size_t index, std::string_view param, std::string message) override {
+        if (process_error_) process_error_(index, param, std::move(message));
+        else error(param, std::move(message));
+        ++errors_;
+    }
+    void set_process_error(std::function<void(std::size_t, std::string_view, std::string)> report) {
+        process_error_ = std::move(report);
+    }
     ValueInfo* side_output(std::string_view name) override {
         auto it = sides_.find(name);
         return it != sides_.end() ? &it->second : nullptr;
@@ -226,6 +237,7 @@ public:
     ValueInfo take_output() { return std::move(output_); }
 
 private:
+    std::function<void(std::size_t, std::string_view, std::string)> process_error_;
     double tiled_share_ = 1.0;
     const GridSpec& grid_;
     std::vector<const ValueInfo*> inputs_;
@@ -238,6 +250,30 @@ private:
     std::map<std::string, ValueInfo, std::less<>> sides_;
     const std::set<std::string, std::less<>>& invalid_;
     int errors_ = 0;
+};
+
+/// What a process's check hook sees: its checked call, the grid, the loop node's inputs.
+class ProcessCheckContextImpl : public ProcessCheckContext {
+public:
+    ProcessCheckContextImpl(const GridSpec& grid, const ProcessCall& call, const std::vector<const ValueInfo*>& inputs,
+                            const std::map<std::string, Location, std::less<>>& param_where, const Location& where,
+                            Diagnostics& diags)
+        : grid_(grid), call_(call), inputs_(inputs), param_where_(param_where), where_(where), diags_(diags) {}
+    const GridSpec& grid() const override { return grid_; }
+    const ProcessCall& call() const override { return call_; }
+    const ValueInfo* node_input(std::size_t i) const override { return i < inputs_.size() ? inputs_[i] : nullptr; }
+    void error(std::string_view param, std::string message) override {
+        auto it = param_where_.find(param);
+        diags_.error(it != param_where_.end() ? it->second : where_, call_.label + ": " + message);
+    }
+
+private:
+    const GridSpec& grid_;
+    const ProcessCall& call_;
+    const std::vector<const ValueInfo*>& inputs_;
+    const std::map<std::string, Location, std::less<>>& param_where_;
+    const Location& where_;
+    Diagnostics& diags_;
 };
 
 bool has_extension(const std::string& path, const std::string& ext) {
@@ -287,6 +323,15 @@ private:
         std::map<std::string, Location, std::less<>> param_where;
         std::map<std::string, const Literal*, std::less<>> literals;
         std::set<std::string, std::less<>> invalid;  ///< parameters with an error: the check hook must not read them
+        /// A loop node's body, as checked: one entry per process the registry knows.
+        struct BodyProcess {
+            const spec::ProcessCallSyntax* syntax = nullptr;
+            ProcessCall call;
+            std::map<std::string, Location, std::less<>> param_where;
+            std::map<std::string, const Literal*, std::less<>> literals;
+            std::set<std::string, std::less<>> invalid;
+        };
+        std::vector<BodyProcess> body;
     };
 
     void check_header() {
@@ -357,6 +402,7 @@ private:
         gather_params(nc);
         convert_params(nc);
         check_paths(nc);
+        check_body(nc);
         auto [out, sides] = node_output(nc);
         define_value(nc, std::move(out), std::move(sides));
     }
@@ -518,7 +564,7 @@ private:
             nc.param_where[arg.key] = arg.value.where;
         }
         for (auto& o : overrides_) {
-            if (o.o.target != nc.planned.label) continue;
+            if (o.o.target != nc.planned.label || !o.o.process.empty()) continue;  // a process's: check_body
             o.used = true;
             if (!node->find_param(o.o.param)) {
                 std::string msg =
@@ -632,6 +678,215 @@ private:
         return true;
     }
 
+    /// A loop node's body (NodeDescriptor::processes): each process known, its parameters checked as a
+    /// node's are (with --set NAME.PROCESS.PARAM=VALUE on top), its own check hook run, then the fields
+    /// wired: every field a process reads is made by the node or by a process before it, and one process
+    /// writes each field.
+    void check_body(NodeCheck& nc) {
+        const auto& call = nc.st.call;
+        if (!nc.node->processes) {
+            if (call.has_body)
+                diags_.error(call.body_where,
+                             call.qualified() +
+                                 " takes no processes: only a loop node (erode:evolve) takes a body "
+                                 "of processes in braces after its call");
+            return;
+        }
+        if (!call.has_body) {
+            diags_.error(call.where,
+                         call.qualified() +
+                             " runs the processes given in braces after its call, one a line: end the line "
+                             "with '{', then e.g. flow() and stream-power() on lines of their own, then '}'; "
+                             "`orogen list process` shows the processes");
+            return;
+        }
+        if (call.body.empty())
+            diags_.error(
+                call.body_where,
+                "the body of " + call.qualified() + " holds no processes; give one a line, e.g. stream-power()");
+        std::map<std::string, int, std::less<>> count;
+        bool all_known = true;
+        for (const auto& ps : call.body) {
+            NodeCheck::BodyProcess bp;
+            bp.syntax = &ps;
+            const int k = ++count[ps.name];
+            bp.call.label = k > 1 ? ps.name + "#" + std::to_string(k) : ps.name;
+            bp.call.process = registry_.find_process(ps.name);
+            if (!bp.call.process) {
+                report_unknown_process(ps);
+                all_known = false;
+                continue;
+            }
+            gather_process_params(nc, bp);
+            convert_process_params(bp);
+            nc.body.push_back(std::move(bp));
+        }
+        report_unmatched_process_overrides(nc);
+        if (all_known) check_fields(nc);
+        // A process's own check, once its parameters are all valid (an error in one is reported already).
+        for (auto& bp : nc.body) {
+            if (!bp.call.process->check || !bp.invalid.empty()) continue;
+            ProcessCheckContextImpl ctx(plan_.grid, bp.call, nc.input_infos, bp.param_where, bp.syntax->where, diags_);
+            try {
+                bp.call.process->check(ctx);
+            } catch (const std::exception& e) { diags_.error(bp.syntax->where, bp.call.label + ": " + e.what()); }
+        }
+        for (const auto& bp : nc.body) nc.planned.processes.push_back(bp.call);
+    }
+
+    void report_unknown_process(const spec::ProcessCallSyntax& ps) {
+        std::vector<std::string> names;
+        for (const auto* p : registry_.processes()) names.push_back(p->name);
+        std::string msg = "unknown process '" + ps.name + "'";
+        const std::string guess = spec::closest(ps.name, names);
+        std::string node_of_that_name;
+        for (const auto& n : all_nodes_)
+            if (n.substr(n.find(':') + 1) == ps.name) node_of_that_name = n;
+        if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+        else if (!node_of_that_name.empty())
+            msg += "; " + node_of_that_name + " is a node, not a process: run it on the loop's result, after it";
+        else msg += "; `orogen list` shows the processes the loaded plugins provide";
+        diags_.error(ps.where, msg);
+    }
+
+    void gather_process_params(NodeCheck& nc, NodeCheck::BodyProcess& bp) {
+        const ProcessDescriptor* d = bp.call.process;
+        std::vector<std::string> names;
+        for (const auto& p : d->params) names.push_back(p.name);
+        auto unknown = [&](const std::string& key, const Location& where) {
+            std::string msg = "process " + bp.call.label + " has no parameter '" + key + "'";
+            const std::string guess = spec::closest(key, names);
+            msg += guess.empty() ? "; `orogen help " + d->name + "` lists them" : "; did you mean '" + guess + "'?";
+            diags_.error(where, msg);
+        };
+        for (const auto& arg : bp.syntax->params) {
+            if (!find_param(d->params, arg.key)) {
+                unknown(arg.key, arg.key_where);
+                continue;
+            }
+            if (bp.literals.count(arg.key)) {
+                diags_.error(arg.key_where, "'" + arg.key + "' is set twice in this process");
+                bp.invalid.insert(arg.key);
+                continue;
+            }
+            bp.literals[arg.key] = &arg.value;
+            bp.param_where[arg.key] = arg.value.where;
+        }
+        for (auto& o : overrides_) {
+            if (o.o.target != nc.planned.label || o.o.process != bp.call.label) continue;
+            o.used = true;
+            if (!find_param(d->params, o.o.param)) {
+                unknown(o.o.param, o.o.param_where);
+                continue;
+            }
+            bp.literals[o.o.param] = &o.o.value;
+            bp.param_where[o.o.param] = o.o.value.where;
+        }
+    }
+
+    static const Param* find_param(const std::vector<Param>& params, std::string_view name) {
+        for (const auto& p : params)
+            if (p.name == name) return &p;
+        return nullptr;
+    }
+
+    void convert_process_params(NodeCheck::BodyProcess& bp) {
+        for (const auto& p : bp.call.process->params) {
+            auto it = bp.literals.find(p.name);
+            if (it == bp.literals.end()) {
+                if (p.required()) {
+                    diags_.error(bp.syntax->where,
+                                 "process " + bp.call.label + " needs parameter '" + p.name + "'" +
+                                     (p.help_text.empty() ? "" : " (" + p.help_text + ")"));
+                    bp.invalid.insert(p.name);
+                } else {
+                    bp.call.params[p.name] = p.default_value;
+                }
+                continue;
+            }
+            auto v = convert(p, *it->second, "process " + bp.call.label, diags_);
+            if (!v) {
+                bp.invalid.insert(p.name);
+                continue;
+            }
+            bp.call.params[p.name] = std::move(*v);
+            bp.call.given.insert(p.name);
+        }
+    }
+
+    /// --set NAME.PROCESS.PARAM for this node whose PROCESS is not in its body.
+    void report_unmatched_process_overrides(NodeCheck& nc) {
+        std::vector<std::string> labels;
+        for (const auto& bp : nc.body) labels.push_back(bp.call.label);
+        for (auto& o : overrides_) {
+            if (o.used || o.o.target != nc.planned.label || o.o.process.empty()) continue;
+            o.used = true;
+            std::string msg = "'" + nc.planned.label + "' has no process '" + o.o.process + "'";
+            const std::string guess = spec::closest(o.o.process, labels);
+            if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
+            else {
+                msg += "; its processes are:";
+                for (const auto& l : labels) msg += " " + l;
+            }
+            diags_.error(o.o.process_where, msg);
+        }
+    }
+
+    /// The fields' wiring, in the body's order.
+    void check_fields(NodeCheck& nc) {
+        std::set<std::string, std::less<>> made = {kElevation, kUplifted};  // the node makes these
+        std::map<std::string, const NodeCheck::BodyProcess*, std::less<>> writer;
+        std::multimap<std::string, const NodeCheck::BodyProcess*, std::less<>> optional_readers;
+        for (const auto& bp : nc.body) {
+            for (const auto& f : bp.call.process->fields) {
+                switch (f.access) {
+                    case FieldAccess::reads:
+                    case FieldAccess::updates:
+                        if (!made.count(f.field)) report_missing_field(bp, f);
+                        break;
+                    case FieldAccess::reads_if_present:
+                        if (!made.count(f.field)) optional_readers.emplace(f.field, &bp);
+                        break;
+                    case FieldAccess::writes:
+                        if (auto it = writer.find(f.field); it != writer.end())
+                            diags_.error(bp.syntax->where,
+                                         bp.call.label + " writes '" + f.field + "', which " + it->second->call.label +
+                                             " (line " + std::to_string(it->second->syntax->where.line) +
+                                             ") writes too: a field has one writer; remove one of them, or use a "
+                                             "process that adds to the field");
+                        writer.emplace(f.field, &bp);
+                        made.insert(f.field);
+                        break;
+                    case FieldAccess::adds: made.insert(f.field); break;
+                }
+                if (f.access == FieldAccess::writes || f.access == FieldAccess::adds) {
+                    auto [b, e] = optional_readers.equal_range(f.field);
+                    for (auto it = b; it != e; ++it)
+                        diags_.warning(it->second->syntax->where,
+                                       it->second->call.label + " uses '" + f.field + "' when it is made, but " +
+                                           bp.call.label + ", which makes it, comes after it: " +
+                                           it->second->call.label + " sees the last sub-step's; move " + bp.call.label +
+                                           " before " + it->second->call.label + " if it should see this one's");
+                    optional_readers.erase(b, e);
+                }
+            }
+        }
+    }
+
+    void report_missing_field(const NodeCheck::BodyProcess& bp, const FieldUse& f) {
+        std::string makers;
+        for (const auto* p : registry_.processes())
+            for (const auto& g : p->fields)
+                if (g.field == f.field && (g.access == FieldAccess::writes || g.access == FieldAccess::adds))
+                    makers += std::string(makers.empty() ? "" : " or ") + p->name + "()";
+        const std::string what = f.field == kFlowGraph ? "the flow graph ('flow')" : "'" + f.field + "'";
+        diags_.error(bp.syntax->where,
+                     bp.call.label + " " + std::string(to_string(f.access)) + " " + what +
+                         (f.unit.empty() || f.field == kFlowGraph ? "" : " (" + f.unit + ")") +
+                         ", which no process before it makes; " +
+                         (makers.empty() ? "no loaded process makes it" : "add " + makers + " before it"));
+    }
+
     /// What the node makes: by default the first heightmap input's info (or the grid's) plus declared layers,
     /// then whatever its check hook says; side values as declared.
     std::pair<ValueInfo, std::map<std::string, ValueInfo, std::less<>>> node_output(NodeCheck& nc) {
@@ -653,6 +908,8 @@ private:
             out.element = ValueType::none;  // the base may have been a series of heightmaps
             out.count = 0;
             for (const auto& l : node->adds_layers) out.layers.insert(l);
+            for (const auto& p : nc.planned.processes)
+                for (const auto& l : p.process->adds_layers) out.layers.insert(l);
         }
         // What the side values hold; a mapped node's hold nothing (it ran once per entry).
         std::map<std::string, ValueInfo, std::less<>> sides;
@@ -682,6 +939,12 @@ private:
                              diags_, std::move(out), nc.invalid);
         ctx.set_sides(std::move(sides));
         ctx.set_tiled_share(options_.tiled_memory_share);
+        ctx.set_process_error([&](std::size_t index, std::string_view param, std::string message) {
+            if (index >= nc.body.size()) return diags_.error(call.where, call.qualified() + ": " + message);
+            const auto& bp = nc.body[index];
+            auto it = bp.param_where.find(param);
+            diags_.error(it != bp.param_where.end() ? it->second : bp.syntax->where, bp.call.label + ": " + message);
+        });
         try {
             nc.node->check(ctx);
         } catch (const InvalidParamRead&) {

@@ -192,6 +192,8 @@ private:
             case ')': kind = Tok::rparen; break;
             case '[': kind = Tok::lbracket; break;
             case ']': kind = Tok::rbracket; break;
+            case '{': kind = Tok::lbrace; break;
+            case '}': kind = Tok::rbrace; break;
             case ',': kind = Tok::comma; break;
             case '=': kind = Tok::equals; break;
             case ':': kind = Tok::colon; break;

@@ -92,6 +92,31 @@ public:
         o.param = param.text;
         o.param_where = param.where;
         ++p_;
+        if (peek().kind == Tok::hash || peek().kind == Tok::dot) {  // NAME.PROCESS[#N].PARAM
+            o.process = o.param;
+            o.process_where = o.param_where;
+            if (peek().kind == Tok::hash) {
+                ++p_;
+                const Token& n = peek();
+                if (n.kind != Tok::number || !n.integer || n.number < 2 || n.text[0] == '+') {
+                    error(n, "expected the process's number after '#' (stream-power#2 is the second stream-power)");
+                    return std::nullopt;
+                }
+                o.process += "#" + n.text;
+                o.process_where.length = n.where.column + n.where.length - o.process_where.column;
+                ++p_;
+            }
+            if (!expect(Tok::dot, "'.' between the process and its parameter (NAME.PROCESS.PARAM=VALUE)"))
+                return std::nullopt;
+            const Token& inner = peek();
+            if (inner.kind != Tok::word) {
+                error(inner, "expected a parameter name after '" + o.process + ".'");
+                return std::nullopt;
+            }
+            o.param = inner.text;
+            o.param_where = inner.where;
+            ++p_;
+        }
         if (!expect(Tok::equals, "'=' and a value (NAME.PARAM=VALUE)")) return std::nullopt;
         auto value = literal();
         if (!value) return std::nullopt;
@@ -182,13 +207,17 @@ private:
             st.name_where = first.where;
             p_ += 2;
             if (auto call = parse_call(spec)) {
+                if (peek().kind == Tok::lbrace) parse_body(*call);
                 st.call = std::move(*call);
                 spec.statements.push_back(std::move(st));
             }
             return;
         }
         if (peek(1).kind == Tok::colon) {  // unnamed call
-            if (auto call = parse_call(spec)) spec.statements.push_back(Statement{"", {}, std::move(*call)});
+            if (auto call = parse_call(spec)) {
+                if (peek().kind == Tok::lbrace) parse_body(*call);
+                spec.statements.push_back(Statement{"", {}, std::move(*call)});
+            }
             return;
         }
         if (first.text == "orogen") {
@@ -414,6 +443,103 @@ private:
             }
             if (unclosed(peek())) return std::nullopt;
             error(peek(), "expected ',' or ')' in the call to " + call.qualified() + ", found " + what(peek()));
+            return std::nullopt;
+        }
+    }
+
+    /// A loop node's body: "{", one process a line, "}". A mistake in one process is reported and the
+    /// next line is read, so every process's mistakes show at once.
+    void parse_body(Call& call) {
+        const Token& open = next();
+        call.has_body = true;
+        call.body_where = open.where;
+        while (true) {
+            const Token& t = peek();
+            if (t.kind == Tok::newline) {
+                ++p_;
+                continue;
+            }
+            if (t.kind == Tok::rbrace) {
+                ++p_;
+                return;
+            }
+            if (t.kind == Tok::eof ||
+                (t.where.line > open.where.line && starts_statement(p_) && !body_closes_before_next_named(p_))) {
+                diags_.error(
+                    open.where,
+                    "this '{' of " + call.qualified() + "'s processes is never closed; add '}' after the last process");
+                return;
+            }
+            const int errors_before = diags_.error_count();
+            if (auto process = parse_process()) call.body.push_back(std::move(*process));
+            if (diags_.error_count() == errors_before && peek().kind != Tok::newline && peek().kind != Tok::rbrace &&
+                peek().kind != Tok::eof)
+                error(peek(),
+                      "expected the end of the line after this process (one process a line), found " + what(peek()));
+            if (diags_.error_count() != errors_before)
+                while (peek().kind != Tok::newline && peek().kind != Tok::rbrace && peek().kind != Tok::eof) ++p_;
+        }
+    }
+
+    /// Whether a '}' comes before the next `NAME = ...` statement (or the end): then a `kind:node(` line at
+    /// `at` is a mistake inside a body (a process written with a kind), not the statement after an unclosed one.
+    bool body_closes_before_next_named(std::size_t at) const {
+        for (std::size_t i = at; i < t_.size(); ++i) {
+            if (t_[i].kind == Tok::rbrace) return true;
+            if (t_[i].kind == Tok::eof) return false;
+            if (t_[i].kind == Tok::newline && i + 2 < t_.size() && t_[i + 1].kind == Tok::word &&
+                t_[i + 2].kind == Tok::equals)
+                return false;
+        }
+        return false;
+    }
+
+    /// name(key=value, ...) in a body.
+    std::optional<ProcessCallSyntax> parse_process() {
+        const Token& name = peek();
+        if (name.kind != Tok::word) {
+            error(name, "expected a process, e.g. stream-power(erodibility=2e-5), found " + what(name));
+            return std::nullopt;
+        }
+        ++p_;
+        if (peek().kind == Tok::colon) {
+            error(peek(),
+                  "a process is called by its name alone, without a kind: write " +
+                      (peek(1).kind == Tok::word ? peek(1).text : name.text) + "(...)");
+            return std::nullopt;
+        }
+        ProcessCallSyntax process{name.text, name.where, {}};
+        if (!expect(Tok::lparen, "'(' after the process " + name.text + " (with no parameters: " + name.text + "())"))
+            return std::nullopt;
+        skip_newlines();
+        if (peek().kind == Tok::rparen) {
+            ++p_;
+            return process;
+        }
+        while (true) {
+            skip_newlines();
+            const Token& key = peek();
+            if (key.kind != Tok::word || peek(1).kind != Tok::equals) {
+                error(key,
+                      "a process takes key=value parameters only (it reads the loop's fields, not values), found " +
+                          what(key));
+                return std::nullopt;
+            }
+            p_ += 2;
+            skip_newlines();
+            auto value = literal();
+            if (!value) return std::nullopt;
+            process.params.push_back(Argument{key.text, key.where, std::move(*value)});
+            skip_newlines();
+            if (peek().kind == Tok::comma) {
+                ++p_;
+                continue;
+            }
+            if (peek().kind == Tok::rparen) {
+                ++p_;
+                return process;
+            }
+            error(peek(), "expected ',' or ')' in the process " + process.name + ", found " + what(peek()));
             return std::nullopt;
         }
     }

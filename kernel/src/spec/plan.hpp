@@ -25,6 +25,8 @@ struct PlannedNode {
     std::map<std::string, ParamValue, std::less<>> params;  ///< every declared parameter, defaults filled in
     std::set<std::string, std::less<>> given;  ///< parameters set in the spec or by --set
     std::vector<std::string> output_files;  ///< output path parameters' values
+    /// A loop node's body (NodeDescriptor::processes): its processes, checked, in the spec's order.
+    std::vector<ProcessCall> processes;
     /// The input (Many::one) that was given a series: the node is mapped over
     /// its entries and outputs a series (-1: runs once, as usual).
     int mapped_input = -1;

@@ -6,7 +6,9 @@
 //               | "grid" INT ["x" INT] { key "=" literal }     vertices; grid 513 cell=30
 //               | name "=" call                     a named value
 //               | call                              (an exporter, usually)
-//   call       := kind ":" node "(" [ arg { "," arg } ] ")"   newlines allowed inside ( ) and [ ]
+//   call       := kind ":" node "(" [ arg { "," arg } ] ")" [ body ]   newlines allowed inside ( ) and [ ]
+//   body       := "{" { [process] [# comment] newline } "}"      a loop node's processes (orogen/process.hpp)
+//   process    := name "(" [ key "=" literal { "," key "=" literal } ] ")"   one a line, run in this order
 //   arg        := ref                               an input: a value name, or name.side
 //               | call                              an input made in place: export:png(render:bloom(x), ...)
 //               | key "=" literal                   a parameter
@@ -36,6 +38,8 @@ enum class Tok {
     rparen,
     lbracket,
     rbracket,
+    lbrace,
+    rbrace,
     comma,
     equals,
     colon,
@@ -89,11 +93,22 @@ struct Argument {
     Literal value;
 };
 
+/// A process in a loop node's body: `stream-power(m=0.5)`.
+struct ProcessCallSyntax {
+    std::string name;
+    Location where;  ///< spans the name
+    std::vector<Argument> params;
+};
+
 struct Call {
     std::string kind, node;  ///< "generate", "diamond-square"
     Location where;  ///< spans kind:node
     std::vector<Input> inputs;
     std::vector<Argument> params;
+    /// The body in braces after the call (a loop node's processes); body_where is its '{'.
+    bool has_body = false;
+    Location body_where;
+    std::vector<ProcessCallSyntax> body;
     std::string qualified() const { return kind + ":" + node; }
 };
 
@@ -122,13 +137,16 @@ struct Spec {
 /// next line so that every error is reported at once.
 Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags);
 
-/// Parse a command-line override "NAME.PARAM=VALUE" (source name "--set").
+/// Parse a command-line override "NAME.PARAM=VALUE" or "NAME.PROCESS.PARAM=VALUE" (source name "--set").
 /// NAME is a value name, or an unnamed node's label as the timing table shows
 /// it: kind:node, kind:node#2, ...
 struct Override {
     std::string target;  ///< NAME, or the label kind:node[#N]
     std::string param;  ///< PARAM
-    Location target_where, param_where;
+    /// NAME.PROCESS.PARAM=VALUE: a parameter of a process in a loop node's body, by its label
+    /// (stream-power, or stream-power#2 for the second); "" for a node's own parameter.
+    std::string process;
+    Location target_where, param_where, process_where;
     Literal value;
 };
 std::optional<Override> parse_override(const std::shared_ptr<const Source>& source, Diagnostics& diags);

@@ -1,6 +1,7 @@
 // erode:stream-power — registers the implicit stream-power landscape model (stream_power.hpp) with the kernel.
-#include "stream_power.hpp"
-#include "tiled.hpp"
+#include <orogen/landscape/stream_power.hpp>
+#include <orogen/landscape/tiled.hpp>
+#include <orogen/landscape/uplift.hpp>
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -26,45 +27,15 @@
 namespace {
 
 using namespace orogen;
-
-/// Fastest rock uplift measured in active ranges (Taiwan, Nanga Parbat, the Southern Alps: 5–10 mm/yr),
-/// with a margin; a faster rate from a layer is an error in its scale.
-constexpr double kMaxUpliftMmYr = 20.0;
-
-std::optional<stream_power::OpenSides> parse_sides(const std::string& text) {
-    stream_power::OpenSides s{false, false, false, false};
-    if (text == "none") return s;
-    if (text == "all") return stream_power::OpenSides{};
-    for (char c : text) {
-        switch (c) {
-            case 'n': s.north = true; break;
-            case 'e': s.east = true; break;
-            case 's': s.south = true; break;
-            case 'w': s.west = true; break;
-            default: return std::nullopt;
-        }
-    }
-    return s;
-}
-
-/// "edge" → nullopt (outlets keep their heights); a number → that height in metres.
-std::optional<std::optional<double>> parse_base_level(const std::string& text) {
-    if (text == "edge") return std::optional<double>{};
-    double v = 0.0;
-    const char* end = text.data() + text.size();
-    const auto [p, ec] = std::from_chars(text.data(), end, v);
-    if (ec != std::errc() || p != end || !std::isfinite(v)) return std::nullopt;
-    return std::optional<double>{v};
-}
-
-/// The largest of every rank's `v` (exact), or `v` itself without tiles.
-double largest(Tiling* tiles, double v) { return tiles ? tiles->reduce(v, Tiling::Reduce::max) : v; }
+using landscape::kMaxUpliftMmYr;
+using landscape::parse_base_level;
+using landscape::parse_sides;
 
 /// The model of one process (Model) or of this rank's tile (TiledModel, joined with the other ranks'
 /// tiles: the same bits as one process), behind the few calls the node makes.
 struct Engine {
-    std::unique_ptr<stream_power::Model> whole;
-    std::unique_ptr<stream_power::TiledModel> tiled;
+    std::unique_ptr<landscape::Model> whole;
+    std::unique_ptr<landscape::TiledModel> tiled;
 
     std::vector<double>& heights() { return tiled ? tiled->heights() : whole->heights(); }
     bool is_outlet(std::size_t i) const {
@@ -93,8 +64,8 @@ constexpr const char* kRainParams[] = {"rain_background",    "wind_from",      "
                                        "condensation_time",  "fallout_time",   "moist_stability", "vapour_scale_height",
                                        "uplift_sensitivity", "rain_resolution"};
 
-stream_power::Settings settings_of(NodeContext& ctx) {
-    stream_power::Settings s;
+landscape::Settings settings_of(NodeContext& ctx) {
+    landscape::Settings s;
     s.erodibility = ctx.real("erodibility");
     s.area_exponent = ctx.real("m");
     s.slope_exponent = ctx.real("n");
@@ -154,179 +125,10 @@ stream_power::Settings settings_of(NodeContext& ctx) {
         s.rain_resolution = ctx.real("rain_resolution");
     }
     s.open = *parse_sides(ctx.text("open"));
-    s.depressions =
-        ctx.text("depressions") == "route" ? stream_power::Depressions::route : stream_power::Depressions::fill;
+    s.depressions = ctx.text("depressions") == "route" ? landscape::Depressions::route : landscape::Depressions::fill;
     if (ctx.text("routing") == "mfd") s.mfd_exponent = ctx.real("mfd_exponent");
     s.deposition = ctx.real("deposition");
     return s;
-}
-
-/// What the uplift helpers share: the node's context, the terrain (this rank's tile when tiled) and the tiling.
-struct UpliftInputs {
-    NodeContext& ctx;
-    const Heightmap& hm;
-    Tiling* tiles;
-    std::size_t n;
-
-    /// A sample's index in the whole grid, for the messages.
-    std::int64_t sample(std::size_t k) const {
-        if (!tiles) return std::int64_t(k);
-        const TileRect own = tiles->owned();
-        const auto x = std::int64_t(k % std::size_t(own.width)), y = std::int64_t(k / std::size_t(own.width));
-        return (own.y0 + y) * tiles->grid_width() + own.x0 + x;
-    }
-    /// Smoothing: the crust bends (flexure), so uplift is spread wider than the plates' sharp relief. Four
-    /// implicit diffusion steps with D·t = σ²/2 (volume-preserving: closed sides; backward Euler keeps the
-    /// maximum principle, so the spread rate is never faster).
-    void smooth(std::vector<double>& rate) const {
-        const double sigma = ctx.real("uplift_smoothing");
-        if (!(sigma > 0.0)) return;
-        diffusion::Settings ds;
-        ds.diffusivity = 1.0;
-        diffusion::Solver blur = tiles ? diffusion::Solver(*tiles, hm.cell(), ds)
-                                       : diffusion::Solver(hm.width(), hm.height(), hm.cell(), ds);
-        for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
-    }
-    /// The uplift falls towards the open sides (the sides held at base level) over uplift_edge_taper
-    /// metres, as a range's uplift falls to its foreland: rate × smoothstep(d/taper), d the distance to
-    /// the nearest open side. Without it, full uplift beside a side held fixed raises a wall that short,
-    /// straight rivers drain in parallel.
-    void taper(std::vector<double>& rate) const {
-        const double taper = ctx.real("uplift_edge_taper");
-        if (!(taper > 0.0)) return;
-        const stream_power::OpenSides open = *parse_sides(ctx.text("open"));
-        const TileRect own = tiles ? tiles->owned() : TileRect{0, 0, hm.width(), hm.height()};
-        const int W = tiles ? tiles->grid_width() : hm.width(), H = tiles ? tiles->grid_height() : hm.height();
-        for (int y = 0; y < own.height; ++y)
-            for (int x = 0; x < own.width; ++x)
-                rate[std::size_t(y) * std::size_t(own.width) + std::size_t(x)] *=
-                    stream_power::edge_taper(own.x0 + x, own.y0 + y, W, H, hm.cell(), open, taper);
-    }
-    /// The fastest |rate + base| over every rank (m/yr).
-    double fastest(const std::vector<double>& rate, double base) const {
-        double fastest = 0.0;
-        for (double r : rate) fastest = std::max(fastest, std::abs(r + base));
-        return largest(tiles, fastest);
-    }
-};
-
-/// Uplift (m/yr per sample): the uniform rate plus the layer read as metres accumulated over
-/// uplift_layer_years, smoothed; refuses a rate faster than any measured range.
-std::vector<double> steady_uplift(const UpliftInputs& in) {
-    NodeContext& ctx = in.ctx;
-    const double uniform = ctx.real("uplift") * 1e-3;  // mm/yr → m/yr
-    std::vector<double> uplift(in.n, uniform);
-    const std::string& layer = ctx.text("uplift_layer");
-    if (layer.empty()) {
-        in.taper(uplift);
-        return uplift;
-    }
-    if (!in.hm.has_layer(layer)) throw BadInput("uplift_layer: the input has no layer '" + layer + "'");
-    const ConstGridView u = in.hm.layer(layer);
-    const double years = ctx.real("uplift_layer_years");
-    std::vector<double> rate(in.n);
-    for (std::size_t i = 0; i < in.n; ++i) {
-        if (!std::isfinite(u.data[i]))
-            throw BadInput("uplift_layer: layer '" + layer + "' holds a non-finite value at sample " +
-                           std::to_string(in.sample(i)));
-        rate[i] = double(u.data[i]) / years;
-    }
-    in.smooth(rate);
-    for (std::size_t i = 0; i < in.n; ++i) uplift[i] += rate[i];
-    in.taper(uplift);
-    const double fastest = in.fastest(uplift, 0.0);
-    if (fastest * 1e3 > kMaxUpliftMmYr) {
-        std::ostringstream msg;
-        msg << "uplift_layer_years: layer '" << layer << "' read over " << years << " years gives " << fastest * 1e3
-            << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
-            << " mm/yr); give a longer uplift_layer_years";
-        throw BadInput(msg.str());
-    }
-    return uplift;
-}
-
-/// The history's frame times (years from the run's start), checked on rank 0 and shared with every rank.
-std::vector<double> history_times(NodeContext& ctx, const std::shared_ptr<const Series>& series, Tiling* tiles) {
-    std::vector<double> times;
-    std::string shared;
-    if (series) {
-        const std::size_t frames = series->size();
-        if (frames < 2)
-            throw BadInput("uplift_history: the series has " + std::to_string(frames) +
-                           " frame(s); a rate needs at least two (the start and the end)");
-        const double span =
-            ctx.real("uplift_history_years") > 0.0 ? ctx.real("uplift_history_years") : ctx.real("years");
-        const double t0 = series->times.front(), t1 = series->times.back();
-        if (!(t1 > t0)) throw BadInput("uplift_history: the series' frames do not advance in time");
-        for (std::size_t k = 0; k < frames; ++k) {
-            times.push_back((series->times[k] - t0) / (t1 - t0) * span);
-            if (k > 0 && !(times[k] > times[k - 1]))
-                throw BadInput("uplift_history: frame " + std::to_string(k) + " is not later than frame " +
-                               std::to_string(k - 1));
-        }
-        shared.assign(reinterpret_cast<const char*>(times.data()), times.size() * sizeof(double));
-    }
-    if (tiles) {
-        tiles->share_from_rank0(shared);
-        times.resize(shared.size() / sizeof(double));
-        std::memcpy(times.data(), shared.data(), shared.size());
-    }
-    return times;
-}
-
-/// Uplift from a history (e.g. plates.timelapse): frame k's time, normalised so that the first frame is
-/// year 0 of the run and the last is uplift_history_years (default: the run's years); between frames k and
-/// k+1 the rate is their height change over the years between them. In a tiled run the series is rank
-/// 0's (whole frames): rank 0 checks it and shares its times, and each interval's two frames are cut into
-/// tiles for every rank to make its rate. Refuses an impossible rate before the run.
-stream_power::UpliftHistory uplift_history(const UpliftInputs& in) {
-    NodeContext& ctx = in.ctx;
-    Tiling* tiles = in.tiles;
-    stream_power::UpliftHistory history;
-    std::shared_ptr<const Series> series;
-    if (!tiles || tiles->rank() == 0) series = ctx.input(1).series();
-    history.times = history_times(ctx, series, tiles);
-    const int W = tiles ? tiles->grid_width() : in.hm.width(), H = tiles ? tiles->grid_height() : in.hm.height();
-    auto frame = [series, tiles, W, H](std::size_t k) -> std::shared_ptr<const Heightmap> {  // collective when tiled
-        std::shared_ptr<const Heightmap> f;
-        if (series) {
-            f = series->at(k).heightmap();
-            if (!f || f->width() != W || f->height() != H)
-                throw BadInput(
-                    "uplift_history: frame " + std::to_string(k) + " is " +
-                    (f ? std::to_string(f->width()) + " x " + std::to_string(f->height()) : "not a heightmap") +
-                    ", the terrain " + std::to_string(W) + " x " + std::to_string(H));
-        }
-        return tiles ? tiles->scatter_from_rank0(f.get()) : f;
-    };
-    auto rate_of = [frame, times = history.times, in](std::size_t k) {
-        const auto a = frame(k), b = frame(k + 1);
-        const double years = times[k + 1] - times[k];
-        std::vector<double> rate(in.n);
-        for (std::size_t i = 0; i < in.n; ++i) {
-            rate[i] = (double(b->heights()[i]) - double(a->heights()[i])) / years;
-            if (!std::isfinite(rate[i]))
-                throw BadInput("uplift_history: frame " + std::to_string(k + 1) +
-                               " holds a non-finite height at sample " + std::to_string(in.sample(i)));
-        }
-        in.smooth(rate);
-        in.taper(rate);
-        return rate;
-    };
-    const double uniform = ctx.real("uplift") * 1e-3;
-    for (std::size_t k = 0; k + 1 < history.times.size(); ++k) {
-        const double fastest = in.fastest(rate_of(k), uniform);
-        if (fastest * 1e3 > kMaxUpliftMmYr) {
-            std::ostringstream msg;
-            msg << "uplift_history_years: frames " << k << " to " << k + 1 << " spread over "
-                << history.times[k + 1] - history.times[k] << " years give " << fastest * 1e3
-                << " mm/yr, faster than any measured range (at most " << kMaxUpliftMmYr
-                << " mm/yr); give a longer uplift_history_years";
-            throw BadInput(msg.str());
-        }
-    }
-    history.rate = rate_of;
-    return history;
 }
 
 /// The heights after the run and the final surface's flow graph as layers: drainage, flow_direction,
@@ -378,22 +180,28 @@ NodeOutputs run(NodeContext& ctx) {
     using clock = std::chrono::steady_clock;
     const auto started = clock::now();
     const std::size_t n = hm->size();
-    const stream_power::Settings s = settings_of(ctx);
+    const landscape::Settings s = settings_of(ctx);
 
-    const UpliftInputs uplift_in{ctx, *hm, tiles, n};
-    std::vector<double> uplift = steady_uplift(uplift_in);
-    stream_power::UpliftHistory history;
-    if (ctx.has_input(1)) history = uplift_history(uplift_in);
+    const landscape::UpliftSources sources{
+        ctx.real("uplift"),           ctx.text("uplift_layer"),      ctx.real("uplift_layer_years"),
+        ctx.real("uplift_smoothing"), ctx.real("uplift_edge_taper"), ctx.real("uplift_history_years")};
+    const landscape::UpliftGrid grid{*hm, tiles, *parse_sides(ctx.text("open"))};
+    std::vector<double> uplift = landscape::steady_uplift(sources, grid);
+    landscape::UpliftHistory history;
+    if (ctx.has_input(1)) {
+        std::shared_ptr<const Series> series;  // rank 0's, whole frames
+        if (!tiles || tiles->rank() == 0) series = ctx.input(1).series();
+        history = landscape::uplift_history(sources, grid, series, ctx.real("years"));
+    }
     const auto base = *parse_base_level(ctx.text("base_level"));
 
     Engine engine;
     std::vector<double> h(hm->heights().begin(), hm->heights().end());
     if (tiles)
-        engine.tiled =
-            std::make_unique<stream_power::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
+        engine.tiled = std::make_unique<landscape::TiledModel>(*tiles, hm->cell(), std::move(h), std::move(uplift), s);
     else
-        engine.whole = std::make_unique<stream_power::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
-                                                             std::move(uplift), s);
+        engine.whole = std::make_unique<landscape::Model>(hm->width(), hm->height(), hm->cell(), std::move(h),
+                                                          std::move(uplift), s);
     if (history.rate) {
         if (tiles) engine.tiled->set_uplift_history(std::move(history));
         else engine.whole->set_uplift_history(std::move(history));
@@ -425,9 +233,8 @@ NodeOutputs run(NodeContext& ctx) {
         last = steps;
         if (const std::int64_t bad = engine.first_non_finite(); bad >= 0) {
             std::ostringstream msg;
-            msg << "non-finite height (" << heights[std::size_t(bad)] << ") at sample "
-                << uplift_in.sample(std::size_t(bad)) << " after step " << step << " of " << steps
-                << "; the simulation became unstable";
+            msg << "non-finite height (" << heights[std::size_t(bad)] << ") at sample " << grid.sample(std::size_t(bad))
+                << " after step " << step << " of " << steps << "; the simulation became unstable";
             throw Error(msg.str());
         }
         ctx.progress(double(step) / double(steps));
@@ -580,9 +387,8 @@ void check(CheckContext& ctx) {
     const std::int64_t hgt = in && in->height > 0 ? in->height : ctx.grid().height;
     // In a tiled run each rank holds its tile's model only (memory_share: this machine's share of the grid).
     const double need = ctx.memory_share() * double(w) * double(hgt) *
-        double(stream_power::kBytesPerCell +
-               (ctx.real("deposition") > 0.0 ? stream_power::kBytesPerCellDeposition : 0) +
-               (ctx.text("rain") == "orographic" ? stream_power::kBytesPerCellRain : 0));
+        double(landscape::kBytesPerCell + (ctx.real("deposition") > 0.0 ? landscape::kBytesPerCellDeposition : 0) +
+               (ctx.text("rain") == "orographic" ? landscape::kBytesPerCellRain : 0));
     const double have = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (have > 0 && need > 0.5 * have) {
         std::ostringstream msg;
@@ -1012,13 +818,13 @@ OROGEN_PLUGIN("erode-stream-power", "0.1.0", registry) {
         .tiled_timelapse = true,  // rank 0 gathers the frames (Timelapse with the tiling)
         .untiled_because =
             [](const std::map<std::string, ParamValue, std::less<>>& p, const std::vector<bool>&) {
-                stream_power::Settings s;
+                landscape::Settings s;
                 if (std::get<std::string>(p.at("routing")) == "mfd") s.mfd_exponent = 1.0;
                 s.deposition = std::get<double>(p.at("deposition"));
                 if (std::get<bool>(p.at("glaciers"))) s.glaciers.balance_gradient = 1.0;
                 s.orographic_rain = std::get<std::string>(p.at("rain")) == "orographic";
                 s.floodplain.area = std::get<double>(p.at("floodplain_area"));
-                return stream_power::untiled_because(s);
+                return landscape::untiled_because(s);
             },
     });
 }

@@ -7,8 +7,8 @@
 #include <orogen/analysis/fft.hpp>
 #include <orogen/analysis/figures.hpp>
 
-#ifdef OROGEN_HAVE_STREAM_POWER
-#include "stream_power.hpp"
+#ifdef OROGEN_HAVE_LANDSCAPE
+#include <orogen/landscape/stream_power.hpp>
 #endif
 
 #include <gtest/gtest.h>
@@ -344,11 +344,11 @@ TEST(Figures, ValleyFiguresSayWhyTheyCannotBeMeasured) {
     EXPECT_NE(s[valley_widening].why_not.find("the fit needs 3"), std::string::npos) << s[valley_widening].why_not;
 }
 
-#ifdef OROGEN_HAVE_STREAM_POWER
+#ifdef OROGEN_HAVE_LANDSCAPE
 TEST(Figures, AStreamPowerSteadyStateGivesThetaMOverNAndKsUOverK) {
     // erode:stream-power's model run to steady state with uniform uplift: channels obey
     // S = (U/K)^(1/n) A^(−m/n), so θ = m/n and k_sn (reference concavity m/n) = (U/K)^(1/n).
-    namespace sp = orogen::stream_power;
+    namespace sp = orogen::landscape;
     const int w = 81, h = 61;
     const double cell = 100.0, U = 1e-3;
     sp::Settings s;

@@ -2,11 +2,11 @@
 // hand-made windows with known answers (straight on, at 45° and 90° bends,
 // the main donor, a diagonal river), the floor a bank stops at, outlets; and in the model, that
 // rivers grow valley floors and give the same bits on one and two threads.
-#include "banks.hpp"
-#include "floodplain.hpp"
-#include "flow.hpp"
+#include <orogen/landscape/banks.hpp>
+#include <orogen/landscape/floodplain.hpp>
+#include <orogen/landscape/flow.hpp>
 #include "noise_terrain.hpp"
-#include "stream_power.hpp"
+#include <orogen/landscape/stream_power.hpp>
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -21,7 +21,7 @@
 namespace {
 
 using namespace orogen;
-using namespace orogen::stream_power;
+using namespace orogen::landscape;
 
 constexpr int kW = 5, kH = 5;
 std::size_t at(int x, int y) { return std::size_t(y) * kW + std::size_t(x); }

@@ -40,8 +40,8 @@ int main(int argc, char** argv) {
     if (argc < 6) return 0;
 
     std::vector<double> filled(z.begin(), z.end());
-    orogen::stream_power::FlowRouter flow(w, h, cell, orogen::stream_power::OpenSides{});
-    flow.route(filled.data(), orogen::stream_power::Depressions::fill);
+    orogen::landscape::FlowRouter flow(w, h, cell, orogen::landscape::OpenSides{});
+    flow.route(filled.data(), orogen::landscape::Depressions::fill);
     if (argc > 6)  // multiple flow directions (Freeman 1991) with this exponent
         flow.accumulate_multiple(filled.data(), std::stod(argv[6]));
     else flow.accumulate();

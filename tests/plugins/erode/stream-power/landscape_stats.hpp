@@ -11,7 +11,7 @@
 //    cell (Hack 1957; Rigon et al. 1996), log-binned medians.
 #pragma once
 
-#include "flow.hpp"
+#include <orogen/landscape/flow.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -82,7 +82,7 @@ inline Stats measure(const float* heights, int w, int h, double cell, double cha
             slopes.push_back(deg);
             steep += deg > 40.0 ? 1 : 0;
             bool lower = false;
-            for (int k = 0; k < 8; ++k) lower = lower || at(x + stream_power::kDx[k], y + stream_power::kDy[k]) < at(x, y);
+            for (int k = 0; k < 8; ++k) lower = lower || at(x + landscape::kDx[k], y + landscape::kDy[k]) < at(x, y);
             pits += lower ? 0 : 1;
             ++interior;
         }
@@ -94,8 +94,8 @@ inline Stats measure(const float* heights, int w, int h, double cell, double cha
 
     // Flow on the filled surface, all sides open.
     std::vector<double> filled(heights, heights + n);
-    stream_power::FlowRouter flow(w, h, cell, stream_power::OpenSides{});
-    flow.route(filled.data(), stream_power::Depressions::fill);
+    landscape::FlowRouter flow(w, h, cell, landscape::OpenSides{});
+    flow.route(filled.data(), landscape::Depressions::fill);
     flow.accumulate();
     const auto& rcv = flow.receivers();
     const auto& area = flow.area();

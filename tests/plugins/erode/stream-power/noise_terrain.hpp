@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace orogen::stream_power::test {
+namespace orogen::landscape::test {
 
 /// w × h heights (m), row-major: white noise of `amplitude` metres from the counter-based generator,
 /// the same on any thread count.
@@ -17,4 +17,4 @@ inline std::vector<double> noise(int w, int h, std::uint64_t seed, double amplit
     return v;
 }
 
-}  // namespace orogen::stream_power::test
+}  // namespace orogen::landscape::test

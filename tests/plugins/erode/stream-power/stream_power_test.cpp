@@ -2,9 +2,9 @@
 // state, a 1-D river against the implicit scheme and against the travelling
 // knickpoint of the kinematic wave, depression handling (every cell drains to
 // an outlet, no loops, the outlet's area is the map's), and determinism.
-#include "basin_join.hpp"
+#include <orogen/landscape/basin_join.hpp>
 #include "noise_terrain.hpp"
-#include "stream_power.hpp"
+#include <orogen/landscape/stream_power.hpp>
 
 #include <orogen/random.hpp>
 
@@ -24,7 +24,7 @@
 namespace {
 
 using namespace orogen;
-using namespace orogen::stream_power;
+using namespace orogen::landscape;
 
 using test::noise;
 
