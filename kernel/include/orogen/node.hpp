@@ -355,6 +355,10 @@ struct NodeDescriptor {
                               const std::vector<bool>& inputs_given)>
         untiled_because;
 
+    /// A tiled loop node (processes = true, tile_halo >= 0) that tiles only some bodies: given its checked
+    /// body, "" when it runs tiled, else why not (plugin API 9). Asked after untiled_because.
+    std::function<std::string(const std::vector<ProcessCall>& body)> untiled_body_because;
+
     std::string qualified_name() const { return kind + ":" + name; }
     const Param* find_param(std::string_view n) const;
 };

@@ -36,7 +36,7 @@
 ///    every rank, TiledFields for a grid eroder's tiled loop; six virtual primitives instead of twenty.
 /// 8: Tiling::send_to_ranks (a seventh primitive: bytes to chosen ranks only) and Tiling::ranks_meeting.
 /// 9: processes (orogen/process.hpp): Registry::add(ProcessDescriptor), NodeDescriptor::processes,
-///    NodeContext::processes() and CheckContext::processes().
+///    NodeDescriptor::untiled_body_because, NodeContext::processes() and CheckContext::processes().
 #define OROGEN_PLUGIN_API_VERSION 9
 
 namespace orogen {

@@ -246,10 +246,11 @@ bool TiledRun::runs_tiled(const PlannedNode& node) { return untiled_reason(node)
 std::string TiledRun::untiled_reason(const PlannedNode& node) {
     if (node.node->tile_halo < 0) return "it cannot be tiled";
     if (node.mapped_input >= 0) return "it is mapped over a series";
-    if (!node.node->untiled_because) return "";
     std::vector<bool> given;
     for (const auto& key : node.inputs) given.push_back(!key.empty());
-    return node.node->untiled_because(node.params, given);
+    if (node.node->untiled_because)
+        if (std::string why = node.node->untiled_because(node.params, given); !why.empty()) return why;
+    return node.node->untiled_body_because ? node.node->untiled_body_because(node.processes) : "";
 }
 
 int TiledRun::agree(int exit_code, int* reporter) {

@@ -1,6 +1,9 @@
 // erode:evolve — landscape evolution as a loop of process plugins: the spec gives the loop's body,
 // one process a line, in braces after the call (orogen/process.hpp; libs/landscape/loop.hpp runs it).
 #include <orogen/landscape/loop.hpp>
+#include <orogen/landscape/model_node.hpp>
+#include <orogen/landscape/processes.hpp>
+#include <orogen/landscape/tiled.hpp>
 #include <orogen/landscape/uplift.hpp>
 
 #include <orogen/error.hpp>
@@ -39,7 +42,18 @@ void write_layers(NodeContext& ctx, landscape::ProcessLoop& loop, const std::vec
     }
 }
 
+/// Under mpirun: the body lowered to erode:stream-power's model, which runs on each rank's tile (the same
+/// bits as the loop: tests/plugins/erode/evolve); the kernel tiles this node only for such a body.
+NodeOutputs run_tiled(NodeContext& ctx) {
+    landscape::LoweredBody lowered = landscape::lower_to_model(ctx.processes(), ctx.seed());
+    if (!lowered.why_not.empty()) throw Error("internal error: a tiled erode:evolve whose body " + lowered.why_not);
+    lowered.settings.open = *landscape::parse_sides(ctx.text("open"));
+    lowered.settings.substeps = int(ctx.integer("substeps"));
+    return landscape::run_model(ctx, {lowered.settings, lowered.uplift, false});
+}
+
 NodeOutputs run(NodeContext& ctx) {
+    if (ctx.tiling()) return run_tiled(ctx);
     using clock = std::chrono::steady_clock;
     const auto started = clock::now();
     std::shared_ptr<Heightmap> hm = ctx.take_heightmap(0);
@@ -183,8 +197,15 @@ OROGEN_PLUGIN("erode-evolve", "0.1.0", registry) {
                     .help("the outlets' height: edge (they keep theirs) or metres, e.g. \"0\""),
                 timelapse_param(),
             },
+        .tile_halo = 1,
         .check = check,
         .run = run,
         .processes = true,
+        .tiled_timelapse = true,
+        .untiled_body_because =
+            [](const std::vector<ProcessCall>& body) {
+                const landscape::LoweredBody lowered = landscape::lower_to_model(body, 0);
+                return lowered.why_not.empty() ? landscape::untiled_because(lowered.settings) : lowered.why_not;
+            },
     });
 }

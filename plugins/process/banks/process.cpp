@@ -5,35 +5,16 @@
 #include <orogen/landscape/banks.hpp>
 
 #include <orogen/parallel.hpp>
+#include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
-
-#include <cmath>
-#include <numbers>
 
 namespace {
 
 using namespace orogen;
 
-struct BankSettings {
-    double erosion = 4.0;
-    double area = 1e6;  // m²
-    double floor_slope = 1.0;  // °
-    double wide_area = 0.0;  // m²
-    double wider_area = 0.0;  // m²
-    int widest_floor = 0;  // cells
-};
-
 class BanksProcess final : public Process {
 public:
-    explicit BanksProcess(const BankSettings& s) {
-        constexpr double rad = std::numbers::pi / 180.0;
-        banks_.erosion = s.erosion;
-        banks_.area = s.area;
-        banks_.floor_slope = std::tan(s.floor_slope * rad);
-        banks_.wide_area = s.wide_area;
-        banks_.wider_area = s.wider_area;
-        banks_.widest_floor = s.widest_floor;
-    }
+    explicit BanksProcess(const landscape::BanksSpec& s) : banks_(landscape::to_banks(s)) {}
 
     void step(ProcessState& state, double dt) override {
         (void)dt;
@@ -78,47 +59,7 @@ void check(ProcessCheckContext& ctx) {
 }  // namespace
 
 OROGEN_PLUGIN("process-banks", "0.1.0", registry) {
-    ProcessParams<BankSettings> p;
-    p.real(&BankSettings::erosion, "erosion")
-        .min(0.0)
-        .max(10.0)
-        .help(
-            "each incision lowers the two cells across a river by this many times the river's own lowering, "
-            "shared between them (straight on, half each; at a bend the outer bank takes more), never below the "
-            "river; 4 = a floor three cells wide; 0 = banks stand");
-    p.real(&BankSettings::area, "area")
-        .min(1.0)
-        .max(1e12)
-        .unit("m²")
-        .help(
-            "drainage area over which a river is wide and deep enough to undercut its banks: bank erosion is "
-            "scaled by 1 - exp(-A/area)");
-    p.real(&BankSettings::floor_slope, "floor_slope")
-        .min(0.0)
-        .max(30.0)
-        .unit("°")
-        .help(
-            "a bank the river has cut down still rises from the river at this angle, as the aprons along a "
-            "valley's foot do (0 = dead flat floors, which hold pits)");
-    p.real(&BankSettings::wide_area, "wide_area")
-        .min(0.0)
-        .max(1e12)
-        .unit("m²")
-        .help(
-            "rivers draining more keep floors five cells wide rather than three: a bank cut down to its floor "
-            "passes the river's push on to the cell beyond it; 0 = three cells everywhere");
-    p.real(&BankSettings::wider_area, "wider_area")
-        .min(0.0)
-        .max(1e12)
-        .unit("m²")
-        .help("rivers draining more (and wide_area) keep floors seven cells wide; 0 = five cells at most");
-    p.integer(&BankSettings::widest_floor, "widest_floor")
-        .min(0)
-        .max(35)
-        .unit("cells")
-        .help(
-            "floors keep widening past seven cells, two cells more each time the drainage area grows by "
-            "wider_area / wide_area, up to this many; each two cells cost a pass; 0 = seven at most");
+    const ProcessParams<landscape::BanksSpec> p = landscape::banks_params();
     registry.add(ProcessDescriptor{
         .name = "banks",
         .summary = "rivers cut their banks as they cut down, widening their valley floors downstream",

@@ -2,19 +2,16 @@
 // step a sub-step (libs/solvers/diffusion.hpp: stable at any dt), the open sides held, closed sides closed.
 #include <orogen/landscape/stream_power.hpp>
 
+#include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
 namespace {
 
 using namespace orogen;
 
-struct Creep {
-    double diffusivity = 0.01;  // m²/yr
-};
-
 class CreepProcess final : public Process {
 public:
-    explicit CreepProcess(const Creep& s) : s_(s) {}
+    explicit CreepProcess(const landscape::CreepSpec& s) : s_(s) {}
 
     void start(ProcessState& state) override {
         if (!(s_.diffusivity > 0.0)) return;
@@ -39,21 +36,14 @@ public:
     }
 
 private:
-    Creep s_;
+    landscape::CreepSpec s_;
     std::optional<diffusion::Solver> solver_;
 };
 
 }  // namespace
 
 OROGEN_PLUGIN("process-creep", "0.1.0", registry) {
-    ProcessParams<Creep> p;
-    p.real(&Creep::diffusivity, "diffusivity")
-        .min(0.0)
-        .max(10.0)
-        .unit("m²/yr")
-        .help(
-            "hillslope diffusivity D (1e-3 to 1e-1 m²/yr measured; ~1 stands in for faster slope processes "
-            "at 30 m cells, docs/landscape.md; 0 = none)");
+    const ProcessParams<landscape::CreepSpec> p = landscape::creep_params();
     registry.add(ProcessDescriptor{
         .name = "creep",
         .summary = "soil creep: linear hillslope diffusion D lap(h), implicit (stable at any step)",

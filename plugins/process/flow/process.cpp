@@ -5,23 +5,17 @@
 #include <orogen/landscape/flow.hpp>
 #include <orogen/landscape/stream_power.hpp>
 
+#include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
 namespace {
 
 using namespace orogen;
 
-struct Flow {
-    std::string routing = "d8";
-    double mfd_exponent = 1.1;
-    std::string depressions = "fill";
-};
-
 class FlowProcess final : public Process {
 public:
-    explicit FlowProcess(const Flow& s)
-        : mode_(s.depressions == "route" ? landscape::Depressions::route : landscape::Depressions::fill),
-          mfd_(s.routing == "mfd" ? s.mfd_exponent : 0.0) {}
+    explicit FlowProcess(const landscape::FlowSpec& s)
+        : mode_(landscape::to_depressions(s)), mfd_(landscape::to_mfd_exponent(s)) {}
 
     void start(ProcessState& state) override {
         const auto& outlets = state.outlets();
@@ -96,18 +90,7 @@ void check(ProcessCheckContext& ctx) {
 }  // namespace
 
 OROGEN_PLUGIN("process-flow", "0.1.0", registry) {
-    ProcessParams<Flow> p;
-    p.choice(&Flow::routing, "routing", {"d8", "mfd"})
-        .help(
-            "d8: all the water to the steepest of the 8 neighbours; mfd: the drainage area split among the lower "
-            "neighbours by slope^mfd_exponent (Freeman 1991: wider, smoother hillslope areas); the graph's "
-            "receivers are the steepest either way");
-    p.real(&Flow::mfd_exponent, "mfd_exponent")
-        .min(0.0, true)
-        .max(100.0)
-        .help("routing=mfd: weight of a lower neighbour = slope^p (1.1: Freeman 1991; larger concentrates)");
-    p.choice(&Flow::depressions, "depressions", {"fill", "route"})
-        .help("fill: each lake is filled to its spill level; route: water crosses it, the heights stay");
+    const ProcessParams<landscape::FlowSpec> p = landscape::flow_params();
     registry.add(ProcessDescriptor{
         .name = "flow",
         .summary = "water routing once a step: D8 or multiple directions, lakes resolved, drainage area",

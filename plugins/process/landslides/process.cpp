@@ -6,6 +6,7 @@
 #include <orogen/landscape/rock.hpp>
 #include <orogen/solvers/threshold_slopes.hpp>
 
+#include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
 #include <numbers>
@@ -15,17 +16,9 @@ namespace {
 
 using namespace orogen;
 
-struct Landslides {
-    double angle = 35.0;  // °
-};
-
 class LandslidesProcess final : public Process {
 public:
-    explicit LandslidesProcess(const Landslides& s) {
-        landscape::Beds one_rock;  // the rock's own expression for its mean angle, so the same bits
-        one_rock.angle = s.angle * (std::numbers::pi / 180.0);
-        uniform_ = one_rock.landslide_slope(0.5);
-    }
+    explicit LandslidesProcess(const landscape::LandslidesSpec& s) : uniform_(landscape::to_landslide_slope(s)) {}
 
     void step(ProcessState& state, double dt) override {
         (void)dt;
@@ -53,14 +46,7 @@ private:
 }  // namespace
 
 OROGEN_PLUGIN("process-landslides", "0.1.0", registry) {
-    ProcessParams<Landslides> p;
-    p.real(&Landslides::angle, "angle")
-        .min(5.0)
-        .max(80.0)
-        .unit("°")
-        .help(
-            "threshold hillslope angle where no rock process before it makes a threshold_slope field (25-40° in "
-            "ranges that erode fast, Montgomery & Brandon 2002)");
+    const ProcessParams<landscape::LandslidesSpec> p = landscape::landslides_params();
     registry.add(ProcessDescriptor{
         .name = "landslides",
         .summary = "threshold hillslopes: whatever stands steeper than the rock's landslide angle slides away",

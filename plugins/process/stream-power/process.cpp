@@ -4,6 +4,7 @@
 #include <orogen/landscape/stream_power.hpp>
 
 #include <orogen/parallel.hpp>
+#include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
 #include <algorithm>
@@ -13,17 +14,9 @@ namespace {
 
 using namespace orogen;
 
-struct StreamPower {
-    double erodibility = 2e-5;  // m^(1-2m)/yr
-    double m = 0.45;
-    double n = 1.0;
-    double channel_area = 0.0;  // m²
-    double deposition = 0.0;
-};
-
 class StreamPowerProcess final : public Process {
 public:
-    explicit StreamPowerProcess(const StreamPower& s) : s_(s) {}
+    explicit StreamPowerProcess(const landscape::StreamPowerSpec& s) : s_(s) {}
 
     void start(ProcessState& state) override {
         inv_ac_ = s_.channel_area > 0.0 ? 1.0 / s_.channel_area : 0.0;
@@ -74,7 +67,7 @@ public:
     }
 
 private:
-    StreamPower s_;
+    landscape::StreamPowerSpec s_;
     double inv_ac_ = 0.0;
     std::vector<double> table_;  // A^m·(1 − e^(−A/A_c)) for whole numbers of cells
     bool keep_incision_ = false;
@@ -86,36 +79,7 @@ private:
 }  // namespace
 
 OROGEN_PLUGIN("process-stream-power", "0.1.0", registry) {
-    ProcessParams<StreamPower> p;
-    p.real(&StreamPower::erodibility, "erodibility")
-        .min(0.0, true)
-        .max(1e-2)
-        .unit("m^(1-2m)/yr")
-        .help(
-            "K: 1e-7 (hard rock, dry) to 1e-4 (soft rock, wet) for m ~ 0.5, n = 1 (Stock & Montgomery 1999); "
-            "times the erodibility_factor of a rock process before it");
-    p.real(&StreamPower::m, "m")
-        .min(0.1)
-        .max(1.5)
-        .help("area exponent (0.3-0.6 with n = 1; m/n is the concavity, 0.35-0.6 in real rivers)");
-    p.real(&StreamPower::n, "n")
-        .min(0.5)
-        .max(4.0)
-        .help("slope exponent (2/3-2 measured, Whipple & Tucker 1999; up to 4, Lague 2014)");
-    p.real(&StreamPower::channel_area, "channel_area")
-        .min(0.0)
-        .max(1e10)
-        .unit("m²")
-        .help(
-            "drainage area where rivers take over from hillslopes: incision is scaled by 1 - exp(-A/channel_area), "
-            "so smaller catchments are shaped by creep (channel heads at 1e3-1e5 m², Montgomery & Dietrich "
-            "1988); 0 = every cell is a river");
-    p.real(&StreamPower::deposition, "deposition")
-        .min(0.0)
-        .max(10.0)
-        .help(
-            "G of Yuan et al. (2019), dimensionless: the sediment flux deposits G·Qs/A on its way down (0 = "
-            "detachment-limited; ~1 = half the eroded rock settles in the valleys at steady state)");
+    const ProcessParams<landscape::StreamPowerSpec> p = landscape::stream_power_params();
     registry.add(ProcessDescriptor{
         .name = "stream-power",
         .summary = "river incision by stream power K A^m S^n, implicit along the flow graph; optional deposition",

@@ -3,28 +3,19 @@
 // bending crust and tapered towards the sides held at base level (libs/landscape/uplift.hpp).
 #include <orogen/landscape/uplift.hpp>
 
+#include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
 namespace {
 
 using namespace orogen;
 
-struct Uplift {
-    double rate = 1.0;  // mm/yr
-    std::string layer;
-    double layer_years = 1e6;  // yr
-    double smoothing = 0.0;  // m
-    double edge_taper = 0.0;  // m
-    double history_years = 0.0;  // yr (0: the run's)
-};
-
 class UpliftProcess final : public Process {
 public:
-    explicit UpliftProcess(const Uplift& s) : s_(s) {}
+    explicit UpliftProcess(const landscape::UpliftSpec& s) : s_(s) {}
 
     void start(ProcessState& state) override {
-        const landscape::UpliftSources sources{s_.rate,          s_.layer, s_.layer_years, s_.smoothing, s_.edge_taper,
-                                               s_.history_years, ""};
+        const landscape::UpliftSources sources = landscape::to_sources(s_);
         const landscape::UpliftGrid grid{state.terrain(), state.tiling(), state.open()};
         rate_ = landscape::steady_uplift(sources, grid);
         if (const Value& history = state.node_input(1); history) {
@@ -50,7 +41,7 @@ public:
     }
 
 private:
-    Uplift s_;
+    landscape::UpliftSpec s_;
     std::vector<double> rate_;
     landscape::UpliftHistory history_;
     std::size_t history_k_ = std::size_t(-1);
@@ -84,36 +75,7 @@ void check(ProcessCheckContext& ctx) {
 }  // namespace
 
 OROGEN_PLUGIN("process-uplift", "0.1.0", registry) {
-    ProcessParams<Uplift> p;
-    p.real(&Uplift::rate, "rate")
-        .min(0.0)
-        .max(landscape::kMaxUpliftMmYr)
-        .unit("mm/yr")
-        .help("uniform rock uplift rate (0.1-10 mm/yr in active ranges)");
-    p.text(&Uplift::layer, "layer")
-        .help("a layer of the terrain read as uplift (m) gained over layer_years, added to `rate`; \"\" = none");
-    p.real(&Uplift::layer_years, "layer_years")
-        .min(1.0)
-        .max(1e9)
-        .unit("yr")
-        .help("years over which the layer's metres were gained (1e6: metres per Myr = mm/yr)");
-    p.real(&Uplift::smoothing, "smoothing")
-        .min(0.0)
-        .max(1e6)
-        .unit("m")
-        .help("spread the layer's or history's uplift over about this distance (flexure of the crust; 0 = as is)");
-    p.real(&Uplift::edge_taper, "edge_taper")
-        .min(0.0)
-        .max(1e6)
-        .unit("m")
-        .help(
-            "all of the uplift falls smoothly to zero over this distance towards the open sides, as a range's "
-            "falls to its foreland (0 = the same right up to the sides)");
-    p.real(&Uplift::history_years, "history_years")
-        .min(0.0)
-        .max(1e9)
-        .unit("yr")
-        .help("the years the history's frames span, its first frame year 0 of the run (0 = the run's years)");
+    const ProcessParams<landscape::UpliftSpec> p = landscape::uplift_params();
     registry.add(ProcessDescriptor{
         .name = "uplift",
         .summary = "rock uplift: a uniform rate, plus a layer read over years or a history's height changes",

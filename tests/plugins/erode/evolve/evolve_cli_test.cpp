@@ -73,7 +73,8 @@ TEST(Evolve, AProcessListGivesTheBytesOfStreamPowerOnOneThreadAndTwo) {
         EXPECT_NE(r.err.find("flow: "), std::string::npos) << r.err;
         EXPECT_NE(r.err.find(" pits resolved"), std::string::npos) << r.err;
         for (const char* file : {"terrain.r32", "terrain.vti"}) {
-            const std::string x = bytes_of(std::filesystem::path(a) / file), y = bytes_of(std::filesystem::path(b) / file);
+            const std::string x = bytes_of(std::filesystem::path(a) / file),
+                              y = bytes_of(std::filesystem::path(b) / file);
             ASSERT_GE(x.size(), 129u * 129u * 4u) << file;
             EXPECT_TRUE(x == y) << file << " differs between erode:stream-power and erode:evolve on " << threads
                                 << " thread(s)";
@@ -104,8 +105,8 @@ TEST(Evolve, SetReachesAProcessParameterAndNamesAWrongOne) {
 TEST(Evolve, ListAndHelpShowTheProcessesAndTheirFields) {
     const RunResult list = run_orogen("list process");
     ASSERT_EQ(list.exit_code, 0);
-    for (const char* p : {"uplift", "rain", "flow", "creep", "rock", "stream-power", "banks", "floodplains",
-                          "landslides"})
+    for (const char* p :
+         {"uplift", "rain", "flow", "creep", "rock", "stream-power", "banks", "floodplains", "landslides"})
         EXPECT_NE(list.out.find(std::string("  ") + p + " "), std::string::npos) << p << " missing:\n" << list.out;
     const RunResult help = run_orogen("help stream-power");
     ASSERT_EQ(help.exit_code, 0);

@@ -1,0 +1,141 @@
+// processes.hpp — the built-in processes of erode:evolve's loop (plugins/process/*), as plain C++: each
+// one's parameters in the spec's units (a struct, its members' initialisers the defaults), their
+// declaration bound to those members (ProcessParams, orogen/process.hpp), and the conversion to the
+// model's own structs (radians, tangents). The process plugins register them; erode:evolve also lowers
+// a body of them, in erode:stream-power's order, to that node's model (Settings), which runs tiled under
+// mpirun (tiled.hpp) and gives the same bits as the loop.
+#pragma once
+
+#include "stream_power.hpp"
+#include "uplift.hpp"
+
+#include <orogen/climate/orographic_rain.hpp>
+#include <orogen/process.hpp>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace orogen::landscape {
+
+/// uplift(...)'s parameters, in the spec's units.
+struct UpliftSpec {
+    double rate = 1.0;  // mm/yr
+    std::string layer;
+    double layer_years = 1e6;  // yr
+    double smoothing = 0.0;  // m
+    double edge_taper = 0.0;  // m
+    double history_years = 0.0;  // yr (0: the run's)
+};
+ProcessParams<UpliftSpec> uplift_params();
+
+/// rain(...)'s parameters, in the spec's units.
+struct RainSpec {
+    double background = 1.0;  // m/yr
+    double wind_from = 270.0;  // °
+    double wind_speed = 10.0;  // m/s
+    double wind_share = 0.1;
+    double condensation_time = 1000.0;  // s
+    double fallout_time = 1000.0;  // s
+    double moist_stability = 0.005;  // 1/s
+    double vapour_scale_height = 2500.0;  // m
+    double uplift_sensitivity = 0.0083;  // kg/m³
+    double resolution = 250.0;  // m
+};
+ProcessParams<RainSpec> rain_params();
+
+/// flow(...)'s parameters, in the spec's units.
+struct FlowSpec {
+    std::string routing = "d8";
+    double mfd_exponent = 1.1;
+    std::string depressions = "fill";
+};
+ProcessParams<FlowSpec> flow_params();
+
+/// creep(...)'s parameters, in the spec's units.
+struct CreepSpec {
+    double diffusivity = 0.01;  // m²/yr
+};
+ProcessParams<CreepSpec> creep_params();
+
+/// rock(...)'s parameters, in the spec's units.
+struct RockSpec {
+    double angle = 0.0;  // °
+    double block_spread = 0.0;
+    double thickness = 0.0;  // m
+    double dip = 0.0;  // °
+    double dip_toward = 0.0;  // °, clockwise from north
+    double angle_spread = 0.0;  // °
+    double erodibility_contrast = 1.0;
+    double fold_amplitude = 0.0;  // m
+    double fold_wavelength = 5000.0;  // m
+    double thickness_spread = 0.0;
+    double fault_spacing = 0.0;  // m
+    double fault_throw = 0.0;  // m
+    double facies_length = 0.0;  // m
+    double facies_share = 0.5;
+};
+ProcessParams<RockSpec> rock_params();
+
+/// stream-power(...)'s parameters, in the spec's units.
+struct StreamPowerSpec {
+    double erodibility = 2e-5;  // m^(1-2m)/yr
+    double m = 0.45;
+    double n = 1.0;
+    double channel_area = 0.0;  // m²
+    double deposition = 0.0;
+};
+ProcessParams<StreamPowerSpec> stream_power_params();
+
+/// banks(...)'s parameters, in the spec's units.
+struct BanksSpec {
+    double erosion = 4.0;
+    double area = 1e6;  // m²
+    double floor_slope = 1.0;  // °
+    double wide_area = 0.0;  // m²
+    double wider_area = 0.0;  // m²
+    int widest_floor = 0;  // cells
+};
+ProcessParams<BanksSpec> banks_params();
+
+/// floodplains(...)'s parameters, in the spec's units.
+struct FloodplainsSpec {
+    double area = 2e6;  // m²
+    double width = 30.0;  // m
+    double exponent = 0.5;
+    double slope = 2.0;  // °
+    double max_slope = 0.0;  // °
+};
+ProcessParams<FloodplainsSpec> floodplains_params();
+
+/// landslides(...)'s parameters, in the spec's units.
+struct LandslidesSpec {
+    double angle = 35.0;  // °
+};
+ProcessParams<LandslidesSpec> landslides_params();
+
+UpliftSources to_sources(const UpliftSpec& s);
+climate::OrographicRain to_rain(const RainSpec& s);
+Depressions to_depressions(const FlowSpec& s);
+/// The multiple-flow-direction exponent, 0 for D8.
+double to_mfd_exponent(const FlowSpec& s);
+Beds to_beds(const RockSpec& s, std::uint64_t seed);
+Banks to_banks(const BanksSpec& s);
+Floodplain to_floodplain(const FloodplainsSpec& s);
+/// tan of the landslides' own angle, by the rock's expression for its mean angle (so the same bits).
+double to_landslide_slope(const LandslidesSpec& s);
+
+/// erode:stream-power's model for a body of the built-in processes: its settings, the uplift's
+/// sources, and why not ("" when it is one). A body is one when its processes are built-in ones, each
+/// at most once, in the model's order (uplift, rain, flow, creep, rock, stream-power, banks,
+/// floodplains, landslides), with flow and stream-power, and the rock's and the landslides' angles agree
+/// (the model slides at the rock's angle exactly when it has one).
+struct LoweredBody {
+    Settings settings;
+    UpliftSources uplift;
+    std::string why_not;  ///< "" when the body is the model
+};
+LoweredBody lower_to_model(const std::vector<ProcessCall>& body, std::uint64_t seed);
+
+}  // namespace orogen::landscape
