@@ -592,7 +592,8 @@ int help_process(const ProcessDescriptor& p, const PluginSet& plugins) {
     if (!p.description.empty()) std::printf("\n%s\n", p.description.c_str());
     std::printf("\nruns: %s%s\n",
                 p.cadence == Cadence::once_per_step ? "once a step (on its first sub-step)" : "every sub-step",
-                p.tile_halo >= 0 ? ("; tiled, halo " + std::to_string(p.tile_halo)).c_str() : "; not tiled");
+                p.tile_halo >= 0 ? ("; tiles under mpirun (halo " + std::to_string(p.tile_halo) + ")").c_str()
+                                 : "; not tiled (a loop with it runs on rank 0 under mpirun)");
     std::printf("fields:\n");
     for (const auto& f : p.fields)
         std::printf("  %-17s %-20s%s%s\n", std::string(to_string(f.access)).c_str(),

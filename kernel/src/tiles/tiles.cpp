@@ -250,6 +250,8 @@ std::string TiledRun::untiled_reason(const PlannedNode& node) {
     for (const auto& key : node.inputs) given.push_back(!key.empty());
     if (node.node->untiled_because)
         if (std::string why = node.node->untiled_because(node.params, given); !why.empty()) return why;
+    for (const auto& process : node.processes)
+        if (process.process->tile_halo < 0) return "process " + process.label + " is not tiled";
     return node.node->untiled_body_because ? node.node->untiled_body_because(node.processes) : "";
 }
 

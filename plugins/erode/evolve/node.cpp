@@ -134,10 +134,10 @@ void check(CheckContext& ctx) {
         const double limit = p.process->max_dt(p, cell);
         if (sub > limit) {
             std::ostringstream msg;
-            msg << "the sub-step dt/substeps = " << sub << " yr is longer than " << p.label << "'s stable step, "
-                << limit << " yr on " << cell << " m cells; give dt <= " << limit * double(ctx.integer("substeps"))
+            msg << "the sub-step dt/substeps = " << sub << " yr is longer than its stable step, " << limit
+                << " yr on " << cell << " m cells; give the node dt <= " << limit * double(ctx.integer("substeps"))
                 << " or substeps >= " << std::int64_t(std::ceil(ctx.real("dt") / limit));
-            ctx.error("dt", msg.str());
+            ctx.process_error(k, "", msg.str());
         }
     }
     // Memory: the loop holds the heights and the uplift received (two doubles a cell) beside the processes'

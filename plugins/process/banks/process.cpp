@@ -73,6 +73,7 @@ OROGEN_PLUGIN("process-banks", "0.1.0", registry) {
         .fields = {{kElevation, FieldAccess::updates, "m", "banks lowered"},
                    {kFlowGraph, FieldAccess::reads, "", "each river's direction and drainage area"},
                    {"incision", FieldAccess::reads, "m", "the river's lowering this sub-step"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .check = check,
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<BanksProcess>(p.bind(call.params));

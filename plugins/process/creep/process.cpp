@@ -54,6 +54,7 @@ OROGEN_PLUGIN("process-creep", "0.1.0", registry) {
             "leaves every eroded cell above its receiver (docs/landscape.md).",
         .params = p.params(),
         .fields = {{kElevation, FieldAccess::updates, "m", "diffused"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<CreepProcess>(p.bind(call.params));
         },

@@ -47,6 +47,7 @@ OROGEN_PLUGIN("process-floodplains", "0.1.0", registry) {
         .params = p.params(),
         .fields = {{kElevation, FieldAccess::updates, "m", "floors planed"},
                    {kFlowGraph, FieldAccess::reads, "", "the rivers and their drainage area"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<FloodplainsProcess>(p.bind(call.params));
         },

@@ -107,6 +107,7 @@ OROGEN_PLUGIN("process-flow", "0.1.0", registry) {
                    {kFlowGraph, FieldAccess::writes, "", "receivers, stack and drainage area (m²)"}},
         .cadence = Cadence::once_per_step,
         .adds_layers = {"drainage", "flow_direction"},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .check = check,
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<FlowProcess>(p.bind(call.params));

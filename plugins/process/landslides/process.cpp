@@ -56,6 +56,7 @@ OROGEN_PLUGIN("process-landslides", "0.1.0", registry) {
         .params = p.params(),
         .fields = {{kElevation, FieldAccess::updates, "m", "lowered to the threshold"},
                    {"threshold_slope", FieldAccess::reads_if_present, "m/m", "the rock's threshold, cell by cell"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<LandslidesProcess>(p.bind(call.params));
         },

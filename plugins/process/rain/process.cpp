@@ -54,6 +54,7 @@ OROGEN_PLUGIN("process-rain", "0.1.0", registry) {
                    {"rain_factor", FieldAccess::writes, "1", "rain over the background rain, in whole 2^-20"}},
         .cadence = Cadence::once_per_step,
         .adds_layers = {"rain"},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<RainProcess>(p.bind(call.params));
         },

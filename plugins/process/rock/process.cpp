@@ -84,6 +84,7 @@ OROGEN_PLUGIN("process-rock", "0.1.0", registry) {
                    {kUplifted, FieldAccess::reads, "m", "the depth of exhumation is the height less this"},
                    {"erodibility_factor", FieldAccess::writes, "1", "K of the rock a cell shows over K (empty: 1)"},
                    {"threshold_slope", FieldAccess::writes, "m/m", "tan of the rock's landslide angle (empty: none)"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .check = check,
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<RockProcess>(p.bind(call.params));

@@ -95,6 +95,7 @@ OROGEN_PLUGIN("process-stream-power", "0.1.0", registry) {
                    {kFlowGraph, FieldAccess::reads, "", "receivers, stack, drainage area"},
                    {"erodibility_factor", FieldAccess::reads_if_present, "1", "the rock's K over K"},
                    {"incision", FieldAccess::writes, "m", "what this sub-step's incision lowered each cell by"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<StreamPowerProcess>(p.bind(call.params));
         },

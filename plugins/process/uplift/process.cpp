@@ -88,6 +88,7 @@ OROGEN_PLUGIN("process-uplift", "0.1.0", registry) {
         .params = p.params(),
         .fields = {{kElevation, FieldAccess::updates, "m", "raised"},
                    {kUplifted, FieldAccess::updates, "m", "the uplift each cell received so far"}},
+        .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .check = check,
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {
             return std::make_unique<UpliftProcess>(p.bind(call.params));
