@@ -17,6 +17,8 @@
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/landscape/loop.hpp>
+#include <orogen/landscape/uplift.hpp>
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -427,6 +429,103 @@ py::dict run_node(const std::string& spec, const py::list& inputs, std::optional
     return run_spec_bound(py::str(spec), std::nullopt, py::dict(), threads, py::none(), false, std::move(bound));
 }
 
+// ------------------------------------------------------------ a model of processes (orogen.Model)
+
+/// A landscape-evolution loop stepped from Python (the landlab habit): the processes of an erode:evolve
+/// body, checked by the kernel as a spec's, over a terrain held here; fields read and written as numpy
+/// arrays between steps (copies: a process may reallocate its fields while it runs).
+class PyModel {
+public:
+    /// `spec` an erode:evolve statement named `label` over the bound value `terrain` (orogen/__init__.py writes it).
+    PyModel(const std::string& spec, const std::string& label, const py::object& terrain, double cell) {
+        BoundValues bound;
+        bound["terrain"] = Value(py::isinstance<PyHeightmap>(terrain)
+                                     ? std::make_shared<Heightmap>(*terrain.cast<const PyHeightmap&>().hm)
+                                     : heightmap_of_array(terrain.cast<py::array>(), cell, 1));
+        CheckOptions check_options;
+        for (const auto& [name, v] : bound) check_options.bound[name] = describe_bound(v);
+        auto source = std::make_shared<spec::Source>("orogen.Model", spec);
+        spec::Diagnostics diags;
+        const spec::Spec parsed = spec::parse(source, diags);
+        if (!diags.has_errors()) plan_ = check(parsed, plugins().registry(), "orogen.Model", check_options, diags);
+        if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, "orogen.Model"));
+        const PlannedNode& node = plan_.nodes.back();
+        auto hm = std::const_pointer_cast<Heightmap>(bound["terrain"].heightmap());
+        landscape::ProcessLoop::Options options;
+        options.open = *landscape::parse_sides(std::get<std::string>(node.params.at("open")));
+        options.base_level = *landscape::parse_base_level(std::get<std::string>(node.params.at("base_level")));
+        options.substeps = int(std::get<std::int64_t>(node.params.at("substeps")));
+        options.years = std::get<double>(node.params.at("years"));
+        options.seed = node_seed(plan_.seed, label);
+        options.warn = [](std::string_view m) { PyErr_WarnEx(PyExc_RuntimeWarning, std::string(m).c_str(), 1); };
+        loop_ = std::make_unique<landscape::ProcessLoop>(node.processes, hm, std::vector<Value>{Value(hm)}, options);
+        loop_->start();
+    }
+
+    void step(double dt, int steps) {
+        if (!(dt > 0.0) || !std::isfinite(dt)) throw py::value_error("dt must be a positive number of years");
+        if (steps < 0) throw py::value_error("steps must be 0 or more");
+        const double sub = dt / loop_->substeps();
+        for (const ProcessCall& p : plan_.nodes.back().processes)
+            if (p.process->max_dt && sub > p.process->max_dt(p, loop_->cell()))
+                throw py::value_error("dt/substeps = " + std::to_string(sub) + " yr is longer than " + p.label +
+                                      "'s stable step, " + std::to_string(p.process->max_dt(p, loop_->cell())) +
+                                      " yr on these cells; give a smaller dt or more substeps");
+        {
+            py::gil_scoped_release release;
+            for (int k = 0; k < steps; ++k) loop_->advance(dt);
+        }
+        if (const std::int64_t bad = loop_->first_non_finite(); bad >= 0)
+            throw std::runtime_error("non-finite height at sample " + std::to_string(bad) + " after step " +
+                                     std::to_string(loop_->step()) + "; give a smaller dt or more substeps");
+    }
+
+    py::array field(const std::string& name) {
+        const std::vector<double>* f = loop_->find_field(name);
+        if (!f) throw py::key_error(unknown_field(name));
+        py::array_t<double> out({py::ssize_t(loop_->height()), py::ssize_t(loop_->width())});
+        if (f->empty()) std::fill(out.mutable_data(), out.mutable_data() + out.size(), 0.0);
+        else std::memcpy(out.mutable_data(), f->data(), f->size() * sizeof(double));
+        return out;
+    }
+
+    void set_field(const std::string& name, const py::array_t<double, py::array::c_style | py::array::forcecast>& a) {
+        std::vector<double>* f = loop_->find_field(name);
+        if (!f) throw py::key_error(unknown_field(name));
+        if (a.ndim() != 2 || a.shape(0) != loop_->height() || a.shape(1) != loop_->width())
+            throw py::value_error("field '" + name + "' is " + std::to_string(loop_->height()) + " rows of " +
+                                  std::to_string(loop_->width()) + "; the array does not match");
+        for (py::ssize_t i = 0; i < a.size(); ++i)
+            if (!std::isfinite(a.data()[i]))
+                throw py::value_error("field '" + name + "': sample " + std::to_string(i) + " is not finite");
+        f->assign(a.data(), a.data() + a.size());
+    }
+
+    std::vector<std::string> fields() const { return loop_->field_names(); }
+    double time() const { return loop_->time(); }
+    std::int64_t steps() const { return loop_->step(); }
+
+    /// The heights now, with the processes' layers (drainage, ...) and the uplift received, as a Heightmap.
+    PyHeightmap result() {
+        loop_->finish();
+        auto out = std::make_shared<Heightmap>(loop_->result());
+        GridView uplifted = out->layer("uplifted", 0.0f);
+        const auto& u = loop_->uplifted_so_far();
+        for (std::size_t i = 0; i < u.size(); ++i) uplifted.data[i] = float(u[i]);
+        return PyHeightmap{out};
+    }
+
+private:
+    std::string unknown_field(const std::string& name) const {
+        std::string names;
+        for (const auto& n : loop_->field_names()) names += (names.empty() ? "" : ", ") + n;
+        return "no field '" + name + "' in this model (its fields: " + names + ")";
+    }
+
+    Plan plan_;  // holds the processes' checked calls the loop reads
+    std::unique_ptr<landscape::ProcessLoop> loop_;
+};
+
 // ------------------------------------------------------------ nodes, help
 
 py::object param_value(const ParamValue& v) {
@@ -565,6 +664,16 @@ PYBIND11_MODULE(_orogen, m) {
                 std::string(to_string(s.series->element)) + "s>";
         });
 
+    py::class_<PyModel>(m, "_Model")
+        .def(py::init<const std::string&, const std::string&, const py::object&, double>(), py::arg("spec"),
+             py::arg("label"), py::arg("terrain"), py::arg("cell"))
+        .def("step", &PyModel::step, py::arg("dt"), py::arg("steps") = 1)
+        .def("field", &PyModel::field, py::arg("name"))
+        .def("set_field", &PyModel::set_field, py::arg("name"), py::arg("values"))
+        .def_property_readonly("fields", &PyModel::fields)
+        .def_property_readonly("time", &PyModel::time)
+        .def_property_readonly("steps", &PyModel::steps)
+        .def("result", &PyModel::result);
     m.def("run", &run_spec, py::arg("spec"), py::kw_only(), py::arg("seed") = py::none(), py::arg("set") = py::dict(),
           py::arg("threads") = py::none(), py::arg("out") = py::none(), py::arg("progress") = false,
           "Run a spec (a path, or the text itself) and return every named value: {name: value}.");

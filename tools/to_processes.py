@@ -5,7 +5,8 @@ the same model as a body of process plugins (docs/processes.md), which gives the
     python3 tools/to_processes.py pipelines/rif.orogen            # prints the rewritten spec
     python3 tools/to_processes.py -i pipelines/rif.orogen         # rewrites it in place
 
-A statement with glaciers=true or chi=true is left as it is: those have no process yet."""
+glaciers=true becomes glaciers() before the incision and troughs() after the floodplains; chi=true becomes
+chi(concavity=m/n) last."""
 import re
 import sys
 
@@ -26,13 +27,19 @@ PROCESSES = [  # (process, {node parameter: process parameter}), in erode:stream
               "bed_fold_wavelength": "fold_wavelength", "bed_thickness_spread": "thickness_spread",
               "bed_fault_spacing": "fault_spacing", "bed_fault_throw": "fault_throw",
               "bed_facies_length": "facies_length", "bed_facies_share": "facies_share"}),
+    ("glaciers", {"ela": "ela", "ice_balance_gradient": "balance_gradient", "ice_max_balance": "max_balance",
+                  "ice_erodibility": "erodibility", "ice_flux_exponent": "flux_exponent",
+                  "glacier_min_flux": "min_flux"}),
     ("stream-power", {"erodibility": "erodibility", "m": "m", "n": "n", "channel_area": "channel_area",
                       "deposition": "deposition"}),
     ("banks", {"bank_erosion": "erosion", "bank_area": "area", "bank_floor_slope": "floor_slope",
                "bank_wide_area": "wide_area", "bank_wider_area": "wider_area", "bank_widest_floor": "widest_floor"}),
     ("floodplains", {"floodplain_area": "area", "floodplain_width": "width", "floodplain_exponent": "exponent",
                      "floodplain_slope": "slope", "floodplain_max_slope": "max_slope"}),
+    ("troughs", {"glacier_half_width": "half_width", "trough_wall_angle": "wall_angle",
+                 "glacier_min_flux": "min_flux"}),
     ("landslides", {"landslide_angle": "angle"}),
+    ("chi", {}),
 ]
 
 
@@ -81,8 +88,6 @@ def call_lines(head, params, indent, width=120):
 
 def rewrite(name, inputs, params, comment):
     given = dict(params)
-    if given.get("glaciers") == "true" or given.get("chi") == "true":
-        return None
     node = [(k, v) for k, v in params if k in NODE]
     body = []
     for process, names in PROCESSES:
@@ -100,6 +105,12 @@ def rewrite(name, inputs, params, comment):
             continue
         if process == "landslides" and not (number(given.get("landslide_angle", "0")) or 0) > 0:
             continue
+        if process in ("glaciers", "troughs") and given.get("glaciers") != "true":
+            continue
+        if process == "chi":
+            if given.get("chi") != "true":
+                continue
+            mine = [("concavity", repr(float(given.get("m", "0.45")) / float(given.get("n", "1"))))]
         if process == "creep" and "diffusivity" not in given:
             mine = [("diffusivity", "0.01")]  # erode:stream-power's default
         body.append((process, mine))

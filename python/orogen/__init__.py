@@ -13,7 +13,7 @@ import math as _math
 from . import _orogen
 from ._orogen import Heightmap, Series, help, nodes, run
 
-__all__ = ["Heightmap", "Series", "help", "node", "nodes", "run"]
+__all__ = ["Heightmap", "Model", "Series", "help", "node", "nodes", "run"]
 
 def _literal(value, where):
     """A Python value as the spec writes it."""
@@ -103,3 +103,71 @@ def node(name, *inputs, cell=None, grid=None, spec_seed=0, label="result", threa
     lines.append(f"{label} = {name}({', '.join(args)})")
     values = _orogen._run_node("\n".join(lines) + "\n", bound, threads=threads)
     return values.get(label)
+
+
+class Model:
+    """A landscape-evolution loop of processes, stepped from Python (the landlab habit, at C++ speed).
+
+        model = orogen.Model(terrain, cell=30, open="ns", processes=[
+            ("uplift", {"rate": 1}),
+            ("flow", {}),
+            ("creep", {"diffusivity": 0.5}),
+            ("stream-power", {"erodibility": 2e-5, "m": 0.5}),
+        ])
+        for _ in range(10):
+            model.step(1e4)                         # one step of dt years: every process, in order
+            z = model["elevation"]                  # a float64 (rows, columns) copy
+            model["elevation"] = np.minimum(z, 3000)  # write a field back between steps
+        terrain = model.result()                    # an orogen.Heightmap with the processes' layers
+
+    `terrain` is an orogen.Heightmap or a 2-D float32 array (rows north to south, `cell` metres apart).
+    `processes` are an erode:evolve body's processes, in order, as (name, {parameter: value}) pairs: the
+    kernel checks them as it checks a spec (unknown processes, parameters out of range, fields read before
+    any process makes them: ValueError with the spec checker's message). `open`, `base_level`, `substeps`
+    and `seed` are erode:evolve's and a spec's (the model's seed is that of a node named `label`), so a
+    model stepped here gives the bits of the same body in a spec. docs/processes.md lists the processes.
+    """
+
+    def __init__(self, terrain, processes, *, cell=None, open="nesw", base_level="edge", substeps=1, seed=0,
+                 label="model"):
+        if not isinstance(terrain, Heightmap):
+            terrain = _grid_of(terrain, 1)
+        if not label.replace("_", "a").isalnum() or not label[0].isalpha():
+            raise ValueError(f"label must be a name as a spec writes one (letters, digits, _), got {label!r}")
+        body = []
+        for k, item in enumerate(processes):
+            if not (isinstance(item, (tuple, list)) and len(item) == 2 and isinstance(item[0], str)
+                    and isinstance(item[1], dict)):
+                raise ValueError(f"process {k + 1} is {item!r}; give (name, {{parameter: value}}) pairs")
+            name, params = item
+            args = ", ".join(f"{p}={_literal(v, name + '.' + p)}" for p, v in params.items())
+            body.append(f"    {name}({args})")
+        lines = ["orogen 1", f"seed {int(seed)}",
+                 f"{label} = erode:evolve(terrain, years=1e9, dt=1, substeps={int(substeps)}, "
+                 f"open={_literal(open, 'open')}, base_level={_literal(base_level, 'base_level')}) {{"]
+        lines += body + ["}"]
+        self._model = _orogen._Model("\n".join(lines) + "\n", label, terrain, 1.0 if cell is None else float(cell))
+
+    def step(self, dt, steps=1):
+        """Run `steps` steps of `dt` years."""
+        self._model.step(float(dt), int(steps))
+
+    def __getitem__(self, name):
+        return self._model.field(name)
+
+    def __setitem__(self, name, values):
+        self._model.set_field(name, values)
+
+    @property
+    def fields(self):
+        """The fields the processes share: elevation, uplifted and each process's."""
+        return list(self._model.fields)
+
+    @property
+    def time(self):
+        """Years simulated so far."""
+        return self._model.time
+
+    def result(self):
+        """The terrain now, with the processes' layers (drainage, flow_direction, ...) and uplifted."""
+        return self._model.result()

@@ -364,3 +364,62 @@ def test_node_reads_fortran_order_and_strided_arrays_and_leaves_them_as_they_wer
     wide[4, 9] = np.inf  # sample (3, 2) of the strided view
     with pytest.raises(ValueError, match=r"input 1: sample \(3, 2\) is inf; heights and layers must be finite"):
         orogen.node("erode:thermal", strided)
+
+
+MODEL_SPEC = """orogen 1
+seed 3
+grid 97 cell=30
+b = generate:diamond-square(roughness=0.6, amplitude=300)
+r = erode:evolve(b, years=5e4, dt=1e4, open="ns") {
+    uplift(rate=2)
+    flow()
+    creep(diffusivity=0.5)
+    stream-power(erodibility=2e-5, m=0.5)
+    landslides(angle=35)
+}
+"""
+
+BODY = [("uplift", {"rate": 2}), ("flow", {}), ("creep", {"diffusivity": 0.5}),
+        ("stream-power", {"erodibility": 2e-5, "m": 0.5}), ("landslides", {"angle": 35})]
+
+
+def test_a_model_stepped_from_python_gives_the_bits_of_the_same_body_in_a_spec():
+    values = orogen.run(MODEL_SPEC)
+    model = orogen.Model(values["b"], BODY, open="ns", seed=3, label="r")
+    for _ in range(5):
+        model.step(1e4)
+    assert model.time == 5e4
+    result = model.result()
+    assert np.array_equal(bits(result.height), bits(values["r"].height))
+    assert np.array_equal(bits(result.layers["drainage"]), bits(values["r"].layers["drainage"]))
+    assert "elevation" in model.fields and "uplifted" in model.fields
+    # 2 mm/yr for 5e4 yr on every cell but the open sides' (base level)
+    assert np.allclose(model["uplifted"][1:-1, :], 100.0)
+
+
+def test_a_field_written_between_steps_is_what_the_next_step_starts_from():
+    values = orogen.run(MODEL_SPEC)
+    a = orogen.Model(values["b"], BODY, open="ns", seed=3, label="r")
+    b = orogen.Model(values["b"], BODY, open="ns", seed=3, label="r")
+    a.step(1e4)
+    b.step(1e4)
+    z = b["elevation"]
+    assert z.dtype == np.float64 and z.shape == (97, 97)
+    b["elevation"] = np.minimum(z, np.median(z))  # plane the upper half off
+    a.step(1e4)
+    b.step(1e4)
+    assert b["elevation"].max() < a["elevation"].max() - 10
+    with pytest.raises(KeyError, match="no field 'soil' in this model"):
+        b["soil"]
+    with pytest.raises(ValueError, match="does not match"):
+        b["elevation"] = np.zeros((3, 3))
+
+
+def test_a_model_is_checked_as_a_spec_is():
+    flat = np.zeros((33, 33), dtype=np.float32)
+    with pytest.raises(ValueError, match="unknown process 'creap'; did you mean 'creep'"):
+        orogen.Model(flat, [("flow", {}), ("creap", {})], cell=30)
+    with pytest.raises(ValueError, match="stream-power reads the flow graph"):
+        orogen.Model(flat, [("stream-power", {})], cell=30)
+    with pytest.raises(ValueError, match="out of range"):
+        orogen.Model(flat, [("flow", {}), ("stream-power", {"m": 9})], cell=30)

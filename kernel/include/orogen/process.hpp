@@ -86,6 +86,7 @@ struct FlowGraph {
     std::span<const std::int64_t> chunks;  ///< stack bounds of independent groups of basins
     std::span<const double> area;  ///< drainage area, m² (weighed by the rain_factor field when one is made)
     std::span<const std::uint8_t> outlets;  ///< 1 at base level (an open side, or the sink of a closed map)
+    std::span<const std::int8_t> directions;  ///< direction(i) of every cell, made once with the graph
     std::int64_t pits = 0;  ///< pits resolved when it was made
     /// The area is split among several lower neighbours (multiple flow directions), not summed down
     /// the receivers alone (D8); the receivers are the steepest either way.

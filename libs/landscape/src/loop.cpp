@@ -107,6 +107,24 @@ std::vector<double>& ProcessLoop::field(std::string_view name) {
     return fields_[std::string(name)];
 }
 
+std::vector<double>* ProcessLoop::find_field(std::string_view name) {
+    if (name == kElevation) return &elevation_;
+    if (name == kUplifted) return &uplifted_;
+    const auto names = field_names();
+    if (std::find(names.begin(), names.end(), name) == names.end()) return nullptr;
+    return &fields_[std::string(name)];
+}
+
+std::vector<std::string> ProcessLoop::field_names() const {
+    std::vector<std::string> names = {kElevation, kUplifted};
+    for (const auto& r : processes_)
+        for (const auto& f : r.call->process->fields)
+            if (f.field != kFlowGraph && std::find(names.begin(), names.end(), f.field) == names.end())
+                names.push_back(f.field);
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
 bool ProcessLoop::wanted(std::string_view name) const {
     for (std::size_t k = 0; k < processes_.size(); ++k) {
         if (k == current_) continue;

@@ -346,9 +346,92 @@ ProcessParams<LandslidesSpec> landslides_params() {
     return p;
 }
 
+ProcessParams<GlaciersSpec> glaciers_params() {
+    ProcessParams<GlaciersSpec> p;
+    p.real(&GlaciersSpec::ela, "ela")
+        .min(-1000.0)
+        .max(9000.0)
+        .unit("m")
+        .help(
+            "the equilibrium-line altitude, above which snow outlasts the summer (Alps today ~2900 m, in the last "
+            "glacial maximum ~1500 m lower)");
+    p.real(&GlaciersSpec::balance_gradient, "balance_gradient")
+        .min(0.0, true)
+        .max(0.1)
+        .unit("1/yr")
+        .help("metres of ice a year gained per metre above the ELA (0.005-0.01 in the Alps)");
+    p.real(&GlaciersSpec::max_balance, "max_balance")
+        .min(0.0, true)
+        .max(20.0)
+        .unit("m/yr")
+        .help("the most ice a year any height gains");
+    p.real(&GlaciersSpec::erodibility, "erodibility")
+        .min(0.0)
+        .max(1.0)
+        .help("K_g of E = K_g*Q^m_g*S^n, Q the ice flux in m³/yr (n: stream-power's)");
+    p.real(&GlaciersSpec::flux_exponent, "flux_exponent").min(0.1).max(1.5).help("m_g of the glacial erosion law");
+    p.real(&GlaciersSpec::min_flux, "min_flux")
+        .min(0.0)
+        .max(1e12)
+        .unit("m³/yr")
+        .help(
+            "the ice flux from which ice slides and erodes; thinner ice (snow on the slopes and peaks) erodes "
+            "nothing, so horns and aretes stand above");
+    return p;
+}
+
+ProcessParams<TroughsSpec> troughs_params() {
+    ProcessParams<TroughsSpec> p;
+    p.real(&TroughsSpec::half_width, "half_width")
+        .min(0.0)
+        .max(1e4)
+        .unit("m")
+        .help(
+            "half the width of a glacier carrying 1e6 m³/yr (width grows as Q^0.4, Bahr 1997); its trough is "
+            "carved that far on each side");
+    p.real(&TroughsSpec::wall_angle, "wall_angle")
+        .min(1.0)
+        .max(80.0)
+        .unit("°")
+        .help("the slope of a trough's walls at the glacier's margin");
+    p.real(&TroughsSpec::min_flux, "min_flux")
+        .min(0.0)
+        .max(1e12)
+        .unit("m³/yr")
+        .help("the ice flux from which a glacier carves a trough (erode:stream-power uses glaciers' min_flux)");
+    return p;
+}
+
+ProcessParams<ChiSpec> chi_params() {
+    ProcessParams<ChiSpec> p;
+    p.real(&ChiSpec::concavity, "concavity")
+        .min(0.0, true)
+        .max(3.0)
+        .help("m/n of the rivers' stream-power law (stream-power's m over its n)");
+    p.real(&ChiSpec::reference_area, "reference_area")
+        .min(0.0, true)
+        .max(1e12)
+        .unit("m²")
+        .help("A_0 of chi = integral of (A_0/A)^(m/n) dx from the outlet upstream");
+    return p;
+}
+
 namespace {
 constexpr double kRad = std::numbers::pi / 180.0;
 }  // namespace
+
+Glaciers to_glaciers(const GlaciersSpec& g, const TroughsSpec& t) {
+    Glaciers out;
+    out.ela = g.ela;
+    out.balance_gradient = g.balance_gradient;
+    out.max_balance = g.max_balance;
+    out.erodibility = g.erodibility;
+    out.flux_exponent = g.flux_exponent;
+    out.glacier_flux = g.min_flux;
+    out.half_width = t.half_width;
+    out.wall_slope = std::tan(t.wall_angle * kRad);
+    return out;
+}
 
 UpliftSources to_sources(const UpliftSpec& s) {
     return UpliftSources{s.rate, s.layer, s.layer_years, s.smoothing, s.edge_taper, s.history_years, ""};
@@ -424,8 +507,8 @@ double to_landslide_slope(const LandslidesSpec& s) {
 }
 
 LoweredBody lower_to_model(const std::vector<ProcessCall>& body, std::uint64_t seed) {
-    static const char* order[] = {"uplift",       "rain",  "flow",        "creep",     "rock",
-                                  "stream-power", "banks", "floodplains", "landslides"};
+    static const char* order[] = {"uplift",       "rain",  "flow",        "creep",   "rock",       "glaciers",
+                                  "stream-power", "banks", "floodplains", "troughs", "landslides", "chi"};
     LoweredBody out;
     Settings& s = out.settings;
     s.diffusivity = 0.0;  // no creep unless the body has it
@@ -434,6 +517,9 @@ LoweredBody lower_to_model(const std::vector<ProcessCall>& body, std::uint64_t s
     std::size_t next = 0;
     bool flow = false, incision = false;
     std::optional<double> rock_angle, slide_angle;
+    std::optional<GlaciersSpec> glaciers;
+    std::optional<TroughsSpec> troughs;
+    std::optional<ChiSpec> chi;
     for (const ProcessCall& call : body) {
         const std::string& name = call.process->name;
         std::size_t k = next;
@@ -471,9 +557,31 @@ LoweredBody lower_to_model(const std::vector<ProcessCall>& body, std::uint64_t s
         } else if (name == "banks") s.banks = to_banks(banks_params().bind(call.params));
         else if (name == "floodplains") s.floodplain = to_floodplain(floodplains_params().bind(call.params));
         else if (name == "landslides") slide_angle = landslides_params().bind(call.params).angle * kRad;
+        else if (name == "glaciers") glaciers = glaciers_params().bind(call.params);
+        else if (name == "troughs") troughs = troughs_params().bind(call.params);
+        else if (name == "chi") {
+            chi = chi_params().bind(call.params);
+            out.chi = true;
+        }
     }
     if (!flow || !incision) {
         out.why_not = "the body has no " + std::string(!flow ? "flow" : "stream-power") + " process";
+        return out;
+    }
+    // The model's glaciers make the ice and carve with one threshold; its chi is at its own m/n, A_0 = 1 m².
+    if (glaciers.has_value() != troughs.has_value()) {
+        out.why_not = "the model's glaciers both erode and carve troughs: give glaciers and troughs together";
+        return out;
+    }
+    if (glaciers) {
+        if (glaciers->min_flux != troughs->min_flux) {
+            out.why_not = "glaciers' and troughs' min_flux differ";
+            return out;
+        }
+        s.glaciers = to_glaciers(*glaciers, *troughs);
+    }
+    if (chi && (chi->reference_area != 1.0 || chi->concavity != s.area_exponent / s.slope_exponent)) {
+        out.why_not = "chi's concavity is not stream-power's m/n, or its reference area not 1 m²";
         return out;
     }
     // The model slides at its rock's angle exactly when it has one.

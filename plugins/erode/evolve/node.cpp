@@ -49,7 +49,7 @@ NodeOutputs run_tiled(NodeContext& ctx) {
     if (!lowered.why_not.empty()) throw Error("internal error: a tiled erode:evolve whose body " + lowered.why_not);
     lowered.settings.open = *landscape::parse_sides(ctx.text("open"));
     lowered.settings.substeps = int(ctx.integer("substeps"));
-    return landscape::run_model(ctx, {lowered.settings, lowered.uplift, false});
+    return landscape::run_model(ctx, {lowered.settings, lowered.uplift, lowered.chi});
 }
 
 NodeOutputs run(NodeContext& ctx) {
@@ -134,11 +134,20 @@ void check(CheckContext& ctx) {
         const double limit = p.process->max_dt(p, cell);
         if (sub > limit) {
             std::ostringstream msg;
-            msg << "the sub-step dt/substeps = " << sub << " yr is longer than its stable step, " << limit
-                << " yr on " << cell << " m cells; give the node dt <= " << limit * double(ctx.integer("substeps"))
+            msg << "the sub-step dt/substeps = " << sub << " yr is longer than its stable step, " << limit << " yr on "
+                << cell << " m cells; give the node dt <= " << limit * double(ctx.integer("substeps"))
                 << " or substeps >= " << std::int64_t(std::ceil(ctx.real("dt") / limit));
             ctx.process_error(k, "", msg.str());
         }
+    }
+    // Glaciers erode in stream-power's detachment-limited sweep only (as erode:stream-power's).
+    bool glaciers = false;
+    for (std::size_t k = 0; k < processes.size(); ++k) {
+        const ProcessCall& p = processes[k];
+        glaciers = glaciers || p.process->name == "glaciers";
+        if (glaciers && p.process->name == "stream-power" && p.real("deposition") > 0.0)
+            ctx.process_error(k, "deposition",
+                              "glaciers erode detachment-limited for now; give deposition=0 or drop glaciers()");
     }
     // Memory: the loop holds the heights and the uplift received (two doubles a cell) beside the processes'
     // fields; the flow graph's process holds about 40 bytes a cell more.

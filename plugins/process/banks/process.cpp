@@ -4,7 +4,6 @@
 // libs/landscape/banks.hpp.
 #include <orogen/landscape/banks.hpp>
 
-#include <orogen/parallel.hpp>
 #include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
@@ -20,18 +19,13 @@ public:
         (void)dt;
         if (!banks_.any()) return;
         const FlowGraph& flow = state.flow();
-        dir_.resize(state.size());
-        parallel_for(0, std::int64_t(dir_.size()), 1 << 15, [&](std::int64_t b, std::int64_t e) {
-            for (std::int64_t i = b; i < e; ++i) dir_[std::size_t(i)] = std::int8_t(flow.direction(i));
-        });
-        eroder_.erode(banks_, state.width(), state.height(), state.cell(), dir_.data(), flow.area.data(),
+        eroder_.erode(banks_, state.width(), state.height(), state.cell(), flow.directions.data(), flow.area.data(),
                       state.field("incision").data(), state.outlets().data(), state.field(kElevation).data());
     }
 
 private:
     landscape::Banks banks_;
     landscape::BankEroder eroder_;
-    std::vector<std::int8_t> dir_;  // each cell's direction to its receiver
 };
 
 void check(ProcessCheckContext& ctx) {

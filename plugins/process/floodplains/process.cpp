@@ -3,7 +3,6 @@
 // (never raised), along reaches gentler than max_slope. libs/landscape/floodplain.hpp.
 #include <orogen/landscape/floodplain.hpp>
 
-#include <orogen/parallel.hpp>
 #include <orogen/landscape/processes.hpp>
 #include <orogen/plugin.hpp>
 
@@ -19,17 +18,13 @@ public:
         (void)dt;
         if (!fp_.any()) return;
         const FlowGraph& flow = state.flow();
-        dir_.resize(state.size());
-        parallel_for(0, std::int64_t(dir_.size()), 1 << 15, [&](std::int64_t b, std::int64_t e) {
-            for (std::int64_t i = b; i < e; ++i) dir_[std::size_t(i)] = std::int8_t(flow.direction(i));
-        });
-        landscape::carve_floodplains(fp_, state.width(), state.height(), state.cell(), dir_.data(), flow.area.data(),
-                                     state.outlets().data(), state.field(kElevation).data(), nearest_, floor_);
+        landscape::carve_floodplains(fp_, state.width(), state.height(), state.cell(), flow.directions.data(),
+                                     flow.area.data(), state.outlets().data(), state.field(kElevation).data(), nearest_,
+                                     floor_);
     }
 
 private:
     landscape::Floodplain fp_;
-    std::vector<std::int8_t> dir_;
     std::vector<double> nearest_, floor_;  // scratch
 };
 

@@ -6,6 +6,7 @@
 #include <orogen/landscape/stream_power.hpp>
 
 #include <orogen/landscape/processes.hpp>
+#include <orogen/parallel.hpp>
 #include <orogen/plugin.hpp>
 
 namespace {
@@ -45,7 +46,7 @@ public:
         GridView direction = out.layer("flow_direction", -1.0f);
         for (std::size_t i = 0; i < area.size(); ++i) {
             drainage.data[i] = float(area[i]);
-            direction.data[i] = float(router_->direction(std::int64_t(i)));
+            direction.data[i] = float(directions_[i]);
         }
     }
 
@@ -68,6 +69,12 @@ private:
         g.area = router_->area();
         g.outlets = router_->outlets();
         g.pits = router_->pits();
+        // Each cell's direction to its receiver, once a step (banks and floodplains read it every sub-step).
+        directions_.resize(router_->size());
+        parallel_for(0, std::int64_t(directions_.size()), 1 << 15, [&](std::int64_t b, std::int64_t e) {
+            for (std::int64_t i = b; i < e; ++i) directions_[std::size_t(i)] = std::int8_t(router_->direction(i));
+        });
+        g.directions = directions_;
         g.multiple = mfd_ > 0.0;
         state.set_flow(g);
     }
@@ -75,6 +82,7 @@ private:
     landscape::Depressions mode_;
     double mfd_;
     std::optional<landscape::FlowRouter> router_;
+    std::vector<std::int8_t> directions_;
     std::int64_t pits_ = 0;
 };
 

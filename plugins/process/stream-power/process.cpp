@@ -8,6 +8,7 @@
 #include <orogen/plugin.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 namespace {
@@ -42,6 +43,16 @@ public:
         in.stack = flow.stack.data();
         in.chunks = flow.chunks;
         in.rock_k = k.empty() ? nullptr : k.data();
+        // Glaciers before it: their K_g·dt·Q^m_g over L^n joins the rivers' factor in the same sweep.
+        if (const std::vector<double>& ice = state.field("glacial_factor"); !ice.empty()) {
+            ice_f_.resize(ice.size());
+            parallel_for(0, std::int64_t(ice.size()), 1 << 14, [&](std::int64_t b, std::int64_t e) {
+                for (std::int64_t i = b; i < e; ++i)
+                    ice_f_[std::size_t(i)] =
+                        ice[std::size_t(i)] != 0.0 ? ice[std::size_t(i)] / std::pow(flow.distance(i), s_.n) : 0.0;
+            });
+            in.ice_f = ice_f_.data();
+        }
         if (s_.deposition > 0.0) {
             const landscape::Deposited d =
                 landscape::incise_with_deposition(in, s_.deposition, !flow.multiple, dt, h.data(), h.size(), scratch_);
@@ -73,6 +84,7 @@ private:
     bool keep_incision_ = false;
     std::vector<double> before_;
     landscape::DepositionScratch scratch_;
+    std::vector<double> ice_f_;  // glaciers: K_g·dt·Q^m_g/L^n
     double sediment_out_ = 0.0;  // m³
 };
 
@@ -94,6 +106,7 @@ OROGEN_PLUGIN("process-stream-power", "0.1.0", registry) {
         .fields = {{kElevation, FieldAccess::updates, "m", "incised"},
                    {kFlowGraph, FieldAccess::reads, "", "receivers, stack, drainage area"},
                    {"erodibility_factor", FieldAccess::reads_if_present, "1", "the rock's K over K"},
+                   {"glacial_factor", FieldAccess::reads_if_present, "m^(1-3m_g)·yr^m_g", "glaciers' K_g·dt·Q^m_g"},
                    {"incision", FieldAccess::writes, "m", "what this sub-step's incision lowered each cell by"}},
         .tile_halo = 1,  // tiled under mpirun within erode:stream-power's model (landscape/processes.hpp)
         .make = [p](const ProcessCall& call) -> std::unique_ptr<Process> {

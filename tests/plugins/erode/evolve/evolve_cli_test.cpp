@@ -84,6 +84,49 @@ TEST(Evolve, AProcessListGivesTheBytesOfStreamPowerOnOneThreadAndTwo) {
     }
 }
 
+// Valley glaciers (ice routed down the valleys, eroding in stream power's sweep, then carving troughs) and
+// the chi layer, against erode:stream-power(glaciers=true, chi=true): the same bytes.
+TEST(Evolve, GlaciersTroughsAndChiGiveTheBytesOfStreamPower) {
+    TempDir dir;
+    const std::string head =
+        "orogen 1\n"
+        "seed 11\n"
+        "grid 129 cell=60\n"
+        "peak = generate:diamond-square(roughness=0.55, amplitude=3000)\n";
+    const std::string whole =
+        "ice = erode:stream-power(peak, years=1e5, dt=2e4, uplift=1, m=0.5, n=1.2, erodibility=6e-6,\n"
+        "    diffusivity=0.1, landslide_angle=34, glaciers=true, ela=600, ice_erodibility=5e-7,\n"
+        "    glacier_half_width=150, trough_wall_angle=35, bank_erosion=4, bank_area=3e4, chi=true)\n";
+    const std::string loop =
+        "ice = erode:evolve(peak, years=1e5, dt=2e4) {\n"
+        "    uplift(rate=1)\n"
+        "    flow()\n"
+        "    creep(diffusivity=0.1)\n"
+        "    glaciers(ela=600, erodibility=5e-7)\n"
+        "    stream-power(m=0.5, n=1.2, erodibility=6e-6)\n"
+        "    banks(erosion=4, area=3e4)\n"
+        "    troughs(half_width=150, wall_angle=35)\n"
+        "    landslides(angle=34)\n"
+        "    chi(concavity=0.41666666666666669)\n"
+        "}\n";
+    const std::string tail = "export:raw(ice, path=\"ice.r32\")\nexport:vtk(ice, path=\"ice.vti\")\n";
+    const auto a = dir.write("whole.orogen", head + whole + tail), b = dir.write("loop.orogen", head + loop + tail);
+    ASSERT_EQ(run_orogen("run " + q(a) + " --quiet --out " + q(dir / "a")).exit_code, 0);
+    const RunResult r = run_orogen("run " + q(b) + " --out " + q(dir / "b"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    // Glaciers there are, or the comparison would not test them.
+    EXPECT_EQ(r.err.find("glaciers: 0 cells under glaciers"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("cells under glaciers at the end"), std::string::npos) << r.err;
+    for (const char* file : {"ice.r32", "ice.vti"}) {
+        const std::string x = bytes_of(dir / "a" / file), y = bytes_of(dir / "b" / file);
+        ASSERT_GE(x.size(), 129u * 129u * 4u) << file;
+        EXPECT_TRUE(x == y) << file << " differs between erode:stream-power and erode:evolve";
+    }
+    const std::string vti = bytes_of(dir / "b" / "ice.vti");
+    for (const char* layer : {"Name=\"ice_flux\"", "Name=\"chi\"", "Name=\"drainage\""})
+        EXPECT_NE(vti.find(layer), std::string::npos) << layer;
+}
+
 TEST(Evolve, SetReachesAProcessParameterAndNamesAWrongOne) {
     TempDir dir;
     const auto loop = dir.write("loop.orogen", std::string(kHead) + kLoop + kTail);

@@ -57,6 +57,11 @@ public:
     std::vector<double>& heights() { return elevation_; }
     const std::vector<double>& uplifted_so_far() const { return uplifted_; }
     Heightmap& result() { return *terrain_; }
+    /// For the host (Python): a field by name, whoever declared it (elevation and uplifted included); null
+    /// if no process of the body declares it.
+    std::vector<double>* find_field(std::string_view name);
+    /// Every field the body's processes declare, and elevation and uplifted (sorted, without the flow graph).
+    std::vector<std::string> field_names() const;
 
     // ProcessState
     int width() const override { return width_; }

@@ -6,6 +6,7 @@
 // mpirun (tiled.hpp) and gives the same bits as the loop.
 #pragma once
 
+#include "glaciers.hpp"
 #include "stream_power.hpp"
 #include "uplift.hpp"
 
@@ -115,7 +116,35 @@ struct LandslidesSpec {
 };
 ProcessParams<LandslidesSpec> landslides_params();
 
+/// glaciers(...)'s parameters, in the spec's units.
+struct GlaciersSpec {
+    double ela = 2500.0;  // m
+    double balance_gradient = 0.007;  // 1/yr
+    double max_balance = 2.0;  // m/yr
+    double erodibility = 2e-6;
+    double flux_exponent = 0.5;
+    double min_flux = 2e5;  // m³/yr
+};
+ProcessParams<GlaciersSpec> glaciers_params();
+
+/// troughs(...)'s parameters, in the spec's units.
+struct TroughsSpec {
+    double half_width = 400.0;  // m
+    double wall_angle = 40.0;  // °
+    double min_flux = 2e5;  // m³/yr
+};
+ProcessParams<TroughsSpec> troughs_params();
+
+/// chi(...)'s parameters.
+struct ChiSpec {
+    double concavity = 0.45;  // m/n
+    double reference_area = 1.0;  // m²
+};
+ProcessParams<ChiSpec> chi_params();
+
 UpliftSources to_sources(const UpliftSpec& s);
+/// The glaciers of both processes (glaciers makes the ice, troughs carves with it).
+Glaciers to_glaciers(const GlaciersSpec& g, const TroughsSpec& t);
 climate::OrographicRain to_rain(const RainSpec& s);
 Depressions to_depressions(const FlowSpec& s);
 /// The multiple-flow-direction exponent, 0 for D8.
@@ -128,12 +157,14 @@ double to_landslide_slope(const LandslidesSpec& s);
 
 /// erode:stream-power's model for a body of the built-in processes: its settings, the uplift's
 /// sources, and why not ("" when it is one). A body is one when its processes are built-in ones, each
-/// at most once, in the model's order (uplift, rain, flow, creep, rock, stream-power, banks,
-/// floodplains, landslides), with flow and stream-power, and the rock's and the landslides' angles agree
-/// (the model slides at the rock's angle exactly when it has one).
+/// at most once, in the model's order (uplift, rain, flow, creep, rock, glaciers, stream-power, banks,
+/// floodplains, troughs, landslides, chi), with flow and stream-power, glaciers and troughs together
+/// with one min_flux, and the rock's and the landslides' angles agree (the model slides at the rock's
+/// angle exactly when it has one).
 struct LoweredBody {
     Settings settings;
     UpliftSources uplift;
+    bool chi = false;  ///< a chi process (the model's chi layer, at its m/n)
     std::string why_not;  ///< "" when the body is the model
 };
 LoweredBody lower_to_model(const std::vector<ProcessCall>& body, std::uint64_t seed);
