@@ -1,5 +1,6 @@
 // erode:stream-power — registers the implicit stream-power landscape model (stream_power.hpp) with the kernel.
 #include <orogen/landscape/model_node.hpp>
+#include <orogen/landscape/processes.hpp>
 #include <orogen/landscape/stream_power.hpp>
 #include <orogen/landscape/tiled.hpp>
 #include <orogen/landscape/uplift.hpp>
@@ -141,65 +142,17 @@ void check(CheckContext& ctx) {
     // angles needs landslides. A shaping parameter without its process is an error only where the process's
     // switch is not given at all (forgotten); a switch given as off (`--set range.floodplain_area=0` on a spec
     // that shapes floodplains) turns the process off on purpose, its shaping parameters then unused.
-    if (!(ctx.real("bed_thickness") > 0.0) && !ctx.given("bed_thickness"))
-        for (const char* p : {"bed_dip", "bed_dip_toward", "bed_angle_spread", "bed_erodibility_contrast",
-                              "bed_fold_amplitude", "bed_fold_wavelength", "bed_thickness_spread", "bed_fault_spacing",
-                              "bed_fault_throw", "bed_facies_length", "bed_facies_share"})
-            if (ctx.given(p))
-                ctx.error(p, std::string(p) + " describes the rock's beds; give bed_thickness (m) as well");
-    if ((ctx.real("bed_fault_spacing") > 0.0) != (ctx.real("bed_fault_throw") > 0.0) &&
-        !ctx.given(ctx.real("bed_fault_spacing") > 0.0 ? "bed_fault_throw" : "bed_fault_spacing"))
-        ctx.error(ctx.real("bed_fault_spacing") > 0.0 ? "bed_fault_spacing" : "bed_fault_throw",
-                  "faults need both a spacing and a throw; give bed_fault_spacing (m) and bed_fault_throw (m)");
-    if (const double spacing = ctx.real("bed_fault_spacing"); spacing > 0.0 && spacing < 100.0)
-        ctx.error("bed_fault_spacing",
-                  "faults closer than 100 m apart would shatter the rock cell by cell; give "
-                  "bed_fault_spacing >= 100 (m), or 0 for no faults");
-    if (const double length = ctx.real("bed_facies_length"); length > 0.0 && length < 100.0)
-        ctx.error("bed_facies_length",
-                  "facies changing within less than 100 m would speckle the beds cell by cell; give "
-                  "bed_facies_length >= 100 (m), or 0 for beds of one strength each");
-    if (ctx.given("bed_facies_share") && !(ctx.real("bed_facies_length") > 0.0) && !ctx.given("bed_facies_length"))
-        ctx.error("bed_facies_share",
-                  "bed_facies_share sets how much the facies change a bed's strength; give bed_facies_length (m) "
-                  "as well");
-    if (ctx.real("landslide_block_spread") > 0.0 && !(ctx.real("landslide_angle") > 0.0) &&
-        !ctx.given("landslide_angle"))
-        ctx.error("landslide_block_spread",
-                  "landslide_block_spread roughens the landslide slopes; give landslide_angle as well");
+    landscape::check_rock(ctx, [](std::string_view p) {
+        return p == "angle" || p == "block_spread" ? "landslide_" + std::string(p) : "bed_" + std::string(p);
+    });
     for (const char* bank : {"bank_area", "bank_floor_slope", "bank_wide_area", "bank_wider_area", "bank_widest_floor"})
         if (ctx.given(bank) && !(ctx.real("bank_erosion") > 0.0) && !ctx.given("bank_erosion"))
             ctx.error(bank, std::string(bank) + " shapes the rivers' bank erosion; give bank_erosion > 0 as well");
-    if (ctx.real("bank_wider_area") > 0.0 && ctx.real("bank_erosion") > 0.0) {
-        if (!(ctx.real("bank_wide_area") > 0.0))
-            ctx.error("bank_wider_area",
-                      "bank_wider_area widens the floors bank_wide_area makes; give bank_wide_area as well");
-        else if (ctx.real("bank_wider_area") < ctx.real("bank_wide_area"))
-            ctx.error("bank_wider_area",
-                      "bank_wider_area is smaller than bank_wide_area: the seven-cell floors start where the "
-                      "five-cell ones do at the earliest; give bank_wider_area >= bank_wide_area");
-    }
-    if (const auto widest = ctx.integer("bank_widest_floor"); widest > 0 && ctx.real("bank_erosion") > 0.0) {
-        if (widest % 2 == 0 || widest < 7)
-            ctx.error("bank_widest_floor",
-                      "bank_widest_floor is " + std::to_string(widest) +
-                          ": floors are an odd number of cells wide, the river in the middle, and seven or more "
-                          "(bank_wider_area makes seven); give 7, 9, 11, …");
-        else if (!(ctx.real("bank_wider_area") > ctx.real("bank_wide_area") && ctx.real("bank_wide_area") > 0.0))
-            ctx.error("bank_widest_floor",
-                      "bank_widest_floor widens the floors past seven cells each time the drainage area grows by "
-                      "bank_wider_area / bank_wide_area; give bank_wider_area > bank_wide_area > 0");
-    }
+    if (ctx.real("bank_erosion") > 0.0)
+        landscape::check_banks(ctx, [](std::string_view p) { return "bank_" + std::string(p); });
     for (const char* fp : {"floodplain_width", "floodplain_exponent", "floodplain_slope", "floodplain_max_slope"})
         if (ctx.given(fp) && !(ctx.real("floodplain_area") > 0.0) && !ctx.given("floodplain_area"))
             ctx.error(fp, std::string(fp) + " shapes the rivers' floodplains; give floodplain_area (m²) as well");
-    if (ctx.given("bed_angle_spread") && !(ctx.real("landslide_angle") > 0.0) && !ctx.given("landslide_angle"))
-        ctx.error("bed_angle_spread", "bed_angle_spread spreads the landslide angle; give landslide_angle as well");
-    if (const double a = ctx.real("landslide_angle"), spread = ctx.real("bed_angle_spread");
-        a > 0.0 && (a - spread < 5.0 || a + spread > 80.0))
-        ctx.error("bed_angle_spread",
-                  "the beds' landslide angles run landslide_angle ± bed_angle_spread, which must stay "
-                  "within 5-80°; give a smaller spread");
     const std::string& layer = ctx.text("uplift_layer");
     const ValueInfo* hist = ctx.input(1);
     if (hist) {

@@ -29,25 +29,7 @@ private:
 };
 
 void check(ProcessCheckContext& ctx) {
-    if (ctx.real("wider_area") > 0.0) {
-        if (!(ctx.real("wide_area") > 0.0))
-            ctx.error("wider_area", "wider_area widens the floors wide_area makes; give wide_area as well");
-        else if (ctx.real("wider_area") < ctx.real("wide_area"))
-            ctx.error("wider_area",
-                      "wider_area is smaller than wide_area: the seven-cell floors start where the "
-                      "five-cell ones do at the earliest; give wider_area >= wide_area");
-    }
-    if (const auto widest = ctx.integer("widest_floor"); widest > 0) {
-        if (widest % 2 == 0 || widest < 7)
-            ctx.error("widest_floor",
-                      "widest_floor is " + std::to_string(widest) +
-                          ": floors are an odd number of cells wide, the river in the middle, and "
-                          "seven or more (wider_area makes seven); give 7, 9, 11, …");
-        else if (!(ctx.real("wider_area") > ctx.real("wide_area") && ctx.real("wide_area") > 0.0))
-            ctx.error("widest_floor",
-                      "widest_floor widens the floors past seven cells each time the drainage area "
-                      "grows by wider_area / wide_area; give wider_area > wide_area > 0");
-    }
+    landscape::check_banks(ctx, [](std::string_view p) { return std::string(p); });
 }
 
 }  // namespace

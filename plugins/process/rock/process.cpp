@@ -35,34 +35,7 @@ private:
 };
 
 void check(ProcessCheckContext& ctx) {
-    // The beds' parameters describe beds: without a thickness there are none.
-    if (!(ctx.real("thickness") > 0.0) && !ctx.given("thickness"))
-        for (const char* p : {"dip", "dip_toward", "erodibility_contrast", "fold_amplitude", "fold_wavelength",
-                              "thickness_spread", "fault_spacing", "fault_throw", "facies_length", "facies_share"})
-            if (ctx.given(p)) ctx.error(p, std::string(p) + " describes the rock's beds; give thickness (m) as well");
-    if ((ctx.real("fault_spacing") > 0.0) != (ctx.real("fault_throw") > 0.0) &&
-        !ctx.given(ctx.real("fault_spacing") > 0.0 ? "fault_throw" : "fault_spacing"))
-        ctx.error(ctx.real("fault_spacing") > 0.0 ? "fault_spacing" : "fault_throw",
-                  "faults need both a spacing and a throw; give fault_spacing (m) and fault_throw (m)");
-    if (const double spacing = ctx.real("fault_spacing"); spacing > 0.0 && spacing < 100.0)
-        ctx.error("fault_spacing",
-                  "faults closer than 100 m apart would shatter the rock cell by cell; give "
-                  "fault_spacing >= 100 (m), or 0 for no faults");
-    if (const double length = ctx.real("facies_length"); length > 0.0 && length < 100.0)
-        ctx.error("facies_length",
-                  "facies changing within less than 100 m would speckle the beds cell by cell; give "
-                  "facies_length >= 100 (m), or 0 for beds of one strength each");
-    if (ctx.given("facies_share") && !(ctx.real("facies_length") > 0.0) && !ctx.given("facies_length"))
-        ctx.error("facies_share",
-                  "facies_share sets how much the facies change a bed's strength; give facies_length (m) as well");
-    for (const char* p : {"block_spread", "angle_spread"})
-        if (ctx.given(p) && !(ctx.real("angle") > 0.0) && !ctx.given("angle"))
-            ctx.error(p, std::string(p) + " varies the rock's threshold angle; give angle as well");
-    if (const double a = ctx.real("angle"), spread = ctx.real("angle_spread");
-        a > 0.0 && (a - spread < 5.0 || a + spread > 80.0))
-        ctx.error("angle_spread",
-                  "the beds' threshold angles run angle ± angle_spread, which must stay within 5-80°; "
-                  "give a smaller spread");
+    landscape::check_rock(ctx, [](std::string_view p) { return std::string(p); });
 }
 
 }  // namespace

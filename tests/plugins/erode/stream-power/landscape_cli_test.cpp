@@ -234,12 +234,13 @@ TEST(LandscapeCli, AProcessTurnedOffOnPurposeKeepsItsShapingParametersUnused) {
     const std::string demo = slurp(std::string(OROGEN_SOURCE_DIR) + "/pipelines/default.orogen");
     const std::size_t outputs = demo.find("\nexport:");
     ASSERT_NE(outputs, std::string::npos);
-    ASSERT_NE(demo.find("floodplain_area="), std::string::npos);  // still the spec that shapes them all
+    ASSERT_NE(demo.find("    floodplains("), std::string::npos);  // still the spec that shapes them all
     const std::string spec =
         q(dir.write("demo.orogen", demo.substr(0, outputs + 1) + "export:raw(soil, path=\"t.r32\")\n"));
-    for (const char* off : {"range.floodplain_area=0", "range.bank_erosion=0", "range.bed_thickness=0",
-                            "range.bed_fault_throw=0", "range.bed_fault_spacing=0", "range.landslide_angle=0",
-                            "range.bed_facies_length=0"}) {
+    // Its range is a loop of processes (docs/processes.md): each switch is a process's parameter.
+    for (const char* off :
+         {"range.floodplains.area=0", "range.banks.erosion=0", "range.rock.thickness=0", "range.rock.fault_throw=0",
+          "range.rock.fault_spacing=0", "range.rock.angle=0", "range.rock.facies_length=0"}) {
         const RunResult r = run_orogen("check " + spec + " --set " + off);
         EXPECT_EQ(r.exit_code, 0) << off << "\n" << r.err;
     }

@@ -155,6 +155,84 @@ Floodplain to_floodplain(const FloodplainsSpec& s);
 /// tan of the landslides' own angle, by the rock's expression for its mean angle (so the same bits).
 double to_landslide_slope(const LandslidesSpec& s);
 
+/// The rock's cross-parameter checks, for rock(...) and for erode:stream-power, whose names differ
+/// (bed_dip for dip, landslide_angle for angle): `name(p)` is the caller's name for rock's parameter p.
+/// A shaping parameter without its process is an error only where the process's switch is not given at
+/// all (forgotten); a switch given as off turns the process off on purpose. `Context` is a node's
+/// CheckContext or a process's ProcessCheckContext.
+template <class Context, class Name>
+void check_rock(Context& ctx, Name name) {
+    const auto real = [&](const char* p) { return ctx.real(name(p)); };
+    const auto given = [&](const char* p) { return ctx.given(name(p)); };
+    const auto error = [&](const char* p, const std::string& message) { ctx.error(name(p), message); };
+    if (!(real("thickness") > 0.0) && !given("thickness"))
+        for (const char* p :
+             {"dip", "dip_toward", "angle_spread", "erodibility_contrast", "fold_amplitude", "fold_wavelength",
+              "thickness_spread", "fault_spacing", "fault_throw", "facies_length", "facies_share"})
+            if (given(p)) error(p, name(p) + " describes the rock's beds; give " + name("thickness") + " (m) as well");
+    if ((real("fault_spacing") > 0.0) != (real("fault_throw") > 0.0) &&
+        !given(real("fault_spacing") > 0.0 ? "fault_throw" : "fault_spacing"))
+        error(real("fault_spacing") > 0.0 ? "fault_spacing" : "fault_throw",
+              "faults need both a spacing and a throw; give " + name("fault_spacing") + " (m) and " +
+                  name("fault_throw") + " (m)");
+    if (const double spacing = real("fault_spacing"); spacing > 0.0 && spacing < 100.0)
+        error("fault_spacing",
+              "faults closer than 100 m apart would shatter the rock cell by cell; give " + name("fault_spacing") +
+                  " >= 100 (m), or 0 for no faults");
+    if (const double length = real("facies_length"); length > 0.0 && length < 100.0)
+        error("facies_length",
+              "facies changing within less than 100 m would speckle the beds cell by cell; give " +
+                  name("facies_length") + " >= 100 (m), or 0 for beds of one strength each");
+    if (given("facies_share") && !(real("facies_length") > 0.0) && !given("facies_length"))
+        error("facies_share",
+              name("facies_share") + " sets how much the facies change a bed's strength; give " +
+                  name("facies_length") + " (m) as well");
+    if (real("block_spread") > 0.0 && !(real("angle") > 0.0) && !given("angle"))
+        error("block_spread",
+              name("block_spread") + " roughens the landslide slopes; give " + name("angle") + " as well");
+    if (given("angle_spread") && !(real("angle") > 0.0) && !given("angle"))
+        error("angle_spread",
+              name("angle_spread") + " spreads the landslide angle; give " + name("angle") + " as well");
+    if (const double a = real("angle"), spread = real("angle_spread");
+        a > 0.0 && (a - spread < 5.0 || a + spread > 80.0))
+        error("angle_spread",
+              "the beds' landslide angles run " + name("angle") + " ± " + name("angle_spread") +
+                  ", which must stay within 5-80°; give a smaller spread");
+}
+
+/// The banks' floors' cross-parameter checks, for banks(...) and erode:stream-power (bank_wide_area for
+/// wide_area): `name` as check_rock's.
+template <class Context, class Name>
+void check_banks(Context& ctx, Name name) {
+    const auto real = [&](const char* p) { return ctx.real(name(p)); };
+    if (real("wider_area") > 0.0) {
+        if (!(real("wide_area") > 0.0))
+            ctx.error(name("wider_area"),
+                      name("wider_area") + " widens the floors " + name("wide_area") + " makes; give " +
+                          name("wide_area") + " as well");
+        else if (real("wider_area") < real("wide_area"))
+            ctx.error(name("wider_area"),
+                      name("wider_area") + " is smaller than " + name("wide_area") +
+                          ": the seven-cell floors start where the five-cell ones do at the earliest; give " +
+                          name("wider_area") + " >= " + name("wide_area"));
+    }
+    if (const auto widest = ctx.integer(name("widest_floor")); widest > 0) {
+        if (widest % 2 == 0 || widest < 7)
+            ctx.error(name("widest_floor"),
+                      name("widest_floor") + " is " + std::to_string(widest) +
+                          ": floors are an odd number of cells wide, the river in the middle, "
+                          "and seven or more (" +
+                          name("wider_area") + " makes seven); give 7, 9, 11, …");
+        else if (!(real("wider_area") > real("wide_area") && real("wide_area") > 0.0))
+            ctx.error(name("widest_floor"),
+                      name("widest_floor") +
+                          " widens the floors past seven cells each time the drainage area "
+                          "grows by " +
+                          name("wider_area") + " / " + name("wide_area") + "; give " + name("wider_area") + " > " +
+                          name("wide_area") + " > 0");
+    }
+}
+
 /// erode:stream-power's model for a body of the built-in processes: its settings, the uplift's
 /// sources, and why not ("" when it is one). A body is one when its processes are built-in ones, each
 /// at most once, in the model's order (uplift, rain, flow, creep, rock, glaciers, stream-power, banks,
