@@ -84,9 +84,9 @@ export TSAN_OPTIONS  ?= halt_on_error=1:second_deadlock_stack=1:suppressions=$(C
 
 # CI's sanitizer phase: ASan + UBSan over the kernel, the fuzz corpora and the plugins its tests use.
 asan-ci: ASAN_ONLY = $(ASAN_CI)
-# out_of_tree_plugin configures and builds a plugin outside the tree (34 s under ASan): its code is one
+# out_of_tree_plugin and out_of_tree_process configure and build a plugin outside the tree (34 s under ASan): its code is one
 # node the release phase loads; what it tests is the install, not memory.
-asan-ci: ASAN_CTEST = -E '^out_of_tree_plugin$$'
+asan-ci: ASAN_CTEST = -E '^out_of_tree_(plugin|process)$$'
 asan-ci: asan
 
 asan: asan-configure
@@ -109,7 +109,7 @@ tsan: setup
 	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=thread,undefined $(SAN_LD)" \
 	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF '-DOROGEN_ONLY=$(TSAN_ONLY)' $(SAN_CMAKE) >/dev/null
 	cmake --build $(TSAN_BUILD) -j$(JOBS)
-	cd $(TSAN_BUILD) && ctest --output-on-failure --no-tests=error -j$(JOBS) -LE 'pipelines|fuzz' -E '^out_of_tree_plugin$$|$(TSAN_SKIP)'
+	cd $(TSAN_BUILD) && ctest --output-on-failure --no-tests=error -j$(JOBS) -LE 'pipelines|fuzz' -E '^out_of_tree_(plugin|process)$$|$(TSAN_SKIP)'
 
 fuzz-smoke:
 	@cd $(ASAN_BUILD)/tests && for t in $(FUZZ_TARGETS); do \

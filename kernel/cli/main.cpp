@@ -685,6 +685,12 @@ int main(int argc, char** argv) {
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         return usage_error(msg);
     }
+    // `orogen run --help`, `orogen analyze -h`: help, whatever else is on the line.
+    for (int i = 2; i < argc; ++i)
+        if (std::string_view(argv[i]) == "--help" || std::string_view(argv[i]) == "-h") {
+            std::fputs(usage_text, stdout);
+            return exit_ok;
+        }
     if (args.command == "analyze") {  // its own options (--against FILE...): see cli/analyze.cpp
         PluginSet plugins;
         plugins.load_all(self_path(argv[0]));

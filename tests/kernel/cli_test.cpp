@@ -72,8 +72,9 @@ TEST(Cli, AHugeGridIsRefusedBeforeAllocatingWithTheMemoryItNeeds) {
     dir.write("big.orogen", "orogen 1\ngrid 1000000x1000000\nb = generate:fault()\nexport:png(b, path=\"b.png\")\n");
     const RunResult r = run_orogen("run big.orogen --out out", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("big.orogen:2:6: error: grid 1000000x1000000 needs 3.6 TiB for one heightmap (4 bytes a vertex)"),
-              std::string::npos)
+    EXPECT_NE(
+        r.err.find("big.orogen:2:6: error: grid 1000000x1000000 needs 3.6 TiB for one heightmap (4 bytes a vertex)"),
+        std::string::npos)
         << r.err;
     EXPECT_FALSE(fs::exists(dir / "out"));  // nothing ran, nothing written
 }
@@ -88,10 +89,12 @@ TEST(Cli, OverridesAreCheckedLikeTheSpec) {
               "--set cut.iterations=-5:1:16: error: 'iterations' of generate:fault is -5, out of range [1, 1000000]\n"
               "  cut.iterations=-5\n"
               "                 ^~\n"
-              "--set cut.displacment=3:1:5: error: generate:fault ('cut') has no parameter 'displacment'; did you mean 'displacement'?\n"
+              "--set cut.displacment=3:1:5: error: generate:fault ('cut') has no parameter 'displacment'; did you mean "
+              "'displacement'?\n"
               "  cut.displacment=3\n"
               "      ^~~~~~~~~~~\n"
-              "--set cutt.iterations=3:1:1: error: --set names 'cutt', but the spec has no value or node of that name; did you mean 'cut'?\n"
+              "--set cutt.iterations=3:1:1: error: --set names 'cutt', but the spec has no value or node of that name; "
+              "did you mean 'cut'?\n"
               "  cutt.iterations=3\n"
               "  ^~~~\n"
               "3 errors in s.orogen\n");
@@ -150,21 +153,24 @@ TEST(Cli, ACallWhereAValueGoesRunsAsTheNamedNodeWould) {
     const RunResult set = run_orogen("check s.orogen --set erode:thermal#3.iterations=7", "", dir.path());
     EXPECT_EQ(set.exit_code, 0) << set.err;
     // A side value of a call in place needs a name.
-    dir.write("side.orogen", "orogen 1\ngrid 65\nc = generate:fault()\nexport:vtk-plates(tectonics:plates(c).plates, "
-                             "path=\"p.pvd\")\n");
+    dir.write("side.orogen",
+              "orogen 1\ngrid 65\nc = generate:fault()\nexport:vtk-plates(tectonics:plates(c).plates, "
+              "path=\"p.pvd\")\n");
     const RunResult side = run_orogen("check side.orogen", "", dir.path());
     EXPECT_EQ(side.exit_code, 2);
-    EXPECT_NE(side.err.find("to use a side value of tectonics:plates, name the value first: NAME = tectonics:plates(...) "
-                            "on a line of its own, then NAME.plates"),
-              std::string::npos)
+    EXPECT_NE(
+        side.err.find("to use a side value of tectonics:plates, name the value first: NAME = tectonics:plates(...) "
+                      "on a line of its own, then NAME.plates"),
+        std::string::npos)
         << side.err;
 }
 
 // The doc errors of issue 32: a value used before its line says where it is; --sed suggests --seed.
 TEST(Cli, AValueUsedBeforeItsLineSaysWhereItIsDefined) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 65\nlow = generate:fault()\nexport:png(glow2, path=\"g.png\")\n"
-                          "glow2 = erode:thermal(low)\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 65\nlow = generate:fault()\nexport:png(glow2, path=\"g.png\")\n"
+              "glow2 = erode:thermal(low)\n");
     const RunResult r = run_orogen("check s.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_EQ(r.err,
@@ -184,17 +190,20 @@ TEST(Cli, CheckSaysTheGridDefaultsAndWarnsOnASpecThatWritesNothing) {
     dir.write("none.orogen", "orogen 1\nbase = generate:fault()\nworn = erode:thermal(base)\n");
     RunResult r = run_orogen("check none.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(r.out, "none.orogen: ok (2 nodes, grid 513x513 (the default: no grid line), cell 1 m (the default: no "
-                     "cell=), seed 0)\n");
-    EXPECT_EQ(r.err, "none.orogen:1:1: warning: this spec writes no files: a run would leave only manifest.json; add an "
-                     "exporter, e.g. export:png(worn, path=\"worn.png\")\n");
+    EXPECT_EQ(r.out,
+              "none.orogen: ok (2 nodes, grid 513x513 (the default: no grid line), cell 1 m (the default: no "
+              "cell=), seed 0)\n");
+    EXPECT_EQ(r.err,
+              "none.orogen:1:1: warning: this spec writes no files: a run would leave only manifest.json; add an "
+              "exporter, e.g. export:png(worn, path=\"worn.png\")\n");
     dir.write("cell.orogen", "orogen 1\ngrid 65\nbase = generate:fault()\nexport:png(base, path=\"b.png\")\n");
     r = run_orogen("check cell.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(r.err, "");
     EXPECT_EQ(r.out, "cell.orogen: ok (2 nodes, grid 65x65, cell 1 m (the default: no cell=), seed 0)\n");
     dir.write("s.orogen", issue_spec);
-    EXPECT_EQ(run_orogen("check s.orogen", "", dir.path()).out, "s.orogen: ok (4 nodes, grid 513x513, cell 30 m, seed 7)\n");
+    EXPECT_EQ(run_orogen("check s.orogen", "", dir.path()).out,
+              "s.orogen: ok (4 nodes, grid 513x513, cell 30 m, seed 7)\n");
 }
 
 TEST(Cli, UsageErrorsExitWithTwo) {
@@ -205,6 +214,29 @@ TEST(Cli, UsageErrorsExitWithTwo) {
     EXPECT_EQ(run_orogen("help generate:falt").err,
               "orogen: error: unknown node 'generate:falt'; did you mean 'generate:fault'?\n");
     EXPECT_EQ(run_orogen("list generat").exit_code, 2);
+}
+
+// --help and -h are help on every command, whatever else the line holds: the usage on stdout, exit 0.
+TEST(Cli, HelpOptionWorksOnEveryCommand) {
+    for (const char* line : {"run --help", "run spec.orogen -h", "check --help", "analyze --help", "analyze a.r32 -h",
+                             "cache --help", "list -h", "--help", "-h"}) {
+        const RunResult r = run_orogen(line);
+        EXPECT_EQ(r.exit_code, 0) << line << "\n" << r.err;
+        EXPECT_NE(r.out.find("orogen run SPEC"), std::string::npos) << line << "\n" << r.out;
+        EXPECT_EQ(r.err, "") << line;
+    }
+}
+
+// A node no loaded plugin provides, nothing like it: the message says where plugins are looked for.
+TEST(Cli, AnUnknownNodeSaysWherePluginsComeFrom) {
+    TempDir dir;
+    dir.write("island.orogen", "orogen 1\nbase = generate:island(size=3)\nexport:png(base, path=\"b.png\")\n");
+    const RunResult r = run_orogen("check island.orogen", "", dir.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("unknown node 'generate:island'; did you mean 'generate:shape'? (a plugin of your own: its "
+                         "folder in OROGEN_PLUGIN_PATH; `orogen version` lists the folders searched)"),
+              std::string::npos)
+        << r.err;
 }
 
 TEST(Cli, ListHelpAndVersionDescribeThePlugins) {
@@ -263,25 +295,34 @@ TEST(PluginSeam, BrokenPluginsAreRefusedOneByOneAndTheRestStillLoad) {
         run_orogen("version", "OROGEN_PLUGIN_PATH=" + fake_plugins + ":" + (dir / "not-a-library.so").string());
     ASSERT_EQ(r.exit_code, 0);
     const std::string w = "orogen: warning: plugin ";
-    EXPECT_NE(r.err.find(w + fake_plugins + "/wrong_version.so: wrong plugin API version in plugin 'future-plugin': "
-                             "got version " + std::to_string(OROGEN_PLUGIN_API_VERSION + 1) + ", supported version is " +
-                             std::to_string(OROGEN_PLUGIN_API_VERSION) +
-                             "; rebuild the plugin against this orogen's headers; skipped\n"),
+    EXPECT_NE(r.err.find(w + fake_plugins +
+                         "/wrong_version.so: wrong plugin API version in plugin 'future-plugin': "
+                         "got version " +
+                         std::to_string(OROGEN_PLUGIN_API_VERSION + 1) + ", supported version is " +
+                         std::to_string(OROGEN_PLUGIN_API_VERSION) +
+                         "; rebuild the plugin against this orogen's headers; skipped\n"),
               std::string::npos)
         << r.err;
-    EXPECT_NE(r.err.find(w + fake_plugins + "/no_entry.so: not an orogen plugin: it has no entry point "
-                             "'orogen_plugin_info' (define one with OROGEN_PLUGIN(...)); skipped\n"),
+    EXPECT_NE(r.err.find(w + fake_plugins +
+                         "/no_entry.so: not an orogen plugin: it has no entry point "
+                         "'orogen_plugin_info' (define one with OROGEN_PLUGIN(...)); skipped\n"),
               std::string::npos)
         << r.err;
     EXPECT_NE(r.err.find(w + (dir / "not-a-library.so").string() + ": cannot load this library ("), std::string::npos)
         << r.err;
     EXPECT_TRUE(std::regex_search(
-        r.err, std::regex(w + "node 'generate:fault' is registered twice: by plugin 'generate-fault' \\(.*/orogen_generate_fault\\.so\\) "
-                              "and by plugin 'fault-clone' \\(" + fake_plugins + "/duplicate_node\\.so\\); keeping the first\\. "
-                              "Duplicate library\\? Remove one of them from the plugin path\\.\n")))
+        r.err,
+        std::regex(
+            w +
+            "node 'generate:fault' is registered twice: by plugin 'generate-fault' \\(.*/orogen_generate_fault\\.so\\) "
+            "and by plugin 'fault-clone' \\(" +
+            fake_plugins +
+            "/duplicate_node\\.so\\); keeping the first\\. "
+            "Duplicate library\\? Remove one of them from the plugin path\\.\n")))
         << r.err;
-    EXPECT_NE(r.err.find(w + fake_plugins + "/throwing_register.so: plugin 'test-register-throws' failed while "
-                             "registering its nodes (cannot find my data files)"),
+    EXPECT_NE(r.err.find(w + fake_plugins +
+                         "/throwing_register.so: plugin 'test-register-throws' failed while "
+                         "registering its nodes (cannot find my data files)"),
               std::string::npos)
         << r.err;
     // The good ones, real and fake, are all there.
@@ -305,8 +346,10 @@ TEST(PluginSeam, TheFirstOfTwoDuplicateNodesIsTheOneThatRuns) {
 
 namespace {
 RunResult run_failing(const TempDir& dir, const std::string& node) {
-    dir.write("f.orogen", "orogen 1\ngrid 33\nok = generate:fault(iterations=3)\nexport:png(ok, path=\"ok.png\")\n"
-                          "bad = generate:" + node + "()\nexport:png(bad, path=\"bad.png\")\n");
+    dir.write("f.orogen",
+              "orogen 1\ngrid 33\nok = generate:fault(iterations=3)\nexport:png(ok, path=\"ok.png\")\n"
+              "bad = generate:" +
+                  node + "()\nexport:png(bad, path=\"bad.png\")\n");
     return run_orogen("run f.orogen --out out --quiet", "OROGEN_PLUGIN_PATH=" + fake_plugins, dir.path());
 }
 }  // namespace
@@ -344,15 +387,19 @@ TEST(Runner, ExitCodesFollowTheKindOfFailure) {
 
 TEST(Runner, CtrlCStopsTheRunAtTheNextCheckWithExit130) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 9\nok = generate:fault()\nexport:png(ok, path=\"ok.png\")\n"
-                          "s = generate:slow()\nexport:png(s, path=\"slow.png\")\n");
-    dir.write("interrupt.sh", "cd '" + dir.path().string() + "'\n"
-                              "OROGEN_PLUGIN_PATH=" + fake_plugins + " " + OROGEN_CLI +
-                              " run s.orogen --out out --quiet 2>err.txt &\n"
-                              "pid=$!\n"
-                              // ok.png staged: the handler is in place and the slow node is next
-                              "until ls out/.orogen-staging-*/ok.png >/dev/null 2>&1; do sleep 0.02; done\n"
-                              "kill -INT $pid\nwait $pid\necho $? > rc.txt\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 9\nok = generate:fault()\nexport:png(ok, path=\"ok.png\")\n"
+              "s = generate:slow()\nexport:png(s, path=\"slow.png\")\n");
+    dir.write("interrupt.sh",
+              "cd '" + dir.path().string() +
+                  "'\n"
+                  "OROGEN_PLUGIN_PATH=" +
+                  fake_plugins + " " + OROGEN_CLI +
+                  " run s.orogen --out out --quiet 2>err.txt &\n"
+                  "pid=$!\n"
+                  // ok.png staged: the handler is in place and the slow node is next
+                  "until ls out/.orogen-staging-*/ok.png >/dev/null 2>&1; do sleep 0.02; done\n"
+                  "kill -INT $pid\nwait $pid\necho $? > rc.txt\n");
     const auto start = std::chrono::steady_clock::now();
     ASSERT_EQ(std::system(("bash '" + (dir / "interrupt.sh").string() + "'").c_str()), 0);
     EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
@@ -374,14 +421,16 @@ TEST(Runner, AnOutputFolderThatCannotBeMadeFailsWithExitOne) {
 
 TEST(Runner, AnOutputThatCannotBeWrittenFailsTheRunAndChangesNothing) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 33\nok = generate:fault(iterations=3)\n"
-                          "export:png(ok, path=\"first.png\")\nexport:png(ok, path=\"blocked/second.png\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 33\nok = generate:fault(iterations=3)\n"
+              "export:png(ok, path=\"first.png\")\nexport:png(ok, path=\"blocked/second.png\")\n");
     dir.write("out/blocked", "a file where a folder should be");
     const RunResult r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
     EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.err.find("s.orogen:5:1: error: node 'export:png#2' (export:png) failed: cannot write "
-                         "out/blocked/second.png: out/blocked is a file, not a folder; move it away or write elsewhere\n"),
-              std::string::npos)
+    EXPECT_NE(
+        r.err.find("s.orogen:5:1: error: node 'export:png#2' (export:png) failed: cannot write "
+                   "out/blocked/second.png: out/blocked is a file, not a folder; move it away or write elsewhere\n"),
+        std::string::npos)
         << r.err;
     EXPECT_FALSE(fs::exists(dir / "out/first.png"));
     EXPECT_EQ(slurp(dir / "out/blocked"), "a file where a folder should be");
@@ -415,8 +464,9 @@ TEST(Outputs, TheIssueSpecWritesBothPngsAndAManifestWithTheirHashes) {
 
 TEST(Outputs, TheTimingTableWidensForLongLabels) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 33\nthe_mountain_before_any_erosion = generate:fault()\n"
-                          "export:raw(the_mountain_before_any_erosion, path=\"x.r32\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 33\nthe_mountain_before_any_erosion = generate:fault()\n"
+              "export:raw(the_mountain_before_any_erosion, path=\"x.r32\")\n");
     const RunResult r = run_orogen("run s.orogen --out o", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     // Every row's kind:name starts in the header's column, and the line numbers end where "line" does.
@@ -451,8 +501,10 @@ TEST(Outputs, SameSpecAndSeedGiveIdenticalBytesWhateverTheThreadCount) {
 TEST(Outputs, AddingANodeDoesNotChangeTheOthers) {
     TempDir dir;
     dir.write("a.orogen", issue_spec);
-    dir.write("b.orogen", std::string(issue_spec) + "extra = generate:fault(iterations=9)\n"
-                                                    "export:png(extra, path=\"extra.png\")\n");
+    dir.write("b.orogen",
+              std::string(issue_spec) +
+                  "extra = generate:fault(iterations=9)\n"
+                  "export:png(extra, path=\"extra.png\")\n");
     ASSERT_EQ(run_orogen("run a.orogen --out a --quiet", "", dir.path()).exit_code, 0);
     ASSERT_EQ(run_orogen("run b.orogen --out b --quiet", "", dir.path()).exit_code, 0);
     EXPECT_EQ(slurp(dir / "a/cut.png"), slurp(dir / "b/cut.png"));
@@ -460,11 +512,13 @@ TEST(Outputs, AddingANodeDoesNotChangeTheOthers) {
 
 TEST(Outputs, A16BitPngRoundTripsThroughImport) {
     TempDir dir;
-    dir.write("make.orogen", "orogen 1\nseed 3\ngrid 65x40 cell=5\nt = generate:diamond-square(amplitude=50)\n"
-                             "export:png(t, path=\"t.png\", bits=16)\n");
+    dir.write("make.orogen",
+              "orogen 1\nseed 3\ngrid 65x40 cell=5\nt = generate:diamond-square(amplitude=50)\n"
+              "export:png(t, path=\"t.png\", bits=16)\n");
     ASSERT_EQ(run_orogen("run make.orogen --out . --quiet", "", dir.path()).exit_code, 0);
-    dir.write("again.orogen", "orogen 1\nt = import:png(path=\"t.png\", low=-20, high=80)\n"
-                              "export:png(t, path=\"again.png\", bits=16)\n");
+    dir.write("again.orogen",
+              "orogen 1\nt = import:png(path=\"t.png\", low=-20, high=80)\n"
+              "export:png(t, path=\"again.png\", bits=16)\n");
     const RunResult r = run_orogen("run again.orogen --out . --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(read_gray_png(dir / "t.png").samples, read_gray_png(dir / "again.png").samples);

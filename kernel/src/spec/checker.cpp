@@ -425,8 +425,11 @@ private:
     void report_unknown_node(const spec::Statement& st, const std::string& label) {
         std::string msg = "unknown node '" + st.call.qualified() + "'";
         const std::string guess = spec::closest(st.call.qualified(), all_nodes_);
-        if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
-        else msg += "; `orogen list` shows the nodes the loaded plugins provide";
+        msg += guess.empty() ? "; `orogen list` shows the nodes the loaded plugins provide"
+                             : "; did you mean '" + guess + "'?";
+        msg +=
+            " (a plugin of your own: its folder in OROGEN_PLUGIN_PATH; `orogen version` lists the folders "
+            "searched)";
         diags_.error(st.call.where, msg);
         if (!st.name.empty() || st.nested) {
             if (!st.name.empty()) defined_at_.emplace(st.name, st.name_where);
@@ -745,7 +748,10 @@ private:
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         else if (!node_of_that_name.empty())
             msg += "; " + node_of_that_name + " is a node, not a process: run it on the loop's result, after it";
-        else msg += "; `orogen list` shows the processes the loaded plugins provide";
+        else
+            msg +=
+                "; `orogen list process` shows the processes the loaded plugins provide (a process of your "
+                "own: its folder in OROGEN_PLUGIN_PATH, docs/processes.md)";
         diags_.error(ps.where, msg);
     }
 
