@@ -227,6 +227,22 @@ TEST(Cli, HelpOptionWorksOnEveryCommand) {
     }
 }
 
+// A node's own check blames one parameter for a clash; when another was set by --set, the override is shown
+// too (the caret on the spec's relief=true alone did not say what the user had just changed).
+TEST(Cli, ACrossParameterErrorPointsAtTheOverrideThatCausedIt) {
+    TempDir dir;
+    dir.write("r.orogen",
+              "orogen 1\ngrid 65\nb = generate:fault()\nexport:png(b, path=\"a.png\")\n"
+              "export:png(b, path=\"r.png\", relief=true)\n");
+    const RunResult r = run_orogen("check r.orogen --set export:png#2.bits=8", "", dir.path());
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("r.orogen:5:36: error: export:png: relief=true writes"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--set export:png#2.bits=8:1:19: note: 'bits' of export:png#2 is set here, on the command "
+                         "line\n  export:png#2.bits=8\n                    ^"),
+              std::string::npos)
+        << r.err;
+}
+
 // A node no loaded plugin provides, nothing like it: the message says where plugins are looked for.
 TEST(Cli, AnUnknownNodeSaysWherePluginsComeFrom) {
     TempDir dir;

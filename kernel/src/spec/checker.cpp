@@ -216,6 +216,7 @@ public:
         const Location& where = it != param_where_.end() ? it->second : call_where_;
         diags_.error(where, node_.node->qualified_name() + ": " + message);
         ++errors_;
+        note_overrides(param);
     }
     ValueInfo& output() override { return output_; }
     const std::vector<ProcessCall>& processes() const override { return node_.processes; }
@@ -237,6 +238,18 @@ public:
     ValueInfo take_output() { return std::move(output_); }
 
 private:
+    /// A cross-parameter error that a --set may have caused (the hook blames one parameter, maybe in the
+    /// spec, for a clash with one set on the command line): each other parameter of this node set by --set
+    /// gets a note at the override, once.
+    void note_overrides(std::string_view blamed) {
+        if (noted_) return;
+        noted_ = true;
+        for (const auto& [name, where] : param_where_)
+            if (name != blamed && where.source && where.source->name.rfind("--set", 0) == 0)
+                diags_.note(where, "'" + name + "' of " + node_.label + " is set here, on the command line");
+    }
+
+    bool noted_ = false;
     std::function<void(std::size_t, std::string_view, std::string)> process_error_;
     double tiled_share_ = 1.0;
     const GridSpec& grid_;
