@@ -471,12 +471,15 @@ private:
                 return;
             }
             const int errors_before = diags_.error_count();
-            if (auto process = parse_process()) call.body.push_back(std::move(*process));
-            if (diags_.error_count() == errors_before && peek().kind != Tok::newline && peek().kind != Tok::rbrace &&
-                peek().kind != Tok::eof)
+            auto process = parse_process();
+            const bool at_line_end = peek().kind == Tok::newline || peek().kind == Tok::rbrace || peek().kind == Tok::eof;
+            if (process && !at_line_end)
                 error(peek(),
                       "expected the end of the line after this process (one process a line), found " + what(peek()));
-            if (diags_.error_count() != errors_before)
+            if (process && at_line_end) call.body.push_back(std::move(*process));
+            // After a mistake (reported here, or by the lexer at a bad token: then nothing was counted), go on
+            // at the next line, so every process's mistakes show at once and the loop always moves on.
+            if (!process || !at_line_end || diags_.error_count() != errors_before)
                 while (peek().kind != Tok::newline && peek().kind != Tok::rbrace && peek().kind != Tok::eof) ++p_;
         }
     }
