@@ -9,7 +9,7 @@ packages=(
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
   libgdal-dev gdal-bin
   libopenexr-dev openexr
-  python3-dev pybind11-dev python3-numpy python3-pytest
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib   # matplotlib: docs/python.md's plots
   libssl-dev libxxhash-dev libstb-dev libpng-dev libdeflate-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
   libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev

@@ -10,6 +10,16 @@ See docs/python.md.
 """
 import math as _math
 
+try:  # every value comes back as a numpy array: without numpy nothing would work, so say so now
+    import numpy as _numpy  # noqa: F401
+except ImportError as _error:
+    import sys as _sys
+
+    raise ImportError(
+        f"orogen needs numpy, which {_sys.executable} cannot import ({_error}); orogen's module was built for "
+        "the interpreter `make` configured (Debian's /usr/bin/python3, with python3-numpy from tools/setup.sh): "
+        "run /usr/bin/python3, or install numpy for this one (docs/python.md)") from None
+
 from . import _orogen
 from ._orogen import Heightmap, Series, help, nodes, run
 

@@ -6,6 +6,7 @@ import os
 import pathlib
 import signal
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -423,3 +424,12 @@ def test_a_model_is_checked_as_a_spec_is():
         orogen.Model(flat, [("stream-power", {})], cell=30)
     with pytest.raises(ValueError, match="out of range"):
         orogen.Model(flat, [("flow", {}), ("stream-power", {"m": 9})], cell=30)
+
+
+def test_import_without_numpy_says_which_interpreter_and_the_fix():
+    # numpy hidden from a fresh interpreter, as on one it was never installed for
+    code = "import sys; sys.modules['numpy'] = None; import orogen"
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=dict(os.environ))
+    assert r.returncode != 0
+    assert "orogen needs numpy, which " + sys.executable + " cannot import" in r.stderr, r.stderr
+    assert "run /usr/bin/python3, or install numpy for this one" in r.stderr
