@@ -472,7 +472,8 @@ private:
             }
             const int errors_before = diags_.error_count();
             auto process = parse_process();
-            const bool at_line_end = peek().kind == Tok::newline || peek().kind == Tok::rbrace || peek().kind == Tok::eof;
+            const bool at_line_end =
+                peek().kind == Tok::newline || peek().kind == Tok::rbrace || peek().kind == Tok::eof;
             if (process && !at_line_end)
                 error(peek(),
                       "expected the end of the line after this process (one process a line), found " + what(peek()));
