@@ -68,16 +68,10 @@ public:
             }
             o.target += ":" + peek().text;
             ++p_;
-            if (peek().kind == Tok::hash) {
-                ++p_;
-                const Token& n = peek();
-                if (n.kind != Tok::number || !n.integer || n.number < 2 || n.text[0] == '+') {
-                    error(n, "expected the label's number after '#' (kind:node#2 is the second unnamed kind:node)");
-                    return std::nullopt;
-                }
-                o.target += "#" + n.text;
-                ++p_;
-            }
+            if (!label_number(o.target,
+                              "expected the label's number after '#' (kind:node#2 is the second unnamed "
+                              "kind:node)"))
+                return std::nullopt;
             o.target_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - name.where.column;
         }
         if (!expect(Tok::dot,
@@ -95,17 +89,11 @@ public:
         if (peek().kind == Tok::hash || peek().kind == Tok::dot) {  // NAME.PROCESS[#N].PARAM
             o.process = o.param;
             o.process_where = o.param_where;
-            if (peek().kind == Tok::hash) {
-                ++p_;
-                const Token& n = peek();
-                if (n.kind != Tok::number || !n.integer || n.number < 2 || n.text[0] == '+') {
-                    error(n, "expected the process's number after '#' (stream-power#2 is the second stream-power)");
-                    return std::nullopt;
-                }
-                o.process += "#" + n.text;
-                o.process_where.length = n.where.column + n.where.length - o.process_where.column;
-                ++p_;
-            }
+            if (!label_number(o.process,
+                              "expected the process's number after '#' (stream-power#2 is the second "
+                              "stream-power)"))
+                return std::nullopt;
+            o.process_where.length = t_[p_ - 1].where.column + t_[p_ - 1].where.length - o.process_where.column;
             if (!expect(Tok::dot, "'.' between the process and its parameter (NAME.PROCESS.PARAM=VALUE)"))
                 return std::nullopt;
             const Token& inner = peek();
@@ -129,6 +117,21 @@ public:
     }
 
 private:
+    /// An override's label number, `#N` (N >= 2), appended to `label` if one follows; false (reported with
+    /// `message`) if the '#' has no such number after it.
+    bool label_number(std::string& label, const std::string& message) {
+        if (peek().kind != Tok::hash) return true;
+        ++p_;
+        const Token& n = peek();
+        if (n.kind != Tok::number || !n.integer || n.number < 2 || n.text[0] == '+') {
+            error(n, message);
+            return false;
+        }
+        label += "#" + n.text;
+        ++p_;
+        return true;
+    }
+
     const Token& peek(std::size_t ahead = 0) const { return t_[std::min(p_ + ahead, t_.size() - 1)]; }
     const Token& next() { return t_[std::min(p_++, t_.size() - 1)]; }
     void skip_line() {
