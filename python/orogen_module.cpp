@@ -4,19 +4,14 @@
 //   run(spec, seed=None, set={}, threads=None, out=None, progress=False) -> {name: value}
 //   nodes() -> [{"name", "kind", "summary"}];  help(name) -> {...}
 //   _run_node(spec, inputs, threads) -> {name: value}: orogen.node() (orogen/__init__.py) runs the spec it
-//   writes with its inputs bound by name (runner.hpp BoundValues): no file, one copy of an array at most.
+//   writes with its inputs bound by name (orogen/session.hpp BoundValues): no file, one copy of an array at most.
 //
 // Bad input (a spec error, a parameter out of range, a file refused at check time) raises ValueError with
 // the CLI's message; a failed run RuntimeError naming the node; Ctrl-C stops the node as on the command
 // line and raises KeyboardInterrupt. The run itself happens on a thread of its own with the GIL released.
-#include "run/loader.hpp"
-#include "spec/plan.hpp"
-#include "run/progress.hpp"
-#include "run/runner.hpp"
-#include "spec/spec.hpp"
-
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/session.hpp>
 #include <orogen/landscape/loop.hpp>
 #include <orogen/landscape/uplift.hpp>
 
@@ -47,9 +42,8 @@ namespace {
 
 /// The plugins, loaded once from the build or install tree (found from this module's own file) and
 /// OROGEN_PLUGIN_PATH; never unloaded (values may hold code of theirs until the interpreter ends).
-PluginSet& plugins() {
-    static PluginSet* set = [] {
-        auto* s = new PluginSet;
+const Session& plugins() {
+    static const Session* set = [] {
         Dl_info info{};
         fs::path here = ::dladdr(reinterpret_cast<void*>(&plugins), &info) && info.dli_fname
             ? fs::absolute(info.dli_fname)
@@ -61,9 +55,9 @@ PluginSet& plugins() {
         const fs::path build = here.parent_path().parent_path().parent_path();
         const fs::path installed = build.parent_path().parent_path();
         std::error_code ec;
-        s->load_all((fs::is_directory(build / "lib" / "orogen" / "plugins", ec) ? build : installed) / "bin" /
-                    "orogen");
-        for (const auto& p : s->problems()) {
+        auto* s = new Session((fs::is_directory(build / "lib" / "orogen" / "plugins", ec) ? build : installed) / "bin" /
+                              "orogen");
+        for (const auto& p : s->plugin_problems()) {
             const std::string text = "orogen: plugin " + p;
             PyErr_WarnEx(PyExc_RuntimeWarning, text.c_str(), 1);
         }
@@ -195,11 +189,6 @@ std::string override_text(const py::handle& v) {
                           " (give a number, bool, string, (x, y) point or a list of points)");
 }
 
-std::string error_count(const spec::Diagnostics& diags, const std::string& name) {
-    return std::to_string(diags.error_count()) + (diags.error_count() == 1 ? " error" : " errors") + " in " + name +
-        "\n";
-}
-
 std::atomic<bool> g_cancel{false};
 std::atomic<int> g_signal{0};
 
@@ -239,11 +228,6 @@ std::string path_text(const py::handle& v, const char* what) {
 
 /// `spec` (a path, or the text itself): its name for messages, its text, and the path input paths are
 /// relative to.
-struct SpecText {
-    std::string name, text;
-    fs::path path;
-};
-
 SpecText read_spec(const std::string& spec) {
     SpecText r;
     std::error_code ec;
@@ -269,7 +253,7 @@ SpecText read_spec(const std::string& spec) {
 
 /// `plan` run on a thread of its own, the GIL released; this thread wakes every 50 ms for Python's signals,
 /// so Ctrl-C asks the node to stop (as SIGINT does on the command line). Raises what the run raised.
-RunResult run_released(const Plan& plan, const RunOptions& options, BoundValues bound) {
+RunResult run_released(const Checked& checked, const RunSettings& settings, BoundValues bound) {
     g_cancel = false;
     g_signal = 0;
     RunResult result;
@@ -278,7 +262,7 @@ RunResult run_released(const Plan& plan, const RunOptions& options, BoundValues 
     std::future<void> finished = done.get_future();
     std::thread worker([&] {
         try {
-            result = run(plan, options, std::move(bound));
+            result = plugins().run(checked, settings, std::move(bound));
         } catch (...) { failure = std::current_exception(); }
         done.set_value();
     });
@@ -317,50 +301,40 @@ py::dict run_spec_bound(const py::object& spec_arg, std::optional<std::uint64_t>
     if (threads && (*threads < 1 || *threads > 1024))
         throw py::value_error("threads must be a number from 1 to 1024, got " + std::to_string(*threads));
 
-    CheckOptions check_options;
+    CheckSettings check_settings;
     for (const auto& [k, v] : overrides)
-        check_options.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
-    check_options.seed = seed;
-    for (const auto& [name, v] : bound) check_options.bound[name] = describe_bound(v);
+        check_settings.overrides.push_back(py::str(k).cast<std::string>() + "=" + override_text(v));
+    check_settings.seed = seed;
+    check_settings.bound = &bound;
     ScratchFolder scratch;  // made below only if a node writes files
-    check_options.out_dir = out ? fs::path(*out) : scratch.path;
+    check_settings.out_dir = out ? fs::path(*out) : scratch.path;
 
-    PluginSet& set = plugins();
-    auto source = std::make_shared<spec::Source>(text.name, std::move(text.text));
-    spec::Diagnostics diags;
-    const spec::Spec parsed = spec::parse(source, diags);
-    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, text.name));
-    Plan plan = check(parsed, set.registry(), text.path, check_options, diags);
-    if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, text.name));
+    Checked checked = plugins().check(text, check_settings);
+    if (!checked.ok()) throw py::value_error(checked.report().text_with_count());
     // The checker's warnings are about files ("this spec writes no files"): moot when nothing is written.
-    if (!diags.all().empty() && out && PyErr_WarnEx(PyExc_UserWarning, diags.format().c_str(), 1) != 0)
+    if (checked.report().warnings > 0 && out &&
+        PyErr_WarnEx(PyExc_UserWarning, checked.report().text().c_str(), 1) != 0)
         throw py::error_already_set();  // warnings turned into errors
 
-    // Every named value (and side value) is wanted back: held past the last node. (A call written where an
-    // input goes is not named: its value is released after its reader, as in the CLI.)
-    for (const PlannedNode& n : plan.nodes) {
-        if (n.value_name.empty() || n.in_place) continue;
-        plan.last_use[n.value_name] = plan.nodes.size();
-        for (const auto& side : n.node->side_outputs) plan.last_use[n.value_name + "." + side.name] = plan.nodes.size();
-    }
+    // Every named value (and side value) is wanted back: held past the last node.
+    checked.keep_named_values();
 
-    ProgressDisplay display(stderr, ::isatty(STDERR_FILENO) != 0, !progress);
-    RunOptions options;
+    RunSettings settings;
     if (out) {
-        options.out_dir = *out;
-    } else if (writes_files(plan)) {  // else out_dir stays empty: no folder, no manifest, nothing written
+        settings.out_dir = *out;
+    } else if (checked.writes_files()) {  // else out_dir stays empty: no folder, no manifest, nothing written
         scratch.make();
-        options.out_dir = scratch.path;
+        settings.out_dir = scratch.path;
     } else {
-        options.out_dir.clear();
+        settings.out_dir.clear();
     }
-    options.threads = threads.value_or(0);
-    options.progress = &display;
-    options.plugins = set.plugins();
-    options.cancel = &g_cancel;
-    options.cancel_signal = &g_signal;
-    options.cache = std::nullopt;  // every node runs: a cached node's values would not be at hand
-    const RunResult result = run_released(plan, options, std::move(bound));
+    settings.threads = threads.value_or(0);
+    settings.progress = stderr;
+    settings.quiet = !progress;
+    settings.cancel = &g_cancel;
+    settings.cancel_signal = &g_signal;
+    settings.cache = std::nullopt;  // every node runs: a cached node's values would not be at hand
+    const RunResult result = run_released(checked, settings, std::move(bound));
 
     py::dict values;
     for (const auto& [key, v] : result.values) {
@@ -437,28 +411,27 @@ py::dict run_node(const std::string& spec, const py::list& inputs, std::optional
 class PyModel {
 public:
     /// `spec` an erode:evolve statement named `label` over the bound value `terrain` (orogen/__init__.py writes it).
-    PyModel(const std::string& spec, const std::string& label, const py::object& terrain, double cell) {
+    PyModel(const std::string& spec, [[maybe_unused]] const std::string& label, const py::object& terrain,
+            double cell) {
         BoundValues bound;
         bound["terrain"] = Value(py::isinstance<PyHeightmap>(terrain)
                                      ? std::make_shared<Heightmap>(*terrain.cast<const PyHeightmap&>().hm)
                                      : heightmap_of_array(terrain.cast<py::array>(), cell, 1));
-        CheckOptions check_options;
-        for (const auto& [name, v] : bound) check_options.bound[name] = describe_bound(v);
-        auto source = std::make_shared<spec::Source>("orogen.Model", spec);
-        spec::Diagnostics diags;
-        const spec::Spec parsed = spec::parse(source, diags);
-        if (!diags.has_errors()) plan_ = check(parsed, plugins().registry(), "orogen.Model", check_options, diags);
-        if (diags.has_errors()) throw py::value_error(diags.format() + error_count(diags, "orogen.Model"));
-        const PlannedNode& node = plan_.nodes.back();
+        CheckSettings check_settings;
+        check_settings.bound = &bound;
+        checked_ = plugins().check(SpecText{"orogen.Model", spec, "orogen.Model"}, check_settings);
+        if (!checked_.ok()) throw py::value_error(checked_.report().text_with_count());
+        node_ = checked_.nodes().back();
+        const CheckedNode& node = node_;
         auto hm = std::const_pointer_cast<Heightmap>(bound["terrain"].heightmap());
         landscape::ProcessLoop::Options options;
-        options.open = *landscape::parse_sides(std::get<std::string>(node.params.at("open")));
-        options.base_level = *landscape::parse_base_level(std::get<std::string>(node.params.at("base_level")));
-        options.substeps = int(std::get<std::int64_t>(node.params.at("substeps")));
-        options.years = std::get<double>(node.params.at("years"));
-        options.seed = node_seed(plan_.seed, label);
+        options.open = *landscape::parse_sides(std::get<std::string>(node.params->at("open")));
+        options.base_level = *landscape::parse_base_level(std::get<std::string>(node.params->at("base_level")));
+        options.substeps = int(std::get<std::int64_t>(node.params->at("substeps")));
+        options.years = std::get<double>(node.params->at("years"));
+        options.seed = node.seed;
         options.warn = [](std::string_view m) { PyErr_WarnEx(PyExc_RuntimeWarning, std::string(m).c_str(), 1); };
-        loop_ = std::make_unique<landscape::ProcessLoop>(node.processes, hm, std::vector<Value>{Value(hm)}, options);
+        loop_ = std::make_unique<landscape::ProcessLoop>(*node.processes, hm, std::vector<Value>{Value(hm)}, options);
         loop_->start();
     }
 
@@ -466,7 +439,7 @@ public:
         if (!(dt > 0.0) || !std::isfinite(dt)) throw py::value_error("dt must be a positive number of years");
         if (steps < 0) throw py::value_error("steps must be 0 or more");
         const double sub = dt / loop_->substeps();
-        for (const ProcessCall& p : plan_.nodes.back().processes)
+        for (const ProcessCall& p : *node_.processes)
             if (p.process->max_dt && sub > p.process->max_dt(p, loop_->cell()))
                 throw py::value_error("dt/substeps = " + std::to_string(sub) + " yr is longer than " + p.label +
                                       "'s stable step, " + std::to_string(p.process->max_dt(p, loop_->cell())) +
@@ -522,7 +495,8 @@ private:
         return "no field '" + name + "' in this model (its fields: " + names + ")";
     }
 
-    Plan plan_;  // holds the processes' checked calls the loop reads
+    Checked checked_;  // holds the processes' checked calls the loop reads
+    CheckedNode node_;
     std::unique_ptr<landscape::ProcessLoop> loop_;
 };
 
@@ -553,7 +527,7 @@ const NodeDescriptor& find_node(const std::string& name) {
         if (d->name == name) found = d;  // "fault" is fine too
     }
     if (found) return *found;
-    const std::string guess = spec::closest(name, names);
+    const std::string guess = closest(name, names);
     throw py::value_error("unknown node '" + name + "'" +
                           (guess.empty() ? "; orogen.nodes() lists them all" : "; did you mean '" + guess + "'?"));
 }

@@ -1,17 +1,12 @@
 // The `orogen` command: run | check | list | help | version | cache | analyze.
 // Exit codes: 0 success, 1 the run failed, 2 bad input (spec, file, value,
 // usage), 130 interrupted (SIGINT), 143 terminated (SIGTERM).
-#include "run/loader.hpp"
-#include "tiles/mpi_comm.hpp"
-#include "spec/plan.hpp"
-#include "run/progress.hpp"
-#include "run/runner.hpp"
-#include "spec/spec.hpp"
-#include "tiles/tiles.hpp"
+// Everything it does goes through the kernel's front door, orogen/session.hpp.
 #include "analyze.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
+#include <orogen/session.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -85,8 +80,8 @@ fs::path self_path(const char* argv0) {
     return ec ? fs::absolute(argv0) : p;
 }
 
-void print_problems(const PluginSet& plugins) {
-    for (const auto& p : plugins.problems()) std::fprintf(stderr, "orogen: warning: plugin %s\n", p.c_str());
+void print_problems(const Session& plugins) {
+    for (const auto& p : plugins.plugin_problems()) std::fprintf(stderr, "orogen: warning: plugin %s\n", p.c_str());
 }
 
 struct Args {
@@ -106,10 +101,7 @@ struct Args {
 };
 
 /// The MPI side of this process: set when mpirun started it.
-struct MpiRun {
-    int rank = 0, size = 1;
-};
-std::optional<MpiRun> g_mpi;
+const MpiScope* g_mpi = nullptr;  // MPI for the life of main (main's mpi_scope)
 
 std::optional<std::uint64_t> parse_u64(const std::string& s) {
     if (s.empty() || s.find_first_not_of("0123456789") != std::string::npos || s.size() > 20) return std::nullopt;
@@ -183,7 +175,7 @@ std::optional<int> parse_args(int argc, char** argv, Args& a) {
             static const std::vector<std::string> options = {
                 "--out",      "--seed",  "--threads",           "--set",  "--cache-size", "--cache",
                 "--no-cache", "--tiles", "--allow-outside-out", "--quiet"};
-            const std::string guess = spec::closest(arg.substr(0, arg.find('=')), options);
+            const std::string guess = closest(arg.substr(0, arg.find('=')), options);
             return usage_error("unknown option '" + arg + "'" +
                                (guess.empty() ? "" : "; did you mean '" + guess + "'?"));
         } else {
@@ -295,13 +287,6 @@ std::vector<std::string> summarise_outputs(const std::vector<fs::path>& outputs)
     return lines;
 }
 
-/// The tiles of a run under mpirun: --tiles or automatic.
-TileSplit tiled_split(const Plan& plan, const Args& args) {
-    const auto [rows, cols] =
-        args.tiles ? *args.tiles : automatic_tiles(g_mpi->size, plan.grid.width, plan.grid.height);
-    return split_grid(plan.grid.width, plan.grid.height, rows, cols);
-}
-
 /// The problem with --tiles for this many ranks, or "".
 std::string tiles_problem(const Args& args, int ranks) {
     if (!args.tiles) return "";
@@ -319,142 +304,94 @@ std::string tiles_problem(const Args& args, int ranks) {
         std::to_string(tiles) + ")";
 }
 
-/// Read, parse and check a spec. Prints diagnostics; returns nullopt on error.
-std::optional<Plan> check_spec_text(const std::string& path, std::string text, const PluginSet& plugins,
-                                    const Args& args);
+std::optional<Checked> check_spec_text(const SpecText& spec, const Session& session, const Args& args);
 
 /// Under mpirun every rank checks the same spec and reaches the same verdict, but rank 0 alone says why.
 /// A rank that left at once with exit code 2 would make mpirun end the others, rank 0 perhaps before it
 /// had written its message (seen under load: the exit code right, the message missing). So the ranks meet
 /// here after rank 0 has written it; failed on any rank is failed on all. One collective on every path.
-bool failed_on_any_rank(bool failed) {
-    if (!g_mpi) return failed;
-    std::fflush(stderr);
-    int any = failed ? 1 : 0;
-    mpi::max_all(&any, 1);
-    return any != 0;
-}
+bool failed_on_any_rank(bool failed) { return g_mpi ? g_mpi->failed_on_any(failed) : failed; }
 
 /// Whether this process prints what the ranks agree on: the only one, or rank 0 under mpirun.
-bool speaks_for_all() { return !g_mpi || g_mpi->rank == 0; }
+bool speaks_for_all() { return !g_mpi || g_mpi->rank() == 0; }
 
-std::optional<Plan> load_spec(const std::string& path, const PluginSet& plugins, const Args& args) {
-    std::error_code ec;
-    std::string problem, text;
-    if (!fs::exists(path, ec)) {
-        problem = "cannot read spec " + path + ": no such file";
-    } else if (fs::is_directory(path, ec)) {
-        problem = "cannot read spec " + path + ": it is a folder; give a .orogen file";
-    } else {
-        try {
-            const auto bytes = read_file(path);
-            text.assign(bytes.begin(), bytes.end());
-        } catch (const std::exception& e) { problem = e.what(); }
-    }
-    if (!problem.empty()) {
+/// The tiled run this process is part of (nullopt: a single process).
+std::optional<TiledSettings> tiled_settings(const Args& args) {
+    if (!g_mpi) return std::nullopt;
+    return TiledSettings{g_mpi->rank(), g_mpi->size(), args.tiles, g_mpi->ranks_on_this_machine()};
+}
+
+std::optional<Checked> load_spec(const std::string& path, const Session& session, const Args& args) {
+    std::optional<SpecText> text;
+    std::string problem;
+    try {
+        text = SpecText::read(path);
+    } catch (const std::exception& e) { problem = e.what(); }
+    if (!text) {
         if (speaks_for_all()) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
         failed_on_any_rank(true);
         return std::nullopt;
     }
-    return check_spec_text(path, std::move(text), plugins, args);
+    return check_spec_text(*text, session, args);
 }
 
-/// Parse and check spec `text` as if read from `path`. Prints diagnostics; returns nullopt on error.
-std::optional<Plan> check_spec_text(const std::string& path, std::string text, const PluginSet& plugins,
-                                    const Args& args) {
-    auto source = std::make_shared<spec::Source>(path, std::move(text));
-    spec::Diagnostics diags;
-    spec::Spec parsed = spec::parse(source, diags);
-    if (diags.has_errors()) {  // syntax first: semantic errors on a broken tree would be noise
-        if (speaks_for_all()) {
-            std::fputs(diags.format().c_str(), stderr);
-            std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
-                         path.c_str());
-        }
-        failed_on_any_rank(true);
-        return std::nullopt;
-    }
-    CheckOptions options;
-    options.overrides = args.overrides;
-    options.seed = args.seed;
-    options.out_dir = args.out;
-    options.allow_outside_out = args.allow_outside_out;
-    if (g_mpi) {
-        // Tiled: each heightmap of a tiled node is one tile, and the ranks on this machine share its memory.
-        const char* local = std::getenv("OMPI_COMM_WORLD_LOCAL_SIZE");
-        const int on_this_machine = std::clamp(local ? std::atoi(local) : g_mpi->size, 1, g_mpi->size);
-        options.heightmap_memory_limit =
-            heightmap_memory_limit() / std::uint64_t(on_this_machine) * std::uint64_t(g_mpi->size);
-        options.tiled_memory_share = double(on_this_machine) / double(g_mpi->size);
-    }
-    Plan plan = check(parsed, plugins.registry(), path, options, diags);
-    if (g_mpi && !diags.has_errors()) {
-        TiledCheckOptions tiled;
-        tiled.ranks = g_mpi->size;
-        tiled.tiles_given = args.tiles.has_value();
-        tiled.whole_grid_limit = heightmap_memory_limit();
-        check_tiled(plan, tiled_split(plan, args), tiled, diags);
-    }
+/// Check `spec`; prints every diagnostic (rank 0 alone under mpirun); nullopt on error.
+std::optional<Checked> check_spec_text(const SpecText& spec, const Session& session, const Args& args) {
+    CheckSettings settings;
+    settings.overrides = args.overrides;
+    settings.seed = args.seed;
+    settings.out_dir = args.out;
+    settings.allow_outside_out = args.allow_outside_out;
+    settings.tiled = tiled_settings(args);
+    Checked checked = session.check(spec, settings);
     // Under mpirun every rank checks the same plan; rank 0 alone prints.
-    if (speaks_for_all()) {
-        if (!diags.all().empty()) std::fputs(diags.format().c_str(), stderr);
-        if (diags.has_errors())
-            std::fprintf(stderr, "%d error%s in %s\n", diags.error_count(), diags.error_count() == 1 ? "" : "s",
-                         path.c_str());
-    }
-    if (failed_on_any_rank(diags.has_errors())) return std::nullopt;
-    return plan;
+    if (speaks_for_all()) std::fputs(checked.report().text_with_count().c_str(), stderr);
+    if (failed_on_any_rank(!checked.ok())) return std::nullopt;
+    return checked;
 }
 
-int cmd_check(const Args& args, const PluginSet& plugins) {
+int cmd_check(const Args& args, const Session& session) {
     if (args.positional.size() != 1) return usage_error("check needs one spec file");
-    auto plan = load_spec(args.positional[0], plugins, args);
-    if (!plan) return exit_bad_input;
+    auto checked = load_spec(args.positional[0], session, args);
+    if (!checked) return exit_bad_input;
     if (!speaks_for_all()) return exit_ok;
     // The grid's defaults are said, not left to be discovered: no grid line is 513 x 513, no cell= is 1 m.
-    std::printf("%s: ok (%zu node%s, grid %dx%d%s, cell %g m%s, seed %llu)\n", args.positional[0].c_str(),
-                plan->nodes.size(), plan->nodes.size() == 1 ? "" : "s", plan->grid.width, plan->grid.height,
-                plan->grid_given ? "" : " (the default: no grid line)", plan->grid.cell,
-                plan->cell_given ? "" : " (the default: no cell=)", static_cast<unsigned long long>(plan->seed));
+    const GridSpec grid = checked->grid();
+    const std::size_t nodes = checked->nodes().size();
+    std::printf("%s: ok (%zu node%s, grid %dx%d%s, cell %g m%s, seed %llu)\n", args.positional[0].c_str(), nodes,
+                nodes == 1 ? "" : "s", grid.width, grid.height,
+                checked->grid_given() ? "" : " (the default: no grid line)", grid.cell,
+                checked->cell_given() ? "" : " (the default: no cell=)",
+                static_cast<unsigned long long>(checked->seed()));
     return exit_ok;
 }
 
-int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugins, bool summary);
+int run_checked(const Checked& checked, const Args& args, const Session& session, bool summary);
 
-int cmd_run(const Args& args, const PluginSet& plugins) {
+int cmd_run(const Args& args, const Session& session) {
     if (args.positional.size() != 1) return usage_error("run needs one spec file");
-    auto plan = load_spec(args.positional[0], plugins, args);
-    if (!plan) return exit_bad_input;
-    return run_plan(plan, args, plugins, true);
+    auto checked = load_spec(args.positional[0], session, args);
+    if (!checked) return exit_bad_input;
+    return run_checked(*checked, args, session, true);
 }
 
-/// Run a checked plan: progress, cancellation, the cache as `args` says. With `summary`, prints the files
+/// Run a checked spec: progress, cancellation, the cache as `args` says. With `summary`, prints the files
 /// written and the timing table.
-int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugins, bool summary) {
+int run_checked(const Checked& checked, const Args& args, const Session& session, bool summary) {
     std::signal(SIGINT, on_interrupt);
     std::signal(SIGTERM, on_interrupt);
     const bool speaks = speaks_for_all();  // under mpirun, rank 0 shows progress and the summary
-    ProgressDisplay progress(stderr, ::isatty(STDERR_FILENO) != 0, args.quiet || !speaks);
-    std::optional<TiledRun> tiled;
-    if (g_mpi) tiled.emplace(tiled_split(*plan, args), g_mpi->rank);
-    RunOptions options;
-    options.tiled = tiled ? &*tiled : nullptr;
-    options.out_dir = args.out;
-    options.threads = args.threads;
-    options.progress = &progress;
-    options.plugins = plugins.plugins();
-    options.cancel = &g_cancel;
-    options.cancel_signal = &g_signal;
-    options.on_note = [](const std::string& note) { std::fprintf(stderr, "orogen: %s\n", note.c_str()); };
-    // A tiled run keeps no cache: its values are tiles, which the cache's keys do not describe (docs/cache.md).
-    options.cache = g_mpi ? std::nullopt : cache_settings(args);
-    for (const auto* n :
-         plugins.registry().nodes()) {  // which plugin (name, version) makes each node: part of its cache key
-        const std::string file = plugins.registry().provider(n->qualified_name());
-        for (const auto& p : options.plugins)
-            if (p.file == file) options.node_plugins[n->qualified_name()] = p;
-    }
-    RunResult result = run(*plan, options);
+    RunSettings settings;
+    settings.out_dir = args.out;
+    settings.threads = args.threads;
+    settings.progress = stderr;
+    settings.quiet = args.quiet || !speaks;
+    settings.cancel = &g_cancel;
+    settings.cancel_signal = &g_signal;
+    settings.on_note = [](const std::string& note) { std::fprintf(stderr, "orogen: %s\n", note.c_str()); };
+    settings.cache = cache_settings(args);
+    settings.tiled = tiled_settings(args);
+    const RunResult result = session.run(checked, settings);
     if (result.exit_code != 0) {
         std::fputs(result.error.c_str(), stderr);
         if (result.exit_code == 130 && g_signal.load() == SIGTERM) return 143;
@@ -462,13 +399,13 @@ int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugi
     }
     if (!args.quiet && speaks && summary) {
         if (g_mpi) {
-            const TileSplit& split = tiled->split();
-            std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size,
-                        g_mpi->size == 1 ? "" : "s", split.grid_width, split.grid_height, split.rows, split.cols);
-            for (const PlannedNode& node : plan->nodes)
-                if (node.node->tile_halo >= 0 && !TiledRun::runs_tiled(node))
+            const TileSplit& split = checked.tiles();
+            std::printf("tiled run: %d rank%s, the %dx%d grid in %dx%d tiles\n", g_mpi->size(),
+                        g_mpi->size() == 1 ? "" : "s", split.grid_width, split.grid_height, split.rows, split.cols);
+            for (const CheckedNode& node : checked.nodes())
+                if (node.node->tile_halo >= 0 && !node.untiled_reason.empty())
                     std::printf("  '%s' (%s) ran on rank 0 over the whole grid: %s\n", node.label.c_str(),
-                                node.node->qualified_name().c_str(), TiledRun::untiled_reason(node).c_str());
+                                node.node->qualified_name().c_str(), node.untiled_reason.c_str());
         }
         std::printf("wrote %zu file%s to %s:\n", result.outputs.size(), result.outputs.size() == 1 ? "" : "s",
                     args.out.c_str());
@@ -480,7 +417,7 @@ int run_plan(std::optional<Plan>& plan, const Args& args, const PluginSet& plugi
 
 /// `orogen analyze`: the command line becomes a spec (cli/analyze.cpp), run without the cache; the table
 /// the analyze:terrain node wrote is printed.
-int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
+int cmd_analyze(int argc, char** argv, const Session& plugins) {
     cli::AnalyzeArgs a;
     if (const std::string problem = cli::parse_analyze_args(argc, argv, a); !problem.empty())
         return usage_error(problem);
@@ -496,14 +433,15 @@ int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
     args.quiet = a.quiet;
     args.no_cache = true;  // the files may change under the same names; measuring is quick
     // The spec's file name only names it in messages: its paths are absolute.
-    auto plan = check_spec_text("orogen-analyze.orogen", composed.text, plugins, args);
-    if (!plan) {
+    const auto checked =
+        check_spec_text(SpecText::of("orogen-analyze.orogen", composed.text, fs::current_path()), plugins, args);
+    if (!checked) {
         std::fprintf(stderr,
                      "(orogen analyze ran the spec above, composed from its command line: a node's cell= is "
                      "--cell, low= and high= are --heights)\n");
         return exit_bad_input;
     }
-    const int rc = run_plan(plan, args, plugins, false);
+    const int rc = run_checked(*checked, args, plugins, false);
     if (rc != exit_ok) return rc;
     try {
         const auto table = read_file(fs::path(a.out) / "analysis.txt");
@@ -518,7 +456,7 @@ int cmd_analyze(int argc, char** argv, const PluginSet& plugins) {
     return exit_ok;
 }
 
-int cmd_list(const Args& args, const PluginSet& plugins) {
+int cmd_list(const Args& args, const Session& plugins) {
     if (args.positional.size() > 1) return usage_error("list takes at most one kind");
     const std::string kind = args.positional.empty() ? "" : args.positional[0];
     static const std::vector<std::string> kinds = {"generate", "erode",  "tectonics", "render",
@@ -526,7 +464,7 @@ int cmd_list(const Args& args, const PluginSet& plugins) {
     if (!kind.empty() && std::find(kinds.begin(), kinds.end(), kind) == kinds.end()) {
         std::string msg = "unknown kind '" + kind +
             "' (kinds: generate, erode, tectonics, render, export, import, analyze; and process)";
-        const std::string guess = spec::closest(kind, kinds);
+        const std::string guess = closest(kind, kinds);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
         return exit_bad_input;
@@ -587,7 +525,7 @@ void print_params(const std::vector<Param>& params) {
     }
 }
 
-int help_process(const ProcessDescriptor& p, const PluginSet& plugins) {
+int help_process(const ProcessDescriptor& p, const Session& plugins) {
     std::printf("process %s — %s\n", p.name.c_str(), p.summary.c_str());
     if (!p.description.empty()) std::printf("\n%s\n", p.description.c_str());
     std::printf("\nruns: %s%s\n",
@@ -609,7 +547,7 @@ int help_process(const ProcessDescriptor& p, const PluginSet& plugins) {
     return exit_ok;
 }
 
-int cmd_help(const Args& args, const PluginSet& plugins) {
+int cmd_help(const Args& args, const Session& plugins) {
     if (args.positional.size() != 1) return usage_error("help needs a node, e.g. `orogen help generate:fault`");
     const std::string& name = args.positional[0];
     const NodeDescriptor* n = plugins.registry().find(name);
@@ -624,7 +562,7 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
         for (const auto* p : plugins.registry().processes()) names.push_back(p->name);
         if (!n) {
             std::string msg = "unknown node '" + name + "'";
-            const std::string guess = spec::closest(name, names);
+            const std::string guess = closest(name, names);
             msg += guess.empty() ? "; `orogen list` shows them all" : "; did you mean '" + guess + "'?";
             std::fprintf(stderr, "orogen: error: %s\n", msg.c_str());
             return exit_bad_input;
@@ -656,7 +594,7 @@ int cmd_help(const Args& args, const PluginSet& plugins) {
     return exit_ok;
 }
 
-int cmd_version(const PluginSet& plugins) {
+int cmd_version(const Session& plugins) {
     std::printf("orogen %s (plugin API %d)\n", OROGEN_VERSION, OROGEN_PLUGIN_API_VERSION);
     std::printf("plugins:\n");
     for (const auto& p : plugins.plugins())
@@ -681,7 +619,7 @@ int main(int argc, char** argv) {
     static const std::vector<std::string> commands = {"run", "check", "list", "help", "version", "cache", "analyze"};
     if (std::find(commands.begin(), commands.end(), args.command) == commands.end()) {
         std::string msg = "unknown command '" + args.command + "'";
-        const std::string guess = spec::closest(args.command, commands);
+        const std::string guess = closest(args.command, commands);
         if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
         return usage_error(msg);
     }
@@ -692,8 +630,7 @@ int main(int argc, char** argv) {
             return exit_ok;
         }
     if (args.command == "analyze") {  // its own options (--against FILE...): see cli/analyze.cpp
-        PluginSet plugins;
-        plugins.load_all(self_path(argv[0]));
+        const Session plugins(self_path(argv[0]));
         print_problems(plugins);
         try {
             return cmd_analyze(argc, argv, plugins);
@@ -708,16 +645,15 @@ int main(int argc, char** argv) {
     if (auto rc = parse_args(argc, argv, args)) return *rc;
 
     // Started by mpirun: MPI for the life of main, one tile per rank.
-    std::optional<mpi::Session> mpi_session;
-    if (mpi::launched_size() > 0 && (args.command == "run" || args.command == "check")) {
+    std::optional<MpiScope> mpi_scope;
+    if (MpiScope::launched_size() > 0 && (args.command == "run" || args.command == "check")) {
         try {
-            mpi_session.emplace(argc, argv);
+            g_mpi = &mpi_scope.emplace(argc, argv);
         } catch (const Error& e) {
             std::fprintf(stderr, "orogen: error: %s\n", e.what());
             return exit_failed;
         }
-        g_mpi = MpiRun{mpi_session->rank(), mpi_session->size()};
-        if (const std::string problem = tiles_problem(args, g_mpi->size); !problem.empty()) {
+        if (const std::string problem = tiles_problem(args, g_mpi->size()); !problem.empty()) {
             if (speaks_for_all()) std::fprintf(stderr, "orogen: error: %s\n", problem.c_str());
             failed_on_any_rank(true);
             return exit_bad_input;
@@ -737,8 +673,7 @@ int main(int argc, char** argv) {
         }
     }
 
-    PluginSet plugins;
-    plugins.load_all(self_path(argv[0]));
+    const Session plugins(self_path(argv[0]));
     print_problems(plugins);
 
     try {

@@ -20,6 +20,7 @@
 #include "io/digest.hpp"
 #include "spec/plan.hpp"
 
+#include <orogen/session.hpp>
 #include <orogen/values.hpp>
 
 #include <array>
@@ -150,37 +151,7 @@ struct EntryInfo {
     std::vector<std::string> texts;  ///< the messages (read and checked with the header: no payload needed)
 };
 
-struct Settings {
-    std::filesystem::path folder;
-    std::uint64_t max_bytes = std::uint64_t(2) << 30;  ///< 2 GiB
-};
-
-/// $XDG_CACHE_HOME/orogen, else $HOME/.cache/orogen; empty if neither variable is set.
-std::filesystem::path default_folder();
-/// "2G", "500M", "64MiB", "1e9", "123456" → bytes; nullopt if it is not a size.
-std::optional<std::uint64_t> parse_size(std::string_view text);
-
-/// What a cache folder holds (`orogen cache info`).
-struct FolderFacts {
-    bool exists = false;  ///< false: no such folder (nothing kept yet)
-    std::uint64_t entries = 0;  ///< `<key>.orc` files
-    std::uint64_t bytes = 0;  ///< their size
-    std::int64_t oldest_ns = 0;  ///< least recently used entry's modification time (ns since 1970), if any
-    std::int64_t newest_ns = 0;  ///< most recently used
-    std::uint64_t temporaries = 0;  ///< half-written entries of runs in progress or killed
-    std::uint64_t temporary_bytes = 0;
-};
-/// Throws orogen::BadInput if `folder` exists but is not a folder or cannot be listed.
-FolderFacts folder_facts(const std::filesystem::path& folder);
-
-struct Cleared {
-    std::uint64_t entries = 0, bytes = 0;  ///< removed
-    std::vector<std::string> failures;  ///< "file: why", one per entry that could not be removed
-};
-/// Remove every entry of `folder` and the temporaries of killed runs (older than an hour; a run in progress
-/// keeps its own). Nothing else in the folder is touched, so pointing --cache at a wrong folder loses no
-/// files of the user's. Throws orogen::BadInput as folder_facts does.
-Cleared clear_folder(const std::filesystem::path& folder);
+// Settings, default_folder, parse_size, folder_facts and clear_folder: <orogen/session.hpp> (the front door).
 
 /// A cache folder in use. Every problem is one line to `warn`, never an error:
 /// the run goes on, without the cache if the folder cannot be used.

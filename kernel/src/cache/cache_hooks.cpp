@@ -9,7 +9,7 @@
 
 #include "io/digest.hpp"
 #include "io/outputs.hpp"
-#include "run/hooks.hpp"
+#include "hooks/hooks.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>

@@ -8,7 +8,7 @@
 // file (and both versions); the others still load.
 #pragma once
 
-#include "runner.hpp"
+#include <orogen/session.hpp>
 
 #include <orogen/plugin.hpp>
 

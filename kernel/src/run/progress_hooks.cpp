@@ -1,7 +1,8 @@
 // Progress and timing as the runner's hook (hooks.hpp): the bar or line of
 // each node that runs, the line of each node that does not (with what it said
 // when it ran, replayed), and each node's seconds in the timing table.
-#include "hooks.hpp"
+#include "hooks/hooks.hpp"
+#include "progress.hpp"
 
 #include <chrono>
 

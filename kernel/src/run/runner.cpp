@@ -1,6 +1,7 @@
 #include "runner.hpp"
 
-#include "hooks.hpp"
+#include "hooks/hooks.hpp"
+#include "progress.hpp"
 
 #include "io/json.hpp"
 #include "io/outputs.hpp"
@@ -113,7 +114,7 @@ public:
     /// What the node said, for the cache to replay when its result is reused.
     const std::vector<std::string>& said() const { return said_; }
     Tiling* tiling() override {
-        if (!options_.tiled || for_entry_ || !TiledRun::runs_tiled(node_)) return nullptr;
+        if (!options_.tiled || for_entry_ || !runs_tiled(node_)) return nullptr;
         if (!tiling_) tiling_.emplace(*options_.tiled, node_.node->tile_halo);  // the node's ghost width
         return &*tiling_;
     }

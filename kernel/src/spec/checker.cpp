@@ -1,7 +1,6 @@
 #include "plan.hpp"
 
 #include "io/outputs.hpp"
-#include "tiles/tiles.hpp"
 
 #include <orogen/error.hpp>
 #include <orogen/io.hpp>
@@ -193,9 +192,7 @@ public:
     const GridSpec& grid() const override { return grid_; }
     // A node with a parameter error never runs, and whether it would tile may hang on that parameter
     // (untiled_because reads the parameters): its whole-grid share stands.
-    double memory_share() const override {
-        return invalid_.empty() && TiledRun::runs_tiled(node_) ? tiled_share_ : 1.0;
-    }
+    double memory_share() const override { return invalid_.empty() && runs_tiled(node_) ? tiled_share_ : 1.0; }
     void set_tiled_share(double share) { tiled_share_ = share; }
     const ValueInfo* input(std::size_t i) const override { return i < inputs_.size() ? inputs_[i] : nullptr; }
     bool given(std::string_view param) const override { return node_.given.count(param) > 0; }
@@ -349,7 +346,8 @@ private:
 
     void check_header() {
         if (!parsed_.version) {
-            diags_.error(file_start_, "a spec starts with its format version: add `orogen 1` as the first line");
+            if (!parsed_.broken_header)  // a header line that did not parse was reported already
+                diags_.error(file_start_, "a spec starts with its format version: add `orogen 1` as the first line");
         } else if (*parsed_.version != 1) {
             diags_.error(parsed_.version_where,
                          "format version " + std::to_string(*parsed_.version) +
@@ -384,6 +382,12 @@ private:
             if (!st.name.empty()) defined_anywhere_.emplace(st.name, st.name_where);
         nested_key_.assign(parsed_.statements.size(), "");
         for (const auto& [name, info] : options_.bound) values_[name] = info;  // made before the first line
+        // A line that did not parse: its syntax error was reported; a read of its value says nothing more.
+        for (const auto& name : parsed_.broken_names) {
+            values_.emplace(name, ValueInfo{});
+            poisoned_.insert(name);
+            labels_.push_back(name);
+        }
     }
 
     void check_statement(std::size_t si) {
@@ -716,7 +720,7 @@ private:
                              "`orogen list process` shows the processes");
             return;
         }
-        if (call.body.empty())
+        if (call.body.empty() && !call.body_broken)
             diags_.error(
                 call.body_where,
                 "the body of " + call.qualified() + " holds no processes; give one a line, e.g. stream-power()");
@@ -738,7 +742,7 @@ private:
             nc.body.push_back(std::move(bp));
         }
         report_unmatched_process_overrides(nc);
-        if (all_known) check_fields(nc);
+        if (all_known && !call.body_broken) check_fields(nc);  // a broken line's process may be what is missing
         // A process's own check, once its parameters are all valid (an error in one is reported already).
         for (auto& bp : nc.body) {
             if (!bp.call.process->check || !bp.invalid.empty()) continue;
@@ -989,7 +993,10 @@ private:
 
     void report_unused_overrides() {
         for (const auto& o : overrides_) {
-            if (o.used) continue;
+            if (o.used ||
+                std::find(parsed_.broken_names.begin(), parsed_.broken_names.end(), o.o.target) !=
+                    parsed_.broken_names.end())
+                continue;
             std::string msg = "--set names '" + o.o.target + "', but the spec has no value or node of that name";
             const std::string guess = spec::closest(o.o.target, labels_);
             if (!guess.empty()) msg += "; did you mean '" + guess + "'?";
@@ -1037,6 +1044,18 @@ private:
 Plan check(const spec::Spec& parsed, const Registry& registry, const fs::path& spec_path, const CheckOptions& options,
            Diagnostics& diags) {
     return Checker(parsed, registry, spec_path, options, diags).run();
+}
+
+std::string untiled_reason(const PlannedNode& node) {
+    if (node.node->tile_halo < 0) return "it cannot be tiled";
+    if (node.mapped_input >= 0) return "it is mapped over a series";
+    std::vector<bool> given;
+    for (const auto& key : node.inputs) given.push_back(!key.empty());
+    if (node.node->untiled_because)
+        if (std::string why = node.node->untiled_because(node.params, given); !why.empty()) return why;
+    for (const auto& process : node.processes)
+        if (process.process->tile_halo < 0) return "process " + process.label + " is not tiled";
+    return node.node->untiled_body_because ? node.node->untiled_body_because(node.processes) : "";
 }
 
 }  // namespace orogen

@@ -34,8 +34,12 @@ public:
                 continue;
             }
             const std::size_t errors_before = std::size_t(diags_.error_count());
+            const Token& first = peek();
+            const bool header = first.kind == Tok::word && peek(1).kind != Tok::equals && peek(1).kind != Tok::colon;
             statement(spec);
             if (std::size_t(diags_.error_count()) != errors_before) {
+                spec.broken = true;
+                spec.broken_header |= header;
                 recover();
                 continue;
             }
@@ -213,6 +217,8 @@ private:
                 if (peek().kind == Tok::lbrace) parse_body(*call);
                 st.call = std::move(*call);
                 spec.statements.push_back(std::move(st));
+            } else {
+                spec.broken_names.push_back(st.name);
             }
             return;
         }
@@ -471,6 +477,7 @@ private:
                 diags_.error(
                     open.where,
                     "this '{' of " + call.qualified() + "'s processes is never closed; add '}' after the last process");
+                call.body_broken = true;
                 return;
             }
             const int errors_before = diags_.error_count();
@@ -483,6 +490,7 @@ private:
             if (process && at_line_end) call.body.push_back(std::move(*process));
             // After a mistake (reported here, or by the lexer at a bad token: then nothing was counted), go on
             // at the next line, so every process's mistakes show at once and the loop always moves on.
+            if (!process || !at_line_end || diags_.error_count() != errors_before) call.body_broken = true;
             if (!process || !at_line_end || diags_.error_count() != errors_before)
                 while (peek().kind != Tok::newline && peek().kind != Tok::rbrace && peek().kind != Tok::eof) ++p_;
         }
@@ -643,8 +651,15 @@ private:
 }  // namespace
 
 Spec parse(const std::shared_ptr<const Source>& source, Diagnostics& diags) {
-    Parser parser(lex(source, diags), diags);
-    return parser.parse_spec(source);
+    const int errors_before = diags.error_count();
+    std::vector<Token> tokens = lex(source, diags);
+    // A file the lexer refused whole (a binary file: one bad token) has no header to look for.
+    const bool refused = tokens.size() == 2 && tokens.front().kind == Tok::bad;
+    Parser parser(std::move(tokens), diags);
+    Spec spec = parser.parse_spec(source);
+    spec.broken |= diags.error_count() != errors_before;
+    spec.broken_header |= refused;
+    return spec;
 }
 
 std::optional<Override> parse_override(const std::shared_ptr<const Source>& source, Diagnostics& diags) {

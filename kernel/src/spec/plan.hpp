@@ -62,6 +62,11 @@ struct CheckOptions {
     std::map<std::string, ValueInfo, std::less<>> bound;
 };
 
+/// "" if `node` runs on every rank's tile in a tiled run (docs/mpi.md), else why it runs on rank 0 over the
+/// whole grid: a question the plan answers, for the checker, the tiled run and the messages alike.
+std::string untiled_reason(const PlannedNode& node);
+inline bool runs_tiled(const PlannedNode& node) { return untiled_reason(node).empty(); }
+
 /// Check `parsed` against `registry`. Errors go to `diags`; the plan is only
 /// meaningful if !diags.has_errors().
 Plan check(const spec::Spec& parsed, const Registry& registry, const std::filesystem::path& spec_path,

@@ -109,6 +109,8 @@ struct Call {
     bool has_body = false;
     Location body_where;
     std::vector<ProcessCallSyntax> body;
+    /// A line of the body did not parse (reported): the body is incomplete, so what it lacks is not checked.
+    bool body_broken = false;
     std::string qualified() const { return kind + ":" + node; }
 };
 
@@ -131,6 +133,13 @@ struct Spec {
     bool has_cell = false;  ///< cell= given (else 1 m)
     Location grid_where;
     std::vector<Statement> statements;
+    /// After a syntax error the checker still checks the statements that parsed, so every mistake is reported
+    /// at once. These say what the broken lines would have made, so it says nothing more about them: the
+    /// names of `NAME = ...` lines that did not parse (a read of one is not "undefined"), and whether an
+    /// `orogen`, `seed` or `grid` line did not parse (no "add `orogen 1`"; no outputs' warning).
+    std::vector<std::string> broken_names;
+    bool broken_header = false;
+    bool broken = false;  ///< any syntax error
 };
 
 /// Parse a whole spec. Syntax errors go to `diags`; the parser recovers at the

@@ -6,7 +6,7 @@
 #include "tiles.hpp"
 
 #include "io/digest.hpp"
-#include "run/hooks.hpp"
+#include "hooks/hooks.hpp"
 
 #include <filesystem>
 

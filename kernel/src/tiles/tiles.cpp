@@ -208,13 +208,13 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
     }
     for (const PlannedNode& node : plan.nodes) {
         const std::string who = "'" + node.label + "' (" + node.node->qualified_name() + ")";
-        if (!TiledRun::runs_tiled(node)) {
+        if (!runs_tiled(node)) {
             const std::string problem =
                 heightmap_memory_problem(split.grid_width, split.grid_height, options.whole_grid_limit);
             if (!problem.empty())
                 diags.error(node.where,
-                            who + " runs on rank 0 over the whole " + grid + " grid (" +
-                                TiledRun::untiled_reason(node) + "), which " + problem +
+                            who + " runs on rank 0 over the whole " + grid + " grid (" + untiled_reason(node) +
+                                "), which " + problem +
                                 "; remove it from this spec (run it on the result, in a smaller spec), "
                                 "change what keeps it from tiling or use a smaller grid");
             continue;
@@ -240,20 +240,6 @@ void check_tiled(const Plan& plan, const TileSplit& split, const TiledCheckOptio
 }
 
 // ------------------------------------------------------------------ one rank
-
-bool TiledRun::runs_tiled(const PlannedNode& node) { return untiled_reason(node).empty(); }
-
-std::string TiledRun::untiled_reason(const PlannedNode& node) {
-    if (node.node->tile_halo < 0) return "it cannot be tiled";
-    if (node.mapped_input >= 0) return "it is mapped over a series";
-    std::vector<bool> given;
-    for (const auto& key : node.inputs) given.push_back(!key.empty());
-    if (node.node->untiled_because)
-        if (std::string why = node.node->untiled_because(node.params, given); !why.empty()) return why;
-    for (const auto& process : node.processes)
-        if (process.process->tile_halo < 0) return "process " + process.label + " is not tiled";
-    return node.node->untiled_body_because ? node.node->untiled_body_because(node.processes) : "";
-}
 
 int TiledRun::agree(int exit_code, int* reporter) {
     // One shape of collective for every agreement, so a rank that failed

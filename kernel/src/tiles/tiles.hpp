@@ -7,6 +7,7 @@
 #include "spec/diagnostics.hpp"
 #include "spec/plan.hpp"
 
+#include <orogen/session.hpp>
 #include <orogen/tiles.hpp>
 #include <orogen/values.hpp>
 
@@ -21,9 +22,6 @@ namespace orogen {
 
 /// The grid cut into rows × cols tiles (TileSplit, orogen/tiles.hpp).
 TileSplit split_grid(int width, int height, int rows, int cols);
-
-/// "RxC" (rows x columns, e.g. "2x3") → {R, C}; nullopt if it is not that.
-std::optional<std::pair<int, int>> parse_tiles(std::string_view text);
 
 /// rows × cols = ranks with tiles as near square as the grid allows.
 std::pair<int, int> automatic_tiles(int ranks, int width, int height);
@@ -50,10 +48,6 @@ public:
     TileRect owned() const { return split_.tile(rank_); }
     const TileSplit& split() const { return split_; }
 
-    /// Whether `node` runs on every rank's tile (else on rank 0 over the whole grid).
-    static bool runs_tiled(const PlannedNode& node);
-    /// "" if `node` runs tiled, else why it runs on rank 0 (for the messages).
-    static std::string untiled_reason(const PlannedNode& node);
     /// Collective, before `node` runs: gives it what it reads: tiles for a
     /// tiled node (a whole value held on rank 0 is cut and sent out), whole
     /// values on rank 0 for the others (tiles are gathered there). Returns

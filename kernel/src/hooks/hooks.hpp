@@ -20,15 +20,22 @@
 //   skipped       j did not run (at_turn answered for it)
 // and once, bound, for each value the caller bound (run()'s `bound`) before
 // the first node, and run_finished, after the last node (failed or not).
+//
+// The room sits below its users (cache/, tiles/, run/), as LLVM keeps
+// PassInstrumentation.h below the pass managers: it includes the plan and the
+// public headers, nothing of theirs.
 #pragma once
 
-#include "runner.hpp"
+#include "spec/plan.hpp"
 
 #include <orogen/node.hpp>
+#include <orogen/session.hpp>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -38,6 +45,33 @@
 namespace orogen {
 
 class Staging;  // io/outputs.hpp
+class ProgressDisplay;  // run/progress.hpp
+class TiledRun;  // tiles/tiles.hpp
+
+/// What a run is told: where files go, threads, progress, cancellation, the cache, the plugins, the tiles.
+struct RunOptions {
+    /// Where the outputs and manifest.json go. Empty: the run writes no files at all (no folder, no
+    /// staging, no manifest), for a plan of which writes_files() is false (the Python module's node());
+    /// a node that asks for an output path then fails.
+    std::filesystem::path out_dir = "out";
+    int threads = 0;  ///< 0: all cores
+    ProgressDisplay* progress = nullptr;
+    std::vector<PluginRecord> plugins;  ///< for the manifest
+    const std::atomic<bool>* cancel = nullptr;
+    /// The signal that set `cancel` (SIGINT or SIGTERM), for the message; the caller picks the exit code.
+    const std::atomic<int>* cancel_signal = nullptr;
+    /// Told at once of each piece of debris of killed runs removed before this run (else kept in RunResult::notes).
+    std::function<void(const std::string&)> on_note;
+    /// The node cache (docs/cache.md); nullopt: every node runs.
+    std::optional<cache::Settings> cache;
+    /// kind:name → the plugin that provides it (its name and version go into cache keys; a node not
+    /// listed is never cached).
+    std::map<std::string, PluginRecord, std::less<>> node_plugins;
+    /// One-line warnings that do not stop the run (a damaged cache entry...); default: the progress display.
+    std::function<void(const std::string&)> on_warning;
+    /// A tiled run under MPI (tiles.hpp): this rank's side of it; nullptr for a single process.
+    TiledRun* tiled = nullptr;
+};
 
 /// A node failed; the message is formatted (node_error). Thrown through the run loop to run().
 struct NodeFailed {
@@ -117,7 +151,6 @@ std::unique_ptr<NodeHooks> cache_hooks(RunShared& shared);
 /// The agreement of a tiled run's ranks (tiles/tiled_hooks.cpp); nullptr for a single process.
 std::unique_ptr<NodeHooks> tiled_hooks(RunShared& shared);
 
-class TiledRun;  // tiles/tiles.hpp
 /// Collective in a tiled run: every rank learns the worst exit code; only the lowest failing rank keeps its
 /// message (tiles/tiled_hooks.cpp).
 void agree_across_ranks(TiledRun& tiled, int& exit_code, std::string& error);
