@@ -42,6 +42,42 @@ void check(CheckContext& ctx) {
         ctx.require_layer(0, "layer", layer, "use \"height\" (the default) or the name of an existing layer");
 }
 
+/// The plates as the state draws them: each polygon clipped to the terrain
+/// (x 0..width, y 0..height, metres) and given a point every `step` metres
+/// along its edges, the collisions clipped and cut into pieces as long, so
+/// that the terrain's height sampled under every point lays them on it.
+PlateHistory drapable(const PlateHistory& plates, double width, double height, double step) {
+    PlateHistory out = plates;
+    const double e = 1e-6 * std::max(width, height);  // just inside: every point samples the terrain
+    const double x0 = e, y0 = e, x1 = width - e, y1 = height - e;
+    for (PlateSnapshot& snap : out.snapshots) {
+        std::vector<PlateState> kept;
+        for (PlateState& p : snap.plates) {
+            std::vector<paraview::XY> polygon;
+            for (const Point2& v : p.polygon) polygon.push_back({v.x, v.y});
+            polygon = paraview::densify(paraview::clip_polygon(polygon, x0, y0, x1, y1), step, true);
+            if (polygon.size() < 3) continue;  // the plate lies off the map at this instant
+            p.polygon.clear();
+            for (const auto& v : polygon) p.polygon.push_back({v[0], v[1]});
+            kept.push_back(std::move(p));
+        }
+        snap.plates = std::move(kept);
+    }
+    out.collisions.clear();
+    for (const CollisionEvent& c : plates.collisions) {
+        paraview::XY a = {c.a.x, c.a.y}, b = {c.b.x, c.b.y};
+        if (!paraview::clip_segment(a, b, x0, y0, x1, y1)) continue;
+        const auto line = paraview::densify({a, b}, step, false);
+        for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+            CollisionEvent piece = c;
+            piece.a = {line[i][0], line[i][1]};
+            piece.b = {line[i + 1][0], line[i + 1][1]};
+            out.collisions.push_back(piece);
+        }
+    }
+    return out;
+}
+
 /// The attribute that colours particles: velocity (by magnitude) if there is one, else the first other one.
 std::string particle_colour(const ParticleSeries& series) {
     if (series.frames.empty()) return {};
@@ -66,10 +102,12 @@ NodeOutputs run(NodeContext& ctx) {
     s.terrain = stem + ".vti";
     s.layer = ctx.text("layer");
 
-    std::vector<vtk::NamedGrid> layers;
-    for (const auto& name : hm.layer_names()) layers.push_back({name, hm.layer(name)});
-    vtk::write_heightmap(hm.view(), layers, folder / s.terrain, o);
-
+    if (s.layer != "height" && !hm.has_layer(s.layer)) {
+        std::string there;
+        for (const auto& name : hm.layer_names()) there += (there.empty() ? "" : ", ") + name;
+        throw BadInput("export:paraview-state: the terrain has no layer '" + s.layer +
+                       "' to colour by (it has: " + (there.empty() ? "no layers" : there) + "); no state written");
+    }
     const ConstGridView heights = hm.view();
     const std::span<const float> h(heights.data, heights.size());
     const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
@@ -79,6 +117,16 @@ NodeOutputs run(NodeContext& ctx) {
     s.size_y = (hm.height() - 1) * hm.cell();
     const ConstGridView coloured = s.layer == "height" ? heights : hm.layer(s.layer);
     s.colours = paraview::colours_for(s.layer, {coloured.data, coloured.size()});
+
+    std::vector<vtk::NamedGrid> layers;
+    for (const auto& name : hm.layer_names()) layers.push_back({name, hm.layer(name)});
+    std::vector<float> shifted;  // the layer relative to its median, when that is what is shown
+    if (s.colours.array != s.layer) {
+        shifted.assign(coloured.data, coloured.data + coloured.size());
+        for (float& v : shifted) v = float(double(v) - s.colours.shift);
+        layers.push_back({s.colours.array, {shifted.data(), coloured.width, coloured.height, coloured.cell}});
+    }
+    vtk::write_heightmap(hm.view(), layers, folder / s.terrain, o);
     const double given = ctx.real("exaggeration");
     s.exaggeration =
         given > 0 ? given : paraview::auto_exaggeration(s.height_max - s.height_min, std::max(s.size_x, s.size_y));
@@ -91,8 +139,18 @@ NodeOutputs run(NodeContext& ctx) {
         if (ctx.has_input(i)) (ctx.input(i).type() == ValueType::plates ? plates_in : particles_in) = &ctx.input(i);
 
     std::size_t files = 2;
+    if (plates_in && plates_in->plates()->snapshots.empty()) {
+        ctx.warn("export:paraview-state: the plate history has no snapshots; the state shows no plates");
+        plates_in = nullptr;
+    }
+    if (particles_in && particles_in->particles()->frames.empty()) {
+        ctx.warn("export:paraview-state: the particle series has no frames; the state shows no particles");
+        particles_in = nullptr;
+    }
     if (plates_in) {
-        const PlateHistory& plates = *plates_in->plates();
+        // Drawn on the terrain: a point every two cells (at most 512 along a side) samples its height.
+        const PlateHistory plates = drapable(*plates_in->plates(), s.size_x, s.size_y,
+                                             std::max(2 * hm.cell(), std::max(s.size_x, s.size_y) / 512));
         s.plates = stem + "-plates.pvd";
         s.collisions = stem + "-collisions.pvd";
         files += vtk::write_plates(plates, folder / s.plates, o, folder / s.collisions);
@@ -144,9 +202,12 @@ OROGEN_PLUGIN("export-paraview", "0.1.0", registry) {
             "history), STEM-particles.pvd (given particle frames; the two optional inputs in either order). The script "
             "opens them by relative path, so the "
             "folder can be moved. The terrain is raised by Warp By Scalar (exaggeration, auto: relief a fifth of the "
-            "larger side), coloured by LAYER with a scalar bar and a colour map that suits it (categorical for plate "
-            "and boundary, diverging for eroded, hypsometric for height), viewed from an oblique camera; plates and "
-            "particles are set to play over their time steps.",
+            "larger side), coloured by LAYER with a scalar bar and a colour map that suits it over its 2-98 % range "
+            "(categorical for plate and boundary; diverging about 0 for eroded and layers of both signs, or about "
+            "its median for an eroded of one sign: where rivers cut deeper than the typical cell; hypsometric for "
+            "height, log for drainage), viewed from an oblique camera; plates and collisions are laid on the "
+            "terrain; plates and particles play over their time steps, opening at the last. tools/pvbatch runs "
+            "pvbatch without a display.",
         .inputs =
             {
                 {"terrain", ValueType::heightmap, Need::required, "the heightmap to show (with its layers)"},

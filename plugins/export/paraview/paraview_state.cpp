@@ -88,59 +88,110 @@ Colours plate_colours(std::vector<int> ids) {
     return categories("plate", ids, names, {{-1, rgb(200, 200, 200)}});
 }
 
+double percentile(std::span<const float> values, double q) {
+    std::vector<float> finite;
+    finite.reserve(values.size());
+    for (float v : values)
+        if (std::isfinite(v)) finite.push_back(v);
+    if (finite.empty()) return 0.0;
+    const std::size_t k =
+        std::min(finite.size() - 1, std::size_t(std::llround(std::clamp(q, 0.0, 1.0) * double(finite.size() - 1))));
+    std::nth_element(finite.begin(), finite.begin() + std::ptrdiff_t(k), finite.end());
+    return finite[k];
+}
+
+namespace {
+
+/// The unit of a layer orogen's nodes write, for the scalar bar ("" when unknown).
+std::string unit_of(const std::string& name) {
+    static const std::map<std::string, std::string> units = {
+        {"height", "m"},    {"eroded", "m"},      {"deposited", "m"},   {"uplift", "m"},
+        {"uplifted", "m"},  {"water", "m"},       {"sediment", "m"},    {"flow", "m/s"},
+        {"drainage", "m²"}, {"hardness", "0..1"}, {"ice_flux", "m³/yr"}};
+    const auto u = units.find(name);
+    return u == units.end() ? "" : u->second;
+}
+
+std::string titled(const std::string& name, const std::string& unit) {
+    return unit.empty() ? name : name + " (" + unit + ")";
+}
+
+}  // namespace
+
 Colours colours_for(const std::string& name, std::span<const float> values) {
-    float lo = values[0], hi = values[0];
-    for (float v : values) lo = std::min(lo, v), hi = std::max(hi, v);
     if (name == "plate" || name == "boundary") {
         std::set<int> ids;
         for (float v : values) {
+            if (!std::isfinite(v)) continue;
             ids.insert(int(std::lround(v)));
             if (ids.size() > max_categories) break;
         }
-        if (ids.size() <= max_categories) {
-            if (name == "plate") {
-                Colours c = plate_colours({ids.begin(), ids.end()});
-                c.title = "plate (id)";
-                return c;
-            }
-            return categories(
-                "boundary", {ids.begin(), ids.end()},
-                {{0, "none"}, {1, "convergent"}, {2, "divergent"}, {3, "transform"}},
-                {{0, rgb(200, 200, 200)}, {1, rgb(215, 48, 39)}, {2, rgb(69, 117, 180)}, {3, rgb(26, 152, 80)}});
+        if (!ids.empty() && ids.size() <= max_categories) {
+            Colours c = name == "plate"
+                ? plate_colours({ids.begin(), ids.end()})
+                : categories(
+                      "boundary", {ids.begin(), ids.end()},
+                      {{0, "none"}, {1, "convergent"}, {2, "divergent"}, {3, "transform"}},
+                      {{0, rgb(200, 200, 200)}, {1, rgb(215, 48, 39)}, {2, rgb(69, 117, 180)}, {3, rgb(26, 152, 80)}});
+            if (name == "plate") c.title = "plate (id)";
+            c.array = name;
+            c.data_low = c.low;
+            c.data_high = c.high;
+            return c;
         }
     }
-    const std::string unit = name == "flow" ? "m/s" : name == "hardness" ? "0..1" : name == "plate" ? "id" : "m";
     Colours c;
-    c.title = name + " (" + unit + ")";
-    // Heavy tails (a few fast cells of flow, a few deep gullies) would wash
-    // the map out: the range ends at the 98th percentile of magnitudes.
-    std::vector<float> mags(values.begin(), values.end());
-    for (float& m : mags) m = std::fabs(m);
-    const std::size_t k = std::min(mags.size() - 1, std::size_t(double(mags.size()) * 0.98));
-    std::nth_element(mags.begin(), mags.begin() + std::ptrdiff_t(k), mags.end());
-    const double top = std::max(double(mags[k]), 1e-9);
-    if (name == "eroded" || (lo < 0 && hi > 0 && name != "height")) {
-        // Brown where the terrain was cut, white at 0, blue-green where it gained (BrBG).
+    c.array = name;
+    const std::string unit = unit_of(name);
+    c.title = titled(name, unit);
+    // The range the colours span: the 2nd to 98th percentile, so a few extreme
+    // cells (a deep gully, the open boundary's rim, one fast cell) do not wash it out.
+    double p2 = percentile(values, 0.02), p98 = percentile(values, 0.98);
+    const std::vector<RGB> brbg = {rgb(140, 81, 10), rgb(216, 179, 101), rgb(245, 245, 245), rgb(90, 180, 172),
+                                   rgb(1, 102, 94)};
+    if (name == "eroded" && (p98 < 0 || p2 > 0)) {
+        // Every cell lost (or gained) much the same: 0 is no landmark in the
+        // picture. What the user asks first is where the rivers cut deepest
+        // relative to the map: the layer minus its median, diverging about it.
+        c.shift = percentile(values, 0.5);
+        c.array = name + "_vs_median";
+        const long long median = std::llround(c.shift);
+        c.title = name + " − median (m); median " + (median < 0 ? "−" : "") + std::to_string(std::llabs(median)) + " m";
+        p2 -= c.shift;
+        p98 -= c.shift;
+    }
+    c.data_low = p2;
+    c.data_high = p98;
+    // eroded (about its median, or about 0 when it reaches 0: most cells
+    // untouched, as after a short rain) or any other layer with both signs:
+    // 0 (no change, or the typical cell) is the landmark.
+    if (name == "eroded" || (name != "height" && p2 < 0 && p98 > 0)) {
+        // Brown below, white at 0, blue-green above (BrBG), symmetric so equal
+        // colours mean equal amounts.
         c.kind = Colours::diverging;
-        if (name == "eroded") c.title = "eroded (m, net change)";
+        if (name == "eroded" && c.shift == 0.0) c.title = "eroded (m; − cut, + deposited)";
+        const double top = std::max({-p2, p98, 1e-9});  // a constant layer: still a range
         c.low = -top;
         c.high = top;
-        c.ramp = {rgb(140, 81, 10), rgb(216, 179, 101), rgb(245, 245, 245), rgb(90, 180, 172), rgb(1, 102, 94)};
+        c.ramp = brbg;
         return c;
     }
     c.kind = Colours::sequential;
+    c.low = p2;
+    c.high = p98 > p2 ? p98 : p2 + std::max(1e-9, std::fabs(p2) * 1e-6);  // a constant layer: still a range
     if (name == "height") {  // hypsometric: lowlands green to rock brown to snow
-        c.low = lo;
-        c.high = hi > lo ? hi : lo + 1.0;
         c.ramp = {rgb(38, 115, 77), rgb(140, 180, 100), rgb(210, 190, 130), rgb(140, 100, 70), rgb(245, 245, 245)};
-        return c;
-    }
-    c.low = lo;
-    c.high = lo >= 0 ? std::max(top, double(lo) + 1e-9) : std::max(double(hi), double(lo) + 1e-9);
-    if (name == "water" || name == "flow") c.ramp = {rgb(247, 251, 255), rgb(107, 174, 214), rgb(8, 48, 107)};
-    else if (name == "sediment") c.ramp = {rgb(255, 247, 188), rgb(254, 153, 41), rgb(102, 37, 6)};
-    else  // viridis, sampled
+    } else if (name == "drainage" || (p2 > 0 && p98 > 1000 * p2)) {
+        // Upstream area spans decades: a log scale shows the branching network.
+        c.log = true;
+        c.ramp = {rgb(247, 251, 255), rgb(107, 174, 214), rgb(8, 48, 107)};
+    } else if (name == "water" || name == "flow") {
+        c.ramp = {rgb(247, 251, 255), rgb(107, 174, 214), rgb(8, 48, 107)};
+    } else if (name == "sediment" || name == "deposited") {
+        c.ramp = {rgb(255, 247, 188), rgb(254, 153, 41), rgb(102, 37, 6)};
+    } else {  // viridis, sampled
         c.ramp = {rgb(68, 1, 84), rgb(59, 82, 139), rgb(33, 145, 140), rgb(94, 201, 98), rgb(253, 231, 37)};
+    }
     return c;
 }
 
@@ -153,14 +204,80 @@ Colours attribute_colours(const std::string& name, std::span<const float> values
     }
     Colours c;
     c.kind = Colours::sequential;
-    c.title = name == "velocity" ? "velocity (m/s)" : name;
+    c.array = name;
+    c.title = name == "velocity" ? "speed (m/s)" : titled(name, unit_of(name));
     c.ramp = {rgb(198, 219, 239), rgb(66, 146, 198), rgb(8, 48, 107)};  // light = slow, dark = fast
     if (magnitudes.empty()) return c;
-    const std::size_t k = std::min(magnitudes.size() - 1, std::size_t(double(magnitudes.size()) * 0.98));
-    std::nth_element(magnitudes.begin(), magnitudes.begin() + std::ptrdiff_t(k), magnitudes.end());
-    c.low = 0.0;
-    c.high = std::max(double(magnitudes[k]), 1e-9);
+    c.low = c.data_low = percentile(magnitudes, 0.02);
+    c.data_high = percentile(magnitudes, 0.98);
+    c.high = std::max(c.data_high, c.low + 1e-9);
     return c;
+}
+
+std::vector<XY> clip_polygon(const std::vector<XY>& polygon, double x0, double y0, double x1, double y1) {
+    std::vector<XY> out = polygon;
+    // One half-plane at a time: inside(p) for each edge of the rectangle.
+    for (int edge = 0; edge < 4 && !out.empty(); ++edge) {
+        const int axis = edge % 2;
+        const double bound = edge == 0 ? x0 : edge == 1 ? y0 : edge == 2 ? x1 : y1;
+        const bool keep_above = edge < 2;
+        const auto inside = [&](const XY& p) { return keep_above ? p[axis] >= bound : p[axis] <= bound; };
+        std::vector<XY> in = std::move(out);
+        out.clear();
+        for (std::size_t i = 0; i < in.size(); ++i) {
+            const XY& p = in[i];
+            const XY& q = in[(i + 1) % in.size()];
+            if (inside(p)) out.push_back(p);
+            if (inside(p) != inside(q)) {
+                const double t = (bound - p[axis]) / (q[axis] - p[axis]);
+                XY cut = {p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])};
+                cut[std::size_t(axis)] = bound;
+                out.push_back(cut);
+            }
+        }
+    }
+    if (out.size() < 3) out.clear();
+    return out;
+}
+
+bool clip_segment(XY& a, XY& b, double x0, double y0, double x1, double y1) {
+    double t0 = 0.0, t1 = 1.0;
+    const double d[2] = {b[0] - a[0], b[1] - a[1]};
+    const double lo[2] = {x0, y0}, hi[2] = {x1, y1};
+    for (int axis = 0; axis < 2; ++axis) {
+        if (d[axis] == 0.0) {
+            if (a[std::size_t(axis)] < lo[axis] || a[std::size_t(axis)] > hi[axis]) return false;
+            continue;
+        }
+        double ta = (lo[axis] - a[std::size_t(axis)]) / d[axis], tb = (hi[axis] - a[std::size_t(axis)]) / d[axis];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 > t1) return false;
+    }
+    const XY start = a;
+    a = {start[0] + t0 * d[0], start[1] + t0 * d[1]};
+    b = {start[0] + t1 * d[0], start[1] + t1 * d[1]};
+    return true;
+}
+
+std::vector<XY> densify(const std::vector<XY>& points, double step, bool closed) {
+    std::vector<XY> out;
+    const std::size_t n = points.size();
+    const std::size_t edges = closed ? n : (n ? n - 1 : 0);
+    for (std::size_t i = 0; i < edges; ++i) {
+        const XY& p = points[i];
+        const XY& q = points[(i + 1) % n];
+        const double length = std::hypot(q[0] - p[0], q[1] - p[1]);
+        const int pieces = std::max(1, int(std::ceil(length / step - 1e-9)));
+        for (int k = 0; k < pieces; ++k) {
+            const double t = double(k) / pieces;
+            out.push_back({p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])});
+        }
+    }
+    if (!closed && n) out.push_back(points.back());
+    if (closed && n < 2) return points;
+    return out;
 }
 
 double auto_exaggeration(double relief, double side) {
@@ -178,7 +295,9 @@ std::string colours_python(const Colours& c) {
         : c.kind == Colours::diverging                ? "diverging"
                                                       : "sequential";
     s << "{\n        \"kind\": \"" << kind << "\",\n        \"title\": " << python_string(c.title)
-      << ",\n        \"range\": [" << number(c.low) << ", " << number(c.high) << "],\n        \"ramp\": [";
+      << ",\n        \"array\": " << python_string(c.array) << ",\n        \"range\": [" << number(c.low) << ", "
+      << number(c.high) << "],\n        \"data_range\": [" << number(c.data_low) << ", " << number(c.data_high)
+      << "],  # 2nd and 98th percentiles\n        \"log\": " << (c.log ? "True" : "False") << ",\n        \"ramp\": [";
     for (std::size_t i = 0; i < c.ramp.size(); ++i) s << (i ? ", " : "") << rgb_list(c.ramp[i]);
     s << "],\n        \"categories\": [";
     for (std::size_t i = 0; i < c.categories.size(); ++i)
@@ -229,7 +348,7 @@ def _options():
     parser.add_argument("--screenshot", metavar="PNG", help="save a picture of the view")
     parser.add_argument("--animation", metavar="PNG", help="save one picture per time step (NAME.0000.png ...)")
     parser.add_argument("--size", default="1600x900", help="picture size, WIDTHxHEIGHT (default 1600x900)")
-    parser.add_argument("--time", type=float, help="show this time step (default: the first)")
+    parser.add_argument("--time", type=float, help="show this time step (default: the last)")
     parser.add_argument("--save-state", metavar="PVSM", help="save the state as a .pvsm (absolute paths: on Load "
                         "State choose 'Search files under specified directory' after moving the folder)")
     # Known options only: inside the ParaView GUI (Load State, --script) sys.argv
@@ -259,11 +378,14 @@ def _apply_colours(lut, colours):
     lut.InterpretValuesAsCategories = 0
     low, high = colours["range"]
     ramp = colours["ramp"]
+    log = colours.get("log", False) and low > 0
     points = []
     for i, rgb in enumerate(ramp):
-        points += [low + (high - low) * i / (len(ramp) - 1)] + rgb
+        t = i / (len(ramp) - 1)
+        points += [low * (high / low) ** t if log else low + (high - low) * t] + rgb
     lut.RGBPoints = points
     lut.ColorSpace = "Diverging" if colours["kind"] == "diverging" else "Lab"
+    lut.UseLogScale = 1 if log else 0
     lut.NanColor = [0.5, 0.5, 0.5]
     lut.RescaleTransferFunction(low, high)
 
@@ -285,7 +407,50 @@ def _colour_by(display, view, association, array, colours, bar=True, separate=Fa
         scalar_bar.ComponentTitle = ""
         scalar_bar.WindowLocation = "Lower Right Corner"
         scalar_bar.ScalarBarLength = 0.4
+        scalar_bar.AddRangeLabels = 1
+        scalar_bar.RangeLabelFormat = "%-#.4g"
     return lut
+
+
+# Run by ParaView (a Programmable Filter) at every time step: the first
+# input's points (lines or polygons in the terrain's plane, Z = 0) raised to
+# the height of the terrain (the second input, an image with "height")
+# under them, interpolated bilinearly, times SCALE, plus LIFT. Plain Python:
+# no numpy needed (and ParaView's own min and max are numpy's here).
+_DRAPE_SCRIPT = """
+import builtins
+from vtkmodules.vtkCommonCore import vtkPoints
+lines = self.GetInputDataObject(0, 0)
+image = self.GetInputDataObject(0, 1)
+out = self.GetOutputDataObject(0)
+out.ShallowCopy(lines)
+heights = image.GetPointData().GetArray("height")
+nx, ny, _ = image.GetDimensions()
+ox, oy, _ = image.GetOrigin()
+sx, sy, _ = image.GetSpacing()
+clamp = lambda v, top: builtins.min(builtins.max(v, 0.0), top)
+raised = vtkPoints()
+raised.SetDataTypeToFloat()
+raised.SetNumberOfPoints(lines.GetNumberOfPoints())
+for k in range(lines.GetNumberOfPoints()):
+    x, y, _ = lines.GetPoint(k)
+    fi, fj = clamp((x - ox) / sx, nx - 1.0), clamp((y - oy) / sy, ny - 1.0)
+    i, j = builtins.min(int(fi), nx - 2), builtins.min(int(fj), ny - 2)
+    u, v = fi - i, fj - j
+    h = lambda a, b: heights.GetValue(a + b * nx)
+    z = (1 - v) * ((1 - u) * h(i, j) + u * h(i + 1, j)) + v * ((1 - u) * h(i, j + 1) + u * h(i + 1, j + 1))
+    raised.SetPoint(k, x, y, z * SCALE + LIFT)
+out.SetPoints(raised)
+"""
+
+
+def _drape(name, source, terrain, exaggeration, lift):
+    """`source` (lines or polygons in the terrain's plane) laid on the warped
+    terrain, `lift` above it so it is not hidden; at every time step."""
+    draped = ProgrammableFilter(registrationName=name + " (draped)", Input=[source, terrain])
+    draped.Script = "SCALE = %r\nLIFT = %r\n%s" % (float(exaggeration), float(lift), _DRAPE_SCRIPT)
+    draped.CopyArrays = 0
+    return draped
 
 
 def open_run():
@@ -309,28 +474,26 @@ def open_run():
     shaded.Splitting = 0  # smooth shading across ridges
     display = Show(shaded, view)
     display.Representation = "Surface"
-    _colour_by(display, view, "POINTS", RUN["layer"], RUN["colours"])
+    _colour_by(display, view, "POINTS", RUN["colours"]["array"], RUN["colours"])
 
     # Plates: their outlines (one colour per plate, so the terrain's colours
-    # stay readable) and the collisions since the previous snapshot, just
-    # above the highest peak.
-    lift = (high + 0.01 * max(RUN["size"])) * exaggeration
+    # stay readable) and the collisions since the previous snapshot, laid on
+    # the terrain (its final heights) a little above it.
+    lift = 0.002 * max(RUN["size"])
     if RUN["plates"]:
         plates = PVDReader(registrationName=RUN["plates"], FileName=_file(RUN["plates"]))
-        raised = Transform(registrationName="plates (raised)", Input=plates)
-        raised.Transform.Translate = [0.0, 0.0, lift]
-        shown = Show(raised, view)
+        shown = Show(_drape("plates", plates, terrain, exaggeration, lift), view)
         shown.Representation = "Wireframe"
-        shown.LineWidth = 2.0
+        shown.LineWidth = 3.0
         shown.Ambient = 1.0
         shown.Diffuse = 0.0
         _colour_by(shown, view, "CELLS", "plate", RUN["plate_colours"], bar=False, separate=True)
     if RUN["collisions"]:
         collisions = PVDReader(registrationName=RUN["collisions"], FileName=_file(RUN["collisions"]))
-        raised = Transform(registrationName="collisions (raised)", Input=collisions)
-        raised.Transform.Translate = [0.0, 0.0, lift * 1.001 + 1.0]
-        shown = Show(raised, view)
-        shown.LineWidth = 4.0
+        shown = Show(_drape("collisions", collisions, terrain, exaggeration, 1.5 * lift), view)
+        shown.LineWidth = 5.0
+        shown.Ambient = 1.0
+        shown.Diffuse = 0.0
         _colour_by(shown, view, "CELLS", "kind", RUN["collision_colours"], bar=False, separate=True)
 
     # Particles: positions in metres, stretched with the terrain.
@@ -350,9 +513,26 @@ def open_run():
             shown.AmbientColor = shown.DiffuseColor = [0.2, 0.45, 0.9]
 
     # Time: every series' steps, snapped to (Play in the toolbar runs them).
+    # It opens at the last step (the plates where they built the range, the
+    # water where it ran to), beside the terrain it left.
     scene = GetAnimationScene()
     scene.UpdateAnimationUsingDataTimeSteps()
     scene.PlayMode = "Snap To TimeSteps"
+    times = list(GetTimeKeeper().TimestepValues)
+    if times:
+        scene.AnimationTime = times[-1]
+        time_text = AnnotateTime(registrationName="time")
+        time_text.Format = "t = {time:g}"
+        shown = Show(time_text, view)
+        shown.WindowLocation = "Upper Right Corner"
+        shown.FontSize = 14
+
+    caption = Text(registrationName="caption")
+    caption.Text = RUN["caption"]
+    shown = Show(caption, view)
+    shown.WindowLocation = "Upper Left Corner"
+    shown.Justification = "Left"
+    shown.FontSize = 14
 
     # An oblique camera: from the azimuth (clockwise from north) and elevation
     # above the horizon, far enough to see the whole terrain.
@@ -393,6 +573,24 @@ main()
 
 }  // namespace
 
+static std::string caption(const StateScript& s) {
+    std::ostringstream o;
+    if (s.colours.shift != 0.0)
+        o << s.layer << " relative to the map's median: brown where the rivers cut deeper than the typical cell, "
+          << "blue-green where less";
+    else if (s.colours.kind == Colours::diverging) o << s.layer << ": brown lowered, blue-green raised";
+    else o << "coloured by " << s.layer;
+    char factor[32];
+    std::snprintf(factor, sizeof factor, "%g", s.exaggeration);
+    o << "; heights x" << factor;
+    if (!s.plates.empty())
+        o << "\nplates' outlines on the terrain (a colour each); collisions: red convergent, "
+          << "blue divergent, green transform";
+    if (!s.particles.empty())
+        o << "\nparticles coloured by " << (s.particle_colour.empty() ? "nothing" : s.particle_colours.title);
+    return o.str();
+}
+
 std::string state_script(const StateScript& s) {
     std::ostringstream o;
     o << "# " << s.script_name << ": a ParaView state written by orogen's export:paraview-state.\n"
@@ -405,7 +603,7 @@ std::string state_script(const StateScript& s) {
       << "#   Batch:     pvbatch " << s.script_name << " --screenshot view.png [--size 1600x900] [--time T]\n"
       << "#              pvbatch " << s.script_name << " --animation frames.png     (a picture per time step)\n"
       << "#              pvbatch " << s.script_name << " --save-state view.pvsm\n"
-      << "#   (Debian's pvbatch draws through X: on a machine without a display, prefix xvfb-run -a.)\n"
+      << "#   (in orogen's clone, tools/pvbatch is pvbatch fetched on first use and run without a display.)\n"
       << "# Frame: X east, Y north, Z up, metres; origin at the north-west corner sample.\n"
       << "\n"
       << "RUN = {\n"
@@ -415,6 +613,7 @@ std::string state_script(const StateScript& s) {
       << "    \"collisions\": " << optional_file(s.collisions) << ",\n"
       << "    \"particles\": " << optional_file(s.particles) << ",\n"
       << "    \"layer\": " << python_string(s.layer) << ",\n"
+      << "    \"caption\": " << python_string(caption(s)) << ",\n"
       << "    \"colours\": " << colours_python(s.colours) << ",\n"
       << "    \"plate_colours\": " << colours_python(s.plates_colours) << ",\n"
       << "    \"collision_colours\": " << colours_python(colours_for("boundary", std::vector<float>{1.0f, 2.0f, 3.0f}))

@@ -1,8 +1,10 @@
 // export:paraview-state in ParaView itself: Debian's pvbatch 5.11 (unpacked by
 // tools/paraview.sh into build/paraview, the ctest fixture paraview_fetch) runs
 // the shipped script under Xvfb after the run's folder has been moved, saves a
-// picture and reports what it built (inspect_state.py). Skips, saying why, only
-// when the packages could not be downloaded (build/paraview/unavailable).
+// picture and reports what it built (inspect_state.py); and the README's own
+// `tools/pvbatch` line, run as written without a display, on a scaled-down demo.
+// Skips, saying why, only when the packages could not be downloaded
+// (build/paraview/unavailable).
 #include "orogen_test.hpp"
 
 #include <gtest/gtest.h>
@@ -12,6 +14,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <map>
+#include <regex>
 #include <set>
 
 using namespace orogen::test;
@@ -44,6 +49,55 @@ std::size_t foreground_colours(const Picture& p) {
     return colours.size();
 }
 
+/// The share of the foreground pixels in the most common colour, colours told
+/// apart by chromaticity (r, g, b over their sum, in 16 × 16 bins), so the
+/// terrain's shading does not split one colour into many: a map drawn in one
+/// flat colour scores near 1 however it is lit.
+double dominant_colour_share(const Picture& p) {
+    const auto background = p.at(0, 0);
+    std::map<int, std::size_t> bins;
+    std::size_t n = 0;
+    for (int y = 0; y < p.height; ++y)
+        for (int x = 0; x < p.width; ++x) {
+            const auto c = p.at(x, y);
+            if (distance(c, background) <= 24) continue;
+            const double sum = std::max(1, c[0] + c[1] + c[2]);
+            ++bins[int(c[0] / sum * 15.999) * 16 + int(c[1] / sum * 15.999)];
+            ++n;
+        }
+    std::size_t most = 0;
+    for (const auto& [bin, count] : bins) most = std::max(most, count);
+    return n ? double(most) / double(n) : 1.0;
+}
+
+/// How the colour bar's range [bar_low, bar_high] and the data's 2–98 % range
+/// [p2, p98] overlap: the smaller of the overlap's shares of each (1: the same
+/// range; below 0.5: the bar misses more than half of the data, or spends more
+/// than half of its colours where there is none). On a log scale, in decades.
+double range_agreement(double bar_low, double bar_high, double p2, double p98, bool log) {
+    if (log) {
+        if (bar_low <= 0 || p2 <= 0) return 0.0;
+        bar_low = std::log10(bar_low), bar_high = std::log10(bar_high), p2 = std::log10(p2), p98 = std::log10(p98);
+    }
+    const double overlap = std::min(bar_high, p98) - std::max(bar_low, p2);
+    if (overlap <= 0) return 0.0;
+    return std::min(overlap / std::max(bar_high - bar_low, 1e-12), overlap / std::max(p98 - p2, 1e-12));
+}
+
+/// The picture and colour checks of issue 52: most of the terrain is not one colour, and the colour bar
+/// spans the coloured array's 2–98 % (computed by ParaView's numpy, not by orogen) within half.
+void expect_shows_something(const nlohmann::json& report, const Picture& picture) {
+    EXPECT_GT(foreground_fraction(picture), 0.2);
+    EXPECT_GT(foreground_colours(picture), 40u);
+    EXPECT_LT(dominant_colour_share(picture), 0.5) << "most of the terrain is one colour";
+    const auto points = report["rgb_points"].get<std::vector<double>>();
+    ASSERT_GE(points.size(), 8u);
+    const double bar_low = points.front(), bar_high = points[points.size() - 4];
+    const auto data = report["data_p2_p98"].get<std::vector<double>>();
+    EXPECT_GE(range_agreement(bar_low, bar_high, data[0], data[1], report["log_scale"] == 1), 0.5)
+        << "colour bar " << bar_low << " .. " << bar_high << ", data's 2-98 % " << data[0] << " .. " << data[1];
+}
+
 /// pvbatch from tools/paraview.sh, or a skip naming why the download was impossible.
 class Pvbatch : public ::testing::Test {
 protected:
@@ -61,7 +115,7 @@ protected:
     nlohmann::json inspect(const fs::path& state, const fs::path& out) {
         fs::create_directories(out);
         const std::string cmd = std::string(OROGEN_XVFB_RUN) + " " + q(pvbatch) + " " + q(OROGEN_INSPECT_STATE) + " " +
-                                q(state) + " " + q(out) + " >" + q(out / "pvbatch.log") + " 2>&1";
+            q(state) + " " + q(out) + " >" + q(out / "pvbatch.log") + " 2>&1";
         // tests/viewer/xvfb-run.sh lets Xvfb pick its own free display, so tests started in the
         // same instant (ctest -j2) cannot share one.
         const int status = std::system(cmd.c_str());
@@ -115,7 +169,8 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     EXPECT_GT(bounds[5] - bounds[4], 10.0);
     EXPECT_EQ(report["terrain_points"], 65 * 65);
 
-    // Coloured by the chosen layer with a diverging map symmetric about 0 and a scalar bar.
+    // Coloured by the chosen layer (erosion and deposition: both signs) with a diverging map
+    // symmetric about 0 and a scalar bar.
     EXPECT_EQ(report["colour_array"][0], "POINTS");
     EXPECT_EQ(report["colour_array"][1], "eroded");
     EXPECT_EQ(report["categorical"], 0);
@@ -127,13 +182,22 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     EXPECT_NE(report["scalar_bar_title"].get<std::string>().find("eroded"), std::string::npos);
 
     // Plates, collisions and particles loaded; time steps of both series; oblique camera.
-    for (const char* s : {"terrain", "plates (raised)", "collisions (raised)", "particles (stretched)"})
+    for (const char* s : {"terrain", "plates (draped)", "collisions (draped)", "particles (stretched)", "caption"})
         EXPECT_TRUE(std::count(report["sources"].begin(), report["sources"].end(), s)) << s;
     EXPECT_GE(report["times"].size(), 4u);  // plate snapshots 0, 20, 40, 60 and SPH frames
     EXPECT_EQ(report["play_mode"], "Snap To TimeSteps");
-    EXPECT_GT(report["shown_at_first"]["plates (raised)"], 0);
+    EXPECT_EQ(report["opened_at"], report["times"].back());  // it opens where the series end
+    EXPECT_GT(report["shown_at_first"]["plates (draped)"], 0);
     EXPECT_GT(report["shown_at_last"]["particles (stretched)"], 0);  // rain falls after the first frame
-    EXPECT_GT(report["shown_at_last"]["collisions (raised)"], 0);
+    EXPECT_GT(report["shown_at_last"]["collisions (draped)"], 0);
+    // The plates lie on the terrain: their heights span its relief (not a flat plane above it) and
+    // stay within a lift of 0.2 % of the side above its highest point, at the first step and the last.
+    for (const char* when : {"plates_z_at_first", "plates_z_at_last"}) {
+        const auto z = report[when].get<std::vector<double>>();
+        EXPECT_GT(z[1] - z[0], 0.5 * (bounds[5] - bounds[4])) << when;
+        EXPECT_GE(z[0], bounds[4] - 1e-3) << when;
+        EXPECT_LE(z[1], bounds[5] + 0.005 * 64 * 40) << when;
+    }
     const auto eye = report["camera_position"].get<std::vector<double>>();
     const auto focus = report["camera_focal_point"].get<std::vector<double>>();
     const double dx = eye[0] - focus[0], dy = eye[1] - focus[1], dz = eye[2] - focus[2];
@@ -152,6 +216,8 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     ASSERT_EQ(first.height, 400);
     EXPECT_GT(foreground_fraction(first), 0.2);
     EXPECT_GT(foreground_colours(first), 40u);
+    const Picture opened = read_picture(dir / "pictures" / "state.png");
+    EXPECT_GT(foreground_fraction(opened), 0.2);
     // And the last time step differs from the first (plates and particles moved).
     const Picture last = read_picture(dir / "pictures" / "last.png");
     EXPECT_GT(differing_pixels(first, last), 500u);
@@ -176,6 +242,61 @@ TEST_F(Pvbatch, ThePlateLayerIsColouredByCategory) {
     ASSERT_GE(annotations.size(), 4u);  // value, name pairs: at least two plates
     EXPECT_EQ(annotations[1].rfind("plate ", 0) == 0 || annotations[1] == "no plate", true) << annotations[1];
     EXPECT_TRUE(report["times"].empty());  // no series: nothing to play
-    const Picture first = read_picture(dir / "pictures" / "first.png");
-    EXPECT_GT(foreground_fraction(first), 0.2);
+    const Picture picture = read_picture(dir / "pictures" / "state.png");
+    ASSERT_EQ(picture.width, 640);
+    EXPECT_GT(foreground_fraction(picture), 0.2);
+}
+
+// Issue 52: the README's ParaView line, exactly as written, on the demo's
+// pipeline scaled down (257² of its 1025², the same processes and the same
+// export:paraview-state line), run without a display: tools/pvbatch chooses
+// Xvfb itself. The picture shows the erosion in more than one colour and the
+// colour bar spans the data's 2–98 %.
+TEST_F(Pvbatch, TheReadmeCommandDrawsTheDemoHeadless) {
+    const fs::path source = OROGEN_SOURCE_DIR;
+    const std::string readme = slurp(source / "README.md");
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(readme, m, std::regex("`(tools/pvbatch ([^` ]+) [^`]*--screenshot ([^` ]+)[^`]*)`")))
+        << "README.md has no `tools/pvbatch STATE --screenshot PNG` line";
+    const std::string line = m[1], state = m[2], png = m[3];
+
+    // The demo, scaled down: its grid line made 257², its lines before the renderings but its
+    // exports, and its export:paraview-state line.
+    std::ifstream demo(source / "pipelines" / "default.orogen");
+    std::string spec, text, paraview_line;
+    bool rendering = false;
+    while (std::getline(demo, text)) {
+        rendering = rendering || text.find("render:") != std::string::npos;
+        if (text.rfind("export:paraview-state(", 0) == 0) paraview_line = text;
+        if (rendering || text.rfind("export:", 0) == 0) continue;
+        if (text.rfind("grid ", 0) == 0) text = "grid 257 cell=30";
+        spec += text + "\n";
+    }
+    ASSERT_FALSE(paraview_line.empty()) << "pipelines/default.orogen has no export:paraview-state line";
+    spec += paraview_line + "\n";
+    TempDir dir;
+    const auto spec_file = dir.write("demo.orogen", spec);
+    const RunResult r = run_orogen("run " + q(spec_file) + " --quiet --no-cache --out " + q(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err << "\n" << spec;
+    ASSERT_TRUE(fs::exists(dir / state)) << state << " is not where the README's line looks for it";
+
+    // The README's line from a folder like the clone's top: tools/ and out/ side by side; no display.
+    fs::create_directory_symlink(source / "tools", dir / "tools");
+    const std::string cmd = "cd " + q(dir.path()) + " && env -u DISPLAY OROGEN_PARAVIEW_DIR=" + q(OROGEN_PARAVIEW_DIR) +
+        " " + line + " >" + q(dir / "pvbatch.log") + " 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << line << "\n" << slurp(dir / "pvbatch.log");
+    const Picture picture = read_picture(dir / png);
+    EXPECT_EQ(picture.width, 1600);  // the script's default size
+    EXPECT_EQ(picture.height, 900);
+    EXPECT_GT(foreground_fraction(picture), 0.2);
+    EXPECT_GT(foreground_colours(picture), 40u);
+    EXPECT_LT(dominant_colour_share(picture), 0.5) << "most of the terrain is one colour";
+
+    // The same state inspected: colour bar against the data, plates on the terrain.
+    const nlohmann::json report = inspect(dir / state, dir / "pictures");
+    ASSERT_FALSE(report.is_null());
+    expect_shows_something(report, read_picture(dir / "pictures" / "state.png"));
+    const auto bounds = report["terrain_bounds"].get<std::vector<double>>();
+    const auto z = report["plates_z_at_last"].get<std::vector<double>>();
+    EXPECT_GT(z[1] - z[0], 0.5 * (bounds[5] - bounds[4]));
 }
