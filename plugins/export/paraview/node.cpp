@@ -175,6 +175,13 @@ NodeOutputs run(NodeContext& ctx) {
             }
             s.particle_colours = paraview::attribute_colours(s.particle_colour, values, components);
         }
+        std::vector<float> sediment;
+        for (const auto& f : particles.frames) {
+            const auto a = f.attributes.find("sediment");
+            if (a != f.attributes.end() && a->second.components == 1)
+                sediment.insert(sediment.end(), a->second.data.begin(), a->second.data.end());
+        }
+        if (!sediment.empty()) s.sediment_threshold = std::max(0.0, paraview::percentile(sediment, 0.9));
     }
 
     AtomicFile file(script);

@@ -206,7 +206,9 @@ Colours attribute_colours(const std::string& name, std::span<const float> values
     c.kind = Colours::sequential;
     c.array = name;
     c.title = name == "velocity" ? "speed (m/s)" : titled(name, unit_of(name));
-    c.ramp = {rgb(198, 219, 239), rgb(66, 146, 198), rgb(8, 48, 107)};  // light = slow, dark = fast
+    if (name == "velocity")  // water: deep blue where it pools, paler (foam) where it runs fast
+        c.ramp = {rgb(8, 48, 107), rgb(33, 113, 181), rgb(107, 174, 214), rgb(222, 235, 247)};
+    else c.ramp = {rgb(198, 219, 239), rgb(66, 146, 198), rgb(8, 48, 107)};  // light = low, dark = high
     if (magnitudes.empty()) return c;
     c.low = c.data_low = percentile(magnitudes, 0.02);
     c.data_high = percentile(magnitudes, 0.98);
@@ -501,16 +503,41 @@ def open_run():
         particles = PVDReader(registrationName=RUN["particles"], FileName=_file(RUN["particles"]))
         stretched = Transform(registrationName="particles (stretched)", Input=particles)
         stretched.Transform.Scale = [1.0, 1.0, exaggeration]
+        # Water: flat, slightly translucent splats (not shaded spheres, which
+        # read as dark beads), deep blue where it pools, paler as it runs fast.
         shown = Show(stretched, view)
         shown.SetRepresentationType("Point Gaussian")
-        shown.GaussianRadius = 0.0035 * max(RUN["size"])
+        shown.GaussianRadius = 0.002 * max(RUN["size"])  # the ground shows between them
+        shown.ShaderPreset = "Plain circle"
+        shown.Opacity = 0.85
+        shown.Ambient = 1.0
+        shown.Diffuse = 0.0
         if RUN["particle_colour"]:  # one range over every frame, so colours compare across time
-            lut = _colour_by(shown, view, "POINTS", RUN["particle_colour"], RUN["particle_colours"], bar=False,
-                             separate=True)
+            lut = _colour_by(shown, view, "POINTS", RUN["particle_colour"], RUN["particle_colours"],
+                             bar=RUN["particle_colour"] == "velocity", separate=True)
             lut.VectorMode = "Magnitude"
+            if RUN["particle_colour"] == "velocity":
+                GetScalarBar(lut, view).WindowLocation = "Lower Left Corner"
+                view.OrientationAxesVisibility = 0  # it would sit on the bar
         else:
-            ColorBy(shown, None)
+            shown.ColorArrayName = ["POINTS", ""]
             shown.AmbientColor = shown.DiffuseColor = [0.2, 0.45, 0.9]
+        # The water that carries the most sediment (its top tenth over the whole
+        # run) in a colour of its own, orange, drawn over the rest.
+        if RUN["sediment_threshold"] is not None:
+            laden = Threshold(registrationName="sediment-laden particles", Input=stretched)
+            laden.Scalars = ["POINTS", "sediment"]
+            laden.LowerThreshold = RUN["sediment_threshold"]
+            laden.UpperThreshold = 1e30
+            laden.ThresholdMethod = "Between"
+            muddy = Show(laden, view)
+            muddy.SetRepresentationType("Point Gaussian")
+            muddy.GaussianRadius = 0.003 * max(RUN["size"])
+            muddy.ShaderPreset = "Plain circle"
+            muddy.Ambient = 1.0
+            muddy.Diffuse = 0.0
+            muddy.ColorArrayName = ["POINTS", ""]
+            muddy.AmbientColor = muddy.DiffuseColor = [0.902, 0.333, 0.051]  # orange: no terrain colour
 
     # Time: every series' steps, snapped to (Play in the toolbar runs them).
     # It opens at the last step (the plates where they built the range, the
@@ -547,7 +574,6 @@ def open_run():
     view.CameraPosition = [c + distance * d for c, d in zip(centre, direction)]
     view.CameraViewUp = [0.0, 0.0, 1.0]
     view.CenterOfRotation = centre
-    view.OrientationAxesVisibility = 1
     SetActiveSource(shaded)
     Render(view)
     return view
@@ -586,8 +612,11 @@ static std::string caption(const StateScript& s) {
     if (!s.plates.empty())
         o << "\nplates' outlines on the terrain (a colour each); collisions: red convergent, "
           << "blue divergent, green transform";
-    if (!s.particles.empty())
-        o << "\nparticles coloured by " << (s.particle_colour.empty() ? "nothing" : s.particle_colours.title);
+    if (!s.particles.empty()) {
+        if (s.particle_colour == "velocity") o << "\nwater particles: deep blue where slow, pale where fast";
+        else o << "\nparticles coloured by " << (s.particle_colour.empty() ? "nothing" : s.particle_colours.title);
+        if (s.sediment_threshold > 0) o << "; orange: the most laden with sediment (top 10 %)";
+    }
     return o.str();
 }
 
@@ -620,6 +649,9 @@ std::string state_script(const StateScript& s) {
       << ",\n"
       << "    \"particle_colour\": " << optional_file(s.particle_colour) << ",\n"
       << "    \"particle_colours\": " << colours_python(s.particle_colours) << ",\n"
+      << "    \"sediment_threshold\": "
+      << (s.sediment_threshold > 0 ? number(s.sediment_threshold) : std::string("None"))
+      << ",  # particles carrying at least this much sediment are drawn apart\n"
       << "    \"exaggeration\": " << number(s.exaggeration) << ",  # vertical, applied by Warp By Scalar\n"
       << "    \"heights\": [" << number(s.height_min) << ", " << number(s.height_max) << "],  # m\n"
       << "    \"size\": [" << number(s.size_x) << ", " << number(s.size_y) << "],  # m, east and north\n"

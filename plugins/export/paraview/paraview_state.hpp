@@ -92,6 +92,9 @@ struct StateScript {
     Colours plates_colours;  ///< of the plate polygons (categorical by id)
     std::string particle_colour;  ///< particle attribute that colours them (empty: solid)
     Colours particle_colours;  ///< of `particle_colour`, by magnitude
+    /// Particles whose "sediment" is at least this are drawn apart, in their own colour (the
+    /// 90th percentile over every frame); 0: none (no sediment attribute, or none carried).
+    double sediment_threshold = 0.0;
     double exaggeration = 1.0;
     double height_min = 0.0, height_max = 0.0;  ///< m
     double size_x = 0.0, size_y = 0.0;  ///< extent east and north, m

@@ -46,7 +46,8 @@ report["sources"] = sorted(name for (name, _id) in GetSources().keys())
 report["camera_position"] = list(view.CameraPosition)
 report["camera_focal_point"] = list(view.CameraFocalPoint)
 report["camera_view_up"] = list(view.CameraViewUp)
-shown = [n for n in ("plates (draped)", "collisions (draped)", "particles (stretched)") if FindSource(n)]
+shown = [n for n in ("plates (draped)", "collisions (draped)", "particles (stretched)", "sediment-laden particles")
+         if FindSource(n)]
 
 
 def points(name):

@@ -189,6 +189,9 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     EXPECT_EQ(report["opened_at"], report["times"].back());  // it opens where the series end
     EXPECT_GT(report["shown_at_first"]["plates (draped)"], 0);
     EXPECT_GT(report["shown_at_last"]["particles (stretched)"], 0);  // rain falls after the first frame
+    // The water carrying the most sediment (its top tenth over the run) drawn apart: some, not all.
+    EXPECT_GT(report["shown_at_last"]["sediment-laden particles"], 0);
+    EXPECT_LT(report["shown_at_last"]["sediment-laden particles"], report["shown_at_last"]["particles (stretched)"]);
     EXPECT_GT(report["shown_at_last"]["collisions (draped)"], 0);
     // The plates lie on the terrain: their heights span its relief (not a flat plane above it) and
     // stay within a lift of 0.2 % of the side above its highest point, at the first step and the last.
