@@ -224,6 +224,15 @@ TEST_F(Pvbatch, TheShippedStateOpensTheMovedRunWarpedColouredAndPlaying) {
     // And the last time step differs from the first (plates and particles moved).
     const Picture last = read_picture(dir / "pictures" / "last.png");
     EXPECT_GT(differing_pixels(first, last), 500u);
+
+    // A file of the run missing: the state stops, naming it and where it looked, and draws nothing.
+    fs::remove(dir / "moved" / "run-plates.pvd");
+    const std::string cmd = std::string(OROGEN_XVFB_RUN) + " " + q(pvbatch) + " " + q(dir / "moved" / "run.py") +
+        " --screenshot " + q(dir / "missing.png") + " >" + q(dir / "missing.log") + " 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0);
+    const std::string log = slurp(dir / "missing.log");
+    EXPECT_NE(log.find("cannot find run-plates.pvd in " + (dir / "moved").string()), std::string::npos) << log;
+    EXPECT_FALSE(fs::exists(dir / "missing.png"));
 }
 
 // Categorical colours for the plate layer: the annotations are the ids present.
