@@ -1,7 +1,7 @@
 // orogen._orogen — the kernel driven from Python (pybind11): the same loader, checker and runner as the
 // `orogen` command (kernel/cli/main.cpp), values handed back as numpy arrays. See docs/python.md.
 //
-//   run(spec, seed=None, set={}, threads=None, out=None, progress=False) -> {name: value}
+//   run(spec, seed=None, set={}, threads=None, out=None, progress=False, values=None, outputs=True) -> {name: value}
 //   nodes() -> [{"name", "kind", "summary"}];  help(name) -> {...}
 //   _run_node(spec, inputs, threads) -> {name: value}: orogen.node() (orogen/__init__.py) runs the spec it
 //   writes with its inputs bound by name (orogen/session.hpp BoundValues): no file, one copy of an array at most.
@@ -292,8 +292,16 @@ RunResult run_released(const Checked& checked, const RunSettings& settings, Boun
 }
 
 /// run() and node(): `bound` are values the spec reads by name without making them (node()'s inputs).
+/// What a run() caller wants back: `values` (only they, and only what they need, run), or every named value;
+/// with `outputs` false, the exporters no value needs do not run.
+struct Wanted {
+    std::optional<std::vector<std::string>> values;
+    bool outputs = true;
+};
+
 py::dict run_spec_bound(const py::object& spec_arg, std::optional<std::uint64_t> seed, const py::dict& overrides,
-                        std::optional<int> threads, const py::object& out_arg, bool progress, BoundValues bound) {
+                        std::optional<int> threads, const py::object& out_arg, bool progress, BoundValues bound,
+                        const Wanted& wanted = {}) {
     const std::string spec = path_text(spec_arg, "spec");
     std::optional<std::string> out;
     if (!out_arg.is_none()) out = path_text(out_arg, "out");
@@ -316,11 +324,16 @@ py::dict run_spec_bound(const py::object& spec_arg, std::optional<std::uint64_t>
         PyErr_WarnEx(PyExc_UserWarning, checked.report().text().c_str(), 1) != 0)
         throw py::error_already_set();  // warnings turned into errors
 
-    // Every named value (and side value) is wanted back: held past the last node.
-    checked.keep_named_values();
+    // The values wanted back are held past the last node; with `values` or outputs=False, only what they need runs.
+    try {
+        if (wanted.values) checked.keep_only(*wanted.values);
+        else if (!wanted.outputs) checked.keep_only(checked.value_keys());
+        else checked.keep_named_values();
+    } catch (const Error& e) { throw py::value_error(std::string("orogen: error: ") + e.what()); }
 
     RunSettings settings;
-    if (out) {
+    const bool pruned = wanted.values || !wanted.outputs;
+    if (out && (!pruned || checked.writes_files())) {  // what was pruned to write nothing writes no manifest
         settings.out_dir = *out;
     } else if (checked.writes_files()) {  // else out_dir stays empty: no folder, no manifest, nothing written
         scratch.make();
@@ -345,8 +358,10 @@ py::dict run_spec_bound(const py::object& spec_arg, std::optional<std::uint64_t>
 }
 
 py::dict run_spec(const py::object& spec_arg, std::optional<std::uint64_t> seed, const py::dict& overrides,
-                  std::optional<int> threads, const py::object& out_arg, bool progress) {
-    return run_spec_bound(spec_arg, seed, overrides, threads, out_arg, progress, {});
+                  std::optional<int> threads, const py::object& out_arg, bool progress,
+                  std::optional<std::vector<std::string>> values, bool outputs) {
+    return run_spec_bound(spec_arg, seed, overrides, threads, out_arg, progress, {},
+                          Wanted{std::move(values), outputs});
 }
 
 /// A 2-D float32 numpy array of any layout (C or Fortran order, a slice with strides) copied once into a
@@ -650,7 +665,10 @@ PYBIND11_MODULE(_orogen, m) {
         .def("result", &PyModel::result);
     m.def("run", &run_spec, py::arg("spec"), py::kw_only(), py::arg("seed") = py::none(), py::arg("set") = py::dict(),
           py::arg("threads") = py::none(), py::arg("out") = py::none(), py::arg("progress") = false,
-          "Run a spec (a path, or the text itself) and return every named value: {name: value}.");
+          py::arg("values") = py::none(), py::arg("outputs") = true,
+          "Run a spec (a path, or the text itself) and return every named value: {name: value}. values=[names]: "
+          "return only these, running only what they need; outputs=False: every named value, without the "
+          "exporters (no file written, no video encoded).");
     m.def("nodes", &nodes, "The nodes the loaded plugins provide: [{'name', 'kind', 'summary'}].");
     m.def("help", &help, py::arg("name"), "A node's description, inputs and parameters (type, default, range, unit).");
     m.def("_run_node", &run_node, py::arg("spec"), py::arg("inputs"), py::arg("threads") = py::none(),

@@ -121,6 +121,29 @@ def test_without_out_nothing_is_written(tmp_path, monkeypatch):
     assert not [n for n in set(os.listdir(tempfile.gettempdir())) - before if n.startswith("orogen-python-")]
 
 
+def test_outputs_false_and_values_run_only_what_is_asked_for(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    whole = orogen.run(SPEC, out=str(tmp_path / "all"))
+    # outputs=False: every named value, the same bits, and not one file even with out= given.
+    quiet = orogen.run(SPEC, out=str(tmp_path / "none"), outputs=False)
+    assert sorted(quiet) == sorted(whole)
+    for name in whole:
+        if hasattr(whole[name], "height"):
+            assert np.array_equal(bits(quiet[name].height), bits(whole[name].height)), name
+    assert not (tmp_path / "none").exists()
+    # values=[...]: only those, and only the nodes they need run. A later node that would fail when it runs
+    # (an export into a path that is a folder) is not reached.
+    broken = SPEC + 'export:raw(t, path="dir.r32")\n'
+    (tmp_path / "b" / "dir.r32").mkdir(parents=True)
+    with pytest.raises(RuntimeError):
+        orogen.run(broken, out=str(tmp_path / "b"))
+    only = orogen.run(broken, out=str(tmp_path / "b"), values=["w"])
+    assert list(only) == ["w"]
+    assert np.array_equal(bits(only["w"].height), bits(whole["w"].height))
+    with pytest.raises(ValueError, match=r"makes no value 'nope' \(it makes b, w, w.timelapse, t, t.timelapse\)"):
+        orogen.run(SPEC, values=["nope"])
+
+
 def test_bad_input_is_a_value_error_with_the_clis_message(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     bad = {

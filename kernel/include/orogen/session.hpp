@@ -152,6 +152,13 @@ public:
     void keep(const std::string& key);
     /// keep() every named value and its side values: what a caller that wants the results back asks for.
     void keep_named_values();
+    /// Run only what `keys` need: every node that none of them reads, directly or through others, is dropped
+    /// (an exporter with it, so no file is written that was not asked for), and the keys are kept. The
+    /// nodes that stay get the same seeds and give the same bits. Throws orogen::BadInput naming a key the
+    /// spec does not make, with the ones it does.
+    void keep_only(const std::vector<std::string>& keys);
+    /// The keys of the values this spec makes ("base", "sim.particles"), in spec order; no exporter's.
+    std::vector<std::string> value_keys() const;
 
 private:
     friend class Session;

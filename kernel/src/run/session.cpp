@@ -119,6 +119,57 @@ void Checked::keep_named_values() {
     }
 }
 
+std::vector<std::string> Checked::value_keys() const {
+    std::vector<std::string> keys;
+    for (const PlannedNode& n : impl_->plan.nodes) {
+        if (n.value_name.empty() || n.in_place) continue;
+        if (n.node->output != ValueType::none || n.node->output_series) keys.push_back(n.value_name);
+        for (const auto& side : n.node->side_outputs) keys.push_back(n.value_name + "." + side.name);
+    }
+    return keys;
+}
+
+void Checked::keep_only(const std::vector<std::string>& keys) {
+    Plan& plan = impl_->plan;
+    // Which node makes each key: its value name (or, in place, its label) and its side values.
+    std::map<std::string, std::size_t, std::less<>> maker;
+    for (std::size_t i = 0; i < plan.nodes.size(); ++i) {
+        const PlannedNode& n = plan.nodes[i];
+        if (n.value_name.empty()) continue;
+        maker[n.value_name] = i;
+        for (const auto& side : n.node->side_outputs) maker[n.value_name + "." + side.name] = i;
+    }
+    std::vector<bool> needed(plan.nodes.size(), false);
+    std::vector<std::size_t> stack;
+    for (const auto& key : keys) {
+        auto it = maker.find(key);
+        if (it == maker.end()) {
+            std::string known;
+            for (const auto& k : value_keys()) known += (known.empty() ? "" : ", ") + k;
+            throw BadInput("the spec makes no value '" + key + "'" +
+                           (known.empty() ? std::string(" (it makes none)") : " (it makes " + known + ")"));
+        }
+        stack.push_back(it->second);
+    }
+    while (!stack.empty()) {
+        const std::size_t i = stack.back();
+        stack.pop_back();
+        if (needed[i]) continue;
+        needed[i] = true;
+        for (const auto& in : plan.nodes[i].inputs)
+            if (auto it = maker.find(in); !in.empty() && it != maker.end()) stack.push_back(it->second);
+    }
+    std::vector<PlannedNode> kept;
+    for (std::size_t i = 0; i < plan.nodes.size(); ++i)
+        if (needed[i]) kept.push_back(std::move(plan.nodes[i]));
+    plan.nodes = std::move(kept);
+    plan.last_use.clear();  // as the checker makes it, over the nodes that stay
+    for (std::size_t i = 0; i < plan.nodes.size(); ++i)
+        for (const auto& in : plan.nodes[i].inputs)
+            if (!in.empty()) plan.last_use[in] = i;
+    for (const auto& key : keys) keep(key);
+}
+
 // ---------------------------------------------------------------- session
 
 namespace {
