@@ -108,3 +108,16 @@ TEST(Docs, ABlockWithSyntaxTheParserRejectsFailsCheck) {
     EXPECT_TRUE(has_statement("# a comment\nglow = render:bloom(beauty)\n"));
     EXPECT_FALSE(has_statement("  cut  = generate:fault(bsae, iterations=200)\n"));  // an error message's source line
 }
+
+// The README's first spec of one's own is pipelines/starter.orogen as shipped (which the pipelines' tests
+// check and run), so the two cannot drift apart.
+TEST(Docs, TheReadmesStarterSpecIsTheShippedOne) {
+    const std::string shipped = slurp(fs::path(OROGEN_SOURCE_DIR) / "pipelines" / "starter.orogen");
+    int found = 0;
+    for (const Block& b : fenced_blocks("README.md"))
+        if (b.info == "orogen" && b.text.find("A first range of one's own") != std::string::npos) {
+            EXPECT_EQ(b.text, shipped) << "README.md:" << b.line << " differs from pipelines/starter.orogen";
+            ++found;
+        }
+    EXPECT_EQ(found, 1) << "README.md shows no (or more than one) starter spec";
+}

@@ -48,6 +48,7 @@ const Case cases[] = {
                         "--set olsen_hemisphere.iterations=30 --set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 "
                         "--set pipe_hemisphere.steps=60"},
     {"sph-rain", "--set rain.steps=30"},
+    {"starter", "", "--set range.dt=5e5"},
 };
 
 /// relative path → sha256 of every file under `dir` but the manifest (which names plugin versions).

@@ -122,6 +122,11 @@ bool CheckContext::require_layer(std::size_t i, std::string_view param, std::str
     if (!in || !in->layers_known || in->layers.count(name)) return true;
     std::string message = "no layer '" + std::string(name) + "' on the input (" + describe_layers(*in) + ")";
     if (!hint.empty()) message += "; " + std::string(hint);
+    // No layers at all: perhaps a node of one's own adds the layer without declaring it.
+    if (in->layers.empty())
+        message +=
+            " (a node that adds a layer declares it in its descriptor's adds_layers, so the checker "
+            "knows it is there: docs/plugins.md)";
     error(param, std::move(message));
     return false;
 }

@@ -218,3 +218,69 @@ TEST(PngExportCli, ReliefIsTheSplatColourShadedByTheLight) {
               std::string::npos)
         << b.err;
 }
+
+// Issue 53, "outputs that are hard to read": colours=rivers draws the drainage layer's rivers in blue over the
+// pale shaded terrain, wider where they drain more; colours=auto puts a layer with both signs on a diverging
+// map around zero (erosion blue, deposition red) and any other on a sequential one.
+TEST(PngExportCli, RiversAndADivergingLayerReadAtAGlance) {
+    TempDir dir;
+    const auto spec = dir.write("colours.orogen",
+                                "orogen 1\nseed 3\ngrid 129 cell=30\n"
+                                "base = generate:fault(iterations=80, displacement=6)\n"
+                                "river = erode:stream-power(base, years=2e5, dt=5e4)\n"
+                                "worn = erode:thermal(base, iterations=40, talus=20)\n"
+                                "export:png(river, path=\"rivers.png\", colours=\"rivers\")\n"
+                                "export:png(worn, path=\"eroded.png\", layer=\"eroded\", colours=\"auto\")\n"
+                                "export:png(river, path=\"area.png\", layer=\"drainage\", bits=16)\n"
+                                "export:png(worn, path=\"eroded16.png\", layer=\"eroded\", bits=16)\n");
+    const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "out") + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    // The layers' values, in order (16-bit grey: the lowest black, the highest white).
+    const GrayImage area = read_gray_png(dir / "out" / "area.png"), e = read_gray_png(dir / "out" / "eroded16.png");
+    auto load = [&](const char* name) {
+        int w = 0, h = 0, c = 0;
+        stbi_uc* px = stbi_load((dir / "out" / name).c_str(), &w, &h, &c, 4);
+        EXPECT_EQ(w, 129);
+        std::vector<stbi_uc> v(px, px + std::size_t(w) * std::size_t(h) * 4);
+        stbi_image_free(px);
+        return v;
+    };
+    const auto rivers = load("rivers.png"), eroded = load("eroded.png");
+    // The largest river is blue (blue well above red); a cell draining only itself, far from any river, is
+    // grey (its channels within a few units).
+    const std::size_t n = area.samples.size();
+    ASSERT_EQ(n, std::size_t(129 * 129));
+    const std::size_t trunk = std::size_t(
+        std::max_element(area.samples.begin(), area.samples.end()) - area.samples.begin());
+    EXPECT_GT(int(rivers[4 * trunk + 2]), int(rivers[4 * trunk]) + 60);
+    std::size_t greys = 0, blues = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const int red = rivers[4 * i], blue = rivers[4 * i + 2];
+        greys += std::abs(blue - red) < 25;
+        blues += blue > red + 40;
+    }
+    EXPECT_GT(greys, n / 2);  // most of the map is ground, not paint
+    EXPECT_GT(blues, n / 100);  // and the river network shows
+    // Diverging: where thermal took the most material the pixel is blue, where it laid the most down red, and
+    // the ground it left alone (eroded 0, most of the map) white-grey: the map is centred on zero.
+    const std::size_t cut = std::size_t(std::min_element(e.samples.begin(), e.samples.end()) - e.samples.begin());
+    const std::size_t laid = std::size_t(std::max_element(e.samples.begin(), e.samples.end()) - e.samples.begin());
+    EXPECT_GT(int(eroded[4 * cut + 2]), int(eroded[4 * cut]) + 40);
+    EXPECT_GT(int(eroded[4 * laid]), int(eroded[4 * laid + 2]) + 40);
+    std::size_t neutral = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const int red = eroded[4 * i], green = eroded[4 * i + 1], blue = eroded[4 * i + 2];
+        neutral += std::abs(red - blue) < 20 && std::abs(red - green) < 20 && red > 130;
+    }
+    EXPECT_GT(neutral, n / 5);
+    // Mistakes at check time: rivers without a drainage layer, and bits= with a colour map.
+    const auto bad = dir.write("bad.orogen",
+                               "orogen 1\ngrid 9\nt = generate:fault()\n"
+                               "export:png(t, path=\"r.png\", colours=\"rivers\")\n"
+                               "export:png(t, path=\"a.png\", colours=\"auto\", bits=16)\n");
+    const RunResult b = run_orogen("check " + q(bad));
+    EXPECT_EQ(b.exit_code, 2);
+    EXPECT_NE(b.err.find("bad.orogen:4:37: error: export:png: no layer 'drainage' on the input"), std::string::npos)
+        << b.err;
+    EXPECT_NE(b.err.find("colours=auto writes an 8-bit colour PNG; drop bits="), std::string::npos) << b.err;
+}
