@@ -382,6 +382,14 @@ private:
     Clock::time_point last_interaction_ = Clock::now();
     bool refine_pending_ = false;
 
+    /// Whether the command line names a run's outputs as a whole (a spec, or an output folder).
+    bool opened_outputs() const {
+        if (o_.spec) return true;
+        std::error_code ec;
+        return std::any_of(o_.files.begin(), o_.files.end(),
+                           [&](const fs::path& f) { return fs::is_directory(f, ec); });
+    }
+
     Content outputs() {
         const auto files = pick_outputs(out_);
         if (files.empty())
@@ -391,7 +399,11 @@ private:
     }
 
     void show(Content c, bool keep_camera) {
+        const bool first = !loaded_;
         scene_->show(std::move(c), keep_camera);
+        // A run's whole output (a folder, a spec) opens on its terrain, the plates a key away ('m'); plates
+        // named on the command line are what was asked to see.
+        if (first && opened_outputs() && scene_->has_terrain()) scene_->set_plates(false);
         loaded_ = true;
     }
 

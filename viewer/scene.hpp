@@ -47,6 +47,9 @@ public:
     void toggle_water();
     void toggle_particles();
     void toggle_plates();
+    void set_plates(bool on);
+    /// A terrain (a .vti or .vtp heightfield) is shown.
+    bool has_terrain() const;
     void toggle_edges();
     void toggle_help();
     void cycle_particle_attribute();
