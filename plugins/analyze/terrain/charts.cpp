@@ -47,8 +47,10 @@ std::string style(std::size_t i, const Terrain& t) {
 }
 
 std::string header(const std::string& title, const std::string& xlabel, const std::string& ylabel) {
+    // The legend under the plot, in rows: beside it, long file names took 40 % of the chart's width.
     return "reset\nset termoption noenhanced\nset title " + gp_string(title) + "\nset xlabel " + gp_string(xlabel) +
-        "\nset ylabel " + gp_string(ylabel) + "\nset grid\nset key outside right top\nunset logscale\n";
+        "\nset ylabel " + gp_string(ylabel) +
+        "\nset grid\nset key below center horizontal samplen 2 font ',9'\nunset logscale\n";
 }
 
 struct Series {

@@ -1,5 +1,6 @@
-// frame_params.hpp — parameters every frame-making render node shares (size,
-// camera), declared once; header-only so each render plugin includes it.
+// frame_params.hpp — render:terrain's frame parameters (size,
+// camera) and the camera's placement; beside its one user (a second render node that makes frames would
+// move it to libs/).
 #pragma once
 
 #include <orogen/node.hpp>

@@ -1,6 +1,6 @@
 // render:terrain — the scene pass: a heightmap drawn with splatting, shadows,
 // sky, water and haze, as a linear float image.
-#include "../frame_params.hpp"
+#include "frame_params.hpp"
 #include "render_terrain.hpp"
 
 #include <orogen/error.hpp>
