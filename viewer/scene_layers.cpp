@@ -85,7 +85,9 @@ const Scene::Impl::Colouring& Scene::Impl::colouring(std::size_t index) {
 
 vtkSmartPointer<vtkImageData> Scene::Impl::colour_texture(std::size_t index) {
     const Terrain& t = *ground();
-    const auto [tw, th] = texture_size();
+    // Plain ints, not a structured binding: the lambdas below capture them (clang 14 cannot capture a binding).
+    const std::pair<int, int> size = texture_size();
+    const int tw = size.first, th = size.second;
     update_shade(tw, th);
     auto image = vtkSmartPointer<vtkImageData>::New();
     image->SetDimensions(tw, th, 1);

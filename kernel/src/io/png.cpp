@@ -16,6 +16,7 @@
 
 #include <csetjmp>
 #include <cstring>
+#include <span>
 #include <ostream>
 
 namespace orogen {
@@ -46,11 +47,25 @@ void read_from_memory(png_structp png, png_bytep out, png_size_t n) {
     r->offset += n;
 }
 
-/// Plain-data decoder. Returns 0 on success, else fills err. colour_type/bit_depth always set if the header was read.
-int decode(const std::uint8_t* bytes, std::size_t size, bool header_only, ErrorSlot& err, png_uint_32& w,
-           png_uint_32& h, int& bit_depth, int& colour_type, std::uint16_t* out, std::size_t out_capacity,
-           bool& wrong_format) {
-    MemoryReader reader{bytes, size, 0};
+/// What the header says.
+struct Header {
+    png_uint_32 w = 0, h = 0;
+    int bit_depth = 0, colour_type = 0;
+    bool wrong_format = false;  ///< not grayscale
+};
+
+/// Plain-data decoder: the header into `hd`, then (unless `out` is empty, the format is wrong or the image
+/// does not fit `out`) the samples. Returns 0 on success, else fills err. The header's fields are always
+/// set if it was read.
+int decode(std::span<const std::uint8_t> bytes, ErrorSlot& err, Header& hd, std::span<std::uint16_t> out) {
+    MemoryReader reader{bytes.data(), bytes.size(), 0};
+    png_uint_32& w = hd.w;
+    png_uint_32& h = hd.h;
+    int& bit_depth = hd.bit_depth;
+    int& colour_type = hd.colour_type;
+    bool& wrong_format = hd.wrong_format;
+    const bool header_only = out.empty();
+    std::uint16_t* const samples = out.data();
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &err, on_error, on_warning);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
     if (!png || !info) {
@@ -70,7 +85,7 @@ int decode(const std::uint8_t* bytes, std::size_t size, bool header_only, ErrorS
     bit_depth = png_get_bit_depth(png, info);
     colour_type = png_get_color_type(png, info);
     wrong_format = colour_type != PNG_COLOR_TYPE_GRAY && colour_type != PNG_COLOR_TYPE_GRAY_ALPHA;
-    if (header_only || wrong_format || std::size_t(w) * h > out_capacity) {
+    if (header_only || wrong_format || std::size_t(w) * h > out.size()) {
         png_destroy_read_struct(&png, &info, nullptr);
         return 0;
     }
@@ -83,7 +98,7 @@ int decode(const std::uint8_t* bytes, std::size_t size, bool header_only, ErrorS
     row = static_cast<png_bytep>(std::malloc(rowbytes));
     for (int pass = 0; pass < passes; ++pass) {
         for (png_uint_32 y = 0; y < h; ++y) {
-            std::uint16_t* dst = out + std::size_t(y) * w;
+            std::uint16_t* dst = samples + std::size_t(y) * w;
             if (pass > 0) {  // interlaced: feed back the row we have so far
                 if (bit_depth == 16) std::memcpy(row, dst, std::size_t(w) * 2);
                 else
@@ -133,13 +148,13 @@ GrayImage read_png(const std::vector<std::uint8_t>& bytes, const std::filesystem
     if (bytes.size() < 8 || std::memcmp(bytes.data(), signature, 8) != 0)
         throw BadInput("cannot read " + path.string() + ": not a PNG file (it does not start with the PNG signature)");
     ErrorSlot err;
-    png_uint_32 w = 0, h = 0;
-    int bit_depth = 0, colour_type = 0;
-    bool wrong_format = false;
+    Header hd;
+    const png_uint_32 &w = hd.w, &h = hd.h;
+    const int &bit_depth = hd.bit_depth, &colour_type = hd.colour_type;
     // Header first, to size the buffer and check the format before decoding.
-    if (decode(bytes.data(), bytes.size(), true, err, w, h, bit_depth, colour_type, nullptr, 0, wrong_format) != 0)
+    if (decode(bytes, err, hd, {}) != 0)
         throw BadInput("cannot read " + path.string() + ": damaged PNG (" + err.message + ")");
-    if (wrong_format) {
+    if (hd.wrong_format) {
         const char* what = colour_type == PNG_COLOR_TYPE_PALETTE ? "a palette (indexed colour) image"
             : (colour_type & PNG_COLOR_MASK_ALPHA)               ? "an RGBA colour image"
                                                                  : "an RGB colour image";
@@ -167,8 +182,7 @@ GrayImage read_png(const std::vector<std::uint8_t>& bytes, const std::filesystem
     image.bits = bit_depth == 16 ? 16 : 8;
     if (header_only) return image;
     image.samples.resize(std::size_t(w) * h);
-    if (decode(bytes.data(), bytes.size(), false, err, w, h, bit_depth, colour_type, image.samples.data(),
-               image.samples.size(), wrong_format) != 0)
+    if (decode(bytes, err, hd, image.samples) != 0)
         throw BadInput("cannot read " + path.string() + ": damaged PNG (" + err.message + ")");
     if (bit_depth < 8) {  // expanded to 8 bits without rescaling: scale 0..2^d-1 to 0..255
         const int max = (1 << bit_depth) - 1;

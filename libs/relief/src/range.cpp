@@ -113,11 +113,12 @@ std::vector<int> crossed_cells(const SiteIndex& index, Point2 a, Point2 b, std::
 }
 
 int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed, GridView* uplift) {
-    return raise_range(terrain, terrain.width, terrain.height, 0, 0, a, b, params, seed, uplift);
+    return raise_range(terrain, GridWindow{terrain.width, terrain.height, 0, 0}, a, b, params, seed, uplift);
 }
 
-int raise_range(GridView terrain, int width, int height, int wx0, int wy0, Point2 a, Point2 b,
-                const RangeParams& params, std::uint64_t seed, GridView* uplift) {
+int raise_range(GridView terrain, GridWindow grid, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
+                GridView* uplift) {
+    const int width = grid.width, height = grid.height, wx0 = grid.x0, wy0 = grid.y0;
     if (params.cones < 1) throw BadInput("range: cones must be at least 1 (got " + std::to_string(params.cones) + ")");
     if (width < 1 || height < 1 || !terrain.data) throw BadInput("range: the terrain grid is empty");
     if (wx0 < 0 || wy0 < 0 || wx0 + terrain.width > width || wy0 + terrain.height > height)

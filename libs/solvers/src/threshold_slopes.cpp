@@ -22,8 +22,11 @@ constexpr double kSqrt2 = 1.4142135623730951;
 /// points give more than min(axial, corner) + 1.03·step, and its axial end already gave axial + step ≥
 /// best: only an edge whose corner is below best − step can lower the vertex further (the skipped ones
 /// could not: the same value, in less time).
-inline double stencil_bound(double n, double s, double w, double e, double nw, double ne, double sw, double se,
-                            double step) {
+struct Stencil {
+    double n, s, w, e, nw, ne, sw, se;  ///< the neighbours' heights, m (+∞ where there is none)
+};
+inline double stencil_bound(const Stencil& k, double step) {
+    const auto [n, s, w, e, nw, ne, sw, se] = k;
     const double straight = std::min(std::min(n, s), std::min(w, e));
     const double corner = std::min(std::min(nw, ne), std::min(sw, se));
     double best = std::min(straight + step, corner + step * kSqrt2);
@@ -65,8 +68,20 @@ struct Sweeps {
     /// ends). Returns the vertices lowered.
     /// `west_moved`, `east_moved`: `moved` of the same columns, copied likewise (with `moved` only).
     /// `rows`: the strip's column of strip_rows (gh values), or null.
-    std::int64_t row_update(int r, int a, int b, const double* west, const double* east, const std::int32_t* west_moved,
-                            const std::int32_t* east_moved, std::int32_t* rows, bool eastward) const {
+    /// A strip's edges, as row_update reads them.
+    struct StripEdges {
+        const double* west;
+        const double* east;
+        const std::int32_t* west_moved;
+        const std::int32_t* east_moved;
+        std::int32_t* rows;
+    };
+    std::int64_t row_update(int r, int a, int b, const StripEdges& edges, bool eastward) const {
+        const double* const west = edges.west;
+        const double* const east = edges.east;
+        const std::int32_t* const west_moved = edges.west_moved;
+        const std::int32_t* const east_moved = edges.east_moved;
+        std::int32_t* const rows = edges.rows;
         constexpr double kNone = std::numeric_limits<double>::infinity();
         std::int64_t lowered = 0;
         const std::size_t base = std::size_t(r) * std::size_t(gw);
@@ -126,7 +141,7 @@ struct Sweeps {
             const double straight = std::min(std::min(n, s), std::min(w, e));
             const double corner = std::min(std::min(nw, ne), std::min(sw, se));
             if (!(std::min(straight, corner) + step < row[c])) continue;
-            const double best = stencil_bound(n, s, w, e, nw, ne, sw, se, step);
+            const double best = stencil_bound({n, s, w, e, nw, ne, sw, se}, step);
             if (best < row[c]) {
                 row[c] = best;
                 if (moved) moved[base + std::size_t(c)] = pass;
@@ -144,8 +159,9 @@ struct Sweeps {
             return y < 0 || y >= gh || x < 0 || x >= gw ? kNone : g[std::size_t(y) * std::size_t(gw) + std::size_t(x)];
         };
         const double step = this->step(std::size_t(r) * std::size_t(gw) + std::size_t(c));
-        return stencil_bound(at(r - 1, c), at(r + 1, c), at(r, c - 1), at(r, c + 1), at(r - 1, c - 1), at(r - 1, c + 1),
-                             at(r + 1, c - 1), at(r + 1, c + 1), step);
+        return stencil_bound({at(r - 1, c), at(r + 1, c), at(r, c - 1), at(r, c + 1), at(r - 1, c - 1),
+                              at(r - 1, c + 1), at(r + 1, c - 1), at(r + 1, c + 1)},
+                             step);
     }
 
     /// After a round of sweeps on the whole grid (x0 = y0 = 0, with `moved`): the rest of the way to the
@@ -229,11 +245,12 @@ struct Sweeps {
                 const std::int32_t* wm = a > 0 ? edge_m(int(s), 0) : nullptr;
                 const std::int32_t* em = b < gw ? edge_m(int(s), 1) : nullptr;
                 std::int32_t* rows = strip_rows ? strip_rows + std::size_t(s) * std::size_t(gh) : nullptr;
+                const StripEdges edges{w, e, wm, em, rows};
                 std::int64_t mine = 0;
                 if (down)
-                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, w, e, wm, em, rows, eastward);
+                    for (int r = y0; r < y1; ++r) mine += row_update(r, a, b, edges, eastward);
                 else
-                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, w, e, wm, em, rows, eastward);
+                    for (int r = y1 - 1; r >= y0; --r) mine += row_update(r, a, b, edges, eastward);
                 lowered += mine;
             }
         });

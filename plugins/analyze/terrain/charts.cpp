@@ -145,17 +145,15 @@ std::string run_gnuplot(const std::string& script, const std::filesystem::path& 
     return {};
 }
 
-}  // namespace
+/// A chart's file and title, and its gnuplot commands with their data ("" plot: no terrain has data).
+struct Pending {
+    Chart chart;
+    std::string body;
+};
 
-ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::filesystem::path& folder,
-                           const std::string& stem) {
+/// The whole map's charts: the slope distribution, the hypsometric curve and the power spectrum.
+void whole_map_charts(const std::vector<Terrain>& terrains, const std::string& stem, std::vector<Pending>& pending) {
     using analysis::FigureId;
-    struct Pending {
-        Chart chart;
-        std::string body;  // the plot commands and data; "" = no data
-    };
-    std::vector<Pending> pending;
-
     pending.push_back({{stem + "-slopes.png", "Slope distribution"},
                        header("Slope distribution", "slope (°)", "share of the samples (% per degree)") +
                            "set xrange [0:90]\n" +
@@ -203,6 +201,11 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
                                    return s;
                                },
                                "lines")});
+}
+
+/// The channels' charts: slope–area, Hack's law, the valley cross-section and valley width against area.
+void channel_charts(const std::vector<Terrain>& terrains, const std::string& stem, std::vector<Pending>& pending) {
+    using analysis::FigureId;
     pending.push_back({{stem + "-slope-area.png", "Slope–area (channel cells)"},
                        header("Slope–area of the channels (A > 1 km²), log-binned; lines: the fits",
                               "drainage area A (m²)", "slope S (m/m)") +
@@ -285,6 +288,15 @@ ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::file
                                        ? fitted(f.valley_widths, f.valley_widths_fit)
                                        : std::vector<std::pair<double, double>>{};
                                })});
+}
+
+}  // namespace
+
+ChartsWritten write_charts(const std::vector<Terrain>& terrains, const std::filesystem::path& folder,
+                           const std::string& stem) {
+    std::vector<Pending> pending;
+    whole_map_charts(terrains, stem, pending);
+    channel_charts(terrains, stem, pending);
 
     ChartsWritten written;
     std::vector<std::unique_ptr<AtomicFile>> files;

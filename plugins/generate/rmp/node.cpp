@@ -228,7 +228,7 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
             const std::uint64_t seed = node_seed(ctx);
             const Placed at = placed(ctx, *hm);  // in a tiled run, this rank's tile of the whole grid's range
             for (int k = 0; k < iterations; ++k) {
-                rmp::raise_range(hm->view(), at.width, at.height, at.window.x0, at.window.y0, a, b, p,
+                rmp::raise_range(hm->view(), rmp::GridWindow{at.width, at.height, at.window.x0, at.window.y0}, a, b, p,
                                  rmp::iteration_seed(seed, k), ctx.flag("uplift") ? &uplift : nullptr);
                 ctx.check_cancelled();
                 ctx.progress(double(k + 1) / iterations);

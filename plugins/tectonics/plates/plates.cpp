@@ -139,8 +139,8 @@ void draw_stamp(const ReliefStamp& stamp, const Params& params, BoundaryRelief& 
         case ReliefStamp::Kind::rift: relief.add_rift(stamp.a, stamp.b); break;
         case ReliefStamp::Kind::cells: {
             const rmp::RangeParams range{params.cones, params.height, params.jitter};
-            rmp::raise_range(terrain, relief.width(), relief.height(), at.x0, at.y0, stamp.a, stamp.b, range,
-                             stamp.seed, uplift);
+            rmp::raise_range(terrain, rmp::GridWindow{relief.width(), relief.height(), at.x0, at.y0}, stamp.a, stamp.b,
+                             range, stamp.seed, uplift);
             break;
         }
     }

@@ -31,10 +31,16 @@ struct RangeParams {
 int raise_range(GridView terrain, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
                 GridView* uplift = nullptr);
 
-/// The same range of a width × height grid, added only to the samples of `window` (global sample
-/// coordinates; `terrain` and `uplift` hold exactly them): a rank's tile in a tiled run gets the bits the
-/// whole grid gets there. Returns the number of cells raised (over the whole grid).
-int raise_range(GridView terrain, int width, int height, int x0, int y0, Point2 a, Point2 b, const RangeParams& params,
-                std::uint64_t seed, GridView* uplift = nullptr);
+/// Where a window lies in the whole grid: the grid's size, and the window's first sample (global coordinates).
+struct GridWindow {
+    int width = 0, height = 0;  ///< the whole grid, samples
+    int x0 = 0, y0 = 0;  ///< the window's first sample
+};
+
+/// The same range of a `grid.width` × `grid.height` grid, added only to the samples of the window at
+/// (grid.x0, grid.y0) (`terrain` and `uplift` hold exactly them): a rank's tile in a tiled run gets the bits
+/// the whole grid gets there. Returns the number of cells raised (over the whole grid).
+int raise_range(GridView terrain, GridWindow grid, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
+                GridView* uplift = nullptr);
 
 }  // namespace orogen::rmp
