@@ -8,11 +8,91 @@
 #include <bit>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 
 namespace orogen::landscape {
 
-namespace {}  // namespace
+namespace {
+
+/// i / W for 0 ≤ i < 2^31 by a multiplication (Granlund & Montgomery): M = ⌈2^k/W⌉ with
+/// k = 31 + ⌈log2 W⌉, exact since (M·W − 2^k)·i < W·2^31 ≤ 2^k.
+class RowOf {
+public:
+    explicit RowOf(int width) {
+        int lg = 0;
+        while ((std::int64_t(1) << lg) < width) ++lg;
+        shift_ = 31 + lg;
+        mul_ = ((std::uint64_t(1) << shift_) + std::uint64_t(width) - 1) / std::uint64_t(width);
+    }
+    int operator()(std::int32_t i) const { return int((std::uint64_t(i) * mul_) >> shift_); }
+
+private:
+    std::uint64_t mul_;
+    int shift_;
+};
+
+/// Per thread: for each basin graph node, which pit basin's links last named it (a stamp unique to the
+/// basin and the call) and where that link is among the group's links. Kept between calls.
+struct NodeSlots {
+    std::vector<std::uint64_t> stamp;
+    std::vector<std::int32_t> at;
+};
+thread_local NodeSlots node_slots;
+std::atomic<std::uint32_t> link_epoch{0};
+
+/// std::sort by link_before, for many links by a radix sort on the pass first: four passes of
+/// 16 bits over (key, index) pairs, then the links in that order, and link_before's own sort
+/// within each run of equal passes. The same order as std::sort (link_before is a total order).
+void sort_links(std::vector<Link>& links) {
+    const std::size_t n = links.size();
+    if (n < (std::size_t(1) << 14)) {
+        std::sort(links.begin(), links.end(), link_before);
+        return;
+    }
+    // The pass's bits turned into an unsigned key of the same order (−0 as +0, as == sees them).
+    const auto key_of = [](double v) {
+        const auto u = std::bit_cast<std::uint64_t>(v + 0.0);
+        return (u >> 63) ? ~u : u | (std::uint64_t(1) << 63);
+    };
+    struct Keyed {
+        std::uint64_t key;
+        std::uint32_t index;
+    };
+    const std::unique_ptr<Keyed[]> a_own(new Keyed[n]), b_own(new Keyed[n]);  // not zeroed: all written
+    Keyed* a = a_own.get();
+    Keyed* b = b_own.get();
+    std::vector<std::uint32_t> count(4 * 65536, 0);
+    for (std::size_t e = 0; e < n; ++e) {
+        const std::uint64_t k = key_of(links[e].pass);
+        a[e] = {k, std::uint32_t(e)};
+        for (int d = 0; d < 4; ++d) ++count[std::size_t(d) * 65536 + ((k >> (16 * d)) & 0xffff)];
+    }
+    for (int d = 0; d < 4; ++d) {
+        std::uint32_t* c = count.data() + std::size_t(d) * 65536;
+        if (std::find(c, c + 65536, std::uint32_t(n)) != c + 65536) continue;  // one digit for all: in order
+        std::uint32_t sum = 0;
+        for (int v = 0; v < 65536; ++v) {
+            const std::uint32_t k = c[v];
+            c[v] = sum;
+            sum += k;
+        }
+        for (std::size_t e = 0; e < n; ++e) b[c[(a[e].key >> (16 * d)) & 0xffff]++] = a[e];
+        std::swap(a, b);
+    }
+    std::vector<Link> sorted;
+    sorted.reserve(n);
+    for (std::size_t e = 0; e < n; ++e) sorted.push_back(links[a[e].index]);
+    for (std::size_t e = 0; e < n;) {
+        std::size_t f = e + 1;
+        while (f < n && a[f].key == a[e].key) ++f;
+        if (f - e > 1) std::sort(sorted.begin() + std::ptrdiff_t(e), sorted.begin() + std::ptrdiff_t(f), link_before);
+        e = f;
+    }
+    links.swap(sorted);
+}
+
+}  // namespace
 
 std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t v) {
     while (parent[std::size_t(v)] != v) {
@@ -24,31 +104,44 @@ std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t v) {
 
 BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     // A total order, so the tree does not depend on the order the links were collected in.
-    if (!std::is_sorted(links.begin(), links.end(), link_before)) std::sort(links.begin(), links.end(), link_before);
-    // Kruskal: the minimum spanning tree of the basin graph.
+    if (!std::is_sorted(links.begin(), links.end(), link_before)) sort_links(links);
+    // Kruskal: the minimum spanning tree of the basin graph (its links in the order taken).
     std::vector<std::int32_t> parent(static_cast<std::size_t>(nodes));
     for (std::int32_t v = 0; v < nodes; ++v) parent[std::size_t(v)] = v;
-    std::vector<std::vector<std::int32_t>> adjacent(static_cast<std::size_t>(nodes));  // indices into links
-    std::int32_t joined = 0;
-    for (std::size_t e = 0; e < links.size() && joined < nodes - 1; ++e) {
+    std::vector<std::int32_t> taken;
+    taken.reserve(std::size_t(std::max(nodes - 1, 0)));
+    std::vector<std::int32_t> degree(std::size_t(nodes) + 1, 0);
+    for (std::size_t e = 0; e < links.size() && std::int32_t(taken.size()) < nodes - 1; ++e) {
         const std::int32_t ra = find_root(parent, std::int32_t(links[e].a)),
                            rb = find_root(parent, std::int32_t(links[e].b));
         if (ra == rb) continue;
         parent[std::size_t(ra)] = rb;
-        ++joined;
-        adjacent[std::size_t(links[e].a)].push_back(std::int32_t(e));
-        adjacent[std::size_t(links[e].b)].push_back(std::int32_t(e));
+        taken.push_back(std::int32_t(e));
+        ++degree[std::size_t(links[e].a) + 1];
+        ++degree[std::size_t(links[e].b) + 1];
+    }
+    // Each node's tree links in the order taken (one array, not a vector per node).
+    for (std::size_t v = 0; v < std::size_t(nodes); ++v) degree[v + 1] += degree[v];
+    std::vector<std::int32_t> adjacent(std::size_t(degree[std::size_t(nodes)]));
+    {
+        std::vector<std::int32_t> fill(degree.begin(), degree.end() - 1);
+        for (const std::int32_t e : taken) {
+            adjacent[std::size_t(fill[std::size_t(links[std::size_t(e)].a)]++)] = e;
+            adjacent[std::size_t(fill[std::size_t(links[std::size_t(e)].b)]++)] = e;
+        }
     }
     // Orient the tree from the sea: each pit basin's way out, and its lake level.
     BasinTree t;
     t.level.assign(std::size_t(nodes), -std::numeric_limits<double>::infinity());
     t.out_link.assign(std::size_t(nodes), -1);
     std::vector<std::uint8_t> seen(static_cast<std::size_t>(nodes), 0);
+    t.order.reserve(std::size_t(nodes));
     t.order.assign(1, 0);
     seen[0] = 1;
     for (std::size_t q = 0; q < t.order.size(); ++q) {
         const std::int32_t v = t.order[q];
-        for (std::int32_t e : adjacent[std::size_t(v)]) {
+        for (std::int32_t k = degree[std::size_t(v)]; k < degree[std::size_t(v) + 1]; ++k) {
+            const std::int32_t e = adjacent[std::size_t(k)];
             const Link& l = links[std::size_t(e)];
             const auto u = std::int32_t(l.a == v ? l.b : l.a);
             if (seen[std::size_t(u)]) continue;
@@ -99,8 +192,15 @@ double FlowRouter::distance(std::int64_t i) const {
 /// branches or integer lanes, which the compiler turns into vector blends (the
 /// comparisons are unpredictable on rough ground). Same arithmetic as the
 /// scalar form, (h_i − h_k)·(1/distance) with ties to the lower k.
-void inner_row_directions(const double* __restrict c, const double* __restrict up, const double* __restrict dn, int W,
-                          double* __restrict dir_out) {
+// With GCC on x86-64, built twice, for AVX2 and for the baseline, picked at load time: the same
+// comparisons and products in wider lanes (no FMA), so the same directions.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define OROGEN_AVX2_CLONE __attribute__((target_clones("avx2", "default")))
+#else
+#define OROGEN_AVX2_CLONE
+#endif
+OROGEN_AVX2_CLONE void inner_row_directions(const double* __restrict c, const double* __restrict up,
+                                            const double* __restrict dn, int W, double* __restrict dir_out) {
     const double d = 1.0 / kSqrt2;
     for (int x = 1; x < W - 1; ++x) {
         const double hi = c[x];
@@ -150,6 +250,7 @@ void FlowRouter::receivers_from(const double* h) {
             const bool inner_row = y > 0 && y < H - 1;
             const double* row = h + y * W;
             if (inner_row) inner_row_directions(row, row - W, row + W, W, dirs.data());
+            const bool near_edge = y <= y0 + 1 || y >= y1 - 2;  // a receiver may lie in the rows shared with a band
             for (int x = 0; x < W; ++x) {
                 const std::int64_t i = y * W + x;
                 if (outlet_[std::size_t(i)]) {
@@ -174,8 +275,7 @@ void FlowRouter::receivers_from(const double* h) {
                 const std::int64_t to = i + off[dir];
                 receiver_[std::size_t(i)] = std::int32_t(to);
                 const auto bit = std::uint8_t(1u << ((dir + 4) & 7));  // seen from `to`, i is neighbour dir+4
-                const std::int64_t ty = y + kDy[dir];
-                if (ty <= y0 || ty >= y1 - 1)
+                if (near_edge && (y + kDy[dir] <= y0 || y + kDy[dir] >= y1 - 1))
                     std::atomic_ref<std::uint8_t>(donors_[std::size_t(to)]).fetch_or(bit, std::memory_order_relaxed);
                 else donors_[std::size_t(to)] = std::uint8_t(donors_[std::size_t(to)] | bit);
             }
@@ -183,11 +283,34 @@ void FlowRouter::receivers_from(const double* h) {
     });
 }
 
+void FlowRouter::find_roots() {
+    // The cells that are their own receiver, in index order: counted and then written by fixed
+    // blocks on every thread.
+    constexpr std::int64_t kBlock = 1 << 16;
+    const std::int64_t blocks = (std::int64_t(size_) + kBlock - 1) / kBlock;
+    std::vector<std::int64_t> start(std::size_t(blocks) + 1, 0);
+    const std::int32_t* rcv = receiver_.data();
+    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t b = b0; b < b1; ++b) {
+            std::int64_t count = 0;
+            for (std::int64_t i = b * kBlock, e = std::min<std::int64_t>(std::int64_t(size_), i + kBlock); i < e; ++i)
+                count += rcv[i] == i;
+            start[std::size_t(b) + 1] = count;
+        }
+    });
+    for (std::int64_t b = 0; b < blocks; ++b) start[std::size_t(b) + 1] += start[std::size_t(b)];
+    roots_.resize(std::size_t(start[std::size_t(blocks)]));
+    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t b = b0; b < b1; ++b) {
+            std::int32_t* out = roots_.data() + start[std::size_t(b)];
+            for (std::int64_t i = b * kBlock, e = std::min<std::int64_t>(std::int64_t(size_), i + kBlock); i < e; ++i)
+                if (rcv[i] == i) *out++ = std::int32_t(i);
+        }
+    });
+}
+
 void FlowRouter::build_stack(bool label_basins) {
     const int W = width_;
-    roots_.clear();
-    for (std::size_t i = 0; i < size_; ++i)
-        if (receiver_[i] == std::int32_t(i)) roots_.push_back(std::int32_t(i));
     std::int64_t off[8];
     for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
     basin_start_.assign(roots_.size() + 1, 0);
@@ -247,9 +370,10 @@ void FlowRouter::build_stack(bool label_basins) {
 
 void FlowRouter::route(double* h, Depressions mode) {
     receivers_from(h);
+    find_roots();
     pits_ = 0;
     graph_pits_ = 0;
-    for (std::size_t i = 0; i < size_; ++i) pits_ += (receiver_[i] == std::int32_t(i) && !outlet_[i]) ? 1 : 0;
+    for (const std::int32_t r : roots_) pits_ += outlet_[std::size_t(r)] ? 0 : 1;
     build_stack(pits_ > 0);
     if (pits_ > 0) resolve_pits(h, mode);
 }
@@ -268,8 +392,13 @@ void FlowRouter::reroute(std::int32_t inside, std::int32_t across) {
     for (;;) {
         const std::int32_t next = receiver_[std::size_t(c)];
         receiver_[std::size_t(c)] = prev;
-        if (next != c) donors_[std::size_t(next)] &= std::uint8_t(~bit_from(c, next));
-        donors_[std::size_t(prev)] |= bit_from(c, prev);
+        // Atomic: the first `prev` is another basin's cell, which its own reroute may change
+        // at the same time (resolve_pits runs the basins in parallel).
+        if (next != c)
+            std::atomic_ref<std::uint8_t>(donors_[std::size_t(next)])
+                .fetch_and(std::uint8_t(~bit_from(c, next)), std::memory_order_relaxed);
+        std::atomic_ref<std::uint8_t>(donors_[std::size_t(prev)])
+            .fetch_or(bit_from(c, prev), std::memory_order_relaxed);
         if (next == c) break;
         prev = c;
         c = next;
@@ -287,7 +416,6 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
     std::vector<std::int32_t> pending;
     for (std::size_t b = 0; b < nb; ++b)
         if (!outlet_[std::size_t(roots_[b])]) pending.push_back(std::int32_t(b));
-    resolved_.clear();
     graph_pits_ = std::int64_t(pending.size());
     std::vector<std::int32_t> node(nb, 0), node_basin{0};
     std::int32_t nodes = 1;
@@ -296,42 +424,78 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
         node_basin.push_back(b);
     }
 
-    // Links over every edge between a pit basin and another basin, found from
-    // the pit basins' own cells (their segments of the stack: basins are
-    // contiguous there), all 8 neighbours; an edge between two pit basins is
-    // taken from its lower-index cell only. Collected per fixed group of pit
-    // basins; each group keeps only its lowest link per pair of nodes (by the
-    // total order the global sort uses, so the result does not depend on the
-    // grouping). The cost follows the lakes' size, not the map's.
+    // Links between a pit basin and each basin next to it, found from the pit
+    // basins' own cells (their segments of the stack: basins are contiguous
+    // there), all 8 neighbours. A pair of pit basins is taken by the lower
+    // node, which sees every edge between the two (each has one end in it); a
+    // pit basin and the sea by the pit basin. Each basin keeps only its lowest
+    // link per pair (by the total order the global sort uses), found through a
+    // per-thread table by node (NodeSlots), so every link is a pair's lowest and
+    // comes once, whatever the grouping. The cost follows the lakes' size, not
+    // the map's.
     const std::int64_t np = std::int64_t(pending.size());
     const std::int64_t link_groups = std::min<std::int64_t>(kChunks, np);
     std::vector<std::vector<Link>> per_block(static_cast<std::size_t>(link_groups));
+    std::int64_t off[8];
+    for (int k = 0; k < 8; ++k) off[k] = std::int64_t(kDy[k]) * W + kDx[k];
+    const RowOf row_of(W);
+    constexpr std::int64_t kAhead = 12;
+    const std::uint64_t epoch = std::uint64_t(link_epoch.fetch_add(1, std::memory_order_relaxed) + 1u) << 32;
     parallel_for(0, link_groups, 1, [&](std::int64_t g0, std::int64_t g1) {
+        NodeSlots& slots = node_slots;
+        if (slots.stamp.size() < std::size_t(nodes)) {
+            slots.stamp.assign(std::size_t(nodes), 0);  // 0: never a stamp (the epoch is ≥ 1)
+            slots.at.resize(std::size_t(nodes));
+        }
+        std::uint64_t* const stamp = slots.stamp.data();
+        std::int32_t* const at = slots.at.data();
         for (std::int64_t g = g0; g < g1; ++g) {
             auto& out = per_block[std::size_t(g)];
             for (std::int64_t p = g * np / link_groups; p < (g + 1) * np / link_groups; ++p) {
                 const std::size_t b = std::size_t(pending[std::size_t(p)]);
                 const std::int32_t ni = node[b];
-                for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
+                const std::uint64_t key = epoch | std::uint64_t(p + 1);
+                const auto bi = std::int32_t(b);
+                const std::int64_t s_end = basin_start_[b + 1];
+                for (std::int64_t s = basin_start_[b]; s < s_end; ++s) {
                     const std::int32_t i = stack_[std::size_t(s)];
-                    const int x = i % W, y = i / W;
+                    if (s + kAhead < s_end) {
+                        // The stack jumps between rows: fetch the basin labels around a cell
+                        // a few cells ahead (its row and the two next to it).
+                        const std::int64_t a = stack_[std::size_t(s + kAhead)];
+                        __builtin_prefetch(&basin_[std::size_t(a)]);
+                        if (a >= W) __builtin_prefetch(&basin_[std::size_t(a - W)]);
+                        if (a + W < std::int64_t(size_)) __builtin_prefetch(&basin_[std::size_t(a + W)]);
+                    }
+                    const double hi = h[i];
+                    const auto visit = [&](std::int32_t j) __attribute__((always_inline)) {
+                        const std::int32_t bj = basin_[std::size_t(j)];
+                        if (bj == bi) return;  // most neighbours, in a large basin
+                        const std::int32_t nj = node[std::size_t(bj)];
+                        if (nj != 0 && nj < ni) return;
+                        const double hj = h[j];
+                        const Link l = nj == 0 ? Link{std::max(hi, hj), std::min(hi, hj), 0, ni, j, i}
+                                               : Link{std::max(hi, hj), std::min(hi, hj), ni, nj, i, j};
+                        if (stamp[nj] != key) {  // the first link of this basin to node nj
+                            stamp[nj] = key;
+                            at[nj] = std::int32_t(out.size());
+                            out.push_back(l);
+                        } else if (Link& kept = out[std::size_t(at[nj])]; link_before(l, kept)) {
+                            kept = l;
+                        }
+                    };
+                    const int y = row_of(i), x = i - y * W;
+                    if (x > 0 && x < W - 1 && y > 0 && y < H - 1) {
+                        for (int k = 0; k < 8; ++k) visit(std::int32_t(i + off[k]));
+                        continue;
+                    }
                     for (int k = 0; k < 8; ++k) {
                         const int nx = x + kDx[k], ny = y + kDy[k];
                         if (nx < 0 || nx >= W || ny < 0 || ny >= H) continue;
-                        const std::int32_t j = std::int32_t(std::int64_t(ny) * W + nx);
-                        const std::int32_t nj = node[std::size_t(basin_[std::size_t(j)])];
-                        if (nj == ni || (nj != 0 && j < i)) continue;
-                        const double pass = std::max(h[i], h[j]), low = std::min(h[i], h[j]);
-                        if (ni < nj) out.push_back({pass, low, ni, nj, i, j});
-                        else out.push_back({pass, low, nj, ni, j, i});
+                        visit(std::int32_t(std::int64_t(ny) * W + nx));
                     }
                 }
             }
-            std::sort(out.begin(), out.end(), pair_then_order);
-            std::size_t kept = 0;
-            for (std::size_t e = 0; e < out.size(); ++e)
-                if (e == 0 || out[e].a != out[kept - 1].a || out[e].b != out[kept - 1].b) out[kept++] = out[e];
-            out.resize(kept);
         }
     });
     const auto& per_pit = per_block;
@@ -346,23 +510,30 @@ void FlowRouter::resolve_pits(double* h, Depressions mode) {
     const auto& out_link = tree.out_link;
     const auto& queue = tree.order;
 
-    // Fill, then carve, parents before children (the order of the walk from
-    // the sea), so that each pit basin's way out is already in place.
-    for (std::size_t q = 1; q < queue.size(); ++q) {
-        const std::int32_t v = queue[q];
-        const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
-        const Link& l = links[std::size_t(out_link[std::size_t(v)])];
-        const auto in = std::int32_t(l.a == v ? l.i : l.j), across = std::int32_t(l.a == v ? l.j : l.i);
-        if (mode == Depressions::fill) {
-            const double lv = level[std::size_t(v)];
-            for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
-                const std::int32_t c = stack_[std::size_t(s)];
-                if (h[c] < lv) h[c] = lv;
+    // Fill, then carve. Each pit basin's cells are its own (the fill, the
+    // reversed path from its pass cell down to its pit); only the donor bits
+    // of the cell across, in another basin, are shared, and they change by
+    // atomic ORs and ANDs of distinct bits: the basins are done in parallel,
+    // with the same bytes as one after the other. resolved_ keeps the order of
+    // the walk from the sea (parents before children), which patch_stack needs.
+    resolved_.resize(queue.empty() ? 0 : queue.size() - 1);
+    parallel_for(1, std::int64_t(queue.size()), 256, [&](std::int64_t q0, std::int64_t q1) {
+        for (std::int64_t q = q0; q < q1; ++q) {
+            const std::int32_t v = queue[std::size_t(q)];
+            const std::size_t b = std::size_t(node_basin[std::size_t(v)]);
+            const Link& l = links[std::size_t(out_link[std::size_t(v)])];
+            const auto in = std::int32_t(l.a == v ? l.i : l.j), across = std::int32_t(l.a == v ? l.j : l.i);
+            if (mode == Depressions::fill) {
+                const double lv = level[std::size_t(v)];
+                for (std::int64_t s = basin_start_[b]; s < basin_start_[b + 1]; ++s) {
+                    const std::int32_t c = stack_[std::size_t(s)];
+                    if (h[c] < lv) h[c] = lv;
+                }
             }
+            reroute(in, across);
+            resolved_[std::size_t(q - 1)] = {std::int32_t(b), in, across};
         }
-        reroute(in, across);
-        resolved_.push_back({std::int32_t(b), in, across});
-    }
+    });
 
     patch_stack();
 }
@@ -466,14 +637,15 @@ void FlowRouter::accumulate(const double* weight) {
     parallel_for(0, groups, 1, [&](std::int64_t g0, std::int64_t g1) {
         for (std::int64_t g = g0; g < g1; ++g) {
             const std::int64_t b = chunks_[std::size_t(g)], e = chunks_[std::size_t(g + 1)];
+            // A cell's count is whole once the walk reaches it (its donors come after it in the
+            // stack): it goes on to the receiver and becomes m² in the same visit.
             for (std::int64_t s = e; s-- > b;) {
                 const std::int32_t i = stack[s], r = rcv[i];
-                if (r != i) area[r] += area[i];
+                const double c = area[i];
+                if (r != i) area[r] += c;
+                area[i] = c * a0;
             }
         }
-    });
-    parallel_for(0, std::int64_t(size_), 1 << 16, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i) area[i] *= a0;
     });
 }
 

@@ -175,7 +175,8 @@ public:
 
 private:
     void receivers_from(const double* h);  // and the donor bits
-    void build_stack(bool label_basins);
+    void find_roots();  // roots_: the cells that are their own receiver
+    void build_stack(bool label_basins);  // from roots_
     void resolve_pits(double* h, Depressions mode);
     void reroute(std::int32_t inside, std::int32_t across);
     void patch_stack();  // after resolve_pits: the stack through the passes
