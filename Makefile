@@ -4,28 +4,61 @@
 BUILD ?= build
 JOBS  ?= 2
 
-.PHONY: all setup configure build demo test bench clean asan asan-ci asan-configure tsan fuzz-smoke fuzz-long
+.PHONY: all setup setup-tests configure build demo test bench bench-check tidy paraview clean asan asan-ci asan-configure tsan fuzz-smoke fuzz-long
 
 all: build
 
 setup:
 	@tools/setup.sh
 
+setup-tests:
+	@tools/setup.sh --tests
+
+# CMAKE_ARGS: more cmake options (CI: -DOROGEN_BUILD_BENCHMARKS=OFF, as it runs no benchmark).
+CMAKE_ARGS ?=
 configure: setup
-	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(CMAKE_ARGS) >/dev/null
 
 build: configure
 	cmake --build $(BUILD) -j$(JOBS)
 
-demo: build
+# The command and its plugins only (target orogen_demo), not the tests. A first build says how long it will
+# take: SECONDS_PER_STEP is a compile step's average on one core of the 2-core machine of docs/benchmarks.md.
+SECONDS_PER_STEP ?= 5
+demo: configure
+	@if [ ! -x $(BUILD)/bin/orogen ]; then \
+	  steps=$$(ninja -C $(BUILD) -t commands orogen_demo | wc -l); \
+	  echo "make demo: a first build of orogen and its plugins: $$steps steps, about $$(( (steps * $(SECONDS_PER_STEP) / $(JOBS) + 59) / 60 )) min on $(JOBS) cores (later runs rebuild only what changed)"; \
+	fi
+	@start=$$(date +%s); cmake --build $(BUILD) -j$(JOBS) --target orogen_demo && \
+	  echo "make demo: built in $$(( $$(date +%s) - start )) s; running pipelines/default.orogen into out/"
 	$(BUILD)/bin/orogen run pipelines/default.orogen --out out
+	@echo "make demo: open it with build/bin/orogen-view out/ (make build first), or in ParaView:" \
+	  "tools/pvbatch out/paraview/orogen.py --screenshot view.png"
 
-test: build
+test: setup-tests build
 	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
 
 # Benchmarks (Google Benchmark): figures go to docs/benchmarks.md.
 bench: build
 	@for b in $(BUILD)/bench/bench_*; do echo "== $$b"; $$b --benchmark_min_time=0.2; done
+
+# A function of at most 150 lines and 8 parameters, over kernel, libs, plugins, viewer and python (clang-tidy-14's
+# readability-function-size, .clang-tidy): a CI phase, so the limit stays a rule.
+tidy: configure
+	tools/tidy.sh $(BUILD)
+
+# ParaView 5.11 for tools/pvbatch (Debian's .debs unpacked into build/paraview; tools/paraview.sh).
+paraview:
+	tools/paraview.sh $(BUILD)/paraview
+
+# The speed ratios a change must not lose (export against cp, the landscape step against fastscapelib, a
+# 1080p frame, the SPH step, the default pipeline), in about three minutes, against the figures recorded in
+# docs/benchmarks.md ("Ratio checks"). Run it before a change to one of those paths lands.
+BENCH_CHECK_TARGETS = orogen_demo bench_diamond_square bench_export_gltf bench_stream_power bench_render bench_sph
+bench-check: configure
+	cmake --build $(BUILD) -j$(JOBS) --target $(BENCH_CHECK_TARGETS)
+	python3 tools/bench_check.py $(BUILD)
 
 # Sanitizer builds (clang-14, tools/setup.sh installs it); see docs/hardening.md.
 #   make asan        AddressSanitizer + UndefinedBehaviorSanitizer build of the whole tree (-O1) and every

@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
 # Installs what orogen needs on Debian 12, only what is missing. Idempotent;
 # works as root or through sudo. Called by `make demo` / `make test`.
+#   tools/setup.sh          the Debian packages
+#   tools/setup.sh --tests  and what only the tests use (the Khronos glTF validator, from npm)
 set -euo pipefail
+for_tests=0
+[[ "${1:-}" == "--tests" ]] && for_tests=1
 
 packages=(
   cmake ninja-build g++ pkg-config
@@ -14,6 +18,7 @@ packages=(
   libavcodec-dev libavformat-dev libswscale-dev ffmpeg
   xvfb xauth libx11-dev
   clang-14 libclang-rt-14-dev clang-format-14   # clang-format-14: the Format test checks .clang-format
+  clang-tidy-14               # make tidy (CI): functions within 150 lines and 8 parameters
   openmpi-bin libopenmpi-dev
   gnuplot-nox                 # analyze:terrain's charts (pngcairo)
 )
@@ -47,9 +52,9 @@ if ((${#missing[@]})); then
 fi
 
 # The Khronos glTF validator (npm package gltf-validator) for the glTF export
-# tests; skipped, with a note, where Node.js is not installed.
+# tests (`make test` only); skipped, with a note, where Node.js is not installed.
 here=$(cd "$(dirname "$0")" && pwd)
-if [[ -f "$here/package.json" ]]; then
+if [[ $for_tests == 1 && -f "$here/package.json" ]]; then
   if command -v npm >/dev/null 2>&1; then
     if [[ ! -d "$here/node_modules/gltf-validator" ]]; then
       echo "setup: installing the glTF validator from the npm registry"
