@@ -47,6 +47,83 @@ std::uint64_t node_seed(NodeContext& ctx) {
     return s < 0 ? ctx.seed() : orogen::random::hash(std::uint64_t(s));
 }
 
+constexpr const char* kRmpDescription =
+    "Each iteration cuts the map into random regions and raises the region under each peak\n"
+    "by `height` (times decay^iteration). More cones (or cuts) per iteration make a steeper,\n"
+    "narrower mountain; more iterations a higher one. Methods find the regions differently:\n"
+    "  voronoi  exact Voronoi cells on the CPU, only the raised ones (default, fastest)\n"
+    "  cones    the thesis's GPU trick: flat cones drawn from above through OSMesa\n"
+    "  graph    faces of `cuts` random lines; the first `regions` faces of a depth-first\n"
+    "           search from each peak's face rise\n"
+    "voronoi and cones use the same sites for a seed, so they give the same mountain.\n"
+    "With no input, starts from the spec's grid, flat at 0 m.";
+
+std::vector<Param> rmp_params() {
+    return {
+        Param::choice("method", {"voronoi", "cones", "graph"}, "voronoi")
+            .help("how the regions are found: exact Voronoi cells, OSMesa-drawn cones, or line cuts"),
+        Param::points("peaks", std::vector<Point2>{{0.5, 0.5}})
+            .min(0)
+            .max(1)
+            .at_most(1024)
+            .help("where the mountains stand, grid-relative (0..1 on both axes)"),
+        Param::integer("iterations", 100).min(1).max(1'000'000).help("raises; height grows with them"),
+        Param::integer("cones", 100)
+            .min(1)
+            .max(10'000'000)
+            .help("Voronoi sites per iteration (voronoi, cones): more give a steeper, narrower mountain"),
+        Param::real("height", 5.0).min(-1e5).max(1e5).unit("m").help("raise of the first iteration"),
+        Param::real("decay", 1.0)
+            .min(0, true)
+            .max(1)
+            .help("the raise is multiplied by this after each iteration (the thesis: 1 - 1/iterations)"),
+        Param::real("jitter", 0.0)
+            .min(0)
+            .max(1)
+            .help("0: every region by the same amount; >0: each by height*(1 + jitter*u), u in [-1, 1) "
+                  "(the thesis's dynamic areal height, 4.2)"),
+        Param::integer("seed", -1)
+            .min(-1)
+            .max(9.0e18)
+            .help("-1: the node's own seed (from the spec's seed and the node's name); otherwise this "
+                  "seed, so variants of a node can share their random regions"),
+        Param::integer("cuts", 5).min(1).max(5000).help("random lines per iteration (graph)"),
+        Param::integer("regions", 2)
+            .min(1)
+            .max(1'000'000)
+            .help("polygons raised per peak per iteration, first in depth-first order (graph)"),
+    };
+}
+
+constexpr const char* kRangeDescription =
+    "Each iteration draws a fresh Voronoi diagram of `cones` sites and raises every cell the\n"
+    "segment from `from` to `to` passes through (and every cell of its Bresenham line's\n"
+    "vertices), as the plate simulation does at each collision. With no input, starts from\n"
+    "the spec's grid, flat at 0 m.";
+
+std::vector<Param> range_params() {
+    return {
+        Param::point("from", Point2{0.2, 0.5}).min(0).max(1).help("one end of the range, grid-relative"),
+        Param::point("to", Point2{0.8, 0.5}).min(0).max(1).help("the other end, grid-relative"),
+        Param::integer("iterations", 50).min(1).max(1'000'000).help("raises, each with new cells"),
+        Param::integer("cones", 100)
+            .min(1)
+            .max(10'000'000)
+            .help("Voronoi sites per iteration: more give a narrower range"),
+        Param::real("height", 5.0).min(-1e5).max(1e5).unit("m").help("raise per iteration"),
+        Param::real("jitter", 0.0)
+            .min(0)
+            .max(1)
+            .help("0: every crossed cell by `height`; >0: each by height*(1 + jitter*u), u in [-1, 1)"),
+        Param::integer("seed", -1)
+            .min(-1)
+            .max(9.0e18)
+            .help("-1: the node's own seed (from the spec's seed and the node's name); otherwise this "
+                  "seed, so variants of a node can share their random regions"),
+        Param::boolean("uplift", false).help("also add the raise to the heightmap's 'uplift' layer (m)"),
+    };
+}
+
 }  // namespace
 
 OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
@@ -54,53 +131,11 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
         .kind = "generate",
         .name = "rmp",
         .summary = "Repeated Magnification and Probing (thesis 3.3): mountains at given peaks",
-        .description = "Each iteration cuts the map into random regions and raises the region under each peak\n"
-                       "by `height` (times decay^iteration). More cones (or cuts) per iteration make a steeper,\n"
-                       "narrower mountain; more iterations a higher one. Methods find the regions differently:\n"
-                       "  voronoi  exact Voronoi cells on the CPU, only the raised ones (default, fastest)\n"
-                       "  cones    the thesis's GPU trick: flat cones drawn from above through OSMesa\n"
-                       "  graph    faces of `cuts` random lines; the first `regions` faces of a depth-first\n"
-                       "           search from each peak's face rise\n"
-                       "voronoi and cones use the same sites for a seed, so they give the same mountain.\n"
-                       "With no input, starts from the spec's grid, flat at 0 m.",
+        .description = kRmpDescription,
         .inputs = {{"base", ValueType::heightmap, Need::optional,
                     "terrain to raise mountains on (default: the spec's grid, flat at 0 m)"}},
         .output = ValueType::heightmap,
-        .params =
-            {
-                Param::choice("method", {"voronoi", "cones", "graph"}, "voronoi")
-                    .help("how the regions are found: exact Voronoi cells, OSMesa-drawn cones, or line cuts"),
-                Param::points("peaks", std::vector<Point2>{{0.5, 0.5}})
-                    .min(0)
-                    .max(1)
-                    .at_most(1024)
-                    .help("where the mountains stand, grid-relative (0..1 on both axes)"),
-                Param::integer("iterations", 100).min(1).max(1'000'000).help("raises; height grows with them"),
-                Param::integer("cones", 100)
-                    .min(1)
-                    .max(10'000'000)
-                    .help("Voronoi sites per iteration (voronoi, cones): more give a steeper, narrower mountain"),
-                Param::real("height", 5.0).min(-1e5).max(1e5).unit("m").help("raise of the first iteration"),
-                Param::real("decay", 1.0)
-                    .min(0, true)
-                    .max(1)
-                    .help("the raise is multiplied by this after each iteration (the thesis: 1 - 1/iterations)"),
-                Param::real("jitter", 0.0)
-                    .min(0)
-                    .max(1)
-                    .help("0: every region by the same amount; >0: each by height*(1 + jitter*u), u in [-1, 1) "
-                          "(the thesis's dynamic areal height, 4.2)"),
-                Param::integer("seed", -1)
-                    .min(-1)
-                    .max(9.0e18)
-                    .help("-1: the node's own seed (from the spec's seed and the node's name); otherwise this "
-                          "seed, so variants of a node can share their random regions"),
-                Param::integer("cuts", 5).min(1).max(5000).help("random lines per iteration (graph)"),
-                Param::integer("regions", 2)
-                    .min(1)
-                    .max(1'000'000)
-                    .help("polygons raised per peak per iteration, first in depth-first order (graph)"),
-            },
+        .params = rmp_params(),
         .tile_halo = 0,  // a sample's raise is a pure function of the seed and its position
         .check =
             [](CheckContext& ctx) {
@@ -175,34 +210,11 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
         .kind = "generate",
         .name = "range",
         .summary = "A mountain range between two points: RMP along a line (thesis 3.6.2)",
-        .description = "Each iteration draws a fresh Voronoi diagram of `cones` sites and raises every cell the\n"
-                       "segment from `from` to `to` passes through (and every cell of its Bresenham line's\n"
-                       "vertices), as the plate simulation does at each collision. With no input, starts from\n"
-                       "the spec's grid, flat at 0 m.",
+        .description = kRangeDescription,
         .inputs = {{"base", ValueType::heightmap, Need::optional,
                     "terrain to raise the range on (default: the spec's grid, flat at 0 m)"}},
         .output = ValueType::heightmap,
-        .params =
-            {
-                Param::point("from", Point2{0.2, 0.5}).min(0).max(1).help("one end of the range, grid-relative"),
-                Param::point("to", Point2{0.8, 0.5}).min(0).max(1).help("the other end, grid-relative"),
-                Param::integer("iterations", 50).min(1).max(1'000'000).help("raises, each with new cells"),
-                Param::integer("cones", 100)
-                    .min(1)
-                    .max(10'000'000)
-                    .help("Voronoi sites per iteration: more give a narrower range"),
-                Param::real("height", 5.0).min(-1e5).max(1e5).unit("m").help("raise per iteration"),
-                Param::real("jitter", 0.0)
-                    .min(0)
-                    .max(1)
-                    .help("0: every crossed cell by `height`; >0: each by height*(1 + jitter*u), u in [-1, 1)"),
-                Param::integer("seed", -1)
-                    .min(-1)
-                    .max(9.0e18)
-                    .help("-1: the node's own seed (from the spec's seed and the node's name); otherwise this "
-                          "seed, so variants of a node can share their random regions"),
-                Param::boolean("uplift", false).help("also add the raise to the heightmap's 'uplift' layer (m)"),
-            },
+        .params = range_params(),
         .tile_halo = 0,  // as generate:rmp: every rank raises its tile of the whole grid's range
         .check =
             [](CheckContext& ctx) {
