@@ -102,14 +102,26 @@ Point2 unit_normal_of(Point2 a, Point2 b) {
     return {-dy / len, dx / len};
 }
 
+// A band across segment a–b: its unit `normal`, how far past the ends it
+// reaches, its profile across and its taper past the ends.
+struct Band {
+    Point2 a, b, normal;
+    double end_reach;
+    const Table& profile;
+    const Table& taper;
+};
+
 // Add profile(s)·taper(beyond) to every sample of the band s ∈ [profile.lo,
 // profile.hi] across segment a–b (s the signed distance along the unit
 // `normal`) and u ∈ [−end_reach, len + end_reach] along it; `beyond` is how
 // far past an end the sample lies. Rows are walked over the band's exact
 // x-interval, so the cost is the band's area, not its bounding box's.
 template <typename Op>
-void stamp_with(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
-                const Table& profile, const Table& taper, Op op) {
+void stamp_with(std::vector<float>& field, TileRect window, const Band& band, Op op) {
+    const Point2 a = band.a, b = band.b, normal = band.normal;
+    const double end_reach = band.end_reach;
+    const Table& profile = band.profile;
+    const Table& taper = band.taper;
     const double s_lo = profile.lo(), s_hi = profile.hi();
     const double dx = b.x - a.x, dy = b.y - a.y;
     const double len = std::hypot(dx, dy);
@@ -156,14 +168,14 @@ void stamp_with(std::vector<float>& field, TileRect window, Point2 a, Point2 b, 
 
 void stamp(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
            const Table& profile, const Table& taper) {
-    stamp_with(field, window, a, b, normal, end_reach, profile, taper, [](float& v, float d) { v += d; });
+    stamp_with(field, window, {a, b, normal, end_reach, profile, taper}, [](float& v, float d) { v += d; });
 }
 
 // The same band, keeping the largest value: order-independent, so repeated
 // contacts at one place keep one shape instead of summing into a smear.
 void stamp_max(std::vector<float>& field, TileRect window, Point2 a, Point2 b, Point2 normal, double end_reach,
                const Table& profile, const Table& taper) {
-    stamp_with(field, window, a, b, normal, end_reach, profile, taper, [](float& v, float d) { v = std::max(v, d); });
+    stamp_with(field, window, {a, b, normal, end_reach, profile, taper}, [](float& v, float d) { v = std::max(v, d); });
 }
 
 // The tables of one relief: per-contact profiles across each kind of
