@@ -54,9 +54,25 @@ void colour(double t, double& r, double& g, double& b) {
     }
 }
 
-// Light from the north-west, 45° up, true vertical scale.
-void shade_into(Image& img, int ox, int oy, const std::vector<float>& z, int w, int h, double cell, int x0, int y0,
-                int cw, int ch, int zoom, double lo = 0.0, double hi = -1.0) {
+// A heightmap: w × h samples `cell` metres apart.
+struct Heights {
+    const std::vector<float>& z;
+    int w, h;
+    double cell;
+};
+
+// The part of a heightmap to draw: cw × ch samples from (x0, y0), each zoom × zoom pixels.
+struct Crop {
+    int x0, y0, cw, ch, zoom;
+};
+
+// Light from the north-west, 45° up, true vertical scale; drawn at (ox, oy) of img, coloured over [lo, hi]
+// (hi < lo: the heightmap's own range).
+void shade_into(Image& img, int ox, int oy, const Heights& heights, Crop crop, double lo = 0.0, double hi = -1.0) {
+    const std::vector<float>& z = heights.z;
+    const int w = heights.w, h = heights.h;
+    const double cell = heights.cell;
+    const int x0 = crop.x0, y0 = crop.y0, cw = crop.cw, ch = crop.ch, zoom = crop.zoom;
     auto at = [&](int x, int y) {
         return double(z[std::size_t(std::clamp(y, 0, h - 1)) * w + std::clamp(x, 0, w - 1)]);
     };
@@ -94,7 +110,7 @@ int shade(const std::vector<std::string>& a) {
     if (a.size() == 11)
         x0 = std::stoi(a[6]), y0 = std::stoi(a[7]), cw = std::stoi(a[8]), ch = std::stoi(a[9]), zoom = std::stoi(a[10]);
     Image img(cw * zoom, ch * zoom);
-    shade_into(img, 0, 0, z, w, h, cell, x0, y0, cw, ch, zoom);
+    shade_into(img, 0, 0, {z, w, h, cell}, {x0, y0, cw, ch, zoom});
     img.save(a[5]);
     return 0;
 }
@@ -122,7 +138,7 @@ int features(const std::string& out) {
     for (const auto& z : panels)
         for (float v : z) lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
     for (int panel = 0; panel < 3; ++panel)
-        shade_into(img, panel * (n + gap), 0, panels[std::size_t(panel)], n, n, cell_m, 0, 0, n, n, 1, lo, hi);
+        shade_into(img, panel * (n + gap), 0, {panels[std::size_t(panel)], n, n, cell_m}, {0, 0, n, n, 1}, lo, hi);
     img.save(out);
     return 0;
 }
