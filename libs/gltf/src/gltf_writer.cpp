@@ -19,10 +19,12 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cstring>
 #include <functional>
 #include <future>
+#include <memory>
 #include <type_traits>
 #include <optional>
 #include <sstream>
@@ -270,31 +272,45 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
     summary.texture_height = th;
     summary.bytes = buffer_length;
     // Generate chunk i + 1 while chunk i is written: writing is a copy into the
-    // page cache on one core, generation runs on the others.
-    auto build = [&](std::size_t i) {
+    // page cache on one core, generation runs on the others. Two buffers, made
+    // once at the largest chunk's size and never zeroed (every byte is written
+    // but the indices' padding, zeroed by hand): a fresh zeroed buffer a chunk
+    // cost a memset and its page faults, 40 % of a 4097² export.
+    auto chunk_bytes = [&](const ChunkViews& v) {
+        return v.vertex_count * 28 + align4(v.index_count * (v.index16 ? 2 : 4));
+    };
+    std::size_t largest = 0;
+    for (const auto& v : views) largest = std::max(largest, chunk_bytes(v));
+    std::array<std::unique_ptr<std::uint8_t[]>, 2> buffers{std::unique_ptr<std::uint8_t[]>(new std::uint8_t[largest]),
+                                                           std::unique_ptr<std::uint8_t[]>(new std::uint8_t[largest])};
+    auto build = [&](std::size_t i, std::uint8_t* bytes) {
         const auto& c = mesh.chunks[i];
         const auto& v = views[i];
         const std::size_t index_bytes = v.index_count * (v.index16 ? 2 : 4);
-        std::vector<std::uint8_t> bytes(v.vertex_count * 28 + align4(index_bytes), 0);
         auto as = [&](std::size_t offset, auto* type, std::size_t n) {
             using T = std::remove_pointer_t<decltype(type)>;
-            return std::span<T>(reinterpret_cast<T*>(bytes.data() + offset), n);
+            return std::span<T>(reinterpret_cast<T*>(bytes + offset), n);
         };
         terrain::chunk_positions(mesh, c, as(0, (float*)nullptr, v.vertex_count * 3));
         terrain::chunk_normals(mesh, c, as(v.vertex_count * 12, (float*)nullptr, v.vertex_count * 3));
         terrain::chunk_texcoords(mesh, c, as(v.vertex_count * 24, (std::uint16_t*)nullptr, v.vertex_count * 2));
         if (v.index16) terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint16_t*)nullptr, v.index_count));
         else terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
-        return bytes;
+        const std::size_t used = v.vertex_count * 28 + index_bytes, size = chunk_bytes(v);
+        std::fill(bytes + used, bytes + size, std::uint8_t(0));
+        return size;
     };
     write_document(model, buffer_length, target, [&](std::ostream& payload) {
-        std::future<std::vector<std::uint8_t>> next = std::async(std::launch::async, build, 0);
+        // Chunk i is built into buffers[i % 2]; chunk i + 1's build starts once chunk i - 1, the last user of
+        // its buffer, has been written.
+        std::future<std::size_t> next = std::async(std::launch::async, build, 0, buffers[0].get());
         for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
-            std::vector<std::uint8_t> bytes = next.get();
-            if (i + 1 < mesh.chunks.size()) next = std::async(std::launch::async, build, i + 1);
+            const std::size_t size = next.get();
+            if (i + 1 < mesh.chunks.size())
+                next = std::async(std::launch::async, build, i + 1, buffers[(i + 1) % 2].get());
             summary.vertices += views[i].vertex_count;
             summary.triangles += mesh.chunks[i].triangle_count();
-            write_span<std::uint8_t>(payload, bytes);
+            payload.write(reinterpret_cast<const char*>(buffers[i % 2].get()), std::streamsize(size));
         }
         payload.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
         write_zeros(payload, buffer_length - png_offset - png.size());
