@@ -80,11 +80,10 @@ inline void slope_at(ConstGridView height, float inv_cell, int x, int y, float& 
     gy = (height.row(yd)[x] - height.row(yu)[x]) * sy;
 }
 
-template <Hardness H>
-inline void prep_cell(const Rule& r, float h, float w, float s, float gx, float gy, const float* layer, int x,
-                      const PrepRow& out) {
+/// One cell after rain and dissolving; `soft` is its softness<H> (1 − hardness).
+inline void prep_cell(const Rule& r, float h, float w, float s, float soft, int x, const PrepRow& out) {
     const float w1 = w + r.rain;
-    const float dissolved = r.solubility * w1 * softness<H>(gx, gy, layer, x);
+    const float dissolved = r.solubility * w1 * soft;
     const float h1 = h - dissolved;
     out.h[x] = h1;
     out.w[x] = w1;
@@ -108,7 +107,7 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
     auto edge = [&](int x) {
         float gx, gy;
         slope_at(in.height, r.inv_cell, x, y, gx, gy);
-        prep_cell<H>(r, hc[x], wc[x], sc[x], gx, gy, layer, x, out);
+        prep_cell(r, hc[x], wc[x], sc[x], softness<H>(gx, gy, layer, x), x, out);
     };
     // Whole vectors (padded_end) where the grids hold that many floats past
     // the row start (they run on into the next row: junk in the padding);
@@ -117,7 +116,8 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
     const float sx = 0.5f * r.inv_cell;
 #pragma GCC ivdep
     for (int x = 1; x < xe; ++x)
-        prep_cell<H>(r, hc[x], wc[x], sc[x], (hc[x + 1] - hc[x - 1]) * sx, (hd[x] - hu[x]) * sy, layer, x, out);
+        prep_cell(r, hc[x], wc[x], sc[x], softness<H>((hc[x + 1] - hc[x - 1]) * sx, (hd[x] - hu[x]) * sy, layer, x), x,
+                  out);
     edge(0);
     if (w > 1) edge(w - 1);
 }
@@ -126,8 +126,10 @@ OROGEN_HYDRAULIC_CLONES void prep_row(const ConstState& in, const Rule& r, int y
 
 /// Olsen's flow factors for one cell from its altitude a, water w, sediment s
 /// and its neighbours' altitudes (absent neighbours: `has` false).
-inline void factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4], float& f, float& g,
-                        float& wr, float& sr) {
+struct Factors {
+    float f, g, wr, sr;
+};
+inline Factors factor_cell(float a, float w, float s, const float (&an)[4], const bool (&has)[4]) {
     float drop_sum = 0.0f, lower_n = 0.0f;
     for (int k = 0; k < 4; ++k) {
         const float d = a - an[k];
@@ -145,10 +147,9 @@ inline void factor_cell(float a, float w, float s, const float (&an)[4], const b
     const float m = std::max(drop_sum, w * (1.0f + lower_n));
     const float inv = 1.0f / std::max(m, 1e-30f);
     const bool flows = drop_sum > 0.0f && w > 0.0f;
-    f = flows ? w * inv : 0.0f;
-    g = flows ? s * inv : 0.0f;
-    wr = w - f * drop_sum;
-    sr = s - g * drop_sum;
+    const float f = flows ? w * inv : 0.0f;
+    const float g = flows ? s * inv : 0.0f;
+    return {f, g, w - f * drop_sum, s - g * drop_sum};
 }
 
 OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, const PrepRow* dn, int w,
@@ -157,7 +158,11 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
         const float an[4] = {x > 0 ? c.a[x - 1] : 0.0f, x + 1 < w ? c.a[x + 1] : 0.0f, up ? up->a[x] : 0.0f,
                              dn ? dn->a[x] : 0.0f};
         const bool has[4] = {x > 0, x + 1 < w, up != nullptr, dn != nullptr};
-        factor_cell(c.a[x], c.w[x], c.s[x], an, has, out.f[x], out.g[x], out.wr[x], out.sr[x]);
+        const Factors k = factor_cell(c.a[x], c.w[x], c.s[x], an, has);
+        out.f[x] = k.f;
+        out.g[x] = k.g;
+        out.wr[x] = k.wr;
+        out.sr[x] = k.sr;
     };
     if (!up || !dn || w < 3) {
         for (int x = 0; x < w; ++x) edge(x);
@@ -178,12 +183,11 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
 #pragma GCC ivdep
     for (int x = 1; x < xe; ++x) {
         const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
-        float fx, gx, wrx, srx;
-        factor_cell(a[x], wc[x], sc[x], an, all, fx, gx, wrx, srx);
-        f[x] = fx;
-        g[x] = gx;
-        wr[x] = wrx;
-        sr[x] = srx;
+        const Factors k = factor_cell(a[x], wc[x], sc[x], an, all);
+        f[x] = k.f;
+        g[x] = k.g;
+        wr[x] = k.wr;
+        sr[x] = k.sr;
     }
     edge(0);
     edge(w - 1);
@@ -191,11 +195,22 @@ OROGEN_HYDRAULIC_CLONES void factor_row(const PrepRow* up, const PrepRow& c, con
 
 // ----------------------------------------------- step 3 gather + step 4
 
+/// A cell's four neighbours (left, right, up, down): altitudes and flow factors.
+struct Neighbours {
+    float a[4], f[4], g[4];
+};
+/// A cell's new terrain, water and sediment.
+struct Cell {
+    float h, w, s;
+};
+
 /// One cell's new state: what it kept after its own outflow (wr, sr), its
 /// neighbours' inflow, then evaporation.
-inline void output_cell(const Rule& r, float a, float h1, float wr, float sr, const float (&an)[4],
-                        const float (&fn)[4], const float (&gn)[4], const bool (&has)[4], float& h_out, float& w_out,
-                        float& s_out) {
+inline Cell output_cell(const Rule& r, float a, float h1, float wr, float sr, const Neighbours& n,
+                        const bool (&has)[4]) {
+    const float(&an)[4] = n.a;
+    const float(&fn)[4] = n.f;
+    const float(&gn)[4] = n.g;
     float w_in = 0.0f, s_in = 0.0f;
     for (int k = 0; k < 4; ++k) {
         const float e = an[k] - a;  // drop from neighbour k (receiving): the giver's own drop
@@ -208,21 +223,43 @@ inline void output_cell(const Rule& r, float a, float h1, float wr, float sr, co
     const float w2 = std::max((wr + w_in) * r.keep, 0.0f);
     const float s2 = sr + s_in;
     const float excess = std::max(s2 - r.capacity * w2, 0.0f);  // deposited where water cannot hold it
-    w_out = w2;
-    s_out = s2 - excess;
-    h_out = h1 + excess;
+    return {h1 + excess, w2, s2 - excess};
 }
 
-OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const FactorRow* fup, const PrepRow& c,
-                                        const FactorRow& fc, const PrepRow* dn, const FactorRow* fdn, int w,
-                                        float* __restrict ho, float* __restrict wo, float* __restrict so) {
+/// Rows y − 1, y and y + 1 of both stages (up and down nullptr outside the grid).
+struct Stencil {
+    const PrepRow* up;
+    const FactorRow* fup;
+    const PrepRow* c;
+    const FactorRow* fc;
+    const PrepRow* dn;
+    const FactorRow* fdn;
+};
+/// An output row: terrain, water, sediment.
+struct OutRow {
+    float *h, *w, *s;
+};
+
+OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const Stencil& rows, int w, const OutRow& out) {
+    const PrepRow* up = rows.up;
+    const FactorRow* fup = rows.fup;
+    const PrepRow& c = *rows.c;
+    const FactorRow& fc = *rows.fc;
+    const PrepRow* dn = rows.dn;
+    const FactorRow* fdn = rows.fdn;
+    float* __restrict ho = out.h;
+    float* __restrict wo = out.w;
+    float* __restrict so = out.s;
     auto edge = [&](int x) {
         const bool has[4] = {x > 0, x + 1 < w, up != nullptr, dn != nullptr};
         const int xl = has[0] ? x - 1 : x, xr = has[1] ? x + 1 : x;
-        const float an[4] = {c.a[xl], c.a[xr], up ? up->a[x] : 0.0f, dn ? dn->a[x] : 0.0f};
-        const float fn[4] = {fc.f[xl], fc.f[xr], fup ? fup->f[x] : 0.0f, fdn ? fdn->f[x] : 0.0f};
-        const float gn[4] = {fc.g[xl], fc.g[xr], fup ? fup->g[x] : 0.0f, fdn ? fdn->g[x] : 0.0f};
-        output_cell(r, c.a[x], c.h[x], fc.wr[x], fc.sr[x], an, fn, gn, has, ho[x], wo[x], so[x]);
+        const Neighbours n = {{c.a[xl], c.a[xr], up ? up->a[x] : 0.0f, dn ? dn->a[x] : 0.0f},
+                              {fc.f[xl], fc.f[xr], fup ? fup->f[x] : 0.0f, fdn ? fdn->f[x] : 0.0f},
+                              {fc.g[xl], fc.g[xr], fup ? fup->g[x] : 0.0f, fdn ? fdn->g[x] : 0.0f}};
+        const Cell k = output_cell(r, c.a[x], c.h[x], fc.wr[x], fc.sr[x], n, has);
+        ho[x] = k.h;
+        wo[x] = k.w;
+        so[x] = k.s;
     };
     if (!up || !dn || w < 3) {
         for (int x = 0; x < w; ++x) edge(x);
@@ -241,14 +278,12 @@ OROGEN_HYDRAULIC_CLONES void output_row(const Rule& r, const PrepRow* up, const 
     const int xe = padded_end(w);
 #pragma GCC ivdep
     for (int x = 1; x < xe; ++x) {
-        const float an[4] = {a[x - 1], a[x + 1], au[x], ad[x]};
-        const float fn[4] = {f[x - 1], f[x + 1], fu[x], fd[x]};
-        const float gn[4] = {g[x - 1], g[x + 1], gu[x], gd[x]};
-        float hx, wx, sx;
-        output_cell(r, a[x], c.h[x], fc.wr[x], fc.sr[x], an, fn, gn, all, hx, wx, sx);
-        ho[x] = hx;
-        wo[x] = wx;
-        so[x] = sx;
+        const Neighbours n = {
+            {a[x - 1], a[x + 1], au[x], ad[x]}, {f[x - 1], f[x + 1], fu[x], fd[x]}, {g[x - 1], g[x + 1], gu[x], gd[x]}};
+        const Cell k = output_cell(r, a[x], c.h[x], fc.wr[x], fc.sr[x], n, all);
+        ho[x] = k.h;
+        wo[x] = k.w;
+        so[x] = k.s;
     }
     edge(0);
     edge(w - 1);
@@ -319,8 +354,10 @@ void step_impl(const ConstState& in, const State& out, const Rule& r) {
                 }
             }
             const bool has_up = y > 0, has_dn = y + 1 < rows;
-            output_row(r, has_up ? &prep_at(y - 1) : nullptr, has_up ? &fac_at(y - 1) : nullptr, prep_at(y), fac_at(y),
-                       has_dn ? &prep_at(y + 1) : nullptr, has_dn ? &fac_at(y + 1) : nullptr, w, ho, wo, so);
+            const Stencil rows3{
+                has_up ? &prep_at(y - 1) : nullptr, has_up ? &fac_at(y - 1) : nullptr, &prep_at(y), &fac_at(y),
+                has_dn ? &prep_at(y + 1) : nullptr, has_dn ? &fac_at(y + 1) : nullptr};
+            output_row(r, rows3, w, {ho, wo, so});
             std::memcpy(out.height.row(int(y)), ho, bytes);
             std::memcpy(out.water.row(int(y)), wo, bytes);
             std::memcpy(out.sediment.row(int(y)), so, bytes);
