@@ -71,11 +71,21 @@ struct RowSums {
 
 inline float rain_factor(const Arrays& a, std::size_t i) { return a.mask ? a.mask[i] : 1.0f; }
 
+/// Which of a cell's neighbours exist (west, east, north, south).
+struct Sides {
+    bool w, e, n, s;
+};
+/// The rain mask at a cell's neighbours (0 where absent) and at the cell.
+struct MaskAround {
+    float w, e, n, s, c;
+};
+
 /// Pass 1 for one cell. The flags say which neighbours exist; the interior
 /// loop passes constants so the compiler drops the tests and vectorises.
-[[gnu::always_inline]] inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw,
-                                             bool he, bool hn, bool hs, float mw, float me, float mn, float ms,
-                                             float mc) {
+[[gnu::always_inline]] inline void flux_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, const Sides has,
+                                             const MaskAround m) {
+    const bool hw = has.w, he = has.e, hn = has.n, hs = has.s;
+    const float mw = m.w, me = m.e, mn = m.n, ms = m.s, mc = m.c;
     const float* __restrict b = a.b;
     const float* __restrict d = a.d;
     const float d1 = d[i] + k.rain_dt * mc;
@@ -112,8 +122,8 @@ OROGEN_PIPE_CLONES void flux_row_impl(const Arrays a, const Sub k, int y) {
     auto edge = [&](int x) {
         const std::size_t i = row + std::size_t(x);
         const bool hw = x > 0, he = x + 1 < W;
-        flux_cell(a, k, i, Ws, hw, he, hn, hs, hw ? m(i - 1) : 0.0f, he ? m(i + 1) : 0.0f, hn ? m(i - Ws) : 0.0f,
-                  hs ? m(i + Ws) : 0.0f, m(i));
+        flux_cell(a, k, i, Ws, {hw, he, hn, hs},
+                  {hw ? m(i - 1) : 0.0f, he ? m(i + 1) : 0.0f, hn ? m(i - Ws) : 0.0f, hs ? m(i + Ws) : 0.0f, m(i)});
     };
     if (!hn || !hs || W < 3) {
         for (int x = 0; x < W; ++x) edge(x);
@@ -123,7 +133,7 @@ OROGEN_PIPE_CLONES void flux_row_impl(const Arrays a, const Sub k, int y) {
     edge(W - 1);
 #pragma GCC ivdep
     for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
-        flux_cell(a, k, i, Ws, true, true, true, true, m(i - 1), m(i + 1), m(i - Ws), m(i + Ws), m(i));
+        flux_cell(a, k, i, Ws, {true, true, true, true}, {m(i - 1), m(i + 1), m(i - Ws), m(i + Ws), m(i)});
 }
 
 void flux_row(const Arrays& a, const Sub& k, int y) {
@@ -131,10 +141,24 @@ void flux_row(const Arrays& a, const Sub& k, int y) {
     else flux_row_impl<false>(a, k, y);
 }
 
+/// The factors of the terrain's tilt at a cell: 1/l one-sided, 1/(2l) central, 0 with no neighbour.
+struct TiltScale {
+    float x, y;
+};
+/// Whether the stored sediment is scaled by `scale` as it is read.
+struct SedimentScale {
+    bool rescale;
+    double scale;
+};
+
 /// Pass 2 for one cell; returns its speed, adds to the row sums.
-[[gnu::always_inline]] inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W, bool hw,
-                                              bool he, bool hn, bool hs, float gx_scale, float gy_scale, float mc,
-                                              bool rescale, double scale) {
+[[gnu::always_inline]] inline void water_cell(const Arrays a, const Sub k, std::size_t i, std::size_t W,
+                                              const Sides has, const TiltScale tilt, float mc,
+                                              const SedimentScale sed) {
+    const bool hw = has.w, he = has.e, hn = has.n, hs = has.s;
+    const float gx_scale = tilt.x, gy_scale = tilt.y;
+    const bool rescale = sed.rescale;
+    const double scale = sed.scale;
     const float* __restrict b = a.b;
     const float d1 = a.d[i] + k.rain_dt * mc;
     const float from_w = hw ? a.fe[i - 1] : 0.0f;
@@ -279,7 +303,7 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
         const bool hw = x > 0, he = x + 1 < W;
         const float gx_scale = (hw && he) ? 0.5f * k.inv_l : ((hw || he) ? k.inv_l : 0.0f);
         const std::size_t i = row + std::size_t(x);
-        water_cell(a, k, i, Ws, hw, he, hn, hs, gx_scale, gy_scale, m(i), Rescale, scale);
+        water_cell(a, k, i, Ws, {hw, he, hn, hs}, {gx_scale, gy_scale}, m(i), {Rescale, scale});
     };
     if (!hn || !hs || W < 3) {
         for (int x = 0; x < W; ++x) edge(x);
@@ -289,7 +313,7 @@ OROGEN_PIPE_CLONES RowSums water_row_impl(const Arrays a, const Sub k, int y, do
     const float gx_scale = 0.5f * k.inv_l;
 #pragma GCC ivdep
     for (std::size_t i = row + 1; i < row + Ws - 1; ++i)
-        water_cell(a, k, i, Ws, true, true, true, true, gx_scale, gy_scale, m(i), Rescale, scale);
+        water_cell(a, k, i, Ws, {true, true, true, true}, {gx_scale, gy_scale}, m(i), {Rescale, scale});
     edge(W - 1);
     return row_sums(a, row, k.gravity);
 }
