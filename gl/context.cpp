@@ -25,11 +25,20 @@ std::recursive_mutex& context_mutex() {
 // races llvmpipe's own worker threads, and the process ends right after.
 OSMesaContext g_context = nullptr;
 std::array<std::uint8_t, 4 * 4 * 4> g_dummy{};  // the context's own 4 × 4 framebuffer, unused
-thread_local int g_depth = 0;                   // nested Locks on this thread
+thread_local int g_depth = 0;  // nested Locks on this thread
 
 void create(std::string_view who) {
-    const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 0, OSMESA_PROFILE, OSMESA_CORE_PROFILE,
-                           OSMESA_CONTEXT_MAJOR_VERSION, 4, OSMESA_CONTEXT_MINOR_VERSION, 5, 0};
+    const int attribs[] = {OSMESA_FORMAT,
+                           OSMESA_RGBA,
+                           OSMESA_DEPTH_BITS,
+                           0,
+                           OSMESA_PROFILE,
+                           OSMESA_CORE_PROFILE,
+                           OSMESA_CONTEXT_MAJOR_VERSION,
+                           4,
+                           OSMESA_CONTEXT_MINOR_VERSION,
+                           5,
+                           0};
     g_context = OSMesaCreateContextAttribs(attribs, nullptr);
     if (!g_context)
         throw Error(std::string(who) +

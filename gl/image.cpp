@@ -150,8 +150,7 @@ void check_frame_size(std::string_view who, int width, int height, double bytes_
     const int limit = max_framebuffer_size();
     if (width < 1 || height < 1 || width > limit || height > limit)
         throw BadInput(std::string(who) + ": a frame of " + std::to_string(width) + " × " + std::to_string(height) +
-                       " pixels cannot be drawn: OSMesa draws from 1 to " + std::to_string(limit) +
-                       " pixels a side");
+                       " pixels cannot be drawn: OSMesa draws from 1 to " + std::to_string(limit) + " pixels a side");
     const double need = double(width) * double(height) * bytes_per_pixel;
     const double memory = double(sysconf(_SC_PHYS_PAGES)) * double(sysconf(_SC_PAGE_SIZE));
     if (need > memory / 2)

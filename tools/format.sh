@@ -4,7 +4,7 @@
 # FORMATTED lists the folders already under the rule: a folder joins when it is formatted in one commit.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-FORMATTED=(libs viewer python kernel plugins/analyze plugins/erode plugins/export plugins/generate plugins/import plugins/process plugins/render plugins/tectonics)
+FORMATTED=(libs viewer python kernel gl tests plugins/analyze plugins/erode plugins/export plugins/generate plugins/import plugins/process plugins/render plugins/tectonics)
 tool=${CLANG_FORMAT:-clang-format-14}
 command -v "$tool" >/dev/null || { echo "format: $tool is not installed (tools/setup.sh installs it)"; exit 2; }
 mapfile -t files < <(git ls-files -- "${FORMATTED[@]/%//*.cpp}" "${FORMATTED[@]/%//*.hpp}" 2>/dev/null ||

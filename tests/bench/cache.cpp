@@ -53,7 +53,8 @@ double process_cpu_seconds() {
 struct ProcessCpu {
     double start = process_cpu_seconds();
     void report(benchmark::State& state) const {
-        state.counters["all_threads_cpu_ms"] = 1e3 * (process_cpu_seconds() - start) / double(std::max<std::int64_t>(1, state.iterations()));
+        state.counters["all_threads_cpu_ms"] =
+            1e3 * (process_cpu_seconds() - start) / double(std::max<std::int64_t>(1, state.iterations()));
     }
 };
 
@@ -66,7 +67,8 @@ cache::Digest key() {
 
 static void BM_CacheRead(benchmark::State& state) {
     const int n = int(state.range(0));
-    cache::Store store({folder(), std::uint64_t(8) << 30}, [](const std::string& w) { std::fprintf(stderr, "%s\n", w.c_str()); });
+    cache::Store store({folder(), std::uint64_t(8) << 30},
+                       [](const std::string& w) { std::fprintf(stderr, "%s\n", w.c_str()); });
     if (!store.save(key(), terrain_entry(n))) state.SkipWithError("could not write the entry");
     const auto bytes = fs::file_size(store.path(key()));
     ProcessCpu cpu;
@@ -83,7 +85,8 @@ BENCHMARK(BM_CacheRead)->Arg(2049)->Unit(benchmark::kMillisecond)->UseRealTime()
 
 static void BM_CacheWrite(benchmark::State& state) {
     const int n = int(state.range(0));
-    cache::Store store({folder(), std::uint64_t(8) << 30}, [](const std::string& w) { std::fprintf(stderr, "%s\n", w.c_str()); });
+    cache::Store store({folder(), std::uint64_t(8) << 30},
+                       [](const std::string& w) { std::fprintf(stderr, "%s\n", w.c_str()); });
     const auto contents = terrain_entry(n);
     ProcessCpu cpu;
     for (auto _ : state)
@@ -129,18 +132,23 @@ const fs::path& glb_scratch() {
         auto* p = new fs::path(fs::temp_directory_path() / ("orogen-bench-cache-glb-" + std::to_string(::getpid())));
         fs::create_directories(*p);
         std::FILE* spec = std::fopen((*p / "glb.orogen").c_str(), "w");
-        std::fputs("orogen 1\nseed 7\ngrid 4097 cell=10\n"
-                   "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
-                   "export:tiles(t, path=\"tiles/t.json\", tile_size=513, format=glb)\n",
-                   spec);
+        std::fputs(
+            "orogen 1\nseed 7\ngrid 4097 cell=10\n"
+            "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
+            "export:tiles(t, path=\"tiles/t.json\", tile_size=513, format=glb)\n",
+            spec);
         std::fclose(spec);
         spec = std::fopen((*p / "gltf.orogen").c_str(), "w");
-        std::fputs("orogen 1\nseed 7\ngrid 4097 cell=10\n"
-                   "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
-                   "export:gltf(t, path=\"t.glb\")\n",
-                   spec);
+        std::fputs(
+            "orogen 1\nseed 7\ngrid 4097 cell=10\n"
+            "t = generate:diamond-square(roughness=0.55, amplitude=1500)\n"
+            "export:gltf(t, path=\"t.glb\")\n",
+            spec);
         std::fclose(spec);
-        std::atexit([] { std::error_code ec; fs::remove_all(glb_scratch(), ec); });  // whichever benchmarks ran
+        std::atexit([] {
+            std::error_code ec;
+            fs::remove_all(glb_scratch(), ec);
+        });  // whichever benchmarks ran
         return p;
     }();
     return f;
@@ -168,7 +176,8 @@ Child run_child(const std::vector<std::string>& args) {
     rusage u{};
     ::wait4(pid, &c.status, 0, &u);
     c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    c.cpu_seconds = double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+    c.cpu_seconds =
+        double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
     c.peak_mib = double(u.ru_maxrss) / 1024.0;
     return c;
 }
@@ -178,8 +187,8 @@ fs::path spec_path(int spec) { return glb_scratch() / (spec == 0 ? "glb.orogen" 
 fs::path out_path(int spec) { return glb_scratch() / (spec == 0 ? "out" : "out-gltf"); }
 
 std::vector<std::string> orogen_run(const fs::path& out, const char* cache_mode, int spec = 0) {
-    std::vector<std::string> a{OROGEN_CLI, "run", spec_path(spec).string(), "--out", out.string(),
-                               "--threads", "2", "--quiet"};
+    std::vector<std::string> a{OROGEN_CLI, "run",    spec_path(spec).string(), "--out", out.string(), "--threads",
+                               "2",        "--quiet"};
     if (std::string(cache_mode) == "none") a.push_back("--no-cache");
     else a.insert(a.end(), {"--cache", (glb_scratch() / "cache").string()});
     return a;
@@ -220,10 +229,10 @@ static void BM_Glb4097Run(benchmark::State& state) {
     }
     report(state, runs);
     state.SetLabel(std::string(spec == 0 ? "tiles, " : "gltf, ") +
-                   (mode == 0   ? "--no-cache"
-                    : mode == 1 ? "cold cache"
-                    : mode == 2 ? "warm, same --out"
-                                : "warm, new --out"));
+                   (mode == 0       ? "--no-cache"
+                        : mode == 1 ? "cold cache"
+                        : mode == 2 ? "warm, same --out"
+                                    : "warm, new --out"));
 }
 BENCHMARK(BM_Glb4097Run)
     ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})

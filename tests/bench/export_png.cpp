@@ -22,7 +22,8 @@ const std::vector<std::uint16_t>& samples(int n) {
         const auto& h = bench::terrain(n);
         const auto [lo, hi] = std::minmax_element(h.begin(), h.end());
         s.resize(h.size());
-        for (std::size_t i = 0; i < h.size(); ++i) s[i] = std::uint16_t(std::lround((h[i] - *lo) / (*hi - *lo) * 65535.0));
+        for (std::size_t i = 0; i < h.size(); ++i)
+            s[i] = std::uint16_t(std::lround((h[i] - *lo) / (*hi - *lo) * 65535.0));
     }
     return s;
 }
@@ -39,7 +40,14 @@ static void BM_Png16_orogen(benchmark::State& state) {
     state.counters["MB"] = double(std::filesystem::file_size(file)) / 1e6;
     std::filesystem::remove(file);
 }
-BENCHMARK(BM_Png16_orogen)->ArgName("level")->Arg(1)->Arg(6)->Arg(12)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(2);
+BENCHMARK(BM_Png16_orogen)
+    ->ArgName("level")
+    ->Arg(1)
+    ->Arg(6)
+    ->Arg(12)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(2);
 
 static void BM_Png16_libpng(benchmark::State& state) {
     const int n = 4097;

@@ -19,4 +19,10 @@ static void BM_VdbTerrain(benchmark::State& state) {
     std::filesystem::remove(bench::scratch() / "t.vdb");
 }
 // Args: size, half floats for the level set (the default)
-BENCHMARK(BM_VdbTerrain)->Args({4097, 0})->Args({4097, 1})->Args({1025, 1})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_VdbTerrain)
+    ->Args({4097, 0})
+    ->Args({4097, 1})
+    ->Args({1025, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);

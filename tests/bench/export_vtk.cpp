@@ -24,4 +24,11 @@ static void BM_Vtk(benchmark::State& state) {
     std::filesystem::remove(file);
 }
 // Args: (0 = .vti, 1 = .vtp), compress, (0 = up z, 1 = up y)
-BENCHMARK(BM_Vtk)->Args({0, 0, 0})->Args({0, 0, 1})->Args({0, 1, 0})->Args({1, 0, 0})->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_Vtk)
+    ->Args({0, 0, 0})
+    ->Args({0, 0, 1})
+    ->Args({0, 1, 0})
+    ->Args({1, 0, 0})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(3);

@@ -24,8 +24,8 @@ void BM_pipe_substep(benchmark::State& state) {
     const double cell = 10.0;
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-            buf[std::size_t(y) * n + x] =
-                20.0f * float(random::uniform(1, x, y)) + 100.0f * std::sin(0.01f * float(x)) * std::cos(0.013f * float(y));
+            buf[std::size_t(y) * n + x] = 20.0f * float(random::uniform(1, x, y)) +
+                100.0f * std::sin(0.01f * float(x)) * std::cos(0.013f * float(y));
     auto view = [&](int k) { return GridView{buf.data() + k * size, n, n, cell}; };
     pipe::State st{view(0), view(1), view(2), view(3), view(4), view(5), view(6), view(7)};
     pipe::Settings s;

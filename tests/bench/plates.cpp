@@ -29,7 +29,9 @@ static void BM_Plates(benchmark::State& state) {
         std::fill(uplift.begin(), uplift.end(), 0.0f);
         std::fill(boundary.begin(), boundary.end(), 0.0f);
         state.ResumeTiming();
-        const Layers layers{{height.data(), n, n, 20.0}, {uplift.data(), n, n, 20.0}, {boundary.data(), n, n, 20.0},
+        const Layers layers{{height.data(), n, n, 20.0},
+                            {uplift.data(), n, n, 20.0},
+                            {boundary.data(), n, n, 20.0},
                             {plate.data(), n, n, 20.0}};
         const Result r = simulate(start, p, 42, layers);
         box2d += r.stats.box2d_seconds;

@@ -127,11 +127,13 @@ void BM_Turntable(benchmark::State& state) {
     const auto path = std::filesystem::temp_directory_path() / "orogen-bench-turntable.mp4";
     const double cpu0 = process_cpu();
     for (auto _ : state) {
-        video::encode_video(path, std::size_t(frames), [&](std::size_t i) {
-            render::Camera c;
-            c.azimuth = 360.0 * double(i) / frames;
-            return render::bloom(renderer.render(width, height, c), {});
-        }, {});
+        video::encode_video(path, std::size_t(frames),
+                            [&](std::size_t i) {
+                                render::Camera c;
+                                c.azimuth = 360.0 * double(i) / frames;
+                                return render::bloom(renderer.render(width, height, c), {});
+                            },
+                            {});
     }
     state.counters["frames"] = frames;
     state.counters["cpu_all_threads_s"] = (process_cpu() - cpu0) / double(state.iterations());

@@ -50,17 +50,31 @@ void BM_Range(benchmark::State& state) {
     rmp::RangeParams p;
     p.cones = int(state.range(0));
     std::uint64_t seed = 1;
-    for (auto _ : state) {
-        benchmark::DoNotOptimize(rmp::raise_range(v, {200, 300}, {800, 700}, p, seed++));
-    }
+    for (auto _ : state) { benchmark::DoNotOptimize(rmp::raise_range(v, {200, 300}, {800, 700}, p, seed++)); }
 }
 
 }  // namespace
 
-BENCHMARK(BM_RmpVoronoi)->Arg(7)->Arg(11)->Arg(16)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000)
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_RmpCones)->Arg(7)->Arg(11)->Arg(16)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000)
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_RmpVoronoi)
+    ->Arg(7)
+    ->Arg(11)
+    ->Arg(16)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_RmpCones)
+    ->Arg(7)
+    ->Arg(11)
+    ->Arg(16)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_RmpGraph)->Arg(3)->Arg(4)->Arg(5)->Arg(50)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_Range)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond)->UseRealTime();
 

@@ -26,8 +26,8 @@ std::vector<float> hills(int n) {
     std::vector<float> h(std::size_t(n) * n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-            h[std::size_t(y) * n + x] = float(50.0 + 50.0 * std::sin(0.006 * x) * std::cos(0.005 * y) +
-                                              0.5 * random::uniform(1, x, y));
+            h[std::size_t(y) * n + x] =
+                float(50.0 + 50.0 * std::sin(0.006 * x) * std::cos(0.005 * y) + 0.5 * random::uniform(1, x, y));
     return h;
 }
 
@@ -74,8 +74,8 @@ void BM_sph_step_dambreak(benchmark::State& state) {
     for (int k = 0; k < side; ++k)
         for (int j = 0; j < side; ++j)
             for (int i = 0; i < side; ++i)
-                sim.add({float((i + 0.5) * spacing), float((j + 0.5) * spacing), float((k + 0.5) * spacing)}, {},
-                        0.0f, 0);
+                sim.add({float((i + 0.5) * spacing), float((j + 0.5) * spacing), float((k + 0.5) * spacing)}, {}, 0.0f,
+                        0);
     const double dt = sim.stable_dt();
     for (int i = 0; i < 20; ++i) sim.substep(dt);
     for (auto _ : state) {

@@ -7,7 +7,9 @@
 using namespace orogen;
 
 OROGEN_PLUGIN("test-stale", "0.1.0", registry) {
-    registry.add({.kind = "generate", .name = "test-stale", .summary = "a flat heightmap at the build's elevation",
+    registry.add({.kind = "generate",
+                  .name = "test-stale",
+                  .summary = "a flat heightmap at the build's elevation",
                   .output = ValueType::heightmap,
                   .run = [](NodeContext& ctx) -> NodeOutputs {
                       const GridSpec g = ctx.grid();

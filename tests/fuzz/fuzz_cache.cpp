@@ -33,13 +33,15 @@ void check_valid(const cache::Contents& c) {
                 const Image& im = *v.image();
                 const std::size_t samples = std::size_t(im.width) * std::size_t(im.height) * 4;
                 if (im.width < 0 || im.height < 0) __builtin_trap();
-                if ((im.format == Image::Format::rgba8 ? im.rgba8.size() : im.rgba32f.size()) != samples) __builtin_trap();
+                if ((im.format == Image::Format::rgba8 ? im.rgba8.size() : im.rgba32f.size()) != samples)
+                    __builtin_trap();
                 break;
             }
             case ValueType::particles:
                 for (const auto& f : v.particles()->frames) {
-                    const std::size_t n = f.attributes.empty() ? 0 : f.attributes.begin()->second.data.size() /
-                                                                         std::size_t(f.attributes.begin()->second.components);
+                    const std::size_t n = f.attributes.empty() ? 0
+                                                               : f.attributes.begin()->second.data.size() /
+                            std::size_t(f.attributes.begin()->second.components);
                     for (const auto& [an, a] : f.attributes)
                         if (a.components < 1 || a.data.size() != n * std::size_t(a.components)) __builtin_trap();
                 }
@@ -70,9 +72,7 @@ void try_decode(const std::vector<std::uint8_t>& entry, const cache::Digest& key
     cache::Contents c;
     try {
         c = cache::decode(entry, key);
-    } catch (const cache::CorruptEntry&) {
-        return;
-    } catch (const cache::OtherVersion&) {
+    } catch (const cache::CorruptEntry&) { return; } catch (const cache::OtherVersion&) {
         return;
     }
     check_valid(c);

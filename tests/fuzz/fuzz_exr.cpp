@@ -25,7 +25,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             const auto* c = info.find(name);
             if (!c || c->type == orogen::exr::SampleType::uint32) __builtin_trap();
         }
-    } catch (const orogen::BadInput&) {
-    }
+    } catch (const orogen::BadInput&) {}
     return 0;
 }

@@ -13,7 +13,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         if (image.width != header.width || image.height != header.height ||
             image.samples.size() != std::size_t(image.width) * std::size_t(image.height))
             __builtin_trap();  // the header and the decoded image disagree
-    } catch (const orogen::BadInput&) {
-    }
+    } catch (const orogen::BadInput&) {}
     return 0;
 }

@@ -18,7 +18,7 @@ namespace {
 
 struct Block {
     std::string file;  ///< relative to the source tree
-    int line = 0;      ///< of the opening fence
+    int line = 0;  ///< of the opening fence
     std::string info;  ///< what follows the ``` ("orogen", "text", "")
     std::string text;
 };
@@ -77,12 +77,14 @@ TEST(Docs, EverySpecBlockInTheReadmeAndDocsPassesCheck) {
             const std::string where = file + ":" + std::to_string(b.line);
             if (b.info != "orogen") {
                 EXPECT_FALSE(b.info.empty() && has_statement(b.text))
-                    << where << ": this block holds spec statements but is not fenced as ```orogen, so nothing "
-                                "checks it; fence it ```orogen (a whole spec), or ```text if it cannot be checked";
+                    << where
+                    << ": this block holds spec statements but is not fenced as ```orogen, so nothing "
+                       "checks it; fence it ```orogen (a whole spec), or ```text if it cannot be checked";
                 continue;
             }
             std::string name = where;
-            std::replace_if(name.begin(), name.end(), [](char c) { return c == '/' || c == ':'; }, '-');
+            std::replace_if(
+                name.begin(), name.end(), [](char c) { return c == '/' || c == ':'; }, '-');
             const fs::path spec = dir.write(name + ".orogen", b.text);
             const RunResult r = run_orogen("check " + q(spec) + " --out " + q(dir / "out"));
             EXPECT_EQ(r.exit_code, 0) << where << ": the spec block fails `orogen check`:\n" << r.err;

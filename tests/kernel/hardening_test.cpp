@@ -31,8 +31,7 @@ namespace {
 
 const std::string fake_plugins = std::string("OROGEN_PLUGIN_PATH=") + OROGEN_FAKE_PLUGIN_DIR;
 
-const char* small_spec =
-    "orogen 1\ngrid 17\nt = generate:fault(iterations=3)\nexport:png(t, path=\"PATH\")\n";
+const char* small_spec = "orogen 1\ngrid 17\nt = generate:fault(iterations=3)\nexport:png(t, path=\"PATH\")\n";
 
 std::string spec_writing(const std::string& path) {
     std::string s = small_spec;
@@ -142,7 +141,9 @@ TEST(Confinement, ASymbolicLinkInsideTheOutputFolderPointingOutIsRefused) {
     RunResult r = run_orogen("check a.orogen --out out", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("error: export:png: 'link/a.png' leads out of the output folder out through a symbolic "
-                         "link (to " + fs::canonical(dir.path()).string() + "/outside/a.png); give a path inside "
+                         "link (to " +
+                         fs::canonical(dir.path()).string() +
+                         "/outside/a.png); give a path inside "
                          "--out, or pass --allow-outside-out to write there\n"),
               std::string::npos)
         << r.err;
@@ -199,8 +200,9 @@ TEST(Inputs, AFifoOrADeviceIsRefusedAtOnceNotReadForever) {
         << r.err;
     r = run_orogen("check pipe.orogen", "timeout 20", dir.path());
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_EQ(r.err, "orogen: error: cannot read pipe.orogen: it is a FIFO (named pipe), not a regular file; give a "
-                     "file (orogen reads only regular files)\n");
+    EXPECT_EQ(r.err,
+              "orogen: error: cannot read pipe.orogen: it is a FIFO (named pipe), not a regular file; give a "
+              "file (orogen reads only regular files)\n");
     EXPECT_FALSE(fs::exists(dir / "out/o.png"));
 }
 
@@ -219,9 +221,7 @@ TEST(BoundedPng, AHugeDeclaredSizeFailsFastInLittleMemory) {
         std::string message = "no error";
         try {
             read_gray_png(dir / "huge.png");
-        } catch (const std::exception& e) {
-            message = e.what();
-        }
+        } catch (const std::exception& e) { message = e.what(); }
         (void)!::write(fds[1], message.data(), message.size());
         ::_exit(0);
     }
@@ -239,10 +239,10 @@ TEST(BoundedPng, AHugeDeclaredSizeFailsFastInLittleMemory) {
                   "vertex),");
     EXPECT_NE(message.find("a quarter of this machine's"), std::string::npos) << message;
     const double cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
-                       1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+        1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
     std::printf("reading the 100000x100000 PNG: %.3f s of CPU, peak RSS %.1f MB\n", cpu, usage.ru_maxrss / 1024.0);
-    EXPECT_LT(cpu, 1.0);                          // seconds of CPU, not wall time: load cannot move it
-    EXPECT_LT(usage.ru_maxrss, 100 * 1024);       // KiB: under 100 MB peak
+    EXPECT_LT(cpu, 1.0);  // seconds of CPU, not wall time: load cannot move it
+    EXPECT_LT(usage.ru_maxrss, 100 * 1024);  // KiB: under 100 MB peak
 }
 
 TEST(BoundedPng, TheCliRefusesItAtCheckTime) {
@@ -266,9 +266,10 @@ TEST(BoundedPng, TooLittleImageDataForTheDeclaredSizeFailsBeforeDecoding) {
             try {
                 read_gray_png_header(dir / "thin.png");
             } catch (const BadInput& e) {
-                EXPECT_EQ(std::string(e.what()), "cannot read " + (dir / "thin.png").string() +
-                                                     ": damaged PNG (its 4000x4000 pixels need at least 15.1 KiB of "
-                                                     "compressed image data, but it holds 10 bytes)");
+                EXPECT_EQ(std::string(e.what()),
+                          "cannot read " + (dir / "thin.png").string() +
+                              ": damaged PNG (its 4000x4000 pixels need at least 15.1 KiB of "
+                              "compressed image data, but it holds 10 bytes)");
                 throw;
             }
         },
@@ -378,8 +379,9 @@ TEST(AllOrNothing, SigtermStopsLikeCtrlCWithExit143AndRemovesTheStaging) {
 
 TEST(AllOrNothing, ASecondCtrlCEndsAtOnceAndTheNextRunCleansUp) {
     TempDir dir;
-    dir.write("m.orogen", "orogen 1\ngrid 9\na = generate:fault()\nexport:png(a, path=\"a.png\")\n"
-                          "s = generate:stubborn()\n");
+    dir.write("m.orogen",
+              "orogen 1\ngrid 9\na = generate:fault()\nexport:png(a, path=\"a.png\")\n"
+              "s = generate:stubborn()\n");
     const auto start = std::chrono::steady_clock::now();
     const pid_t pid = spawn_orogen(dir.path(), {"run", "m.orogen", "--out", "out", "--quiet"}, dir / "err.txt");
     // Once the stubborn node runs (a Ctrl-C before it would be seen by the runner's check between nodes and
@@ -397,8 +399,8 @@ TEST(AllOrNothing, ASecondCtrlCEndsAtOnceAndTheNextRunCleansUp) {
     dir.write("ok.orogen", spec_writing("t.png"));
     const RunResult r = run_orogen("run ok.orogen --out out --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::string note = "orogen: removed .orogen-staging-" + std::to_string(pid) +
-                             ", left by a run that no longer exists (1 file, ";
+    const std::string note =
+        "orogen: removed .orogen-staging-" + std::to_string(pid) + ", left by a run that no longer exists (1 file, ";
     EXPECT_EQ(r.err.substr(0, note.size()), note) << r.err;
     EXPECT_EQ(r.err.back(), '\n');
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
@@ -421,8 +423,8 @@ TEST(AllOrNothing, SigkillAtAnyPointLeavesThePreviousCompleteRun) {
     pid_t previous = 0;
     for (int point : {0, 1, 3}) {  // staging made, first output staged, three outputs staged (slow node running)
         SCOPED_TRACE("killed with " + std::to_string(point) + " files staged");
-        const pid_t pid = spawn_orogen(dir.path(), {"run", "slow.orogen", "--out", "out", "--quiet", "--seed", "2"},
-                                       dir / "err.txt");
+        const pid_t pid =
+            spawn_orogen(dir.path(), {"run", "slow.orogen", "--out", "out", "--quiet", "--seed", "2"}, dir / "err.txt");
         while (staged_count(dir / "out") < point ||
                (previous && fs::exists(dir / "out" / (".orogen-staging-" + std::to_string(previous)))))
             std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -435,8 +437,9 @@ TEST(AllOrNothing, SigkillAtAnyPointLeavesThePreviousCompleteRun) {
         std::erase_if(now, [](const auto& kv) { return kv.first.rfind(".orogen-staging-", 0) == 0; });
         EXPECT_EQ(now, complete);  // the previous run, whole; its manifest matches (checked above)
         if (previous)  // each run first removed the debris of the one killed before it, and said so
-            EXPECT_NE(slurp(dir / "err.txt").find("orogen: removed .orogen-staging-" + std::to_string(previous) +
-                                                  ", left by a run that no longer exists ("),
+            EXPECT_NE(slurp(dir / "err.txt")
+                          .find("orogen: removed .orogen-staging-" + std::to_string(previous) +
+                                ", left by a run that no longer exists ("),
                       std::string::npos)
                 << slurp(dir / "err.txt");
         previous = pid;
@@ -489,16 +492,18 @@ TEST(AllOrNothing, StrayTemporariesOfDeadProcessesAreRemovedAndNamed) {
     dir.write("s.orogen", spec_writing("t.png"));
     const RunResult r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(r.err, "orogen: removed deep/.t.glb.999999999.0.tmp (2.9 KiB), a temporary file left by a run that "
-                     "no longer exists\n");
+    EXPECT_EQ(r.err,
+              "orogen: removed deep/.t.glb.999999999.0.tmp (2.9 KiB), a temporary file left by a run that "
+              "no longer exists\n");
     EXPECT_FALSE(fs::exists(dir / "out/deep/.t.glb.999999999.0.tmp"));
     EXPECT_TRUE(fs::exists(dir / "out/.keep.me.tmp"));
 }
 
 TEST(Inputs, ImportRawReadsWhatExportRawWroteAndRefusesACutFileAtCheckTime) {
     TempDir dir;
-    dir.write("w.orogen", "orogen 1\ngrid 33 cell=7\nt = generate:fault(iterations=9)\nexport:raw(t, path=\"t.r32\")\n"
-                          "export:png(t, path=\"t.png\", bits=16)\n");
+    dir.write("w.orogen",
+              "orogen 1\ngrid 33 cell=7\nt = generate:fault(iterations=9)\nexport:raw(t, path=\"t.r32\")\n"
+              "export:png(t, path=\"t.png\", bits=16)\n");
     ASSERT_EQ(run_orogen("run w.orogen --out . --quiet", "", dir.path()).exit_code, 0);
     dir.write("r.orogen", "orogen 1\nt = import:raw(path=\"t.r32\")\nexport:png(t, path=\"again.png\", bits=16)\n");
     RunResult r = run_orogen("run r.orogen --out . --quiet", "", dir.path());
@@ -532,6 +537,7 @@ TEST(AllOrNothing, AStagingFolderWhoseLockIsHeldIsLeftAlone) {
     ::close(fd);  // the "run" ends
     r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_EQ(r.err, "orogen: removed .orogen-staging-999999999, left by a run that no longer exists (1 file, 20 bytes)\n");
+    EXPECT_EQ(r.err,
+              "orogen: removed .orogen-staging-999999999, left by a run that no longer exists (1 file, 20 bytes)\n");
     EXPECT_FALSE(fs::exists(dir / "out/.orogen-staging-999999999"));
 }

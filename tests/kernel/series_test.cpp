@@ -57,8 +57,9 @@ TEST(Series, AnEitherInputTakesOneValueOrASeries) {
                                  "b = generate:test-either(one)\n"
                                  "export:png(a, path=\"a.png\")\nexport:png(b, path=\"b.png\")\n");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const RunResult check = run_spec(dir, "f = generate:test-frames(frames=5)\nx = generate:test-either(f)\n"
-                                          "export:test-series(x, path=\"x.txt\")\n",
+    const RunResult check = run_spec(dir,
+                                     "f = generate:test-frames(frames=5)\nx = generate:test-either(f)\n"
+                                     "export:test-series(x, path=\"x.txt\")\n",
                                      "check");
     // test-either is not mapped (it takes the series itself), so its output is one heightmap.
     EXPECT_EQ(check.exit_code, 2);
@@ -138,11 +139,14 @@ TEST(Series, AnEroderRecordsATimelapseEveryKStepsAndTheLastOne) {
 
 TEST(Series, ATimelapseThatWouldNotFitInMemoryIsRefusedAtCheckTime) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 4097\nb = generate:fault(iterations=1)\n"
-                          "t = erode:thermal(b, iterations=10000000, timelapse_every=1)\nexport:png(t, path=\"t.png\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 4097\nb = generate:fault(iterations=1)\n"
+              "t = erode:thermal(b, iterations=10000000, timelapse_every=1)\nexport:png(t, path=\"t.png\")\n");
     const RunResult r = run_orogen("check s.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("error: erode:thermal: a time-lapse of 10000001 snapshots of 4097×4097 needs"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("error: erode:thermal: a time-lapse of 10000001 snapshots of 4097×4097 needs"),
+              std::string::npos)
+        << r.err;
     EXPECT_NE(r.err.find("; record less often"), std::string::npos) << r.err;
 }
 

@@ -62,14 +62,17 @@ TEST(Parser, ReadsPointsListsSideValuesAndMultiLineCalls) {
 
 TEST(Parser, ReportsEverySyntaxErrorAtOnce) {
     Diagnostics d;
-    parse_text("orogen 1\na = generate:fault(iterations=5 displacement=2)\nb = generate:fault(x=\"open\n"
-               "c = generate:fault(x=3) $\nwibble 3\n",
-               d);
+    parse_text(
+        "orogen 1\na = generate:fault(iterations=5 displacement=2)\nb = generate:fault(x=\"open\n"
+        "c = generate:fault(x=3) $\nwibble 3\n",
+        d);
     const std::string out = d.format();
     EXPECT_EQ(d.error_count(), 4) << out;
     EXPECT_NE(out.find("t.orogen:2:33: error: expected ',' or ')' in the call to generate:fault, found 'displacement'"),
-              std::string::npos) << out;
-    EXPECT_NE(out.find("t.orogen:3:22: error: unterminated string: add a closing '\"' on this line"), std::string::npos) << out;
+              std::string::npos)
+        << out;
+    EXPECT_NE(out.find("t.orogen:3:22: error: unterminated string: add a closing '\"' on this line"), std::string::npos)
+        << out;
     EXPECT_NE(out.find("t.orogen:4:25: error: unexpected character '$'"), std::string::npos) << out;
     EXPECT_NE(out.find("t.orogen:5:1: error: unknown statement 'wibble'"), std::string::npos) << out;
 }

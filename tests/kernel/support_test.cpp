@@ -85,8 +85,7 @@ TEST(AtomicFile, AnAbandonedWriteLeavesTheOldFileAndNoTemporary) {
         AtomicFile f(dir / "good.png");
         f.stream() << "half";
         throw std::runtime_error("the node failed half way");
-    } catch (const std::runtime_error&) {
-    }
+    } catch (const std::runtime_error&) {}
     EXPECT_EQ(orogen::test::slurp(dir / "good.png"), "good");
     EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1);
 }
@@ -97,8 +96,9 @@ TEST(AtomicFile, AMissingFolderIsAClearError) {
         AtomicFile f(dir / "no-such-folder" / "x.png");
         FAIL() << "expected an error";
     } catch (const Error& e) {
-        EXPECT_EQ(std::string(e.what()), "cannot write " + (dir / "no-such-folder" / "x.png").string() + ": folder " +
-                                             (dir / "no-such-folder").string() + " does not exist");
+        EXPECT_EQ(std::string(e.what()),
+                  "cannot write " + (dir / "no-such-folder" / "x.png").string() + ": folder " +
+                      (dir / "no-such-folder").string() + " does not exist");
     }
 }
 
@@ -121,9 +121,9 @@ TEST(AtomicFile, TheDigestTakenWhileWritingIsTheFilesAndSparesTheReadBack) {
         AtomicFile f(target);
         f.stream() << "header " << 42 << '\n';
         EXPECT_EQ(f.stream().tellp(), std::streampos(10));
-        f.stream().write(big.data(), 1000);                     // into the block
+        f.stream().write(big.data(), 1000);  // into the block
         f.stream().write(big.data(), std::streamsize(big.size()));  // straight through
-        for (int i = 0; i < 70000; ++i) f.stream().put(char(i));    // overflows the block one byte at a time
+        for (int i = 0; i < 70000; ++i) f.stream().put(char(i));  // overflows the block one byte at a time
         f.write({reinterpret_cast<const std::uint8_t*>(big.data()), 5});
         f.commit();
     }
@@ -251,8 +251,9 @@ TEST(Png, BadFilesAreRefusedWithTheirName) {
         read_gray_png(dir / "text.png");
         FAIL();
     } catch (const BadInput& e) {
-        EXPECT_EQ(std::string(e.what()), "cannot read " + (dir / "text.png").string() +
-                                             ": not a PNG file (it does not start with the PNG signature)");
+        EXPECT_EQ(std::string(e.what()),
+                  "cannot read " + (dir / "text.png").string() +
+                      ": not a PNG file (it does not start with the PNG signature)");
     }
 
     std::vector<std::uint8_t> rgba(16 * 16 * 4, 200);
@@ -319,9 +320,7 @@ TEST(Heightmap, MissingLayerNamesTheOnesThatExist) {
     try {
         std::as_const(hm).layer("sediment");
         FAIL();
-    } catch (const BadInput& e) {
-        EXPECT_STREQ(e.what(), "the heightmap has no layer 'sediment' (it has water)");
-    }
+    } catch (const BadInput& e) { EXPECT_STREQ(e.what(), "the heightmap has no layer 'sediment' (it has water)"); }
 }
 
 TEST(SplitNames, ItemsLoseTheirSpacesAndEmptyOnesAreDropped) {

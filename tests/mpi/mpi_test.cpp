@@ -24,8 +24,8 @@ using namespace orogen::test;
 
 /// `mpirun -n RANKS orogen ARGS`, one machine, ranks allowed to outnumber cores and to run as root (CI).
 RunResult run_mpi(int ranks, const std::string& args) {
-    const std::string launcher = std::string(OROGEN_MPIEXEC) + " --oversubscribe --allow-run-as-root -n " +
-                                 std::to_string(ranks) + " ";
+    const std::string launcher =
+        std::string(OROGEN_MPIEXEC) + " --oversubscribe --allow-run-as-root -n " + std::to_string(ranks) + " ";
     // run_orogen puts the binary after the environment: mpirun starts it from there.
     return run_orogen(args, "OMPI_MCA_rmaps_base_oversubscribe=1 " + launcher);
 }
@@ -60,7 +60,9 @@ export:raw(t, path="t.r32")
 struct Case {
     int ranks;
     std::string tiles;  // "" automatic
-    friend void PrintTo(const Case& c, std::ostream* os) { *os << c.ranks << " ranks, tiles " << (c.tiles.empty() ? "automatic" : c.tiles); }
+    friend void PrintTo(const Case& c, std::ostream* os) {
+        *os << c.ranks << " ranks, tiles " << (c.tiles.empty() ? "automatic" : c.tiles);
+    }
 };
 
 class Seam : public ::testing::TestWithParam<Case> {};
@@ -70,8 +72,8 @@ void expect_same_outputs(const std::string& spec_text, const std::vector<std::st
     const auto spec = dir.write("s.orogen", spec_text);
     const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q");
     ASSERT_EQ(one.exit_code, 0) << one.err;
-    const RunResult many = run_mpi(c.ranks, "run " + q(spec) + " --out " + q(dir / "many") +
-                                                (c.tiles.empty() ? "" : " --tiles " + c.tiles));
+    const RunResult many = run_mpi(
+        c.ranks, "run " + q(spec) + " --out " + q(dir / "many") + (c.tiles.empty() ? "" : " --tiles " + c.tiles));
     ASSERT_EQ(many.exit_code, 0) << many.err;
     EXPECT_NE(many.out.find("tiled run: " + std::to_string(c.ranks) + " rank"), std::string::npos) << many.out;
     for (const auto& f : files) {
@@ -268,7 +270,8 @@ TEST(Mpi, StreamPowerSettingsThatDoNotTileRunOnRankZeroAndSaySo) {
     // the run: the other ranks' progress and information lines are quiet).
     EXPECT_NE(r.err.find("rank 0 of 2, up to "), std::string::npos) << r.err;
     EXPECT_EQ(r.out.find("'s1' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;
-    EXPECT_EQ(r.out.find("'s7' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;  // uplift_history tiles
+    EXPECT_EQ(r.out.find("'s7' (erode:stream-power) ran on rank 0"), std::string::npos)
+        << r.out;  // uplift_history tiles
     EXPECT_EQ(r.out.find("'s13' (erode:stream-power) ran on rank 0"), std::string::npos) << r.out;  // floodplains tile
 }
 
@@ -304,8 +307,9 @@ TEST(Mpi, PipeSedimentTotalsAreTheSingleProcesssToTheLastBit) {
 TEST(Mpi, TilesNarrowerThanPipeOrHydraulicHalosAreRefusedAtTheNode) {
     TempDir dir;
     // 20 columns in 1x4: tiles 5 wide. Pipe needs 3 (fine), hydraulic 12 (refused); 1x8: tiles 2 wide, both refused.
-    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 20x16\nf = generate:fault()\np = erode:pipe(f, steps=2)\n"
-                                            "h = erode:hydraulic(p, iterations=3)\nexport:raw(h, path=\"h.r32\")\n");
+    const auto spec = dir.write("s.orogen",
+                                "orogen 1\ngrid 20x16\nf = generate:fault()\np = erode:pipe(f, steps=2)\n"
+                                "h = erode:hydraulic(p, iterations=3)\nexport:raw(h, path=\"h.r32\")\n");
     const RunResult r = run_mpi(4, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 1x4");
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("s.orogen:5:5: error: 'h' (erode:hydraulic) exchanges a halo of 12 vertices with each "
@@ -352,9 +356,10 @@ TEST(Mpi, ASpecErrorIsSaidOnceByRankZeroBeforeAnyRankLeaves) {
 TEST(Mpi, TimelapseOfATiledNodeThatDoesNotGatherItIsRefused) {
     // A plugin's tiled node without tiled_timelapse (every node of orogen's own gathers its frames).
     TempDir dir;
-    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 33\nf = generate:fault()\n"
-                                            "p = erode:test-tiled-no-lapse(f, timelapse_every=2)\n"
-                                            "export:raw(p, path=\"p.r32\")\n");
+    const auto spec = dir.write("s.orogen",
+                                "orogen 1\ngrid 33\nf = generate:fault()\n"
+                                "p = erode:test-tiled-no-lapse(f, timelapse_every=2)\n"
+                                "export:raw(p, path=\"p.r32\")\n");
     const std::string launcher =
         std::string(OROGEN_MPIEXEC) + " --oversubscribe --allow-run-as-root -x OROGEN_PLUGIN_PATH -n 2 ";
     const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "o"),
@@ -422,7 +427,8 @@ class TimelapseSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(TimelapseSeam, TiledTimelapsesEqualOneProcesss) {
     expect_same_outputs(kTimelapseSpec, {"t.mpg", "h.mpg", "p.mpg", "d.mpg"}, GetParam());
 }
-INSTANTIATE_TEST_SUITE_P(Ranks, TimelapseSeam, ::testing::Values(Case{2, ""}, Case{3, "1x3"}, Case{4, "2x2"}), kCaseName);
+INSTANTIATE_TEST_SUITE_P(Ranks, TimelapseSeam, ::testing::Values(Case{2, ""}, Case{3, "1x3"}, Case{4, "2x2"}),
+                         kCaseName);
 
 TEST(Mpi, WholeValueFromRankZeroIsCutIntoTiles) { expect_same_outputs(kScatterSpec, {"t.r32"}, {3, "3x1"}); }
 
@@ -437,8 +443,9 @@ TEST(Mpi, MoreRanksThanTilesIsRefused) {
 
 TEST(Mpi, TilesNarrowerThanTheHaloAreRefusedAtTheNode) {
     TempDir dir;
-    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 28x20\nf = generate:fault()\nt = erode:thermal(f)\n"
-                                            "export:raw(t, path=\"t.r32\")\n");
+    const auto spec = dir.write("s.orogen",
+                                "orogen 1\ngrid 28x20\nf = generate:fault()\nt = erode:thermal(f)\n"
+                                "export:raw(t, path=\"t.r32\")\n");
     const RunResult r = run_mpi(4, "run " + q(spec) + " --out " + q(dir / "o") + " --tiles 1x4");
     EXPECT_EQ(r.exit_code, 2);
     // Once (rank 0 speaks), at the thermal node's line, naming the halo, the tile width and what to change.
@@ -464,10 +471,12 @@ fs::path write_poisoned_raw(const TempDir& dir, int width, int height) {
     h[std::size_t(height / 2) * std::size_t(width) + std::size_t(width - 1)] = 3e38f;
     h[std::size_t(height / 2) * std::size_t(width) + std::size_t(width - 2)] = -3e38f;
     dir.write("p.r32", std::string(reinterpret_cast<const char*>(h.data()), h.size() * sizeof(float)));
-    dir.write("p.r32.json", "{\"format\": \"r32\", \"sample_type\": \"float32\", \"byte_order\": \"little-endian\", "
-                            "\"width\": " + std::to_string(width) + ", \"height\": " + std::to_string(height) +
-                                ", \"cell_size\": 1, \"height_min\": -3e38, \"height_max\": 3e38, \"units\": \"m\", "
-                                "\"layout\": \"rows north to south, samples west to east, no header\"}");
+    dir.write("p.r32.json",
+              "{\"format\": \"r32\", \"sample_type\": \"float32\", \"byte_order\": \"little-endian\", "
+              "\"width\": " +
+                  std::to_string(width) + ", \"height\": " + std::to_string(height) +
+                  ", \"cell_size\": 1, \"height_min\": -3e38, \"height_max\": 3e38, \"units\": \"m\", "
+                  "\"layout\": \"rows north to south, samples west to east, no header\"}");
     return dir / "p.r32";
 }
 
@@ -476,9 +485,10 @@ TEST(Mpi, ARankThatFailsEndsEveryRankWithOneErrorAndNoOutputs) {
     write_poisoned_raw(dir, 400, 16);
     // Staged before the failure: export:raw of the input. The NaN shows at the check after step 64, when it
     // has spread ~128 vertices: only in the east tile of 1x2, so rank 1 fails while rank 0 goes on.
-    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 400x16\np = import:raw(path=\"p.r32\")\n"
-                                            "export:raw(p, path=\"before.r32\")\n"
-                                            "t = erode:thermal(p, iterations=100)\nexport:raw(t, path=\"t.r32\")\n");
+    const auto spec = dir.write("s.orogen",
+                                "orogen 1\ngrid 400x16\np = import:raw(path=\"p.r32\")\n"
+                                "export:raw(p, path=\"before.r32\")\n"
+                                "t = erode:thermal(p, iterations=100)\nexport:raw(t, path=\"t.r32\")\n");
     const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one"));
     ASSERT_EQ(one.exit_code, 1) << one.err;
     const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "many") + " --tiles 1x2");
@@ -501,9 +511,10 @@ TEST(Mpi, ARankThatFailsEndsEveryRankWithOneErrorAndNoOutputs) {
 TEST(Mpi, APipeRankWithABadRainMaskEndsEveryRankWithOneError) {
     TempDir dir;
     write_poisoned_raw(dir, 400, 16);  // as a rain mask: a negative factor in the east tile only
-    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 400x16\nf = generate:fault()\nm = import:raw(path=\"p.r32\")\n"
-                                            "export:raw(f, path=\"f.r32\")\n"
-                                            "p = erode:pipe(f, m, steps=4)\nexport:raw(p, path=\"p.r32\")\n");
+    const auto spec = dir.write("s.orogen",
+                                "orogen 1\ngrid 400x16\nf = generate:fault()\nm = import:raw(path=\"p.r32\")\n"
+                                "export:raw(f, path=\"f.r32\")\n"
+                                "p = erode:pipe(f, m, steps=4)\nexport:raw(p, path=\"p.r32\")\n");
     const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one"));
     ASSERT_EQ(one.exit_code, 2) << one.err;
     // Rank 1 fails before the solver's first collective; rank 0 meets its failure there.
@@ -521,8 +532,9 @@ TEST(Mpi, APipeRankWithABadRainMaskEndsEveryRankWithOneError) {
 
 TEST(Mpi, AFailedWriteOnRankZeroEndsEveryRank) {
     TempDir dir;
-    const auto spec = dir.write("s.orogen", "orogen 1\ngrid 33\nf = generate:fault()\nt = erode:thermal(f, iterations=4)\n"
-                                            "export:raw(f, path=\"f.r32\")\nexport:raw(t, path=\"t.r32\")\n");
+    const auto spec = dir.write("s.orogen",
+                                "orogen 1\ngrid 33\nf = generate:fault()\nt = erode:thermal(f, iterations=4)\n"
+                                "export:raw(f, path=\"f.r32\")\nexport:raw(t, path=\"t.r32\")\n");
     fs::create_directories(dir / "o" / "t.r32");  // a folder where the file should go
     const RunResult r = run_mpi(2, "run " + q(spec) + " --out " + q(dir / "o"));
     EXPECT_EQ(r.exit_code, 1) << r.err;
@@ -556,7 +568,8 @@ TEST(Mpi, DefaultPipelineEqualsOneProcess) {
     ASSERT_GT(want.size(), 20u);
     for (const std::string tiles : {"1x3", "2x2"}) {
         const int ranks = tiles == "1x3" ? 3 : 4;
-        const RunResult many = run_mpi(ranks, "run " + q(spec) + " --out " + q(dir / tiles) + " --tiles " + tiles + shorter);
+        const RunResult many =
+            run_mpi(ranks, "run " + q(spec) + " --out " + q(dir / tiles) + " --tiles " + tiles + shorter);
         ASSERT_EQ(many.exit_code, 0) << many.err;
         EXPECT_EQ(many.out.find("ran on rank 0 over the whole grid"), std::string::npos) << many.out;
         // The plates' counts come from rank 0's simulation, once (the other ranks only draw its outcome).
@@ -624,10 +637,10 @@ export:vtk-plates(p.plates, path="plates/p.pvd")
 
 class PlatesSeam : public ::testing::TestWithParam<Case> {};
 TEST_P(PlatesSeam, PlatesEqualOneProcess) {
-    expect_same_outputs(kPlatesSpec,
-                        {"q.r32", "q.vti", "t.r32", "plates/p.pvd", "plates/p_plates_000040.vtp",
-                         "plates/p_collisions_000040.vtp"},
-                        GetParam());
+    expect_same_outputs(
+        kPlatesSpec,
+        {"q.r32", "q.vti", "t.r32", "plates/p.pvd", "plates/p_plates_000040.vtp", "plates/p_collisions_000040.vtp"},
+        GetParam());
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, PlatesSeam,
                          ::testing::Values(Case{1, ""}, Case{2, ""}, Case{3, "3x1"}, Case{3, "1x3"}, Case{4, "2x2"}),
@@ -656,23 +669,27 @@ TEST_P(EngineTilesSeam, EveryRanksEngineTilesEqualOneProcesss) {
     const auto spec = dir.write("s.orogen", kEngineTilesSpec);
     const RunResult one = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " -q");
     ASSERT_EQ(one.exit_code, 0) << one.err;
-    const RunResult many = run_mpi(GetParam().ranks, "run " + q(spec) + " --out " + q(dir / "many") +
-                                                         (GetParam().tiles.empty() ? "" : " --tiles " + GetParam().tiles));
+    const RunResult many = run_mpi(GetParam().ranks,
+                                   "run " + q(spec) + " --out " + q(dir / "many") +
+                                       (GetParam().tiles.empty() ? "" : " --tiles " + GetParam().tiles));
     ASSERT_EQ(many.exit_code, 0) << many.err;
     // Every file one process wrote, the same bytes, and no other: png/ 6 × 4 tiles, r32/ 6 × 4 tiles and a
     // VRT each, big/ 2 × 1 tiles and a VRT each, and in each folder the index and the mosaic VRT.
     std::vector<std::string> a, b;
     for (const auto& e : fs::recursive_directory_iterator(dir / "one"))
-        if (e.is_regular_file() && e.path().filename() != "manifest.json") a.push_back(fs::relative(e.path(), dir / "one").string());
+        if (e.is_regular_file() && e.path().filename() != "manifest.json")
+            a.push_back(fs::relative(e.path(), dir / "one").string());
     for (const auto& e : fs::recursive_directory_iterator(dir / "many"))
-        if (e.is_regular_file() && e.path().filename() != "manifest.json") b.push_back(fs::relative(e.path(), dir / "many").string());
+        if (e.is_regular_file() && e.path().filename() != "manifest.json")
+            b.push_back(fs::relative(e.path(), dir / "many").string());
     std::sort(a.begin(), a.end());
     std::sort(b.begin(), b.end());
     // glb/: the level-of-detail pyramid, 6 × 4 + 3 × 2 + 2 × 1 + 1 chunks and the tileset.
     EXPECT_EQ(a.size(), (24u + 2u) + (48u + 2u) + (4u + 2u) + (33u + 1u));
     ASSERT_EQ(a, b);
     for (const auto& f : a)
-        EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / "many" / f)) << f << " differs on " << GetParam().ranks << " ranks";
+        EXPECT_TRUE(slurp(dir / "one" / f) == slurp(dir / "many" / f))
+            << f << " differs on " << GetParam().ranks << " ranks";
     // The manifest of the tiled run lists every file with its SHA-256 (the other ranks' tiles with the
     // digests they took while writing, which rank 0 adopts: a digest sent for the wrong file shows here).
     const std::string manifest = slurp(dir / "many" / "manifest.json");
@@ -686,7 +703,6 @@ TEST_P(EngineTilesSeam, EveryRanksEngineTilesEqualOneProcesss) {
 }
 INSTANTIATE_TEST_SUITE_P(Ranks, EngineTilesSeam,
                          ::testing::Values(Case{2, ""}, Case{3, "3x1"}, Case{4, "1x4"}, Case{4, "2x2"}), kCaseName);
-
 
 /// Every point array of `image` by name, as floats.
 std::map<std::string, std::vector<float>> arrays_of(vtkImageData* image) {

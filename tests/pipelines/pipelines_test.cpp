@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 
 struct Case {
-    const char* name;       ///< pipelines/<name>.orogen
+    const char* name;  ///< pipelines/<name>.orogen
     const char* overrides;  ///< to keep the test short (the full run is what users get)
     /// Appended in the sanitizer builds (CI's ASan+UBSan phase), where the erosion loops run 10-25x slower:
     /// fewer steps, every node still run. A case with these is not compared with its golden hashes there
@@ -43,10 +43,11 @@ const Case cases[] = {
      "--set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 --set pipe_hemisphere.steps=60"},
     {"erosion-thermal-4.3", ""},
     {"orogeny", "--set range.dt=3e5", "--set plates.steps=200 --set range.dt=1e6 --set scree.iterations=10"},
-    {"erosion-sph-4.1", "--set sph_crooked.steps=8 --set sph_pyramid.steps=8 --set sph_hemisphere.steps=8 "
-                        "--set olsen_crooked.iterations=30 --set olsen_pyramid.iterations=30 "
-                        "--set olsen_hemisphere.iterations=30 --set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 "
-                        "--set pipe_hemisphere.steps=60"},
+    {"erosion-sph-4.1",
+     "--set sph_crooked.steps=8 --set sph_pyramid.steps=8 --set sph_hemisphere.steps=8 "
+     "--set olsen_crooked.iterations=30 --set olsen_pyramid.iterations=30 "
+     "--set olsen_hemisphere.iterations=30 --set pipe_crooked.steps=60 --set pipe_pyramid.steps=60 "
+     "--set pipe_hemisphere.steps=60"},
     {"sph-rain", "--set rain.steps=30"},
     {"starter", "", "--set range.dt=5e5"},
 };
@@ -79,7 +80,8 @@ TEST_P(Pipeline, GivesTheSameBytesOnOneAndTwoThreadsAndMatchesItsGoldenHashes) {
     EXPECT_EQ(one, hashes(dir / "2"));
     EXPECT_EQ(slurp(dir / "1" / "manifest.json"), slurp(dir / "2" / "manifest.json"));
 
-    const fs::path golden = fs::path(OROGEN_SOURCE_DIR) / "tests" / "pipelines" / "golden" / (std::string(c.name) + ".sha256");
+    const fs::path golden =
+        fs::path(OROGEN_SOURCE_DIR) / "tests" / "pipelines" / "golden" / (std::string(c.name) + ".sha256");
     std::string text;  // the `sha256sum` format: "<hash>  <file>"
     for (const auto& [file, hash] : one) {
         // Frames drawn by llvmpipe repeat exactly on one machine (checked above) but their
@@ -100,7 +102,8 @@ TEST_P(Pipeline, GivesTheSameBytesOnOneAndTwoThreadsAndMatchesItsGoldenHashes) {
 
 INSTANTIATE_TEST_SUITE_P(Shipped, Pipeline, testing::ValuesIn(cases), [](const testing::TestParamInfo<Case>& info) {
     std::string n = info.param.name;
-    std::replace_if(n.begin(), n.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)); }, '_');
+    std::replace_if(
+        n.begin(), n.end(), [](char ch) { return !std::isalnum(static_cast<unsigned char>(ch)); }, '_');
     return n;
 });
 
@@ -128,9 +131,10 @@ TEST(Pipelines, ThePlatesTimelapseBecomesAVideoWithAFramePerSnapshot) {
                                    " --quiet --set plates.steps=60 --set plates.timelapse_every=20"
                                    " --set frames.width=160 --set frames.height=90");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    const std::string probe = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                              "stream=nb_read_frames,width,height -of csv=p=0 " +
-                              q(dir / "out" / "plates-timelapse.mp4") + " > " + q(dir / "probe.txt");
+    const std::string probe =
+        "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+        "stream=nb_read_frames,width,height -of csv=p=0 " +
+        q(dir / "out" / "plates-timelapse.mp4") + " > " + q(dir / "probe.txt");
     ASSERT_EQ(std::system(probe.c_str()), 0);
     EXPECT_EQ(slurp(dir / "probe.txt"), "160,90,4\n");  // steps 0, 20, 40 and 60
 }

@@ -40,26 +40,26 @@ struct Band {
 
 // `orogen analyze` on the four 27–30 m DEMs of ../shared/realism/dems (docs/realism.md), rounded outwards.
 const Band kBands[] = {
-    {FigureId::slope_mean, 19.26, 30.38},           // °
-    {FigureId::slope_median, 19.18, 31.68},         // °
-    {FigureId::slope_p90, 29.17, 46.88},            // °
-    {FigureId::steeper_30, 8.14, 54.87},            // % of the area
-    {FigureId::steeper_40, 0.219, 23.98},           // % of the area
+    {FigureId::slope_mean, 19.26, 30.38},  // °
+    {FigureId::slope_median, 19.18, 31.68},  // °
+    {FigureId::slope_p90, 29.17, 46.88},  // °
+    {FigureId::steeper_30, 8.14, 54.87},  // % of the area
+    {FigureId::steeper_40, 0.219, 23.98},  // % of the area
     {FigureId::hypsometric_integral, 0.3674, 0.5399},
     {FigureId::spectral_exponent, 4.267, 4.726},
-    {FigureId::pits, 0.0153, 0.1420},               // % of the interior samples
+    {FigureId::pits, 0.0153, 0.1420},  // % of the interior samples
     {FigureId::concavity, 0.491, 1.073},
-    {FigureId::steepness, 26.12, 134.36},           // m^0.9 (θ_ref 0.45)
+    {FigureId::steepness, 26.12, 134.36},  // m^0.9 (θ_ref 0.45)
     {FigureId::hack_exponent, 0.450, 0.574},
-    {FigureId::drainage_density, 1.798, 2.234},     // 1/km
-    {FigureId::network_share, 4.58, 5.73},          // % of the samples
-    {FigureId::local_relief, 542.3, 1061.0},        // m
-    {FigureId::hillslope_length, 250.3, 377.5},     // m
-    {FigureId::curvature_spread, 5.80, 11.49},      // 1/km
+    {FigureId::drainage_density, 1.798, 2.234},  // 1/km
+    {FigureId::network_share, 4.58, 5.73},  // % of the samples
+    {FigureId::local_relief, 542.3, 1061.0},  // m
+    {FigureId::hillslope_length, 250.3, 377.5},  // m
+    {FigureId::curvature_spread, 5.80, 11.49},  // 1/km
     {FigureId::channel_sinuosity, 1.133, 1.248},
-    {FigureId::channel_curvature, 7.10, 16.77},     // 1/km
-    {FigureId::valley_width, 145.7, 187.9},         // m, 10 m above rivers draining more than 1 km²
-    {FigureId::valley_widening, 0.0023, 0.2825},    // the width's exponent of the drainage area
+    {FigureId::channel_curvature, 7.10, 16.77},  // 1/km
+    {FigureId::valley_width, 145.7, 187.9},  // m, 10 m above rivers draining more than 1 km²
+    {FigureId::valley_widening, 0.0023, 0.2825},  // the width's exponent of the drainage area
 };
 
 constexpr int kSide = 1025;  ///< the shipped pipelines' grid
@@ -118,9 +118,10 @@ class DefaultPipeline : public testing::TestWithParam<int> {};
 
 TEST_P(DefaultPipeline, LiesInsideRealRangesFiguresAtThirtyMetres) {
     // The terrain exactly as `make demo` makes it; only the pictures are made smaller.
-    expect_inside_the_bands("default", "--seed " + std::to_string(GetParam()) +
-                                           " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1"
-                                           " --set spin.frames=2 --set spin.width=64 --set spin.height=36");
+    expect_inside_the_bands("default",
+                            "--seed " + std::to_string(GetParam()) +
+                                " --set beauty.width=160 --set beauty.height=90 --set beauty.samples=1"
+                                " --set spin.frames=2 --set spin.width=64 --set spin.height=36");
 }
 
 TEST(Orogeny, LiesInsideRealRangesFiguresAtThirtyMetres) {
@@ -151,7 +152,8 @@ std::optional<Reference> read_reference(const fs::path& dems, const std::string&
         return std::stod(json.substr(json.find(':', at) + 1));
     };
     Reference r{name, {}, int(number("nx")), int(number("ny")), number("dx_m")};
-    if (r.width <= 0 || r.height <= 0 || data.size() != std::size_t(r.width) * std::size_t(r.height) * 4) return std::nullopt;
+    if (r.width <= 0 || r.height <= 0 || data.size() != std::size_t(r.width) * std::size_t(r.height) * 4)
+        return std::nullopt;
     r.heights.resize(data.size() / 4);
     std::memcpy(r.heights.data(), data.data(), data.size());
     return r;
@@ -163,8 +165,8 @@ struct Preset {
     /// The farthest it may be from its namesake: its seed-42 distance when it was made (docs/realism.md)
     /// plus about a fifth, so a change that pulls it away from the range it is named after fails here.
     double within;
-    int side = kSide;      ///< the pipeline's grid, vertices a side
-    double cell = 30.0;    ///< its cell size, m
+    int side = kSide;  ///< the pipeline's grid, vertices a side
+    double cell = 30.0;  ///< its cell size, m
     /// The references it is told apart from, at about its cell size (slope figures depend on it).
     std::vector<const char*> references = {"himalaya_baspa_30m", "morocco_rif_27m", "nz_kahurangi_30m",
                                            "nz_raukumara_30m"};
@@ -187,7 +189,8 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
         refs.push_back(std::move(*r));
     }
     std::vector<orogen::analysis::Figures> ref_figures;
-    for (const auto& r : refs) ref_figures.push_back(orogen::analysis::measure({r.heights.data(), r.width, r.height, r.cell}));
+    for (const auto& r : refs)
+        ref_figures.push_back(orogen::analysis::measure({r.heights.data(), r.width, r.height, r.cell}));
     std::vector<const orogen::analysis::Figures*> pointers;
     for (const auto& f : ref_figures) pointers.push_back(&f);
     const auto bands = orogen::analysis::reference_bands(pointers);
@@ -220,10 +223,15 @@ INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
                          // Raukumara 0.73 with facies every 300 m since stop 49 (0.79 before; 0.65), Kahurangi
                          // 0.65 (0.67 with stop 48's facies over 3 km; 0.50), Mont Blanc 1.15 with its banks (1.68
                          // without, nearest the Andes).
-                         testing::Values(Preset{"himalaya", "himalaya_baspa_30m", 1.2}, Preset{"rif", "morocco_rif_27m", 0.65},
+                         testing::Values(Preset{"himalaya", "himalaya_baspa_30m", 1.2},
+                                         Preset{"rif", "morocco_rif_27m", 0.65},
                                          Preset{"raukumara", "nz_raukumara_30m", 0.8},
                                          Preset{"kahurangi", "nz_kahurangi_30m", 0.8},
-                                         Preset{"montblanc", "alps_montblanc_93m", 1.35, 769, 90.0,
+                                         Preset{"montblanc",
+                                                "alps_montblanc_93m",
+                                                1.35,
+                                                769,
+                                                90.0,
                                                 {"alps_montblanc_93m", "andes_peru_lima_90m", "rockies_frontrange_90m",
                                                  "india_shillong_50m"}}),
                          [](const auto& info) { return std::string(info.param.pipeline); });

@@ -69,9 +69,9 @@ private:
     bool mounted_ = false;
 };
 
-#define OROGEN_SKIP_WITHOUT_TINY_DISK(disk)                                                                  \
-    if (!(disk).available())                                                                                \
-    GTEST_SKIP() << "SKIPPED: cannot mount a 64 KiB tmpfs here (needs root or CAP_SYS_ADMIN), so the "       \
+#define OROGEN_SKIP_WITHOUT_TINY_DISK(disk)                                                            \
+    if (!(disk).available())                                                                           \
+    GTEST_SKIP() << "SKIPPED: cannot mount a 64 KiB tmpfs here (needs root or CAP_SYS_ADMIN), so the " \
                     "disk-full case is not tested"
 
 }  // namespace orogen::test

@@ -22,8 +22,8 @@ class TempDir {
 public:
     TempDir() {
         static int counter = 0;
-        path_ = fs::path(OROGEN_BINARY_DIR) / "test-tmp" /
-                (std::to_string(::getpid()) + "-" + std::to_string(counter++));
+        path_ =
+            fs::path(OROGEN_BINARY_DIR) / "test-tmp" / (std::to_string(::getpid()) + "-" + std::to_string(counter++));
         fs::remove_all(path_);
         fs::create_directories(path_);
     }
@@ -69,9 +69,9 @@ inline RunResult run_orogen(const std::string& args, const std::string& env = ""
     const fs::path dir = fs::path(OROGEN_BINARY_DIR) / "test-tmp" / "cli";
     fs::create_directories(dir);
     const std::string stem = (dir / (std::to_string(::getpid()) + "-" + std::to_string(counter++))).string();
-    const std::string cmd = (cwd.empty() ? "" : "cd '" + cwd.string() + "' && ") + "env OROGEN_PLUGIN_PATH= OROGEN_NO_CACHE=1 " + env +
-                            " " + std::string(OROGEN_CLI) + " " + args +
-                            " >" + stem + ".out 2>" + stem + ".err </dev/null";
+    const std::string cmd = (cwd.empty() ? "" : "cd '" + cwd.string() + "' && ") +
+        "env OROGEN_PLUGIN_PATH= OROGEN_NO_CACHE=1 " + env + " " + std::string(OROGEN_CLI) + " " + args + " >" + stem +
+        ".out 2>" + stem + ".err </dev/null";
     const int status = std::system(cmd.c_str());
     RunResult r;
     r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

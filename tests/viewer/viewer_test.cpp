@@ -27,9 +27,9 @@
 
 namespace fs = std::filesystem;
 using namespace orogen;
+using orogen::test::differing_pixels;
 using orogen::test::Picture;
 using orogen::test::read_picture;
-using orogen::test::differing_pixels;
 
 namespace {
 
@@ -51,7 +51,8 @@ protected:
 
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir = fs::temp_directory_path() / ("orogen_view_test_" + std::string(info->name()) + "_" + std::to_string(getpid()));
+        dir = fs::temp_directory_path() /
+            ("orogen_view_test_" + std::string(info->name()) + "_" + std::to_string(getpid()));
         fs::remove_all(dir);
         fs::create_directories(dir);
     }
@@ -60,7 +61,7 @@ protected:
     /// Run `orogen-view args` (a shell command line) in `dir`; `prefix` goes before the program (e.g. "env -u DISPLAY").
     Result view(const std::string& args, const std::string& prefix = "") {
         const std::string cmd = "cd '" + dir.string() + "' && " + prefix + " '" OROGEN_VIEW "' " + args + " >'" +
-                                (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
+            (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
         const int status = std::system(cmd.c_str());
         Result r;
         r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -132,7 +133,7 @@ TEST_F(Viewer, ColouringByALayerChangesThePixelsAndUsesItsColourMap) {
         for (int x = 0; x < n; ++x) {
             flow[y * n + x] = float(x) / n;
             plate[y * n + x] = float((x < n / 2 ? 0 : 1) + (y < n / 2 ? 0 : 2) + 3);  // ids 3..6 in quadrants
-            eroded[y * n + x] = x < n / 2 ? -2.f : 2.f;                             // deposits west, erosion east
+            eroded[y * n + x] = x < n / 2 ? -2.f : 2.f;  // deposits west, erosion east
         }
     write_vti(dir / "t.vti", plain_and_plateau(), n, n, {{"flow", flow}, {"plate", plate}, {"eroded", eroded}});
     ASSERT_EQ(view("t.vti --screenshot splat.png " + top_view).code, 0);
@@ -140,8 +141,8 @@ TEST_F(Viewer, ColouringByALayerChangesThePixelsAndUsesItsColourMap) {
     ASSERT_EQ(r.code, 0) << r.err;
     ASSERT_EQ(view("t.vti --screenshot plate.png --layer plate " + top_view).code, 0);
     ASSERT_EQ(view("t.vti --screenshot eroded.png --layer eroded " + top_view).code, 0);
-    const Picture splat = read_picture(dir / "splat.png"), fl = read_picture(dir / "flow.png"), pl = read_picture(dir / "plate.png"),
-                  er = read_picture(dir / "eroded.png");
+    const Picture splat = read_picture(dir / "splat.png"), fl = read_picture(dir / "flow.png"),
+                  pl = read_picture(dir / "plate.png"), er = read_picture(dir / "eroded.png");
     EXPECT_GT(differing_pixels(splat, fl), 20000u);
     // Flow rises west to east: the colour map's ends differ.
     EXPECT_GT(distance(patch(fl, 70, 160), patch(fl, 250, 160)), 80);
@@ -220,7 +221,8 @@ TEST_F(Viewer, PlatesSeriesFramesDifferOverTime) {
         ASSERT_EQ(r.code, 0) << r.err;
     }
     ASSERT_EQ(view(". --screenshot folder.png --time 0 " + top_view).code, 0);
-    const Picture p0 = read_picture(dir / "p0.png"), p1 = read_picture(dir / "p1.png"), p2 = read_picture(dir / "p2.png");
+    const Picture p0 = read_picture(dir / "p0.png"), p1 = read_picture(dir / "p1.png"),
+                  p2 = read_picture(dir / "p2.png");
     EXPECT_GT(differing_pixels(p0, p1), 1000u);
     EXPECT_GT(differing_pixels(p1, p2), 1000u);
     // The plates tint the terrain: without them (m toggles, here: no .pvd) the picture differs.
@@ -252,8 +254,8 @@ TEST_F(Viewer, ParticleSeriesFramesShowMovingColouredParticles) {
     ASSERT_EQ(view("t.vti p.pvd --screenshot b.png --time 0.5 " + top_view).code, 0);
     ASSERT_EQ(view("t.vti --screenshot c.png " + top_view).code, 0);
     const Picture a = read_picture(dir / "a.png"), b = read_picture(dir / "b.png"), c = read_picture(dir / "c.png");
-    EXPECT_GT(differing_pixels(a, c), 500u);   // particles drawn
-    EXPECT_GT(differing_pixels(a, b), 500u);   // and they moved
+    EXPECT_GT(differing_pixels(a, c), 500u);  // particles drawn
+    EXPECT_GT(differing_pixels(a, b), 500u);  // and they moved
 }
 
 // export:vtk writes Z up by default (ParaView's frame) and Y up on request
@@ -281,8 +283,9 @@ TEST_F(Viewer, ZUpAndYUpFilesShowTheSamePicture) {
         vtk::write_plates(moving_plates(), dir / tag / "plates.pvd", o);
         vtk::write_particles(particles, dir / tag / "p.vtp", o);
         for (const char* input : {"t.vti", "m.vtp"}) {
-            const Result r = view(tag + "/" + input + " " + tag + "/plates.pvd " + tag + "/p.vtp --layer ramp --time 1 " +
-                                  "--screenshot " + tag + "_" + input + ".png " + top_view);
+            const Result r =
+                view(tag + "/" + input + " " + tag + "/plates.pvd " + tag + "/p.vtp --layer ramp --time 1 " +
+                     "--screenshot " + tag + "_" + input + ".png " + top_view);
             ASSERT_EQ(r.code, 0) << r.err;
         }
     }
@@ -332,13 +335,30 @@ TEST_F(Viewer, EachKeyDoesWhatTheHelpSays) {
     const std::string before = replay({});
     EXPECT_EQ(state_value(before, "layer"), "splat");
     // Every toggle at once (each changes its own setting), then the keys that go back.
-    const std::string all = replay({{"l", 'l'}, {"w", 'w'}, {"p", 'p'}, {"m", 'm'}, {"e", 'e'}, {"h", 'h'}, {"v", 'v'},
-                                    {"plus", '+'}, {"period", '.'}, {"space", ' '}, {"a", 'a'}, {"f", 'f'}});
-    const std::vector<std::pair<std::string, std::string>> expected{
-        {"layer", "height"}, {"water", "off"},          {"particles", "off"}, {"plates", "off"},
-        {"edges", "on"},     {"help", "on"},            {"view", "top"},      {"exaggeration", "1.25"},
-        {"time_index", "1"}, {"playing", "on"},         {"particle_attribute", "1"},
-        {"full_resolution", "on"}};
+    const std::string all = replay({{"l", 'l'},
+                                    {"w", 'w'},
+                                    {"p", 'p'},
+                                    {"m", 'm'},
+                                    {"e", 'e'},
+                                    {"h", 'h'},
+                                    {"v", 'v'},
+                                    {"plus", '+'},
+                                    {"period", '.'},
+                                    {"space", ' '},
+                                    {"a", 'a'},
+                                    {"f", 'f'}});
+    const std::vector<std::pair<std::string, std::string>> expected{{"layer", "height"},
+                                                                    {"water", "off"},
+                                                                    {"particles", "off"},
+                                                                    {"plates", "off"},
+                                                                    {"edges", "on"},
+                                                                    {"help", "on"},
+                                                                    {"view", "top"},
+                                                                    {"exaggeration", "1.25"},
+                                                                    {"time_index", "1"},
+                                                                    {"playing", "on"},
+                                                                    {"particle_attribute", "1"},
+                                                                    {"full_resolution", "on"}};
     for (const auto& [key, value] : expected) {
         EXPECT_EQ(state_value(all, key), value) << key;
         EXPECT_NE(state_value(before, key), value) << key;
@@ -355,7 +375,8 @@ TEST_F(Viewer, EachKeyDoesWhatTheHelpSays) {
                                          "LeftButtonReleaseEvent 260 170 0 0 0 0 0\n";
     const std::string dragged = view("t.vti plates.pvd --events events.log --print-state --size 320x240").out;
     EXPECT_NE(state_value(dragged, "camera"), state_value(before, "camera"));
-    std::ofstream(dir / "events.log", std::ios::app) << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
+    std::ofstream(dir / "events.log", std::ios::app)
+        << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
     const std::string reset = view("t.vti plates.pvd --events events.log --print-state --size 320x240").out;
     EXPECT_EQ(state_value(reset, "camera"), state_value(before, "camera"));
     // s writes a screenshot into the working folder.
@@ -392,8 +413,10 @@ TEST_F(Viewer, SwitchingBackToALayerShowsWhatAFreshStartShows) {
     const Picture fresh = read_picture(dir / "fresh.png"), fresh125 = read_picture(dir / "fresh125.png");
     ASSERT_GT(differing_pixels(fresh, fresh125), 100u);  // the exaggeration changes the shading
     // splat → height → flow → splat (kept) → height → splat (kept)
-    EXPECT_EQ(differing_pixels(after({{"l", 'l'}, {"l", 'l'}, {"l", 'l'}, {"L", 'L'}, {"L", 'L'}, {"L", 'L'}}, "back.png"), fresh, 0),
-              0u);
+    EXPECT_EQ(
+        differing_pixels(after({{"l", 'l'}, {"l", 'l'}, {"l", 'l'}, {"L", 'L'}, {"L", 'L'}, {"L", 'L'}}, "back.png"),
+                         fresh, 0),
+        0u);
     // splat → height, exaggerate, → splat: coloured again with the new hillshade
     EXPECT_EQ(differing_pixels(after({{"l", 'l'}, {"plus", '+'}, {"L", 'L'}}, "exaggerated.png"), fresh125, 0), 0u);
 }
@@ -433,7 +456,8 @@ TEST_F(Viewer, ZoomingInRefinesTheMeshInViewToFullResolution) {
     const Picture autop = above_status_line(read_picture(dir / "auto.png")),
                   coarse = above_status_line(read_picture(dir / "coarse.png")),
                   full = above_status_line(read_picture(dir / "full.png"));
-    EXPECT_GT(differing_pixels(full, coarse), std::size_t(full.width * full.height / 20));  // the test can see decimation
+    EXPECT_GT(differing_pixels(full, coarse),
+              std::size_t(full.width * full.height / 20));  // the test can see decimation
     EXPECT_LE(differing_pixels(autop, full), std::size_t(full.width * full.height / 1000));
     // Zooming with the mouse wheel refines too (when the camera comes to rest).
     std::string wheel = "# StreamVersion 1\n";
@@ -447,10 +471,11 @@ TEST_F(Viewer, ZoomingInRefinesTheMeshInViewToFullResolution) {
 TEST_F(Viewer, ADragDrawsACoarserMeshAndTheStillFrameAfterItTheFullOne) {
     const int n = 513;
     write_vti(dir / "t.vti", rippled(n), n, n);
-    const std::string drag = "# StreamVersion 1\n"
-                             "LeftButtonPressEvent 160 100 0 0 0 0 0\n"
-                             "MouseMoveEvent 170 104 0 0 0 0 0\n"
-                             "MouseMoveEvent 180 108 0 0 0 0 0\n";
+    const std::string drag =
+        "# StreamVersion 1\n"
+        "LeftButtonPressEvent 160 100 0 0 0 0 0\n"
+        "MouseMoveEvent 170 104 0 0 0 0 0\n"
+        "MouseMoveEvent 180 108 0 0 0 0 0\n";
     // Still dragging (no release yet): the coarser mesh.
     std::ofstream(dir / "dragging.log") << drag;
     const Result dragging = view("t.vti --events dragging.log --print-state --size 320x200 --screenshot dragging.png");
@@ -466,7 +491,8 @@ TEST_F(Viewer, ADragDrawsACoarserMeshAndTheStillFrameAfterItTheFullOne) {
                   still = above_status_line(read_picture(dir / "dragged.png"));
     EXPECT_GT(differing_pixels(coarse, still), std::size_t(still.width * still.height / 50));
     // ... and after r, exactly what a fresh start shows.
-    std::ofstream(dir / "dragged.log", std::ios::app) << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
+    std::ofstream(dir / "dragged.log", std::ios::app)
+        << key_events({{"r", 'r'}}).substr(std::string("# StreamVersion 1\n").size());
     ASSERT_EQ(view("t.vti --events dragged.log --size 320x200 --screenshot reset.png").code, 0);
     ASSERT_EQ(view("t.vti --size 320x200 --screenshot fresh.png").code, 0);
     EXPECT_EQ(differing_pixels(read_picture(dir / "reset.png"), read_picture(dir / "fresh.png"), 0), 0u);
@@ -480,12 +506,16 @@ TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) 
         std::ofstream(dir / "tmp.orogen") << "orogen 1\nseed 3\ngrid 65 cell=10\n" << body;
         fs::rename(dir / "tmp.orogen", spec);  // as editors save: a new file in one step
     };
-    const std::string good1 = "t = generate:diamond-square(roughness=0.5, amplitude=50)\nexport:vtk(t, path=\"t.vti\")\n";
-    const std::string good2 = "t = generate:diamond-square(roughness=0.5, amplitude=400)\nexport:vtk(t, path=\"t.vti\")\n";
+    const std::string good1 =
+        "t = generate:diamond-square(roughness=0.5, amplitude=50)\nexport:vtk(t, path=\"t.vti\")\n";
+    const std::string good2 =
+        "t = generate:diamond-square(roughness=0.5, amplitude=400)\nexport:vtk(t, path=\"t.vti\")\n";
     const std::string bad = "t = generate:diamond-square(roughness=0.5, amplitude=400\nexport:vtk(t, path=\"t.vti\")\n";
     write_spec(good1);
-    const std::string cmd = "cd '" + dir.string() + "' && '" OROGEN_VIEW "' w.orogen --watch --exit-after-reloads 4 "
-                            "--orogen '" OROGEN_CLI "' --out out --screenshot shot.png --size 320x240 >stdout 2>stderr";
+    const std::string cmd = "cd '" + dir.string() +
+        "' && '" OROGEN_VIEW
+        "' w.orogen --watch --exit-after-reloads 4 "
+        "--orogen '" OROGEN_CLI "' --out out --screenshot shot.png --size 320x240 >stdout 2>stderr";
     int status = -1;
     std::thread viewer([&] { status = std::system(cmd.c_str()); });
     auto wait_for = [&](const std::string& text) {
@@ -507,10 +537,10 @@ TEST_F(Viewer, WatchReRunsTheSpecShowsErrorsKeepsTheLastGoodTerrainAndRecovers) 
     EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << status;  // exits cleanly after the 4th load
     const std::string out = slurp(dir / "stdout");
     EXPECT_NE(out.find("w.orogen:4:"), std::string::npos) << out;  // file:line:col of the syntax error
-    const Picture p1 = read_picture(dir / "shot-1.png"), p2 = read_picture(dir / "shot-2.png"), p3 = read_picture(dir / "shot-3.png"),
-                  p4 = read_picture(dir / "shot-4.png");
+    const Picture p1 = read_picture(dir / "shot-1.png"), p2 = read_picture(dir / "shot-2.png"),
+                  p3 = read_picture(dir / "shot-3.png"), p4 = read_picture(dir / "shot-4.png");
     EXPECT_GT(differing_pixels(p1, p2), 2000u);  // the parameter change shows
-    EXPECT_GT(differing_pixels(p2, p3), 200u);   // the error text shows
+    EXPECT_GT(differing_pixels(p2, p3), 200u);  // the error text shows
     // ... over the last good terrain: the lower right quarter is unchanged.
     std::size_t same = 0, total = 0;
     for (int y = 140; y < 220; ++y)
@@ -535,9 +565,10 @@ TEST_F(Viewer, BadInputGivesOneClearErrorAndExit2) {
            "(16-bit heightmap), .r16, .r32 (with their .json sidecar), .tif/.tiff (GeoTIFF), .vrt and the .json index "
            "of export:tiles, and .orogen specs");
     fs::create_directories(dir / "empty");
-    expect("empty", std::string("cannot open 'empty': the folder holds nothing orogen-view shows (") +
-                        ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar), "
-                        ".tif/.tiff (GeoTIFF), .vrt and the .json index of export:tiles, and .orogen specs)");
+    expect("empty",
+           std::string("cannot open 'empty': the folder holds nothing orogen-view shows (") +
+               ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar), "
+               ".tif/.tiff (GeoTIFF), .vrt and the .json index of export:tiles, and .orogen specs)");
     const auto h = plain_and_plateau();
     raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
     fs::remove(dir / "t.r16.json");
@@ -567,11 +598,12 @@ TEST_F(Viewer, BadInputGivesOneClearErrorAndExit2) {
 }
 
 TEST_F(Viewer, GltfFromTheExporterOpens) {
-    const std::string spec = "orogen 1\nseed 1\ngrid 65 cell=10\nt = generate:diamond-square(amplitude=100)\n"
-                             "export:gltf(t, path=\"t.glb\")\n";
+    const std::string spec =
+        "orogen 1\nseed 1\ngrid 65 cell=10\nt = generate:diamond-square(amplitude=100)\n"
+        "export:gltf(t, path=\"t.glb\")\n";
     std::ofstream(dir / "g.orogen") << spec;
     const std::string run = "'" OROGEN_CLI "' run '" + (dir / "g.orogen").string() + "' --out '" + dir.string() +
-                            "' --quiet >/dev/null 2>&1";
+        "' --quiet >/dev/null 2>&1";
     ASSERT_EQ(std::system(run.c_str()), 0);
     const Result r = view("t.glb --screenshot g.png " + top_view);
     ASSERT_EQ(r.code, 0) << r.err;
@@ -642,10 +674,12 @@ TEST_F(Viewer, OpensTheGeoTiffAndTheTilesOfARunAsItsVti) {
                                          "export:vtk(w, path=\"t.vti\")\n"
                                          "export:geotiff(w, path=\"t.tif\", layers=all)\n"
                                          "export:tiles(w, path=\"tiles/t.json\", tile_size=33)\n";
-    const std::string run = "cd '" + dir.string() + "' && OROGEN_NO_CACHE=1 '" OROGEN_CLI "' run gis.orogen --out . --quiet";
+    const std::string run =
+        "cd '" + dir.string() + "' && OROGEN_NO_CACHE=1 '" OROGEN_CLI "' run gis.orogen --out . --quiet";
     ASSERT_EQ(std::system(run.c_str()), 0);
     for (const char* input : {"t.vti", "t.tif", "tiles/t.vrt", "tiles/t.json"}) {
-        const Result r = view(std::string(input) + " --screenshot " + fs::path(input).filename().string() + ".png " + top_view);
+        const Result r =
+            view(std::string(input) + " --screenshot " + fs::path(input).filename().string() + ".png " + top_view);
         ASSERT_EQ(r.code, 0) << input << ": " << r.err;
     }
     // The map (above the status line, which names the file): compared pixel by pixel.
@@ -657,7 +691,8 @@ TEST_F(Viewer, OpensTheGeoTiffAndTheTilesOfARunAsItsVti) {
     EXPECT_EQ(differing_pixels(vti, map_of(read_picture(dir / "t.tif.png")), 0), 0u);  // the same floats
     // 16-bit tiles: heights within a 65535th of the range, the same picture but for rounding.
     EXPECT_LT(differing_pixels(vti, map_of(read_picture(dir / "t.vrt.png"))), 200u);
-    EXPECT_EQ(differing_pixels(map_of(read_picture(dir / "t.vrt.png")), map_of(read_picture(dir / "t.json.png")), 0), 0u);
+    EXPECT_EQ(differing_pixels(map_of(read_picture(dir / "t.vrt.png")), map_of(read_picture(dir / "t.json.png")), 0),
+              0u);
     // The GeoTIFF's bands are the layers, by name.
     const Result layer = view("t.tif --events /dev/null --print-state --layer eroded --top --size 200x200");
     ASSERT_EQ(layer.code, 0) << layer.err;

@@ -8,8 +8,8 @@ using namespace orogen;
 
 struct Soil {
     double production = 2e-4;  // P0, m/yr: bare rock's weathering rate
-    double depth = 0.5;        // h0, m: production falls e-fold per this much soil
-    double diffusivity = 0.01; // D, m²/yr
+    double depth = 0.5;  // h0, m: production falls e-fold per this much soil
+    double diffusivity = 0.01;  // D, m²/yr
 };
 
 class SoilProcess final : public Process {
@@ -30,8 +30,8 @@ public:
                     const std::size_t a = std::size_t(y) * W + x, b = std::size_t(y + dy) * W + x + dx;
                     const std::size_t from = z[a] > z[b] ? a : b, to = from == a ? b : a;
                     // what the slope carries, limited to the soil the upper cell has
-                    const double q = std::min(k * (1.0 - std::exp(-H[from] / s_.depth)) * (z[from] - z[to]),
-                                              0.25 * H[from]);
+                    const double q =
+                        std::min(k * (1.0 - std::exp(-H[from] / s_.depth)) * (z[from] - z[to]), 0.25 * H[from]);
                     flux[from] -= q, flux[to] += q;
                 }
         for (std::size_t i = 0; i < z.size(); ++i)

@@ -4,7 +4,9 @@
 using namespace orogen;
 
 OROGEN_PLUGIN("fault-clone", "0.0.1", registry) {
-    registry.add({.kind = "generate", .name = "fault", .summary = "an impostor",
+    registry.add({.kind = "generate",
+                  .name = "fault",
+                  .summary = "an impostor",
                   .output = ValueType::heightmap,
                   .run = [](NodeContext&) -> NodeOutputs { return std::make_shared<Heightmap>(2, 2, 1.0); }});
 }

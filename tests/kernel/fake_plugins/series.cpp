@@ -24,8 +24,7 @@ std::atomic<int> most_alive{0};
 std::shared_ptr<Heightmap> counted(int w, int h, double cell, float fill) {
     const int now = ++alive;
     int seen = most_alive.load();
-    while (now > seen && !most_alive.compare_exchange_weak(seen, now)) {
-    }
+    while (now > seen && !most_alive.compare_exchange_weak(seen, now)) {}
     return std::shared_ptr<Heightmap>(new Heightmap(w, h, cell, fill), [](Heightmap* p) {
         --alive;
         delete p;
@@ -35,7 +34,9 @@ std::shared_ptr<Heightmap> counted(int w, int h, double cell, float fill) {
 }  // namespace
 
 OROGEN_PLUGIN("test-series", "0.0.1", registry) {
-    registry.add({.kind = "generate", .name = "test-frames", .summary = "a series of heightmaps filled with 0, 1, 2, ...",
+    registry.add({.kind = "generate",
+                  .name = "test-frames",
+                  .summary = "a series of heightmaps filled with 0, 1, 2, ...",
                   .output = ValueType::heightmap,
                   .output_series = true,
                   .params = {Param::integer("frames", 3).min(0).max(1000)},
@@ -47,7 +48,9 @@ OROGEN_PLUGIN("test-series", "0.0.1", registry) {
                       s->make = [g](std::size_t i) -> Value { return counted(g.width, g.height, g.cell, float(i)); };
                       return s;
                   }});
-    registry.add({.kind = "generate", .name = "test-add", .summary = "adds `amount` to every height",
+    registry.add({.kind = "generate",
+                  .name = "test-add",
+                  .summary = "adds `amount` to every height",
                   .inputs = {{"terrain", ValueType::heightmap, Need::required, ""}},
                   .output = ValueType::heightmap,
                   .params = {Param::real("amount", 1.0)},
@@ -59,7 +62,9 @@ OROGEN_PLUGIN("test-series", "0.0.1", registry) {
                           out->heights()[i] = in.heights()[i] + float(ctx.real("amount"));
                       return out;
                   }});
-    registry.add({.kind = "generate", .name = "test-either", .summary = "a heightmap or a series; outputs the entry count",
+    registry.add({.kind = "generate",
+                  .name = "test-either",
+                  .summary = "a heightmap or a series; outputs the entry count",
                   .inputs = {{"terrain", ValueType::heightmap, Need::required, "", Many::either}},
                   .output = ValueType::heightmap,
                   .run = [](NodeContext& ctx) -> NodeOutputs {
@@ -67,7 +72,9 @@ OROGEN_PLUGIN("test-series", "0.0.1", registry) {
                       const float n = v.type() == ValueType::series ? float(v.series()->size()) : -1.0f;
                       return std::make_shared<Heightmap>(2, 2, 1.0, n);
                   }});
-    registry.add({.kind = "export", .name = "test-series", .summary = "writes each entry's time and first height",
+    registry.add({.kind = "export",
+                  .name = "test-series",
+                  .summary = "writes each entry's time and first height",
                   .inputs = {{"series", ValueType::heightmap, Need::required, "", Many::series}},
                   .params = {Param::path("path", PathRole::output, {".txt"}),
                              Param::boolean("sums", false).help("also write each entry's sum of heights")},

@@ -224,8 +224,7 @@ TEST(Figures, ParallelRiversAtSteadyStateGiveTheirConcavityAndSteepness) {
     // Every 1 km reach of these channels is straight.
     EXPECT_NEAR(f[channel_sinuosity].value, 1.0, 1e-12);
     ASSERT_FALSE(f.slope_area.x.empty());
-    for (std::size_t b = 0; b < f.slope_area.x.size(); ++b)
-        EXPECT_GT(f.slope_area.y[b], 0.0);
+    for (std::size_t b = 0; b < f.slope_area.x.size(); ++b) EXPECT_GT(f.slope_area.y[b], 0.0);
 }
 
 TEST(Figures, AWindingChannelIsSinuousAndAStraightOneIsNot) {
@@ -252,7 +251,8 @@ TEST(Figures, AWindingChannelIsSinuousAndAStraightOneIsNot) {
     for (int x = 0; x < w; ++x) straight[std::size_t(h / 2) * w + std::size_t(x)] = float(1000.0 - 20.0 * x);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
-            if (y != h / 2) straight[std::size_t(y) * w + std::size_t(x)] = float(1000.0 - 20.0 * x + 300.0 * std::abs(y - h / 2));
+            if (y != h / 2)
+                straight[std::size_t(y) * w + std::size_t(x)] = float(1000.0 - 20.0 * x + 300.0 * std::abs(y - h / 2));
     const Figures line = measure({straight.data(), w, h, 100.0});
     ASSERT_TRUE(line[channel_sinuosity].ok()) << line[channel_sinuosity].why_not;
     EXPECT_NEAR(line[channel_sinuosity].value, 1.0, 1e-12);

@@ -85,8 +85,9 @@ TEST(Raw, GivenRangeMapsItsEndsAndClampsOutside) {
     EXPECT_EQ(q, (std::vector<std::uint16_t>{0, 0, 2114, 32768, 65535, 65535}));
     EXPECT_EQ(clamped, 2u);
     std::vector<float> flat(4, 7.0f);
-    EXPECT_EQ(raw::quantize16(ConstGridView(flat.data(), 2, 2, 1.0), raw::min_max(ConstGridView(flat.data(), 2, 2, 1.0))),
-              (std::vector<std::uint16_t>(4, 0)));
+    EXPECT_EQ(
+        raw::quantize16(ConstGridView(flat.data(), 2, 2, 1.0), raw::min_max(ConstGridView(flat.data(), 2, 2, 1.0))),
+        (std::vector<std::uint16_t>(4, 0)));
 }
 
 TEST(Raw, BadExtensionAndRangeAreBadInput) {
@@ -102,9 +103,7 @@ TEST(Raw, BadExtensionAndRangeAreBadInput) {
     try {
         raw::write_raw(g, dir / "t.r16", raw::Range{10, 10});
         FAIL();
-    } catch (const BadInput& e) {
-        EXPECT_STREQ(e.what(), "the height range must have high > low, got low=10 high=10");
-    }
+    } catch (const BadInput& e) { EXPECT_STREQ(e.what(), "the height range must have high > low, got low=10 high=10"); }
     EXPECT_TRUE(test::folder_entries(dir.path()).empty());
 }
 
@@ -133,9 +132,7 @@ namespace {
 std::string bad_input_text(const std::function<void()>& f) {
     try {
         f();
-    } catch (const BadInput& e) {
-        return e.what();
-    }
+    } catch (const BadInput& e) { return e.what(); }
     return "no error";
 }
 }  // namespace
@@ -178,14 +175,16 @@ TEST(RawRead, AHugeDeclaredSizeACutFileAndABrokenSidecarAreRefusedBeforeReading)
     }
     std::string m = bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); });
     EXPECT_EQ(m.substr(0, m.find(" more than")),
-              "cannot read " + file + ": its sidecar declares 100000x100000 samples, which needs 37.3 GiB for one "
-              "heightmap (4 bytes a vertex),");
+              "cannot read " + file +
+                  ": its sidecar declares 100000x100000 samples, which needs 37.3 GiB for one "
+                  "heightmap (4 bytes a vertex),");
     std::ofstream(dir / "t.r16.json", std::ios::binary) << sidecar;
     const std::string data = test::file_text(dir / "t.r16");
     std::ofstream(dir / "t.r16", std::ios::binary) << data.substr(0, 1000);
     EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
-              "cannot read " + file + ": it holds 1000 bytes, but its sidecar's 65x40 16-bit samples need exactly "
-              "5200; it is truncated");
+              "cannot read " + file +
+                  ": it holds 1000 bytes, but its sidecar's 65x40 16-bit samples need exactly "
+                  "5200; it is truncated");
     std::ofstream(dir / "t.r16", std::ios::binary) << data;
     with("\"width\": 65", "\"width\": -1");
     EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
@@ -195,10 +194,14 @@ TEST(RawRead, AHugeDeclaredSizeACutFileAndABrokenSidecarAreRefusedBeforeReading)
               "cannot read " + file + ".json: it is not valid JSON; export:raw writes it beside the RAW file");
     fs::remove(dir / "t.r16.json");
     EXPECT_EQ(bad_input_text([&] { raw::read_raw_header(dir / "t.r16"); }),
-              "cannot read " + file + ": its sidecar " + file + ".json does not exist; a RAW file says nothing of its "
-              "size, so the sidecar export:raw writes must sit beside it");
-    EXPECT_EQ(bad_input_text([&] { raw::parse_sidecar("{\"format\": \"r16\", \"width\": 3, \"height\": 3, "
-                                                      "\"cell_size\": 1, \"height_min\": 5, \"height_max\": 1}",
-                                                      "s.json"); }),
+              "cannot read " + file + ": its sidecar " + file +
+                  ".json does not exist; a RAW file says nothing of its "
+                  "size, so the sidecar export:raw writes must sit beside it");
+    EXPECT_EQ(bad_input_text([&] {
+                  raw::parse_sidecar(
+                      "{\"format\": \"r16\", \"width\": 3, \"height\": 3, "
+                      "\"cell_size\": 1, \"height_min\": 5, \"height_max\": 1}",
+                      "s.json");
+              }),
               "cannot read s.json: \"height_max\" (1) is below \"height_min\" (5)");
 }

@@ -81,7 +81,9 @@ TEST_P(Schemes, StepSpreadsAsTheErrorFunction) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Diffusion, Schemes, ::testing::Values(diffusion::Scheme::implicit, diffusion::Scheme::adi),
-                         [](const auto& info) { return info.param == diffusion::Scheme::implicit ? "implicit" : "adi"; });
+                         [](const auto& info) {
+                             return info.param == diffusion::Scheme::implicit ? "implicit" : "adi";
+                         });
 
 TEST(Diffusion, ImplicitKeepsTheMaximumPrincipleAtHugeSteps) {
     const int w = 64, h = 64;

@@ -107,12 +107,13 @@ TEST(Vtk, ImageDataLiesInTheXYPlaneNorthUpByDefault) {
     double bounds[6];
     img->GetBounds(bounds);
     EXPECT_DOUBLE_EQ(bounds[0], 0.0);
-    EXPECT_DOUBLE_EQ(bounds[1], 32 * 25.0);   // X east to (w−1)·cell
+    EXPECT_DOUBLE_EQ(bounds[1], 32 * 25.0);  // X east to (w−1)·cell
     EXPECT_DOUBLE_EQ(bounds[2], -16 * 25.0);  // Y north: the south row at −(h−1)·cell
-    EXPECT_DOUBLE_EQ(bounds[3], 0.0);         // the north row (row 0) at 0
+    EXPECT_DOUBLE_EQ(bounds[3], 0.0);  // the north row (row 0) at 0
     EXPECT_DOUBLE_EQ(bounds[4], 0.0);
     EXPECT_DOUBLE_EQ(bounds[5], 0.0);
-    for (const auto& [name, data] : {std::pair<const char*, const std::vector<float>*>{"height", &heights}, {"plate", &plate}}) {
+    for (const auto& [name, data] :
+         {std::pair<const char*, const std::vector<float>*>{"height", &heights}, {"plate", &plate}}) {
         vtkDataArray* a = img->GetPointData()->GetArray(name);
         ASSERT_NE(a, nullptr) << name;
         // Sample (x, row) is the point at X = x·cell, Y = −row·cell.
@@ -135,7 +136,8 @@ TEST(Vtk, ImageDataWithUpYHoldsHeightAndEveryLayerInTheXZPlane) {
         water[i] = 0.01f * float(i % 7);
         plate[i] = float(i % 3);
     }
-    const std::vector<ov::NamedGrid> layers = {{"water", {water.data(), w, h, 25.0}}, {"plate", {plate.data(), w, h, 25.0}}};
+    const std::vector<ov::NamedGrid> layers = {{"water", {water.data(), w, h, 25.0}},
+                                               {"plate", {plate.data(), w, h, 25.0}}};
     ov::write_heightmap({heights.data(), w, h, 25.0}, layers, dir / "t.vti", up_y());
 
     vtkNew<vtkXMLImageDataReader> r;
@@ -155,7 +157,8 @@ TEST(Vtk, ImageDataWithUpYHoldsHeightAndEveryLayerInTheXZPlane) {
     vtkPointData* pd = img->GetPointData();
     ASSERT_EQ(pd->GetNumberOfArrays(), 3);
     for (const auto& [name, data] : {std::pair<const char*, const std::vector<float>*>{"height", &heights},
-                                     {"water", &water}, {"plate", &plate}}) {
+                                     {"water", &water},
+                                     {"plate", &plate}}) {
         vtkDataArray* a = pd->GetArray(name);
         ASSERT_NE(a, nullptr) << name;
         ASSERT_EQ(a->GetNumberOfTuples(), w * h);
@@ -298,8 +301,9 @@ TEST(Vtk, ParticleTimeSeriesAsASingleVtpIsBadInput) {
         ov::write_particles(s, dir / "p.vtp");
         FAIL();
     } catch (const BadInput& e) {
-        EXPECT_STREQ(e.what(), "the particles have 2 frames; write a time series as .pvd (one .vtp per frame), or a "
-                               "single frame as .vtp");
+        EXPECT_STREQ(e.what(),
+                     "the particles have 2 frames; write a time series as .pvd (one .vtp per frame), or a "
+                     "single frame as .vtp");
     }
     s.frames.resize(1);
     EXPECT_EQ(ov::write_particles(s, dir / "p.vtp"), 1u);
@@ -334,7 +338,8 @@ TEST(Vtk, PlatesArePolygonsAndCollisionsPerSnapshot) {
     EXPECT_EQ(plates->GetNumberOfPoints(), 7);
     EXPECT_EQ(plates->GetCellData()->GetArray("plate")->GetTuple1(1), 2.0);
     EXPECT_DOUBLE_EQ(plates->GetCellData()->GetArray("velocity")->GetComponent(0, 0), 2.0);
-    EXPECT_DOUBLE_EQ(plates->GetCellData()->GetArray("velocity")->GetComponent(0, 1), -0.5);  // (2, 0.5) south → north −0.5
+    EXPECT_DOUBLE_EQ(plates->GetCellData()->GetArray("velocity")->GetComponent(0, 1),
+                     -0.5);  // (2, 0.5) south → north −0.5
     EXPECT_FLOAT_EQ(float(plates->GetCellData()->GetArray("density")->GetTuple1(1)), 1.2f);
     EXPECT_EQ(frame_of(plates), "z");
     double p[3];

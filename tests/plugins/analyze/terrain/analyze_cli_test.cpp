@@ -25,8 +25,9 @@ fs::path write_f32(const TempDir& dir, const std::string& name, int w, int h, do
         for (int x = 0; x < w; ++x) z[std::size_t(y) * w + x] = float(f(x, y));
     const fs::path path = dir / (name + ".f32");
     std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(z.data()), std::streamsize(z.size() * 4));
-    dir.write(name + ".json", "{\"nx\": " + std::to_string(w) + ", \"ny\": " + std::to_string(h) +
-                                  ", \"dx_m\": " + std::to_string(cell) + "}");
+    dir.write(name + ".json",
+              "{\"nx\": " + std::to_string(w) + ", \"ny\": " + std::to_string(h) +
+                  ", \"dx_m\": " + std::to_string(cell) + "}");
     return path;
 }
 
@@ -36,7 +37,8 @@ double figure(const std::string& json, const std::string& name, const std::strin
     if (at == std::string::npos) return std::nan("");
     std::smatch m;
     const std::string rest = json.substr(at);
-    if (!std::regex_search(rest, m, std::regex("\"" + key + "\": \\{\"value\": ([-0-9.e+]+|null)"))) return std::nan("");
+    if (!std::regex_search(rest, m, std::regex("\"" + key + "\": \\{\"value\": ([-0-9.e+]+|null)")))
+        return std::nan("");
     return m[1] == "null" ? std::nan("") : std::stod(m[1]);
 }
 
@@ -77,7 +79,8 @@ TEST(AnalyzeCli, ComparesWithReferencesAndNamesTheNearest) {
     const auto r = run_orogen("analyze " + q(dome) + " " + q(rif) + " --against " + q(rif) + " " + q(rough) +
                               " --no-render --out " + q(dir / "out"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.out.find("morocco_rif_27m-2*"), std::string::npos) << "a reference, named apart from the terrain\n" << r.out;
+    EXPECT_NE(r.out.find("morocco_rif_27m-2*"), std::string::npos) << "a reference, named apart from the terrain\n"
+                                                                   << r.out;
     EXPECT_NE(r.out.find("references"), std::string::npos);
     EXPECT_TRUE(std::regex_search(r.out, std::regex("median slope .* OUT +in\\n"))) << r.out;
     EXPECT_NE(r.out.find("resembles most"), std::string::npos);
@@ -90,14 +93,16 @@ TEST(AnalyzeCli, ComparesWithReferencesAndNamesTheNearest) {
 
 TEST(AnalyzeCli, RendersTheTerrainsWithOneCamera) {
     TempDir dir;
-    const fs::path small = write_f32(dir, "small", 120, 90, 30.0, [](int x, int y) { return 5.0 * x + 300 * std::sin(y * 0.1); });
+    const fs::path small =
+        write_f32(dir, "small", 120, 90, 30.0, [](int x, int y) { return 5.0 * x + 300 * std::sin(y * 0.1); });
     const auto r = run_orogen("analyze " + q(small) + " --against " + q(rif) + " --out " + q(dir / "out"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_TRUE(fs::exists(dir / "out/renders/small.png"));
     EXPECT_TRUE(fs::exists(dir / "out/renders/morocco_rif_27m.png"));
     const std::string page = slurp(dir / "out/README.md");
     EXPECT_NE(page.find("![small](renders/small.png)"), std::string::npos) << page;
-    EXPECT_NE(r.out.find("(one reference: no spread to measure the distance to it by; give two or more"), std::string::npos)
+    EXPECT_NE(r.out.find("(one reference: no spread to measure the distance to it by; give two or more"),
+              std::string::npos)
         << r.out;
 }
 
@@ -105,15 +110,17 @@ TEST(AnalyzeCli, EveryFileKindGivesTheSameFigures) {
     // One terrain written by orogen itself as .vti (both up axes), .r32, GeoTIFF and OpenEXR, read back by analyze:
     // the figures must agree (and so the orientation and the cell size of each reader).
     TempDir dir;
-    dir.write("t.orogen", "orogen 1\nseed 3\ngrid 97x81 cell=30\n"
-                          "t = generate:diamond-square(roughness=0.6, amplitude=900)\n"
-                          "export:vtk(t, path=\"t.vti\")\nexport:vtk(t, path=\"y.vti\", up=y)\n"
-                          "export:raw(t, path=\"t.r32\")\nexport:geotiff(t, path=\"t.tif\")\n"
-                          "export:exr(t, path=\"t.exr\")\n");
+    dir.write("t.orogen",
+              "orogen 1\nseed 3\ngrid 97x81 cell=30\n"
+              "t = generate:diamond-square(roughness=0.6, amplitude=900)\n"
+              "export:vtk(t, path=\"t.vti\")\nexport:vtk(t, path=\"y.vti\", up=y)\n"
+              "export:raw(t, path=\"t.r32\")\nexport:geotiff(t, path=\"t.tif\")\n"
+              "export:exr(t, path=\"t.exr\")\n");
     const auto made = run_orogen("run " + q(dir / "t.orogen") + " --quiet --out " + q(dir / "in"));
     ASSERT_EQ(made.exit_code, 0) << made.err;
-    const auto r = run_orogen("analyze " + q(dir / "in/t.vti") + " " + q(dir / "in/y.vti") + " " + q(dir / "in/t.r32") +
-                              " " + q(dir / "in/t.tif") + " " + q(dir / "in/t.exr") + " --no-render --out " + q(dir / "out"));
+    const auto r =
+        run_orogen("analyze " + q(dir / "in/t.vti") + " " + q(dir / "in/y.vti") + " " + q(dir / "in/t.r32") + " " +
+                   q(dir / "in/t.tif") + " " + q(dir / "in/t.exr") + " --no-render --out " + q(dir / "out"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::string json = slurp(dir / "out/analysis.json");
     for (const char* key : {"slope_median", "hypsometric_integral", "spectral_exponent", "pits", "local_relief"}) {
@@ -138,7 +145,8 @@ TEST(AnalyzeCli, HolesAreMaskedAndCounted) {
     GDALSetRasterNoDataValue(band, -9999);
     std::vector<float> z(64 * 64);
     for (int y = 0; y < 64; ++y)
-        for (int x = 0; x < 64; ++x) z[std::size_t(y * 64 + x)] = (x >= 20 && x < 30 && y >= 20 && y < 26) ? -9999.0f : float(3 * x + 4 * y);
+        for (int x = 0; x < 64; ++x)
+            z[std::size_t(y * 64 + x)] = (x >= 20 && x < 30 && y >= 20 && y < 26) ? -9999.0f : float(3 * x + 4 * y);
     ASSERT_EQ(GDALRasterIO(band, GF_Write, 0, 0, 64, 64, z.data(), 64, 64, GDT_Float32, 0, 0), CE_None);
     GDALClose(ds);
     const auto r = run_orogen("analyze " + q(tif) + " --no-render --out " + q(dir / "out"));
@@ -211,7 +219,8 @@ TEST(AnalyzeCli, TheSameBytesOnOneThreadOrTwo) {
                              q(dir / (std::string("t") + threads)))
                       .exit_code,
                   0);
-    for (const char* file : {"analysis.json", "analysis.txt", "README.md", "analysis-spectrum.png", "analysis-slope-area.png"})
+    for (const char* file :
+         {"analysis.json", "analysis.txt", "README.md", "analysis-spectrum.png", "analysis-slope-area.png"})
         EXPECT_EQ(slurp(dir / "t1" / file), slurp(dir / "t2" / file)) << file;
 }
 
@@ -219,7 +228,8 @@ TEST(AnalyzeCli, WithoutGnuplotTheReportComesWithoutCharts) {
     TempDir dir;
     const auto r = run_orogen("analyze " + q(rif) + " --no-render --out " + q(dir / "out"), "PATH=/nonexistent");
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_NE(r.err.find("no charts: gnuplot is not installed (apt-get install gnuplot-nox)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("no charts: gnuplot is not installed (apt-get install gnuplot-nox)"), std::string::npos)
+        << r.err;
     EXPECT_TRUE(fs::exists(dir / "out/analysis.json"));
     EXPECT_FALSE(fs::exists(dir / "out/analysis-slopes.png"));
     EXPECT_EQ(slurp(dir / "out/README.md").find("## Charts"), std::string::npos);

@@ -76,7 +76,8 @@ TEST(Hydraulic, OlsenDrainsCompletelyWhenTheDropExceedsTheWater) {
 TEST(Hydraulic, OutflowIsTheWaterTheNextStepMoves) {
     auto outflow = [](Grid& g) {
         std::vector<float> flow(g.height.size(), -1.0f);
-        hydraulic::outflow({{g.height.data(), g.w, g.h, g.cell}, {g.water.data(), g.w, g.h, g.cell},
+        hydraulic::outflow({{g.height.data(), g.w, g.h, g.cell},
+                            {g.water.data(), g.w, g.h, g.cell},
                             {g.sediment.data(), g.w, g.h, g.cell}},
                            no_sources(), nullptr, GridView{flow.data(), g.w, g.h, g.cell});
         return flow;

@@ -65,7 +65,7 @@ std::vector<float> olsen_change(const std::vector<float>& start) {
 /// Ditches met along a path across the slope: troughs of the change that
 /// are local minima over ±2 samples and cut at least 20 % of the path's deepest.
 struct Ditches {
-    std::vector<double> depth;    // m below the path's median change
+    std::vector<double> depth;  // m below the path's median change
     std::vector<double> spacing;  // samples between neighbouring ditches
     double profile_spread = 0.0;  // (max − min) of the change along the path, m
 };
@@ -81,7 +81,8 @@ double cv(const std::vector<double>& v) {  // coefficient of variation
 Ditches ditches_along(const std::vector<float>& change, const std::vector<std::pair<double, double>>& path) {
     std::vector<double> c;
     for (auto [x, y] : path) {
-        const int xi = std::clamp(int(std::lround(x)), 0, kSize - 1), yi = std::clamp(int(std::lround(y)), 0, kSize - 1);
+        const int xi = std::clamp(int(std::lround(x)), 0, kSize - 1),
+                  yi = std::clamp(int(std::lround(y)), 0, kSize - 1);
         c.push_back(change[std::size_t(yi) * kSize + xi]);
     }
     std::vector<double> sorted = c;
@@ -132,10 +133,11 @@ TEST(Experiment41, PipeModelCutsDifferingDitchesWhereOlsenLowersEvenly) {
         ASSERT_FALSE(pipe.depth.empty()) << name << ": the pipe model cut no ditch across the slope";
         const double shallow = *std::min_element(pipe.depth.begin(), pipe.depth.end());
         const double deep = *std::max_element(pipe.depth.begin(), pipe.depth.end());
-        std::printf("%-10s pipe: %zu ditches %.3f..%.3f m deep, spacing cv %.2f, profile spread %.3f m | "
-                    "olsen: %zu ditches, profile spread %.5f m\n",
-                    name, pipe.depth.size(), shallow, deep, cv(pipe.spacing), pipe.profile_spread, olsen.depth.size(),
-                    olsen.profile_spread);
+        std::printf(
+            "%-10s pipe: %zu ditches %.3f..%.3f m deep, spacing cv %.2f, profile spread %.3f m | "
+            "olsen: %zu ditches, profile spread %.5f m\n",
+            name, pipe.depth.size(), shallow, deep, cv(pipe.spacing), pipe.profile_spread, olsen.depth.size(),
+            olsen.profile_spread);
         EXPECT_GE(pipe.depth.size(), 3u) << name;
         // Differing: unequal depths, or unequal spacing (uniform ditches would
         // have a depth ratio near 1 and a spacing cv near 0).

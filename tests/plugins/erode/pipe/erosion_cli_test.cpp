@@ -68,17 +68,22 @@ TEST(ErosionCli, LayersCarryFromNodeToNode) {
 // a zero-step pipe run (whose fluxes and speed are all zero).
 TEST(ErosionCli, PipeAfterHydraulicIgnoresItsFlowLayer) {
     TempDir dir;
-    const std::string head = "orogen 1\n"
-                             "grid 65 cell=1\n"
-                             "base = generate:shape(kind=pyramid, height=20)\n"
-                             "wet = erode:pipe(base, steps=10, dt=0.5)\n"
-                             "olsen = erode:hydraulic(wet, iterations=5, rain=2, evaporation=0)\n";
-    const auto direct = dir.write("direct.orogen", head + "p = erode:pipe(olsen, steps=3, dt=2)\n"
-                                                          "export:raw(p, path=\"p.r32\")\n"
-                                                          "export:vtk(olsen, path=\"olsen.vti\")\n");
-    const auto fresh = dir.write("fresh.orogen", head + "z = erode:pipe(olsen, steps=0)\n"
-                                                        "p = erode:pipe(z, steps=3, dt=2)\n"
-                                                        "export:raw(p, path=\"p.r32\")\n");
+    const std::string head =
+        "orogen 1\n"
+        "grid 65 cell=1\n"
+        "base = generate:shape(kind=pyramid, height=20)\n"
+        "wet = erode:pipe(base, steps=10, dt=0.5)\n"
+        "olsen = erode:hydraulic(wet, iterations=5, rain=2, evaporation=0)\n";
+    const auto direct = dir.write("direct.orogen",
+                                  head +
+                                      "p = erode:pipe(olsen, steps=3, dt=2)\n"
+                                      "export:raw(p, path=\"p.r32\")\n"
+                                      "export:vtk(olsen, path=\"olsen.vti\")\n");
+    const auto fresh = dir.write("fresh.orogen",
+                                 head +
+                                     "z = erode:pipe(olsen, steps=0)\n"
+                                     "p = erode:pipe(z, steps=3, dt=2)\n"
+                                     "export:raw(p, path=\"p.r32\")\n");
     ASSERT_EQ(run_orogen("run " + q(direct) + " --out " + q(dir / "a")).exit_code, 0);
     ASSERT_EQ(run_orogen("run " + q(fresh) + " --out " + q(dir / "b")).exit_code, 0);
     EXPECT_EQ(slurp(dir / "a" / "p.r32"), slurp(dir / "b" / "p.r32"));

@@ -171,8 +171,8 @@ Metrics metrics(const std::vector<float>& hgt, int w, int h) {
 
 void print(const char* what, const std::vector<float>& hgt, int w, int h) {
     const Metrics m = metrics(hgt, w, h);
-    std::printf("%-8s checker(global) %.4g m  checker(8x8 RMS) %.4g m  laplacian RMS %.4g m  pits %d  peaks %d\n",
-                what, m.checker_global, m.checker_block, m.laplace_rms, m.pits, m.peaks);
+    std::printf("%-8s checker(global) %.4g m  checker(8x8 RMS) %.4g m  laplacian RMS %.4g m  pits %d  peaks %d\n", what,
+                m.checker_global, m.checker_block, m.laplace_rms, m.pits, m.peaks);
 }
 
 }  // namespace
@@ -321,7 +321,8 @@ int main(int argc, char** argv) {
     for (std::size_t k = 0; k < panels.size(); ++k) {
         const int ox = int(k % cols) * w, oy = int(k / cols) * h;
         for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) all[std::size_t(oy + y) * (w * cols) + ox + x] = panels[k][std::size_t(y) * w + x];
+            for (int x = 0; x < w; ++x)
+                all[std::size_t(oy + y) * (w * cols) + ox + x] = panels[k][std::size_t(y) * w + x];
     }
     write_rgb(out + "/" + prefix + "-panel.png", w * cols, h * rows_n, all, false);
     return 0;

@@ -253,8 +253,11 @@ TEST(Pipe, SameBytesOnOneAndTwoThreads) {
         tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
         b.run(s, 40, 0.2);
     }
-    for (auto [x, y] : {std::pair{&a.height, &b.height}, {&a.water, &b.water}, {&a.sediment, &b.sediment},
-                        {&a.fw, &b.fw}, {&a.speed, &b.speed}})
+    for (auto [x, y] : {std::pair{&a.height, &b.height},
+                        {&a.water, &b.water},
+                        {&a.sediment, &b.sediment},
+                        {&a.fw, &b.fw},
+                        {&a.speed, &b.speed}})
         EXPECT_EQ(std::memcmp(x->data(), y->data(), x->size() * sizeof(float)), 0);
 }
 

@@ -88,7 +88,6 @@ int main(int argc, char** argv) {
     }
     std::ofstream out(argv[1], std::ios::binary);
     write_rgba_png(out, W, W, rgba);
-    std::printf("%zu particles alive after %d steps (%lld sub-steps)\n", pos.size(), steps,
-                (long long)sim.substeps());
+    std::printf("%zu particles alive after %d steps (%lld sub-steps)\n", pos.size(), steps, (long long)sim.substeps());
     return 0;
 }

@@ -29,10 +29,12 @@ const char* kAttributes[] = {"velocity", "density", "pressure", "sediment", "aci
 std::string spec(const std::string& sph_args) {
     return "orogen 1\nseed 3\ngrid 33 cell=1\n"
            "hill = generate:shape(kind=pyramid, height=10)\n"
-           "wet = erode:sph(hill, " + sph_args + ")\n"
-           "export:vtk-particles(wet.particles, path=\"p.pvd\")\n"
-           "export:vdb-particles(wet.particles, path=\"p.vdb\")\n"
-           "export:raw(wet, path=\"wet.r32\")\n";
+           "wet = erode:sph(hill, " +
+        sph_args +
+        ")\n"
+        "export:vtk-particles(wet.particles, path=\"p.pvd\")\n"
+        "export:vdb-particles(wet.particles, path=\"p.vdb\")\n"
+        "export:raw(wet, path=\"wet.r32\")\n";
 }
 
 }  // namespace

@@ -52,7 +52,7 @@ TEST(SphDamBreak, SurgeFrontFollowsMartinAndMoyceWithinTenPercentUpToT3) {
     const Point martin_moyce[] = {{0.41, 1.11}, {0.84, 1.22}, {1.19, 1.44}, {1.43, 1.67}, {1.63, 1.89},
                                   {1.83, 2.11}, {1.98, 2.33}, {2.20, 2.56}, {2.32, 2.78}, {2.51, 3.00},
                                   {2.65, 3.22}, {2.83, 3.44}, {2.98, 3.67}};
-    const double a = 0.2;       // column width, m (height 2a)
+    const double a = 0.2;  // column width, m (height 2a)
     const double s = a / 16.0;  // particle spacing: 16 × 32 × 4 particles
     const double g = 9.81;
     const Flat tank(41, 3, a / 8.0);  // 5a long, two cells (4 particles) deep
@@ -65,7 +65,8 @@ TEST(SphDamBreak, SurgeFrontFollowsMartinAndMoyceWithinTenPercentUpToT3) {
         const double t = p.T * time_scale;
         if (t > sim.time()) sim.advance(t - sim.time(), ++step);
         double front = 0.0;
-        for (const sph::Vec3& q : sim.positions()) front = std::max(front, double(q.x) + s / 2.0);  // the leading particle's edge
+        for (const sph::Vec3& q : sim.positions())
+            front = std::max(front, double(q.x) + s / 2.0);  // the leading particle's edge
         const double Z = front / a;
         std::printf("T %.2f  Z %.3f  (Martin & Moyce %.2f)\n", p.T, Z, p.Z);
         if (p.T < 0.8) continue;

@@ -148,7 +148,8 @@ TEST(SphDeterminism, SameBytesOnOneAndTwoThreads) {
         auto& t = terrain[std::size_t(threads - 1)];
         t.resize(h.size());
         sim.write_terrain(GridView{t.data(), kSize, kSize, 1.0});
-        for (const sph::Vec3& p : sim.positions()) positions[std::size_t(threads - 1)].insert(positions[std::size_t(threads - 1)].end(), {p.x, p.y, p.z});
+        for (const sph::Vec3& p : sim.positions())
+            positions[std::size_t(threads - 1)].insert(positions[std::size_t(threads - 1)].end(), {p.x, p.y, p.z});
     }
     ASSERT_EQ(terrain[0].size(), terrain[1].size());
     EXPECT_EQ(0, std::memcmp(terrain[0].data(), terrain[1].data(), terrain[0].size() * sizeof(float)));
@@ -206,10 +207,12 @@ TEST(SphDeterminism, TheChunkedTerrainExchangeGivesTheSerialLoopsBits) {
             EXPECT_EQ(serial.volume, chunked.volume);
             EXPECT_EQ(serial.carried, chunked.carried);
             EXPECT_EQ(serial.removed, chunked.removed);
-            EXPECT_EQ(0, std::memcmp(serial.terrain.data(), chunked.terrain.data(), serial.terrain.size() * sizeof(float)));
+            EXPECT_EQ(
+                0, std::memcmp(serial.terrain.data(), chunked.terrain.data(), serial.terrain.size() * sizeof(float)));
             ASSERT_EQ(serial.positions.size(), chunked.positions.size());
-            EXPECT_EQ(0, std::memcmp(serial.positions.data(), chunked.positions.data(),
-                                     serial.positions.size() * sizeof(float)));
+            EXPECT_EQ(0,
+                      std::memcmp(serial.positions.data(), chunked.positions.data(),
+                                  serial.positions.size() * sizeof(float)));
             EXPECT_EQ(serial.counts.sea, chunked.counts.sea);
             EXPECT_EQ(serial.counts.left, chunked.counts.left);
         }
@@ -249,7 +252,7 @@ TEST(SphDeterminism, MergingTheParticlesThatChangedCellGivesTheRadixSortsBits) {
     }
     EXPECT_EQ(runs[0].merged, 0);
     EXPECT_GT(2 * runs[1].merged, runs[1].substeps);  // most sub-steps: few particles change cell
-    EXPECT_GT(runs[2].merged, runs[1].merged);        // with no limit, more of them
+    EXPECT_GT(runs[2].merged, runs[1].merged);  // with no limit, more of them
     ASSERT_GT(runs[0].positions.size(), 3u * 2000u);
     for (std::size_t k = 1; k < runs.size(); ++k) {
         SCOPED_TRACE(k == 1 ? "merge up to 1/8 moved" : "merge always");

@@ -23,10 +23,10 @@ namespace orogen::landscape {
 struct Stats {
     double median_slope_deg = 0.0;
     double steeper_than_40 = 0.0;  ///< share of cells, 0..1
-    double pit_share = 0.0;        ///< share of interior cells, 0..1
-    double concavity = 0.0;        ///< θ from the slope–area fit
-    double hack = 0.0;             ///< h from the length–area fit
-    double relief = 0.0;           ///< max − min, m
+    double pit_share = 0.0;  ///< share of interior cells, 0..1
+    double concavity = 0.0;  ///< θ from the slope–area fit
+    double hack = 0.0;  ///< h from the length–area fit
+    double relief = 0.0;  ///< max − min, m
     int concavity_bins = 0, hack_bins = 0;
 };
 
@@ -75,9 +75,11 @@ inline Stats measure(const float* heights, int w, int h, double cell, double cha
     for (int y = 1; y + 1 < h; ++y)
         for (int x = 1; x + 1 < w; ++x) {
             const double dzdx = ((at(x + 1, y - 1) + 2 * at(x + 1, y) + at(x + 1, y + 1)) -
-                                 (at(x - 1, y - 1) + 2 * at(x - 1, y) + at(x - 1, y + 1))) / (8 * cell);
+                                 (at(x - 1, y - 1) + 2 * at(x - 1, y) + at(x - 1, y + 1))) /
+                (8 * cell);
             const double dzdy = ((at(x - 1, y + 1) + 2 * at(x, y + 1) + at(x + 1, y + 1)) -
-                                 (at(x - 1, y - 1) + 2 * at(x, y - 1) + at(x + 1, y - 1))) / (8 * cell);
+                                 (at(x - 1, y - 1) + 2 * at(x, y - 1) + at(x + 1, y - 1))) /
+                (8 * cell);
             const double deg = std::atan(std::hypot(dzdx, dzdy)) * 180.0 / std::numbers::pi;
             slopes.push_back(deg);
             steep += deg > 40.0 ? 1 : 0;
@@ -104,7 +106,8 @@ inline Stats measure(const float* heights, int w, int h, double cell, double cha
     const auto& stack = flow.stack();
     for (std::size_t s = n; s-- > 0;) {
         const std::int32_t i = stack[s], r = rcv[std::size_t(i)];
-        if (r != i) length[std::size_t(r)] = std::max(length[std::size_t(r)], length[std::size_t(i)] + flow.distance(i));
+        if (r != i)
+            length[std::size_t(r)] = std::max(length[std::size_t(r)], length[std::size_t(i)] + flow.distance(i));
     }
     std::vector<double> la, ls, ll, lla;
     const double max_area = *std::max_element(area.begin(), area.end());

@@ -13,7 +13,8 @@ namespace orogen::landscape::test {
 inline std::vector<double> noise(int w, int h, std::uint64_t seed, double amplitude) {
     std::vector<double> v(std::size_t(w) * std::size_t(h));
     for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) v[std::size_t(y) * std::size_t(w) + std::size_t(x)] = amplitude * random::uniform(seed, x, y);
+        for (int x = 0; x < w; ++x)
+            v[std::size_t(y) * std::size_t(w) + std::size_t(x)] = amplitude * random::uniform(seed, x, y);
     return v;
 }
 

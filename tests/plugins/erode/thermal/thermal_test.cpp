@@ -26,7 +26,7 @@ std::vector<float> noise_terrain(int w, int h, std::uint64_t seed, float amplitu
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)
             v[std::size_t(y) * w + x] = amplitude * float(random::uniform(seed, x, y)) +
-                                        0.2f * amplitude * std::sin(0.1f * float(x)) * std::cos(0.07f * float(y));
+                0.2f * amplitude * std::sin(0.1f * float(x)) * std::cos(0.07f * float(y));
     return v;
 }
 
@@ -77,10 +77,12 @@ TEST_P(ThermalNeighbourhoods, TallColumnBecomesPileAtTalusSlope) {
     double worst = 0.0;
     for (int y = 1; y < n - 1; ++y)
         for (int x = 1; x < n - 1; ++x) {
-            if (axis) worst = std::max({worst, at(x, y) - at(x + 1, y) - t_axis, at(x, y) - at(x, y + 1) - t_axis,
-                                        at(x + 1, y) - at(x, y) - t_axis, at(x, y + 1) - at(x, y) - t_axis});
-            if (diag) worst = std::max({worst, at(x, y) - at(x + 1, y + 1) - t_diag, at(x + 1, y + 1) - at(x, y) - t_diag,
-                                        at(x + 1, y) - at(x, y + 1) - t_diag, at(x, y + 1) - at(x + 1, y) - t_diag});
+            if (axis)
+                worst = std::max({worst, at(x, y) - at(x + 1, y) - t_axis, at(x, y) - at(x, y + 1) - t_axis,
+                                  at(x + 1, y) - at(x, y) - t_axis, at(x, y + 1) - at(x, y) - t_axis});
+            if (diag)
+                worst = std::max({worst, at(x, y) - at(x + 1, y + 1) - t_diag, at(x + 1, y + 1) - at(x, y) - t_diag,
+                                  at(x + 1, y) - at(x, y + 1) - t_diag, at(x, y + 1) - at(x + 1, y) - t_diag});
         }
     EXPECT_LT(worst, 1e-3);
 
@@ -112,9 +114,11 @@ TEST(Thermal, TalusHeightFormBoundsEveryNeighbourDifference) {
     for (int y = 0; y + 1 < n; ++y)
         for (int x = 0; x + 1 < n; ++x) {
             const float a = v[std::size_t(y) * n + x];
-            for (float b : {v[std::size_t(y) * n + x + 1], v[std::size_t(y + 1) * n + x], v[std::size_t(y + 1) * n + x + 1]})
+            for (float b :
+                 {v[std::size_t(y) * n + x + 1], v[std::size_t(y + 1) * n + x], v[std::size_t(y + 1) * n + x + 1]})
                 worst = std::max(worst, std::fabs(double(a) - double(b)));
-            worst = std::max(worst, std::fabs(double(v[std::size_t(y) * n + x + 1]) - double(v[std::size_t(y + 1) * n + x])));
+            worst = std::max(worst,
+                             std::fabs(double(v[std::size_t(y) * n + x + 1]) - double(v[std::size_t(y + 1) * n + x])));
         }
     EXPECT_LT(worst, 2.0 + 1e-3);
 }
@@ -179,8 +183,8 @@ TEST(Thermal, StepsInOneSweepEqualSingleSteps) {
         const auto start = noise_terrain(w, h, 21, 40.0f);
         std::vector<float> hard(start.size());
         for (std::size_t i = 0; i < hard.size(); ++i) hard[i] = float(random::uniform(22, i)) * 1.2f - 0.1f;
-        for (auto nb : {thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated,
-                        thermal::Neighbourhood::moore}) {
+        for (auto nb :
+             {thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated, thermal::Neighbourhood::moore}) {
             for (auto hm : {thermal::Hardness::constant, thermal::Hardness::height, thermal::Hardness::layer}) {
                 thermal::Settings s;
                 s.neighbourhood = nb;
@@ -238,8 +242,8 @@ TEST(Thermal, ErodeInPlaceEqualsSingleSteps) {
         thermal::erode(GridView{eroded.data(), w, h, 1.0}, iterations, s, nullptr,
                        [&](std::int64_t i, ConstGridView) { reported.push_back(i); });
         EXPECT_EQ(std::memcmp(eroded.data(), a.data(), a.size() * sizeof(float)), 0) << threads << " threads";
-        EXPECT_EQ(reported, (std::vector<std::int64_t>{thermal::kStepsPerSweep, 2 * thermal::kStepsPerSweep,
-                                                       iterations}));
+        EXPECT_EQ(reported,
+                  (std::vector<std::int64_t>{thermal::kStepsPerSweep, 2 * thermal::kStepsPerSweep, iterations}));
     }
 }
 
@@ -254,8 +258,8 @@ TEST(Thermal, StepMatchesAPlainReferenceOnEveryCell) {
         std::vector<float> hard(v.size());
         for (std::size_t i = 0; i < hard.size(); ++i) hard[i] = float(random::uniform(52, i)) * 1.2f - 0.1f;
         const float lo = *std::min_element(v.begin(), v.end()), hi = *std::max_element(v.begin(), v.end());
-        for (auto nb : {thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated,
-                        thermal::Neighbourhood::moore}) {
+        for (auto nb :
+             {thermal::Neighbourhood::von_neumann, thermal::Neighbourhood::rotated, thermal::Neighbourhood::moore}) {
             for (auto hm : {thermal::Hardness::constant, thermal::Hardness::height, thermal::Hardness::layer}) {
                 thermal::Settings s;
                 s.neighbourhood = nb;
@@ -351,7 +355,8 @@ std::vector<float> noisy_slope(int n) {
     std::vector<float> v(std::size_t(n) * n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x)
-            v[std::size_t(y) * n + x] = 0.3f * float(x) + 0.1f * float(y) + 2.0f * float(random::uniform(3, x, y)) - 1.0f;
+            v[std::size_t(y) * n + x] =
+                0.3f * float(x) + 0.1f * float(y) + 2.0f * float(random::uniform(3, x, y)) - 1.0f;
     return v;
 }
 
@@ -372,7 +377,10 @@ TEST(Thermal, DefaultNeighbourhoodLeavesNoCheckerboard) {
         thermal::erode(GridView{v.data(), n, n, 1.0}, 400, s);
         return checkerboard_energy(v, n, n);
     };
-    const double before = [&] { auto v = noisy_slope(n); return checkerboard_energy(v, n, n); }();
+    const double before = [&] {
+        auto v = noisy_slope(n);
+        return checkerboard_energy(v, n, n);
+    }();
     const double moore = run(thermal::Neighbourhood::moore);
     const double von_neumann = run(thermal::Neighbourhood::von_neumann);
     const double rotated = run(thermal::Neighbourhood::rotated);

@@ -113,7 +113,7 @@ struct Attribute {
 struct Parsed {
     std::map<std::string, Attribute> attributes;
     std::vector<std::pair<std::string, std::int32_t>> channels;  ///< name, pixel type (0 uint, 1 half, 2 float)
-    std::size_t header_end = 0;                                  ///< the offset table starts here
+    std::size_t header_end = 0;  ///< the offset table starts here
 };
 
 Parsed parse_header(const std::vector<std::uint8_t>& b) {
@@ -188,8 +188,8 @@ void write_with_imf(const fs::path& p, Imf::PixelType type, Imf::Compression com
     std::vector<std::uint32_t> uints(values.size());
     for (std::size_t i = 0; i < values.size(); ++i) uints[i] = std::uint32_t(std::abs(values[i]));
     char* base = type == Imf::HALF ? reinterpret_cast<char*>(halves.data())
-                 : type == Imf::UINT ? reinterpret_cast<char*>(uints.data())
-                                     : reinterpret_cast<char*>(const_cast<float*>(values.data()));
+        : type == Imf::UINT        ? reinterpret_cast<char*>(uints.data())
+                                   : reinterpret_cast<char*>(const_cast<float*>(values.data()));
     const std::size_t bytes = type == Imf::HALF ? 2 : 4;
     Imf::FrameBuffer fb;
     fb.insert("Y", Imf::Slice(type, base, bytes, bytes * w));
@@ -210,7 +210,7 @@ void write_windowed(const fs::path& p, int x0, int y0, int w, int h, const std::
     Imf::FrameBuffer fb;
     // OpenEXR addresses a slice by absolute pixel coordinates: the base is moved back to (0, 0).
     char* base = reinterpret_cast<char*>(const_cast<float*>(values.data())) -
-                 (std::ptrdiff_t(y0) * w + x0) * std::ptrdiff_t(sizeof(float));
+        (std::ptrdiff_t(y0) * w + x0) * std::ptrdiff_t(sizeof(float));
     fb.insert("Y", Imf::Slice(Imf::FLOAT, base, sizeof(float), sizeof(float) * std::size_t(w)));
     Imf::OutputFile out(p.c_str(), header);
     out.setFrameBuffer(fb);
@@ -227,9 +227,7 @@ std::vector<std::string> entries(const fs::path& dir) {
 std::string refusal(const fs::path& p, const exr::ReadOptions& o = {}) {
     try {
         exr::read(p, o);
-    } catch (const BadInput& e) {
-        return e.what();
-    }
+    } catch (const BadInput& e) { return e.what(); }
     return "(read without an error)";
 }
 
@@ -390,8 +388,9 @@ TEST(ExrImport, WrongChannelsAndLossyOrNonFiniteDataAreRefusedByName) {
     write_with_imf(dir / "float.exr", Imf::FLOAT, Imf::PIZ_COMPRESSION, 16, 8, v);
     exr::ReadOptions o;
     o.cell = 1.0;
-    EXPECT_NE(refusal(dir / "uint.exr", o).find("channel 'Y' holds 32-bit unsigned integers; import:exr reads 32-bit "
-                                                "or 16-bit float channels"),
+    EXPECT_NE(refusal(dir / "uint.exr", o)
+                  .find("channel 'Y' holds 32-bit unsigned integers; import:exr reads 32-bit "
+                        "or 16-bit float channels"),
               std::string::npos)
         << refusal(dir / "uint.exr", o);
     EXPECT_NE(refusal(dir / "b44.exr", o).find("it is compressed with b44, which import:exr does not read"),
@@ -417,8 +416,9 @@ TEST(ExrImport, WrongChannelsAndLossyOrNonFiniteDataAreRefusedByName) {
     write_terrain(t, dir / "nan.exr");
     exr::ReadOptions all;
     all.all_layers = true;
-    EXPECT_NE(refusal(dir / "nan.exr", all).find("sample (4, 2) of channel 'water' is NaN; heights and layers must be "
-                                                 "finite numbers"),
+    EXPECT_NE(refusal(dir / "nan.exr", all)
+                  .find("sample (4, 2) of channel 'water' is NaN; heights and layers must be "
+                        "finite numbers"),
               std::string::npos)
         << refusal(dir / "nan.exr", all);
     // Not an EXR at all.
@@ -461,8 +461,9 @@ TEST(ExrImport, ForgedSizesAndOverlappingChunksAreRefusedBeforeAllocating) {
     auto huge = good;
     patch_box(huge, "dataWindow", 0, 0, 999999, 999999);
     put(dir / "huge.exr", huge);
-    EXPECT_NE(refusal(dir / "huge.exr", o).find("its data window is 1000000x1000000 samples, which needs 3.6 TiB for "
-                                                "one heightmap"),
+    EXPECT_NE(refusal(dir / "huge.exr", o)
+                  .find("its data window is 1000000x1000000 samples, which needs 3.6 TiB for "
+                        "one heightmap"),
               std::string::npos)
         << refusal(dir / "huge.exr", o);
 
@@ -490,7 +491,8 @@ TEST(ExrImport, ForgedSizesAndOverlappingChunksAreRefusedBeforeAllocating) {
     std::memcpy(twice.data() + table + 8, twice.data() + table, 8);
     put(dir / "twice.exr", twice);
     const std::string why = refusal(dir / "twice.exr", o);
-    EXPECT_TRUE(why.find("share the same bytes") != std::string::npos || why.find("truncated or damaged") != std::string::npos)
+    EXPECT_TRUE(why.find("share the same bytes") != std::string::npos ||
+                why.find("truncated or damaged") != std::string::npos)
         << why;
 }
 
@@ -505,7 +507,8 @@ TEST(ExrCli, AForgedHugeFileFailsInAOneGibAddressSpace) {
     auto tall = bytes_of(dir / "t.exr");
     patch_box(tall, "dataWindow", 0, 0, 29999, 1999);
     put(dir / "tall.exr", tall);
-    dir.write("s.orogen", "orogen 1\ngrid 9\nd = import:exr(path=\"tall.exr\", layers=all)\nexport:raw(d, path=\"d.r32\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 9\nd = import:exr(path=\"tall.exr\", layers=all)\nexport:raw(d, path=\"d.r32\")\n");
     for (const char* command : {"check s.orogen", "run s.orogen --out out"}) {
         const RunResult r = run_orogen(command, "prlimit --as=1073741824", dir.path());
         EXPECT_EQ(r.exit_code, 2) << command << "\n" << r.err;
@@ -516,12 +519,13 @@ TEST(ExrCli, AForgedHugeFileFailsInAOneGibAddressSpace) {
 
 TEST(ExrCli, ExportThenImportThroughTheBinaryKeepsEveryBit) {
     TempDir dir;
-    dir.write("out.orogen", "orogen 1\nseed 5\ngrid 65 cell=20\nb = generate:fault(iterations=40, displacement=8)\n"
-                            "w = erode:hydraulic(b, iterations=5)\n"
-                            "export:exr(w, path=\"t.exr\", layers=all)\n"
-                            "export:exr(w, path=\"s.exr\", layers=\"water, eroded\", split=true, channel=height, "
-                            "compression=piz)\n"
-                            "export:raw(w, path=\"w.r32\")\n");
+    dir.write("out.orogen",
+              "orogen 1\nseed 5\ngrid 65 cell=20\nb = generate:fault(iterations=40, displacement=8)\n"
+              "w = erode:hydraulic(b, iterations=5)\n"
+              "export:exr(w, path=\"t.exr\", layers=all)\n"
+              "export:exr(w, path=\"s.exr\", layers=\"water, eroded\", split=true, channel=height, "
+              "compression=piz)\n"
+              "export:raw(w, path=\"w.r32\")\n");
     RunResult r = run_orogen("run out.orogen --out out --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(entries(dir / "out"),
@@ -530,10 +534,12 @@ TEST(ExrCli, ExportThenImportThroughTheBinaryKeepsEveryBit) {
     // Again, on one thread: the same bytes.
     r = run_orogen("run out.orogen --out again --quiet --threads 1", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    for (const char* f : {"t.exr", "s.exr", "s.water.exr"}) EXPECT_EQ(slurp(dir / "out" / f), slurp(dir / "again" / f)) << f;
-    dir.write("in.orogen", "orogen 1\ngrid 9\nd = import:exr(path=\"out/t.exr\", layers=all)\n"
-                           "export:raw(d, path=\"d.r32\")\nexport:exr(d, path=\"t.exr\", layers=all)\n"
-                           "s = import:exr(path=\"out/s.water.exr\", channel=height)\nexport:raw(s, path=\"s.r32\")\n");
+    for (const char* f : {"t.exr", "s.exr", "s.water.exr"})
+        EXPECT_EQ(slurp(dir / "out" / f), slurp(dir / "again" / f)) << f;
+    dir.write("in.orogen",
+              "orogen 1\ngrid 9\nd = import:exr(path=\"out/t.exr\", layers=all)\n"
+              "export:raw(d, path=\"d.r32\")\nexport:exr(d, path=\"t.exr\", layers=all)\n"
+              "s = import:exr(path=\"out/s.water.exr\", channel=height)\nexport:raw(s, path=\"s.r32\")\n");
     r = run_orogen("run in.orogen --out back --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(slurp(dir / "back/d.r32"), slurp(dir / "out/w.r32"));
@@ -550,21 +556,23 @@ TEST(ExrCli, BadParametersAndFilesFailAtCheckTimeNamingTheParameter) {
     write_terrain(special_terrain(9, 9), dir / "t.exr");
     dir.write("text.exr", "not an image");
     write_windowed(dir / "feet.exr", 0, 0, 4, 4, std::vector<float>(16, 1.0f), "ft");
-    dir.write("s.orogen", "orogen 1\ngrid 33\nb = generate:fault()\n"
-                          "export:exr(b, path=\"a.exr\", layers=\"snow\")\n"
-                          "export:exr(b, path=\"b.exr\", channel=\"\")\n"
-                          "export:exr(b, path=\"c.tif\")\n"
-                          "d = import:exr(path=\"text.exr\")\n"
-                          "e = import:exr(path=\"t.exr\", channel=Z)\n"
-                          "f = import:exr(path=\"t.exr\", layers=\"water, snow\")\n"
-                          "g = import:exr(path=\"feet.exr\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 33\nb = generate:fault()\n"
+              "export:exr(b, path=\"a.exr\", layers=\"snow\")\n"
+              "export:exr(b, path=\"b.exr\", channel=\"\")\n"
+              "export:exr(b, path=\"c.tif\")\n"
+              "d = import:exr(path=\"text.exr\")\n"
+              "e = import:exr(path=\"t.exr\", channel=Z)\n"
+              "f = import:exr(path=\"t.exr\", layers=\"water, snow\")\n"
+              "g = import:exr(path=\"feet.exr\")\n");
     const RunResult r = run_orogen("check s.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
     for (const char* m :
          {"s.orogen:4:36: error: export:exr: no layer 'snow' on the input",
           "s.orogen:5:37: error: export:exr: a channel name cannot be empty",
-          "s.orogen:6:20: error: export:exr writes .exr files; 'c.tif' has another extension", "s.orogen:7:21: error: import:exr: cannot read text.exr: it is not an "
-                                              "OpenEXR file",
+          "s.orogen:6:20: error: export:exr writes .exr files; 'c.tif' has another extension",
+          "s.orogen:7:21: error: import:exr: cannot read text.exr: it is not an "
+          "OpenEXR file",
           "s.orogen:8:38: error: import:exr: cannot read t.exr: it has no channel 'Z' (its channels are: Y, eroded, "
           "water); give channel=NAME",
           "s.orogen:9:37: error: import:exr: cannot read t.exr: it has no channel 'snow'",

@@ -215,11 +215,12 @@ TEST(GeoTiffImport, NodataHolesAreFilledFromTheirSurroundingsOrRefused) {
 
 TEST(GeoTiffCli, ExportThenImportThroughTheBinaryAndGdalinfoReadsIt) {
     TempDir dir;
-    dir.write("out.orogen", "orogen 1\nseed 5\ngrid 65 cell=20\nb = generate:fault(iterations=40, displacement=8)\n"
-                            "w = erode:hydraulic(b, iterations=5)\n"
-                            "export:geotiff(w, path=\"dem.tif\", crs=\"EPSG:32633\", origin=(400000, 5000000), "
-                            "layers=\"water, eroded\", nodata=\"-9999\")\n"
-                            "export:raw(w, path=\"w.r32\")\n");
+    dir.write("out.orogen",
+              "orogen 1\nseed 5\ngrid 65 cell=20\nb = generate:fault(iterations=40, displacement=8)\n"
+              "w = erode:hydraulic(b, iterations=5)\n"
+              "export:geotiff(w, path=\"dem.tif\", crs=\"EPSG:32633\", origin=(400000, 5000000), "
+              "layers=\"water, eroded\", nodata=\"-9999\")\n"
+              "export:raw(w, path=\"w.r32\")\n");
     RunResult r = run_orogen("run out.orogen --out out --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     // gdalinfo (Debian's gdal-bin, installed by tools/setup.sh) as a GIS user would check the file.
@@ -230,25 +231,29 @@ TEST(GeoTiffCli, ExportThenImportThroughTheBinaryAndGdalinfoReadsIt) {
     EXPECT_NE(info.find("\"description\":\"eroded\""), std::string::npos);
     EXPECT_NE(info.find("\"noDataValue\":-9999"), std::string::npos);
     // Import it again, at its own size: the same floats as the RAW of the same terrain.
-    dir.write("in.orogen", "orogen 1\ngrid 9\nd = import:geotiff(path=\"out/dem.tif\", resample=none)\n"
-                           "export:raw(d, path=\"d.r32\")\n");
+    dir.write("in.orogen",
+              "orogen 1\ngrid 9\nd = import:geotiff(path=\"out/dem.tif\", resample=none)\n"
+              "export:raw(d, path=\"d.r32\")\n");
     r = run_orogen("run in.orogen --out back --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(read_r32(dir / "back/d.r32"), read_r32(dir / "out/w.r32"));
-    EXPECT_NE(slurp(dir / "back/d.r32.json").find("\"cell_size\": 20,"), std::string::npos) << slurp(dir / "back/d.r32.json");
+    EXPECT_NE(slurp(dir / "back/d.r32.json").find("\"cell_size\": 20,"), std::string::npos)
+        << slurp(dir / "back/d.r32.json");
 }
 
 TEST(GeoTiffCli, BadInputIsRefusedAtCheckTimeNamingTheParameter) {
     TempDir dir;
     dir.write("not-a-raster.tif", "this is text");
-    dir.write("s.orogen", "orogen 1\ngrid 33\nb = generate:fault()\n"
-                          "export:geotiff(b, path=\"a.tif\", crs=\"EPSG:999999\")\n"
-                          "export:geotiff(b, path=\"b.tif\", layers=\"snow\")\n"
-                          "export:geotiff(b, path=\"c.tif\", nodata=\"lots\")\n"
-                          "d = import:geotiff(path=\"not-a-raster.tif\")\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 33\nb = generate:fault()\n"
+              "export:geotiff(b, path=\"a.tif\", crs=\"EPSG:999999\")\n"
+              "export:geotiff(b, path=\"b.tif\", layers=\"snow\")\n"
+              "export:geotiff(b, path=\"c.tif\", nodata=\"lots\")\n"
+              "d = import:geotiff(path=\"not-a-raster.tif\")\n");
     const RunResult r = run_orogen("check s.orogen", "", dir.path());
     EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("s.orogen:4:37: error: export:geotiff: unknown CRS 'EPSG:999999'"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("s.orogen:4:37: error: export:geotiff: unknown CRS 'EPSG:999999'"), std::string::npos)
+        << r.err;
     EXPECT_NE(r.err.find("s.orogen:5:40: error: export:geotiff: no layer 'snow' on the input"), std::string::npos)
         << r.err;
     EXPECT_NE(r.err.find("s.orogen:6:40: error: export:geotiff: nodata must be a number (e.g. -32768) or none, got "

@@ -52,7 +52,8 @@ std::string validate(const fs::path& file, int& exit_code, std::string& skip) {
         return "";
     }
     const fs::path out = file.string() + ".report";
-    const int status = std::system(("node " + test::q(tool) + " " + test::q(file) + " >" + test::q(out) + " 2>&1").c_str());
+    const int status =
+        std::system(("node " + test::q(tool) + " " + test::q(file) + " >" + test::q(out) + " 2>&1").c_str());
     exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     return test::file_text(out);
 }

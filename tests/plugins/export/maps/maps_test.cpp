@@ -52,7 +52,7 @@ TEST(SplatMap, LowFlatGroundIsSandAndASteepSnowySlopeIsRock) {
     const auto m = maps::splat_map({ramp.data(), n, n, 100.0});
     const std::uint8_t* low = &m[4 * (32 * n + 0)];
     const std::uint8_t* high = &m[4 * (32 * n + 64)];
-    EXPECT_EQ(low[0], 255);   // sand
+    EXPECT_EQ(low[0], 255);  // sand
     EXPECT_EQ(high[3], 255);  // snow
     // The same heights on a 60° slope: the top is rock (snow does not rest there).
     const auto steep = plane(n, 10.0, std::tan(60.0 * M_PI / 180.0), 0.0);
@@ -98,9 +98,10 @@ TEST(NormalMap, FlatIsStraightUpAndSlopesTiltTheRightWay) {
 
 TEST(MapsCli, TheBinaryWritesBothMapsAtTheTerrainsSize) {
     TempDir dir;
-    dir.write("s.orogen", "orogen 1\ngrid 65 cell=10\nhill = generate:shape(kind=pyramid, height=300)\n"
-                          "export:splatmap(hill, path=\"maps/splat.png\")\n"
-                          "export:normalmap(hill, path=\"maps/normal.png\", green=directx, scale=2)\n");
+    dir.write("s.orogen",
+              "orogen 1\ngrid 65 cell=10\nhill = generate:shape(kind=pyramid, height=300)\n"
+              "export:splatmap(hill, path=\"maps/splat.png\")\n"
+              "export:normalmap(hill, path=\"maps/normal.png\", green=directx, scale=2)\n");
     const RunResult r = run_orogen("run s.orogen --out out --quiet", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     for (const char* f : {"out/maps/splat.png", "out/maps/normal.png"}) {

@@ -250,8 +250,8 @@ TEST(PngExportCli, RiversAndADivergingLayerReadAtAGlance) {
     // grey (its channels within a few units).
     const std::size_t n = area.samples.size();
     ASSERT_EQ(n, std::size_t(129 * 129));
-    const std::size_t trunk = std::size_t(
-        std::max_element(area.samples.begin(), area.samples.end()) - area.samples.begin());
+    const std::size_t trunk =
+        std::size_t(std::max_element(area.samples.begin(), area.samples.end()) - area.samples.begin());
     EXPECT_GT(int(rivers[4 * trunk + 2]), int(rivers[4 * trunk]) + 60);
     std::size_t greys = 0, blues = 0;
     for (std::size_t i = 0; i < n; ++i) {

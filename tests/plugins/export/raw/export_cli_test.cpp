@@ -16,17 +16,18 @@ const std::string header = "orogen 1\nseed 7\ngrid 65 cell=10\nbase = generate:f
 
 TEST(ExportCli, EveryFormatIsWritten) {
     TempDir dir;
-    const auto spec = dir.write("all.orogen", header +
-                                                  "worn = erode:thermal(base, iterations=5)\n"
-                                                  "export:gltf(worn, path=\"t.glb\", scale=2, chunks=2)\n"
-                                                  "export:gltf(worn, path=\"sub/t.gltf\", decimate=2)\n"
-                                                  "export:vtk(worn, path=\"t.vti\")\n"
-                                                  "export:vtk(worn, path=\"t.vtp\", decimate=2)\n"
-                                                  "export:vdb(worn, path=\"t.vdb\")\n"
-                                                  "export:raw(worn, path=\"t.r16\")\n"
-                                                  "export:raw(worn, path=\"t.r32\")\n"
-                                                  "export:png(worn, path=\"eroded.png\", layer=\"eroded\", bits=16)\n"
-                                                  "export:png(worn, path=\"shade.png\", hillshade=true)\n");
+    const auto spec = dir.write("all.orogen",
+                                header +
+                                    "worn = erode:thermal(base, iterations=5)\n"
+                                    "export:gltf(worn, path=\"t.glb\", scale=2, chunks=2)\n"
+                                    "export:gltf(worn, path=\"sub/t.gltf\", decimate=2)\n"
+                                    "export:vtk(worn, path=\"t.vti\")\n"
+                                    "export:vtk(worn, path=\"t.vtp\", decimate=2)\n"
+                                    "export:vdb(worn, path=\"t.vdb\")\n"
+                                    "export:raw(worn, path=\"t.r16\")\n"
+                                    "export:raw(worn, path=\"t.r32\")\n"
+                                    "export:png(worn, path=\"eroded.png\", layer=\"eroded\", bits=16)\n"
+                                    "export:png(worn, path=\"shade.png\", hillshade=true)\n");
     const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "out"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     for (const char* f : {"t.glb", "sub/t.gltf", "sub/t.bin", "t.vti", "t.vtp", "t.vdb", "t.r16", "t.r16.json", "t.r32",
@@ -40,14 +41,15 @@ TEST(ExportCli, EveryFormatIsWritten) {
 
 TEST(ExportCli, BadExportsFailAtCheckTimeAndSayWhere) {
     TempDir dir;
-    const auto spec = dir.write("bad.orogen", header +
-                                                  "export:gltf(base, path=\"t.obj\")\n"
-                                                  "export:gltf(base, path=\"u.glb\", decimate=0)\n"
-                                                  "export:png(base, path=\"w.png\", layer=\"water\")\n"
-                                                  "export:vtk-particles(base, path=\"p.pvd\")\n"
-                                                  "export:vtk(base, path=\"v.vti\", decimate=2)\n"
-                                                  "export:raw(base, path=\"r.r16\", low=5)\n"
-                                                  "export:vdb(base, path=\"/no/such/folder/t.vdb\")\n");
+    const auto spec = dir.write("bad.orogen",
+                                header +
+                                    "export:gltf(base, path=\"t.obj\")\n"
+                                    "export:gltf(base, path=\"u.glb\", decimate=0)\n"
+                                    "export:png(base, path=\"w.png\", layer=\"water\")\n"
+                                    "export:vtk-particles(base, path=\"p.pvd\")\n"
+                                    "export:vtk(base, path=\"v.vti\", decimate=2)\n"
+                                    "export:raw(base, path=\"r.r16\", low=5)\n"
+                                    "export:vdb(base, path=\"/no/such/folder/t.vdb\")\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2) << r.err;
     for (const char* want : {

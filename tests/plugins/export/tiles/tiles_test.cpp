@@ -50,7 +50,8 @@ TEST(TilesLayout, TilesCoverTheGridAndNeighboursShareOneRowOrColumn) {
                 ASSERT_LE(t.width, size);
                 ASSERT_LE(t.x0 + t.width, w);
                 for (int y = t.y0; y < t.y0 + t.height; ++y)
-                    for (int x = t.x0; x < t.x0 + t.width; ++x) ++covered[std::size_t(y) * std::size_t(w) + std::size_t(x)];
+                    for (int x = t.x0; x < t.x0 + t.width; ++x)
+                        ++covered[std::size_t(y) * std::size_t(w) + std::size_t(x)];
                 // a neighbour to the east starts on this tile's last column
                 for (const Tile& u : tiles)
                     if (u.row == t.row && u.column == t.column + 1) EXPECT_EQ(u.x0, t.x0 + t.width - 1);
@@ -92,7 +93,8 @@ TEST(TilesCli, PngTilesShareTheirEdgesAndMosaicToTheWholeTerrain) {
                         << name << " sample " << x << "," << y;
         }
     // Neighbours: the east edge of one is the west edge of the next, the south edge the next row's north edge.
-    const GrayImage a = read_gray_png(dir / "out/engine/alps_x1_y2.png"), b = read_gray_png(dir / "out/engine/alps_x2_y2.png"),
+    const GrayImage a = read_gray_png(dir / "out/engine/alps_x1_y2.png"),
+                    b = read_gray_png(dir / "out/engine/alps_x2_y2.png"),
                     c = read_gray_png(dir / "out/engine/alps_x1_y3.png");
     for (int i = 0; i < 33; ++i) {
         EXPECT_EQ(a.samples[std::size_t(i * 33 + 32)], b.samples[std::size_t(i * 33)]);
@@ -117,8 +119,10 @@ TEST(TilesCli, TheRunSaysWhatItWroteOnceAndQuietSaysNothing) {
     RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "small"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("export:tiles: warning: the grid (129 × 129 samples) is smaller than one tile of 257"),
-              std::string::npos) << r.err;
-    EXPECT_NE(r.err.find("export:tiles: wrote 1 tile of 129 × 129 samples, engine/alps.json"), std::string::npos) << r.err;
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("export:tiles: wrote 1 tile of 129 × 129 samples, engine/alps.json"), std::string::npos)
+        << r.err;
     EXPECT_EQ(r.err.find("the last tiles are"), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find("tiles of 257"), std::string::npos) << r.err;
 
@@ -144,11 +148,12 @@ TEST(TilesCli, TheRunSaysWhatItWroteOnceAndQuietSaysNothing) {
 
 TEST(TilesCli, GdalReadsTheMosaicThroughTheVrtInMetres) {
     TempDir dir;
-    const auto spec = dir.write("t.orogen", spec_head +
-                                                "export:tiles(w, path=\"png/t.json\", tile_size=40)\n"  // uneven last tiles
-                                                "export:tiles(w, path=\"r16/t.json\", format=r16, tile_size=65)\n"
-                                                "export:tiles(w, path=\"r32/t.json\", format=r32, tile_size=17)\n"
-                                                "export:raw(w, path=\"whole.r32\")\n");
+    const auto spec = dir.write("t.orogen",
+                                spec_head +
+                                    "export:tiles(w, path=\"png/t.json\", tile_size=40)\n"  // uneven last tiles
+                                    "export:tiles(w, path=\"r16/t.json\", format=r16, tile_size=65)\n"
+                                    "export:tiles(w, path=\"r32/t.json\", format=r32, tile_size=17)\n"
+                                    "export:raw(w, path=\"whole.r32\")\n");
     const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "out"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find("for equal tiles use a grid of k"), std::string::npos) << r.err;  // 128 is not 3 · 39
@@ -214,12 +219,13 @@ TEST(TilesCli, BadParametersAreCheckErrorsThatSayWhere) {
 // has no 16-bit scale, nor a mesh parameter given to a raster format).
 TEST(TilesCli, EveryMistakeInOneCallIsReportedAtOnce) {
     TempDir dir;
-    const auto spec = dir.write("bad.orogen", spec_head + "export:tiles(w, path=\"t.json\", format=r32, low=5, scale=2)\n");
+    const auto spec =
+        dir.write("bad.orogen", spec_head + "export:tiles(w, path=\"t.json\", format=r32, low=5, scale=2)\n");
     const RunResult r = run_orogen("check " + q(spec));
     EXPECT_EQ(r.exit_code, 2) << r.err;
-    for (const char* want : {"error: export:tiles: scale applies to format=glb",
-                             "error: export:tiles: give both low and high",
-                             "error: export:tiles: low and high set the 16-bit scale; format=r32"})
+    for (const char* want :
+         {"error: export:tiles: scale applies to format=glb", "error: export:tiles: give both low and high",
+          "error: export:tiles: low and high set the 16-bit scale; format=r32"})
         EXPECT_NE(r.err.find(want), std::string::npos) << "missing: " << want << "\n" << r.err;
     EXPECT_NE(r.err.find("3 errors in"), std::string::npos) << r.err;
 }
@@ -285,7 +291,8 @@ TEST(TilesLod, NeighboursOfOneLevelShareTheirEdgeVerticesAndNormalsBitForBit) {
         ASSERT_EQ(rows, mb.vertex_count() / nb);
         for (std::size_t r = 0; r < rows; ++r) {
             const std::size_t ea = r * na + na - 1, wb = r * nb;  // a's east edge, b's west edge
-            for (int k = 0; k < 3; ++k) EXPECT_EQ(ma.normals[3 * ea + std::size_t(k)], mb.normals[3 * wb + std::size_t(k)]);
+            for (int k = 0; k < 3; ++k)
+                EXPECT_EQ(ma.normals[3 * ea + std::size_t(k)], mb.normals[3 * wb + std::size_t(k)]);
             EXPECT_EQ(ma.positions[3 * ea + 1], mb.positions[3 * wb + 1]);
             EXPECT_EQ(double(ma.positions[3 * ea]) + a->x0 * 2.0, double(mb.positions[3 * wb]) + b->x0 * 2.0);
         }
@@ -305,8 +312,8 @@ TEST(TilesLod, DeviationBoundsTheCoarseSurfaceAndSkirtsCoverTheCracks) {
         else EXPECT_GT(dev, 0.0) << "a rough terrain loses detail at level " << c.level;
         // The skirt is at least the gap between the full-resolution edge and any level's edge along it.
         const auto e = lod::edge_lattices(c, w, h, levels);
-        const double skirt = lod::skirt_depth(c, sample(g, w, e[0][0], e[0][1]), sample(g, w, e[1][0], e[1][1]), w, h,
-                                              levels, 2.0, 1.0);
+        const double skirt =
+            lod::skirt_depth(c, sample(g, w, e[0][0], e[0][1]), sample(g, w, e[1][0], e[1][1]), w, h, levels, 2.0, 1.0);
         for (int j = 1; j < levels; ++j) {
             const int st = 1 << j;
             for (int x = c.x0; x <= c.x1; ++x) {
@@ -323,8 +330,9 @@ TEST(TilesLod, DeviationBoundsTheCoarseSurfaceAndSkirtsCoverTheCracks) {
         for (std::size_t k = bare.vertex_count(); k < m.vertex_count(); ++k) {
             bool found = false;
             for (std::size_t v = 0; v < bare.vertex_count() && !found; ++v)
-                found = bare.positions[3 * v] == m.positions[3 * k] && bare.positions[3 * v + 2] == m.positions[3 * k + 2] &&
-                        std::abs(double(bare.positions[3 * v + 1]) - skirt - double(m.positions[3 * k + 1])) < 1e-3;
+                found = bare.positions[3 * v] == m.positions[3 * k] &&
+                    bare.positions[3 * v + 2] == m.positions[3 * k + 2] &&
+                    std::abs(double(bare.positions[3 * v + 1]) - skirt - double(m.positions[3 * k + 1])) < 1e-3;
             EXPECT_TRUE(found) << "skirt vertex " << k << " of chunk " << c.file;
         }
     }
@@ -332,8 +340,10 @@ TEST(TilesLod, DeviationBoundsTheCoarseSurfaceAndSkirtsCoverTheCracks) {
 
 TEST(TilesCli, GlbChunksPassTheKhronosValidatorAndTheTilesetNestsTheLevels) {
     TempDir dir;
-    const auto spec = dir.write("t.orogen", spec_head + "export:tiles(w, path=\"g/tileset.json\", tile_size=33, "
-                                                        "format=glb, texture=64)\n");
+    const auto spec = dir.write("t.orogen",
+                                spec_head +
+                                    "export:tiles(w, path=\"g/tileset.json\", tile_size=33, "
+                                    "format=glb, texture=64)\n");
     const RunResult r = run_orogen("run " + q(spec) + " --out " + q(dir / "one") + " --threads 1");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     ASSERT_EQ(run_orogen("run " + q(spec) + " --out " + q(dir / "two") + " --threads 2").exit_code, 0);
@@ -359,10 +369,13 @@ TEST(TilesCli, GlbChunksPassTheKhronosValidatorAndTheTilesetNestsTheLevels) {
     const fs::path tool = fs::path(OROGEN_SOURCE_DIR) / "tools" / "gltf-validate";
     if (std::system("node --version >/dev/null 2>&1") != 0 ||
         !fs::exists(fs::path(OROGEN_SOURCE_DIR) / "tools/node_modules/gltf-validator"))
-        GTEST_SKIP() << "SKIPPED glTF validation: node or the gltf-validator npm package is missing (npm install --prefix tools)";
-    for (const char* f : {"tileset_l0_x0_y0.glb", "tileset_l0_x3_y2.glb", "tileset_l1_x1_y0.glb", "tileset_l2_x0_y0.glb"}) {
+        GTEST_SKIP() << "SKIPPED glTF validation: node or the gltf-validator npm package is missing (npm install "
+                        "--prefix tools)";
+    for (const char* f :
+         {"tileset_l0_x0_y0.glb", "tileset_l0_x3_y2.glb", "tileset_l1_x1_y0.glb", "tileset_l2_x0_y0.glb"}) {
         const fs::path report = dir / (std::string(f) + ".report");
-        const int status = std::system(("node " + q(tool) + " " + q(dir / "one/g" / f) + " >" + q(report) + " 2>&1").c_str());
+        const int status =
+            std::system(("node " + q(tool) + " " + q(dir / "one/g" / f) + " >" + q(report) + " 2>&1").c_str());
         const std::string text = slurp(report);
         EXPECT_EQ(WIFEXITED(status) ? WEXITSTATUS(status) : -1, 0) << f << "\n" << text;
         EXPECT_NE(text.find("errors 0 warnings 0 infos 0"), std::string::npos) << f << "\n" << text;

@@ -67,7 +67,7 @@ TEST(Vdb, PlaneGivesExactSignedDistancesInTheBand) {
                 ASSERT_NEAR(acc.getValue({i, j, k}), expected, 1e-4) << i << " " << j << " " << k;
             }
             EXPECT_FLOAT_EQ(acc.getValue({i, jg - 40, k}), -6.0f);  // deep ground: inside
-            EXPECT_FLOAT_EQ(acc.getValue({i, jg + 40, k}), 6.0f);   // sky: outside
+            EXPECT_FLOAT_EQ(acc.getValue({i, jg + 40, k}), 6.0f);  // sky: outside
         }
     // The default half floats stay within 1/1000 of a voxel; the height grid stays exact.
     auto half = float_grid(read_all(dir / "half.vdb"), "surface");
@@ -156,7 +156,7 @@ TEST(Vdb, WaterLayerBecomesALevelSetOfTheWaterBody) {
     for (int k = 10; k < 30; ++k)
         for (int i = 10; i < 30; ++i) {
             ground[std::size_t(k * w + i)] = 80.0f;  // a basin 20 m deep, flat
-            water[std::size_t(k * w + i)] = 15.0f;   // water surface at 95 m
+            water[std::size_t(k * w + i)] = 15.0f;  // water surface at 95 m
         }
     const ConstGridView wv(water.data(), w, h, 1.0);
     const auto s = vdb::write_terrain({ground.data(), w, h, 1.0}, &wv, dir / "t.vdb");
@@ -169,10 +169,10 @@ TEST(Vdb, WaterLayerBecomesALevelSetOfTheWaterBody) {
     auto acc = wgrid->getConstAccessor();
     EXPECT_FLOAT_EQ(acc.getValue({20, 87, 20}), -3.0f);  // mid-lake, 7 m down: deep inside (clamped, flood-filled)
     EXPECT_NEAR(acc.getValue({20, 94, 20}), -1.0f, 1e-5);  // 1 m under the surface
-    EXPECT_NEAR(acc.getValue({20, 96, 20}), 1.0f, 1e-5);   // 1 m above it
+    EXPECT_NEAR(acc.getValue({20, 96, 20}), 1.0f, 1e-5);  // 1 m above it
     EXPECT_NEAR(acc.getValue({20, 81, 20}), -1.0f, 1e-5);  // 1 m above the lake bed
-    EXPECT_GT(acc.getValue({20, 78, 20}), 0.0f);           // in the ground: not water
-    EXPECT_GT(acc.getValue({2, 100, 2}), 0.0f);            // a dry corner
+    EXPECT_GT(acc.getValue({20, 78, 20}), 0.0f);  // in the ground: not water
+    EXPECT_GT(acc.getValue({2, 100, 2}), 0.0f);  // a dry corner
     EXPECT_GT(acc.getValue({2, 90, 2}), 0.0f);
 }
 

@@ -42,7 +42,8 @@ double high_frequency_share(const Heightmap& hm) {
 }  // namespace
 
 TEST(DiamondSquare, FillsEveryVertexOfAnyGridSize) {
-    for (auto [w, h] : {std::pair{2, 2}, {3, 3}, {5, 5}, {65, 65}, {100, 37}, {37, 100}, {513, 257}, {2, 300}, {1, 7}}) {
+    for (auto [w, h] :
+         {std::pair{2, 2}, {3, 3}, {5, 5}, {65, 65}, {100, 37}, {37, 100}, {513, 257}, {2, 300}, {1, 7}}) {
         const Heightmap hm = make(w, h, 100.0, 0.5, 1);
         for (float v : hm.heights()) ASSERT_TRUE(std::isfinite(v)) << w << "x" << h;
         if (w * h > 4) {

@@ -24,14 +24,16 @@ const char* kHeader = "orogen 1\nseed 11\ngrid 65 cell=10\n";
 
 TEST(RmpCli, AllMethodsRunAndAreTheSameBytesOnOneAndTwoThreads) {
     TempDir dir;
-    const auto spec = dir.write("m.orogen", std::string(kHeader) +
-        "v = generate:rmp(cones=40, iterations=30, jitter=0.5, peaks=[(0.3, 0.3), (0.7, 0.6)])\n"
-        "c = generate:rmp(method=cones, cones=40, iterations=30)\n"
-        "g = generate:rmp(method=graph, cuts=6, regions=3, iterations=30)\n"
-        "r = generate:range(from=(0.1, 0.9), to=(0.9, 0.2), cones=80, iterations=10, uplift=true)\n"
-        "s = generate:shape(kind=hemisphere, height=50)\n"
-        "export:raw(v, path=\"v.r32\")\nexport:raw(c, path=\"c.r32\")\nexport:raw(g, path=\"g.r32\")\n"
-        "export:raw(r, path=\"r.r32\")\nexport:raw(s, path=\"s.r32\")\n");
+    const auto spec =
+        dir.write("m.orogen",
+                  std::string(kHeader) +
+                      "v = generate:rmp(cones=40, iterations=30, jitter=0.5, peaks=[(0.3, 0.3), (0.7, 0.6)])\n"
+                      "c = generate:rmp(method=cones, cones=40, iterations=30)\n"
+                      "g = generate:rmp(method=graph, cuts=6, regions=3, iterations=30)\n"
+                      "r = generate:range(from=(0.1, 0.9), to=(0.9, 0.2), cones=80, iterations=10, uplift=true)\n"
+                      "s = generate:shape(kind=hemisphere, height=50)\n"
+                      "export:raw(v, path=\"v.r32\")\nexport:raw(c, path=\"c.r32\")\nexport:raw(g, path=\"g.r32\")\n"
+                      "export:raw(r, path=\"r.r32\")\nexport:raw(s, path=\"s.r32\")\n");
     const auto one = run_orogen("run " + q(spec) + " --quiet --threads 1 --out " + q(dir / "one"));
     ASSERT_EQ(one.exit_code, 0) << one.err;
     const auto two = run_orogen("run " + q(spec) + " --quiet --threads 2 --out " + q(dir / "two"));
@@ -54,8 +56,10 @@ TEST(RmpCli, AllMethodsRunAndAreTheSameBytesOnOneAndTwoThreads) {
 TEST(RmpCli, ConesAndVoronoiGiveTheSameMountainForTheSameSeed) {
     // --set changes a node's parameters, not its label (its seed): two runs of one node.
     TempDir dir;
-    const auto spec = dir.write("m.orogen", std::string(kHeader) +
-        "m = generate:rmp(cones=50, iterations=40, jitter=0.3)\nexport:raw(m, path=\"m.r32\")\n");
+    const auto spec =
+        dir.write("m.orogen",
+                  std::string(kHeader) +
+                      "m = generate:rmp(cones=50, iterations=40, jitter=0.3)\nexport:raw(m, path=\"m.r32\")\n");
     const auto v = run_orogen("run " + q(spec) + " --quiet --out " + q(dir / "v"));
     ASSERT_EQ(v.exit_code, 0) << v.err;
     const auto c = run_orogen("run " + q(spec) + " --quiet --set m.method=cones --out " + q(dir / "c"));
@@ -110,8 +114,10 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(RmpCli, OsmesaContextFailureIsAClearRunError) {
     // Mesa refuses the shared 4.5 core context (orogen/gl_context.hpp) when told to offer OpenGL 3.0 only.
     TempDir dir;
-    const auto spec = dir.write("c.orogen", std::string(kHeader) + "m = generate:rmp(method=cones)\n"
-                                                                   "export:raw(m, path=\"m.r32\")\n");
+    const auto spec = dir.write("c.orogen",
+                                std::string(kHeader) +
+                                    "m = generate:rmp(method=cones)\n"
+                                    "export:raw(m, path=\"m.r32\")\n");
     const auto r = run_orogen("run " + q(spec) + " --quiet --out " + q(dir / "out"), "MESA_GL_VERSION_OVERRIDE=3.0");
     EXPECT_EQ(r.exit_code, 1) << r.err;
     EXPECT_NE(r.err.find("cones: OSMesa could not create an OpenGL 4.5 core context"), std::string::npos) << r.err;
@@ -128,9 +134,12 @@ TEST(RmpCli, ShippedPipelinesKeepTheirGoldenOutputs) {
         const char* sha256;
     };
     const Golden goldens[] = {
-        {"rmp-jitter.orogen", "rmp-jitter-static.png", "6f673d41826d26a831ea59e223008938a2d3df4a74cfcdd913eb7a2154ef11e2"},
-        {"rmp-jitter.orogen", "rmp-jitter-dynamic.png", "c3f71af9634d08446826f6ce381943618b53187ab85013eccd51f55ae0b3f60a"},
-        {"rmp-mountains.orogen", "rmp-mountains.png", "e872a179f0457851111330655367808545d705f373e9e539854c404b00ffead1"},
+        {"rmp-jitter.orogen", "rmp-jitter-static.png",
+         "6f673d41826d26a831ea59e223008938a2d3df4a74cfcdd913eb7a2154ef11e2"},
+        {"rmp-jitter.orogen", "rmp-jitter-dynamic.png",
+         "c3f71af9634d08446826f6ce381943618b53187ab85013eccd51f55ae0b3f60a"},
+        {"rmp-mountains.orogen", "rmp-mountains.png",
+         "e872a179f0457851111330655367808545d705f373e9e539854c404b00ffead1"},
     };
     for (const Golden& g : goldens) {
         TempDir dir;

@@ -87,8 +87,7 @@ TEST(Shape, CrookedStaysWithinItsHeightAndIsNotAPlane) {
     }
     EXPECT_GT(north, south);
     int turns = 0;
-    for (int x = 1; x < 128; ++x)
-        turns += (s.at(x, 64) - s.at(x - 1, 64)) * (s.at(x + 1, 64) - s.at(x, 64)) < 0;
+    for (int x = 1; x < 128; ++x) turns += (s.at(x, 64) - s.at(x - 1, 64)) * (s.at(x + 1, 64) - s.at(x, 64)) < 0;
     EXPECT_GE(turns, 2);
 }
 
@@ -97,6 +96,7 @@ TEST(Shape, UnknownKindNamesTheChoices) {
         kind_from_name("sphere");
         FAIL();
     } catch (const BadInput& e) {
-        EXPECT_STREQ(e.what(), "shape: unknown kind 'sphere'; use one of crooked, pyramid, hemisphere, flat, plane, cone");
+        EXPECT_STREQ(e.what(),
+                     "shape: unknown kind 'sphere'; use one of crooked, pyramid, hemisphere, flat, plane, cone");
     }
 }

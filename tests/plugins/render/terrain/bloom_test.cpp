@@ -87,7 +87,7 @@ TEST(Blur, XThenYEqualsTheTwoDimensionalGaussian) {
                 for (int j = -r; j <= r; ++j)
                     for (int i = -r; i <= r; ++i)
                         s += double(k[std::size_t(std::abs(i))]) * k[std::size_t(std::abs(j))] *
-                             im.rgba32f[4 * std::size_t(mirror(y + j, h) * w + mirror(x + i, w)) + std::size_t(c)];
+                            im.rgba32f[4 * std::size_t(mirror(y + j, h) * w + mirror(x + i, w)) + std::size_t(c)];
                 worst = std::max(worst, std::abs(s - xy.rgba32f[4 * std::size_t(y * w + x) + std::size_t(c)]));
             }
     EXPECT_LT(worst, 2e-6);
@@ -121,7 +121,8 @@ TEST(Bloom, TheChainEqualsThePassesOneByOne) {
     b.sigma = 0.06;  // 3.84 pixels of the full image, 1.92 of the half-size bright pass
     const Image chained = bloom(im, b);
     const double sigma = b.sigma * 64 / b.bright.scale;
-    const Image by_hand = combine(im, blur(blur(bright_pass(im, b.bright), Axis::x, sigma), Axis::y, sigma), b.strength);
+    const Image by_hand =
+        combine(im, blur(blur(bright_pass(im, b.bright), Axis::x, sigma), Axis::y, sigma), b.strength);
     ASSERT_EQ(chained.rgba32f.size(), by_hand.rgba32f.size());
     for (std::size_t i = 0; i < chained.rgba32f.size(); ++i) ASSERT_NEAR(chained.rgba32f[i], by_hand.rgba32f[i], 1e-5);
     // The glow reaches beyond the bright square.

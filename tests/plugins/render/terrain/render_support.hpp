@@ -14,7 +14,10 @@ namespace orogen::test {
 
 /// Every render test runs without a display: OSMesa needs none.
 struct NoDisplay : ::testing::Environment {
-    void SetUp() override { ::unsetenv("DISPLAY"); ::unsetenv("WAYLAND_DISPLAY"); }
+    void SetUp() override {
+        ::unsetenv("DISPLAY");
+        ::unsetenv("WAYLAND_DISPLAY");
+    }
 };
 
 /// Peak signal-to-noise ratio of two 8-bit buffers, dB (infinity when equal).

@@ -109,9 +109,11 @@ TEST(Splatting, TheShaderFollowsTheRulesOfSplatWeights) {
     for (int x = 2; x < 126; ++x) {
         const float h = float((x + 0.5) / 128.0 * (n - 1));
         const terrain::SplatWeights w = terrain::splat_weights(h, 0, float(n - 1), 0.995f);
-        const float want_g = w.sand * colours[0][1] + w.grass * colours[1][1] + w.rock * colours[2][1] + w.snow * colours[3][1];
+        const float want_g =
+            w.sand * colours[0][1] + w.grass * colours[1][1] + w.rock * colours[2][1] + w.snow * colours[3][1];
         const float got_g = im.rgba32f[4 * std::size_t(64 * 128 + x) + 1];
-        EXPECT_NEAR(got_g / want_g, 1.0, 0.3) << "column " << x << " height " << h << " got " << got_g << " want " << want_g;
+        EXPECT_NEAR(got_g / want_g, 1.0, 0.3)
+            << "column " << x << " height " << h << " got " << got_g << " want " << want_g;
     }
 }
 
@@ -169,13 +171,15 @@ TEST(Splatting, AHollowIsDarkerAndGreenerThanTheFlatAroundIt) {
     // The hollow's floor (the middle 6 × 6 pixels) against open plain near a corner away from the column.
     const double floor_green = mean(albedo, 61, 66, 1) / mean(albedo, 61, 66, 0);
     const double plain_green = mean(albedo, 100, 110, 1) / mean(albedo, 100, 110, 0);
-    EXPECT_GT(floor_green, 1.1 * plain_green) << "green/red in the hollow " << floor_green << ", on the plain " << plain_green;
+    EXPECT_GT(floor_green, 1.1 * plain_green)
+        << "green/red in the hollow " << floor_green << ", on the plain " << plain_green;
     const auto colours = Style::default_materials();
     EXPECT_EQ(nearest(albedo, std::size_t(64 * 128 + 64), colours), grass);
     EXPECT_EQ(nearest(albedo, std::size_t(105 * 128 + 105), colours), sand);
     const double floor_light = mean(lit, 61, 66, 1) / mean(albedo, 61, 66, 1);
     const double plain_light = mean(lit, 100, 110, 1) / mean(albedo, 100, 110, 1);
-    EXPECT_LT(floor_light, 0.9 * plain_light) << "light on the hollow's floor " << floor_light << ", on the plain " << plain_light;
+    EXPECT_LT(floor_light, 0.9 * plain_light)
+        << "light on the hollow's floor " << floor_light << ", on the plain " << plain_light;
 }
 
 // Issue 32, item 5: a river from the water layer is a smooth ribbon, not cells: a one-sample-wide river
@@ -207,7 +211,8 @@ TEST(Water, ADiagonalRiverOfSingleCellsIsASmoothRibbon) {
             const int x = k + d, y = k - d;
             const std::size_t i = 4 * std::size_t(y * px + x);
             double diff = 0;
-            for (int c = 0; c < 3; ++c) diff += std::abs(wet.rgba32f[i + std::size_t(c)] - dry.rgba32f[i + std::size_t(c)]);
+            for (int c = 0; c < 3; ++c)
+                diff += std::abs(wet.rgba32f[i + std::size_t(c)] - dry.rgba32f[i + std::size_t(c)]);
             if (diff > 0.05) {
                 if (first < 0) first = d;
                 last = d;
@@ -217,7 +222,8 @@ TEST(Water, ADiagonalRiverOfSingleCellsIsASmoothRibbon) {
         EXPECT_LE(std::abs(first + last), 3) << "the river's middle strays from the diagonal at x + y = " << 2 * k;
         widths.push_back(last - first + 1);
     }
-    const double lo = *std::min_element(widths.begin(), widths.end()), hi = *std::max_element(widths.begin(), widths.end());
+    const double lo = *std::min_element(widths.begin(), widths.end()),
+                 hi = *std::max_element(widths.begin(), widths.end());
     EXPECT_GE(lo, 0.7 * hi) << "the river's width runs from " << lo << " to " << hi << " px (a sawtooth or beads)";
 }
 
@@ -294,7 +300,9 @@ TEST(Reflection, TheSeaMirrorsWhatStandsAboveItAndNothingBelow) {
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 double d = 0;
-                for (int k = 0; k < 3; ++k) d += std::abs(a.rgba32f[4 * std::size_t(y * w + x) + k] - b.rgba32f[4 * std::size_t(y * w + x) + k]);
+                for (int k = 0; k < 3; ++k)
+                    d +=
+                        std::abs(a.rgba32f[4 * std::size_t(y * w + x) + k] - b.rgba32f[4 * std::size_t(y * w + x) + k]);
                 if (d > 0.02) {
                     ++count;
                     mean_x += x;
@@ -415,7 +423,8 @@ TEST(Sea, TheHorizonSeparatesTheSeaFromTheSky) {
     c.elevation = 4;  // the horizon 4° above the frame's middle: row (1 − tan 4° / tan 20°) / 2 of the height
     const int w = 160, h = 96;
     const Image img = TerrainRenderer(hm, s).render(w, h, c);
-    const double horizon = (1.0 - std::tan(4.0 * std::numbers::pi / 180) / std::tan(20.0 * std::numbers::pi / 180)) / 2 * h;
+    const double horizon =
+        (1.0 - std::tan(4.0 * std::numbers::pi / 180) / std::tan(20.0 * std::numbers::pi / 180)) / 2 * h;
     // Mean luminance of a row's first and last eighth (the island stands in the middle).
     auto luminance = [&](int row) {
         double sum = 0;
@@ -501,7 +510,8 @@ TEST(Golden, TheSceneMatchesItsGoldenImageAndRepeatsExactly) {
     ASSERT_EQ(a.rgba32f.size(), b.rgba32f.size());
     EXPECT_TRUE(a.rgba32f == b.rgba32f) << "the same scene rendered twice differs";
     const auto bytes = png_export::to_srgb8(a, png_export::Tonemap::aces, 0);
-    const std::filesystem::path golden = std::filesystem::path(OROGEN_SOURCE_DIR) / "tests/plugins/render/terrain/golden_scene.png";
+    const std::filesystem::path golden =
+        std::filesystem::path(OROGEN_SOURCE_DIR) / "tests/plugins/render/terrain/golden_scene.png";
     if (std::getenv("OROGEN_UPDATE_GOLDEN")) {
         AtomicFile f(golden);
         write_rgba_png(f.stream(), a.width, a.height, bytes);

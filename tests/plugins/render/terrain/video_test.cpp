@@ -33,9 +33,10 @@ std::string run(const std::string& cmd) {
 }
 
 std::map<std::string, std::string> probe(const fs::path& video) {
-    const std::string text = run("ffprobe -v error -select_streams v:0 -count_frames -show_entries "
-                                 "stream=codec_name,width,height,r_frame_rate,nb_read_frames -of default=nw=1 " +
-                                 q(video) + " 2>&1");
+    const std::string text =
+        run("ffprobe -v error -select_streams v:0 -count_frames -show_entries "
+            "stream=codec_name,width,height,r_frame_rate,nb_read_frames -of default=nw=1 " +
+            q(video) + " 2>&1");
     std::map<std::string, std::string> m;
     std::size_t start = 0;
     while (start < text.size()) {
@@ -117,8 +118,9 @@ TEST(Video, AFailedEncodeLeavesNoFile) {
                  Error);
     EXPECT_TRUE(fs::is_empty(dir.path())) << "a partial video or temporary file was left";
     // A frame of another size is refused the same way.
-    EXPECT_THROW(video::encode_video(dir / "t.mp4", 3, [&](std::size_t i) { return t.frame(i, 96 + 2 * int(i), 64); }, {}),
-                 BadInput);
+    EXPECT_THROW(
+        video::encode_video(dir / "t.mp4", 3, [&](std::size_t i) { return t.frame(i, 96 + 2 * int(i), 64); }, {}),
+        BadInput);
     EXPECT_TRUE(fs::is_empty(dir.path()));
 }
 

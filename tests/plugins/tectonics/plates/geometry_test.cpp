@@ -74,7 +74,8 @@ TEST(PlatesGeometry, SplitConservesAreaToOnePartInAMillion) {
                                {random::uniform_in(-50, 50, seed, 3, i), random::uniform_in(-50, 50, seed, 4, i)});
         const Point2 c = centroid(poly);
         const double a = random::uniform_in(0, 2 * std::numbers::pi, seed, 5, i);
-        const Point2 p{c.x + random::uniform_in(-0.3, 0.3, seed, 6, i), c.y + random::uniform_in(-0.3, 0.3, seed, 7, i)};
+        const Point2 p{c.x + random::uniform_in(-0.3, 0.3, seed, 6, i),
+                       c.y + random::uniform_in(-0.3, 0.3, seed, 7, i)};
         auto parts = split_convex(poly, p, {std::cos(a), std::sin(a)}, 1e-6);
         if (!parts) continue;
         ++splits;
@@ -90,9 +91,9 @@ TEST(PlatesGeometry, SplitConservesAreaToOnePartInAMillion) {
 
 TEST(PlatesGeometry, CutTooCloseToAVertexIsRefused) {
     const Polygon sq = {{0, 0}, {4, 0}, {4, 4}, {0, 4}};
-    EXPECT_FALSE(split_convex(sq, {0, 0}, {1, 1}, 0.05));      // through two corners
-    EXPECT_FALSE(split_convex(sq, {0.01, 0}, {1, 1}, 0.05));   // grazing a corner
-    EXPECT_FALSE(split_convex(sq, {10, 10}, {1, 0}, 0.05));    // misses
+    EXPECT_FALSE(split_convex(sq, {0, 0}, {1, 1}, 0.05));  // through two corners
+    EXPECT_FALSE(split_convex(sq, {0.01, 0}, {1, 1}, 0.05));  // grazing a corner
+    EXPECT_FALSE(split_convex(sq, {10, 10}, {1, 0}, 0.05));  // misses
     EXPECT_TRUE(split_convex(sq, {2, 2}, {1, 0.3}, 0.05));
 }
 
@@ -111,8 +112,7 @@ TEST(PlatesGeometry, RandomPlatesTileTheAreaWithConvexPlatesOfAtMostEightVertice
                 EXPECT_GE(p.polygon.size(), 3u);
                 EXPECT_LE(std::hypot(p.velocity.x, p.velocity.y), 1.0);
                 EXPECT_TRUE(p.density == std::clamp(p.density, oceanic_density - 0.02, oceanic_density + 0.02) ||
-                            p.density ==
-                                std::clamp(p.density, continental_density - 0.02, continental_density + 0.02));
+                            p.density == std::clamp(p.density, continental_density - 0.02, continental_density + 0.02));
                 total += signed_area(p.polygon);
             }
             EXPECT_NEAR(total, size.x * size.y, 1e-9 * size.x * size.y) << count << " plates, seed " << seed;

@@ -13,7 +13,8 @@ namespace {
 const char* kHeader = "orogen 1\nseed 5\ngrid 65 cell=10\ncrust = generate:diamond-square(amplitude=50)\n";
 
 RunResult check(const TempDir& dir, const std::string& call) {
-    const auto spec = dir.write("bad.orogen", std::string(kHeader) + "p = " + call + "\nexport:raw(p, path=\"p.r32\")\n");
+    const auto spec =
+        dir.write("bad.orogen", std::string(kHeader) + "p = " + call + "\nexport:raw(p, path=\"p.r32\")\n");
     return run_orogen("check " + q(spec));
 }
 
@@ -41,7 +42,8 @@ TEST(PlatesCli, BadStepsDtPlatesAndDriveAreCheckErrors) {
         {"tectonics:plates(crust, dt=0)", "error: 'dt' of tectonics:plates is 0, out of range (0, 10] s"},
         {"tectonics:plates(crust, dt=-0.5)", "error: 'dt' of tectonics:plates is -0.5, out of range (0, 10] s"},
         {"tectonics:plates(crust, drive=sideways)",
-         "error: 'drive' of tectonics:plates is 'sideways', which is not one of still, converge, rotate, shear, thesis"},
+         "error: 'drive' of tectonics:plates is 'sideways', which is not one of still, converge, rotate, shear, "
+         "thesis"},
     };
     for (const auto& c : cases) {
         const auto r = check(dir, c.call);
@@ -52,10 +54,11 @@ TEST(PlatesCli, BadStepsDtPlatesAndDriveAreCheckErrors) {
 
 TEST(PlatesCli, SameSeedGivesTheSameBytesOnOneAndTwoThreadsAndAcrossRuns) {
     TempDir dir;
-    const auto spec = dir.write("p.orogen", std::string(kHeader) +
-        "p = tectonics:plates(crust, plates=8, steps=300, rift_threshold=5000)\n"
-        "export:raw(p, path=\"p.r32\")\n"
-        "export:vtk-plates(p.plates, path=\"plates.pvd\")\n");
+    const auto spec = dir.write("p.orogen",
+                                std::string(kHeader) +
+                                    "p = tectonics:plates(crust, plates=8, steps=300, rift_threshold=5000)\n"
+                                    "export:raw(p, path=\"p.r32\")\n"
+                                    "export:vtk-plates(p.plates, path=\"plates.pvd\")\n");
     std::string first;
     for (const char* threads : {"1", "2", "2"}) {
         const fs::path out = dir / (std::string("out") + threads + std::to_string(first.size()));
@@ -78,10 +81,12 @@ TEST(PlatesCli, ShippedPipelinesKeepTheirGoldenOutputs) {
         const char* sha256;
     };
     const Golden goldens[] = {
-        {"plates-relief.orogen", "plates-relief.png", "ff2a10700a6965e8884a10123c9ac6db66a68ed800c0b69800577c68c767a6c0"},
+        {"plates-relief.orogen", "plates-relief.png",
+         "ff2a10700a6965e8884a10123c9ac6db66a68ed800c0b69800577c68c767a6c0"},
         {"plates-tectonics.orogen", "plates-tectonics.png",
          "9b3a287fb52b70e96384475b8f9f53d5446fc48d4b205e22b453290daaaea554"},
-        {"plates-thesis.orogen", "plates-thesis.png", "0b28de4f80cb0d410a92279f479a882412cdd968c6d86033abea38f7abde831e"},
+        {"plates-thesis.orogen", "plates-thesis.png",
+         "0b28de4f80cb0d410a92279f479a882412cdd968c6d86033abea38f7abde831e"},
     };
     for (const Golden& g : goldens) {
         TempDir dir;

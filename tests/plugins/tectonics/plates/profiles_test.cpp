@@ -72,7 +72,7 @@ TEST(PlatesProfiles, SaturateAndTerraceBehave) {
     }
     EXPECT_NEAR(terrace(2.0, 1.0), 2.0, 1e-12);
     EXPECT_NEAR(terrace(1.3, 1.0) - terrace(1.1, 1.0), 0.2 * 0.2 / 0.75, 1e-9);  // a tread: 20 % per step
-    EXPECT_GT(terrace(1.95, 1.0) - terrace(1.8, 1.0), 0.5);                     // the scarp
+    EXPECT_GT(terrace(1.95, 1.0) - terrace(1.8, 1.0), 0.5);  // the scarp
 }
 
 // A range is rough along its crest: the crest line (the highest sample
@@ -164,7 +164,8 @@ TEST(PlatesProfiles, RiftIsLowerWithARidgeAndSteppedFlanks) {
         EXPECT_GT(f.at(64, y), floor_e + 4.0) << "a ridge on the axis, row " << y;
         // Walk the east flank from the floor's edge to the rim: slopes per sample.
         std::vector<double> slope;
-        for (int x = 64 + int(w.rift_floor); x < 64 + int(w.rift_half); ++x) slope.push_back(f.at(x + 1, y) - f.at(x, y));
+        for (int x = 64 + int(w.rift_floor); x < 64 + int(w.rift_half); ++x)
+            slope.push_back(f.at(x + 1, y) - f.at(x, y));
         const double mean = std::accumulate(slope.begin(), slope.end(), 0.0) / double(slope.size());
         int treads = 0, scarps = 0;
         for (std::size_t i = 0; i < slope.size(); ++i) {
@@ -182,9 +183,15 @@ TEST(PlatesProfiles, RepeatedContactsSaturate) {
     const ReliefShape shape = shape_with_cell(30.0);
     using Add = void (*)(BoundaryRelief&);
     const Add adds[] = {
-        [](BoundaryRelief& r) { r.add_range({30, 64}, {100, 64}); },
-        [](BoundaryRelief& r) { r.add_subduction({30, 64}, {100, 64}, {0, 1}); },
-        [](BoundaryRelief& r) { r.add_rift({30, 64}, {100, 64}); },
+        [](BoundaryRelief& r) {
+            r.add_range({30, 64}, {100, 64});
+        },
+        [](BoundaryRelief& r) {
+            r.add_subduction({30, 64}, {100, 64}, {0, 1});
+        },
+        [](BoundaryRelief& r) {
+            r.add_rift({30, 64}, {100, 64});
+        },
     };
     for (int kind = 0; kind < 3; ++kind) {
         auto total = [&](int contacts) {
@@ -205,8 +212,9 @@ TEST(PlatesProfiles, RepeatedContactsSaturate) {
             EXPECT_GT(lo200, 20.0 * lo1) << kind;
             EXPECT_LT(lo200, 2.0 * lo1) << kind;
         }
-        EXPECT_LE(hi200, (1.0 + shape.jitter) * 1.25 * shape.saturation *
-                             std::max({shape.range_height, shape.arc_height, shape.ridge_height}))
+        EXPECT_LE(hi200,
+                  (1.0 + shape.jitter) * 1.25 * shape.saturation *
+                      std::max({shape.range_height, shape.arc_height, shape.ridge_height}))
             << kind;
     }
 }
@@ -234,8 +242,8 @@ TEST(PlatesProfiles, ShapesChangeOnlySamplesNearTheSegmentAndReportTheChange) {
             EXPECT_NEAR(u.at(x, y), dh, 1e-4) << x << "," << y;
             const double reach_sub = w.arc_offset + w.arc_band + w.vent_radius * 1.2 + 1;
             const bool near = dist(x, y, 30, 64, 98, 64) <= reach_sub ||
-                              dist(x, y, 64, 6, 64, 30) <= w.rift_half + 0.1 * c + w.end_reach + 1 ||
-                              dist(x, y, 100, 90, 100, 120) <= w.range_half + w.end_reach + 1;
+                dist(x, y, 64, 6, 64, 30) <= w.rift_half + 0.1 * c + w.end_reach + 1 ||
+                dist(x, y, 100, 90, 100, 120) <= w.range_half + w.end_reach + 1;
             if (!near) EXPECT_EQ(dh, 0.0f) << x << "," << y;
             changed += dh != 0.0f;
         }

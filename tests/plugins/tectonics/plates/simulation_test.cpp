@@ -177,11 +177,13 @@ TEST(PlatesSimulation, DensePlateUnderLightGivesTrenchAndArc) {
         if (dense_west) {
             EXPECT_LT(lo, meet) << "trench on the dense (west) side";
             EXPECT_GT(hi, meet) << "arc on the light (east) side";
-            for (int x = 0; x < int(meet) - 1; ++x) EXPECT_LE(highest[std::size_t(x)], 0.0f) << "no arc on the dense side";
+            for (int x = 0; x < int(meet) - 1; ++x)
+                EXPECT_LE(highest[std::size_t(x)], 0.0f) << "no arc on the dense side";
         } else {
             EXPECT_GT(lo, meet);
             EXPECT_LT(hi, meet);
-            for (int x = int(meet) + 2; x < g.n; ++x) EXPECT_LE(highest[std::size_t(x)], 0.0f) << "no arc on the dense side";
+            for (int x = int(meet) + 2; x < g.n; ++x)
+                EXPECT_LE(highest[std::size_t(x)], 0.0f) << "no arc on the dense side";
         }
         EXPECT_GT(std::abs(hi - meet), std::abs(lo - meet)) << "the arc stands farther inland than the trench";
     }
@@ -353,9 +355,13 @@ TEST(PlatesSimulation, EventsDrawnIntoWindowsGiveTheWholeGridsBits) {
         p.ranges = style;
         p.max_plates = max_plates(w, h);
         const auto start = random_plates(area_size(w, h), 12, 0.5, 1.0, 7);
-        std::vector<float> whole = base, uplift(base.size(), 0.0f), boundary(base.size(), 0.0f), plate(base.size(), 0.0f);
-        const Result r = simulate(start, p, 7, {{whole.data(), w, h, 10.0}, {uplift.data(), w, h, 10.0},
-                                                {boundary.data(), w, h, 10.0}, {plate.data(), w, h, 10.0}});
+        std::vector<float> whole = base, uplift(base.size(), 0.0f), boundary(base.size(), 0.0f),
+                           plate(base.size(), 0.0f);
+        const Result r = simulate(start, p, 7,
+                                  {{whole.data(), w, h, 10.0},
+                                   {uplift.data(), w, h, 10.0},
+                                   {boundary.data(), w, h, 10.0},
+                                   {plate.data(), w, h, 10.0}});
         ASSERT_GT(r.replay.stamps.size(), 10u);
         EXPECT_EQ(std::count_if(r.replay.stamps.begin(), r.replay.stamps.end(),
                                 [](const ReliefStamp& s) { return s.kind == ReliefStamp::Kind::subduction; }) > 0,
@@ -375,15 +381,19 @@ TEST(PlatesSimulation, EventsDrawnIntoWindowsGiveTheWholeGridsBits) {
                 for (int y = 0; y < t.height; ++y)
                     for (int x = 0; x < t.width; ++x)
                         th[std::size_t(y) * t.width + x] = base[std::size_t(t.y0 + y) * w + std::size_t(t.x0 + x)];
-                draw_tile(replay, p, 7, {{th.data(), t.width, t.height, 10.0}, {tu.data(), t.width, t.height, 10.0},
-                                         {tb.data(), t.width, t.height, 10.0}, {tp.data(), t.width, t.height, 10.0}},
+                draw_tile(replay, p, 7,
+                          {{th.data(), t.width, t.height, 10.0},
+                           {tu.data(), t.width, t.height, 10.0},
+                           {tb.data(), t.width, t.height, 10.0},
+                           {tp.data(), t.width, t.height, 10.0}},
                           t);
                 int differ = 0;
                 for (int y = 0; y < t.height; ++y)
                     for (int x = 0; x < t.width; ++x) {
-                        const std::size_t g = std::size_t(t.y0 + y) * w + std::size_t(t.x0 + x), k = std::size_t(y) * t.width + x;
+                        const std::size_t g = std::size_t(t.y0 + y) * w + std::size_t(t.x0 + x),
+                                          k = std::size_t(y) * t.width + x;
                         differ += std::memcmp(&th[k], &whole[g], 4) != 0 || std::memcmp(&tu[k], &uplift[g], 4) != 0 ||
-                                  tb[k] != boundary[g] || tp[k] != plate[g];
+                            tb[k] != boundary[g] || tp[k] != plate[g];
                     }
                 EXPECT_EQ(differ, 0) << "window at (" << t.x0 << ", " << t.y0 << ")";
             }
