@@ -122,7 +122,8 @@ BasinTree solve_basin_graph(std::vector<Link>& links, std::int32_t nodes) {
     }
     // Each node's tree links in the order taken (one array, not a vector per node).
     for (std::size_t v = 0; v < std::size_t(nodes); ++v) degree[v + 1] += degree[v];
-    std::vector<std::int32_t> adjacent(std::size_t(degree[std::size_t(nodes)]));
+    // static_cast, not std::size_t(...): that would declare a function (the vexing parse, which clang takes).
+    std::vector<std::int32_t> adjacent(static_cast<std::size_t>(degree[std::size_t(nodes)]));
     {
         std::vector<std::int32_t> fill(degree.begin(), degree.end() - 1);
         for (const std::int32_t e : taken) {
