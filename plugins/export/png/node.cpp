@@ -70,16 +70,19 @@ void check(CheckContext& ctx) {
     }
 }
 
-/// The value at quantile q (0..1) of the finite samples of `grid`.
-float quantile(ConstGridView grid, double q) {
+/// The values at quantiles lo and hi (0..1, lo <= hi) of the finite samples of `grid`, from one copy.
+std::pair<float, float> quantiles(ConstGridView grid, double lo, double hi) {
     std::vector<float> v;
     v.reserve(grid.size());
     for (std::size_t i = 0; i < grid.size(); ++i)
         if (std::isfinite(grid.data[i])) v.push_back(grid.data[i]);
-    if (v.empty()) return 0.0f;
-    const auto k = std::size_t(std::clamp(q, 0.0, 1.0) * double(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
-    return v[k];
+    if (v.empty()) return {0.0f, 0.0f};
+    auto at = [&](double q) { return v.begin() + std::ptrdiff_t(std::clamp(q, 0.0, 1.0) * double(v.size() - 1)); };
+    const auto h = at(hi);
+    std::nth_element(v.begin(), h, v.end());
+    const auto l = at(lo);
+    std::nth_element(v.begin(), l, h);  // the lower one lies among those before the upper
+    return {*l, *h};
 }
 
 /// A soft light from the heights: 0.55 in shadow to 1 facing the light, so colours stay readable.
@@ -95,7 +98,7 @@ std::vector<float> soft_light(ConstGridView heights, double azimuth, double elev
 /// sequential map (dark blue, teal, yellow) over its 2–98 % range, so outliers do not wash it out. Shaded
 /// by the terrain, so the map reads as ground.
 std::vector<std::uint8_t> colour_map(ConstGridView values, ConstGridView heights, double azimuth, double elevation) {
-    const float lo = quantile(values, 0.02), hi = quantile(values, 0.98);
+    const auto [lo, hi] = quantiles(values, 0.02, 0.98);
     const bool diverging = lo < 0.0f && hi > 0.0f;
     const float reach = std::max(std::abs(lo), std::abs(hi));
     const std::vector<float> light = soft_light(heights, azimuth, elevation);
