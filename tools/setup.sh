@@ -12,6 +12,7 @@ packages=(
   libglm-dev libbox2d-dev libosmesa6-dev libvtk9-dev libopenvdb-dev libtinygltf-dev nlohmann-json3-dev
   libboost-dev libboost-filesystem-dev libboost-iostreams-dev libboost-system-dev
   libgdal-dev gdal-bin
+  libxgboost-dev                                # orogen analyze --discriminate (XGBoost C API)
   libopenexr-dev openexr
   python3-dev pybind11-dev python3-numpy python3-pytest python3-matplotlib   # matplotlib: docs/python.md's plots
   libssl-dev libxxhash-dev libstb-dev libpng-dev libdeflate-dev libtbb-dev libgtest-dev libgmock-dev libbenchmark-dev
