@@ -91,6 +91,15 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
             if (!n || *n < 1 || *n > 1024 || *n != std::floor(*n))
                 return "--threads needs a number from 1 to 1024" + (got ? ", got '" + v + "'" : std::string());
             a.threads = int(*n);
+        } else if (is("--window-m")) {
+            const bool got = value("--window-m", v);
+            const auto n = got ? parse_number(v) : std::nullopt;
+            if (!n || *n <= 0.0 || *n > 1e7)
+                return "--window-m needs the windows' side in metres, a number above 0 (3840: 128 cells at 30 m)" +
+                    (got ? ", got '" + v + "'" : std::string());
+            a.window_m = *n;
+        } else if (arg == "--discriminate") {
+            a.discriminate = true;
         } else if (arg == "--no-render") {
             a.render = false;
         } else if (arg == "--quiet" || arg == "-q") {
@@ -106,6 +115,18 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
             ? "analyze needs at least one terrain file"
             : "analyze needs a terrain to measure before --against (the files after it are references)";
     if (references && a.against.empty()) return "--against needs at least one reference DEM after it";
+    if (a.window_m && !a.discriminate) return "--window-m is the window of --discriminate; add --discriminate";
+    if (a.discriminate) {
+        if (a.files.size() < 2 || a.against.size() < 2)
+            return "--discriminate leaves one source out at a time, so it needs at least two generated terrains "
+                   "and two real DEMs after --against (got " +
+                std::to_string(a.files.size()) + " and " + std::to_string(a.against.size()) +
+                "); run the pipeline with other seeds (--seed) for more terrains";
+        if (a.files.size() + a.against.size() > 32)
+            return "--discriminate takes at most 32 files at once, got " +
+                std::to_string(a.files.size() + a.against.size());
+        return {};
+    }
     if (a.files.size() + a.against.size() > 16)
         return "analyze compares at most 16 files at once, got " + std::to_string(a.files.size() + a.against.size());
     return {};
@@ -170,14 +191,31 @@ ComposedSpec compose_analyze_spec(const AnalyzeArgs& args) {
         }
         s << value << " = " << node << "\n";
         values.push_back(value);
-        // The report's name: the file's stem, made unique, without the commas that separate names.
+        // The report's name: the file's stem, made unique, without the commas that separate names. With
+        // --discriminate, runs of one pipeline often share a file name (out42/terrain.r32, out1/terrain.r32):
+        // their folder names them.
         std::string name = file.stem().string();
+        const auto same_stem = [&](const std::string& other) { return fs::path(other).stem() == file.stem(); };
+        if (args.discriminate && std::count_if(all.begin(), all.end(), same_stem) > 1 &&
+            !file.parent_path().filename().empty())
+            name = file.parent_path().filename().string() + "/" + name;
         std::replace(name.begin(), name.end(), ',', '_');
         if (name.empty()) name = value;
         std::string unique = name;
         for (int k = 2; taken.count(unique); ++k) unique = name + "-" + std::to_string(k);
         taken.insert(unique);
         spec.names.push_back(unique);
+    }
+    if (args.discriminate) {
+        std::string names;
+        for (std::size_t i = 0; i < values.size(); ++i) names += (i ? "," : "") + spec.names[i];
+        s << "analyze:discriminate(";
+        for (std::size_t i = 0; i < values.size(); ++i) s << (i ? ", " : "") << values[i];
+        s << ", names=" << literal(names) << ", real=" << args.against.size();
+        if (args.window_m) s << ", window_m=" << number(*args.window_m);
+        s << ", path=\"discriminate.json\", picture=\"discriminate.png\")\n";
+        spec.text = s.str();
+        return spec;
     }
     std::string names, images;
     for (std::size_t i = 0; i < values.size(); ++i) {

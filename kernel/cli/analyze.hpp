@@ -1,7 +1,9 @@
 // `orogen analyze FILE... [--against DEM...]`: the command line turned into a spec the normal runner
 // runs — an import node per file (chosen by its extension), analyze:terrain over all of them (the
 // --against files last, as references), and render:terrain + export:png per terrain with one camera.
-// The kernel stays free of libs/: the measuring is the plugin's; this file only writes spec text.
+// With --discriminate, analyze:discriminate over all of them instead (the generated terrains first, the
+// real DEMs last). The kernel stays free of libs/: the measuring is the plugins'; this file only writes
+// spec text.
 #pragma once
 
 #include <optional>
@@ -17,6 +19,10 @@ struct AnalyzeArgs {
     std::optional<double> cell;  ///< --cell M: the cell size of every file (m)
     std::optional<std::pair<double, double>> heights;  ///< --heights LOW:HIGH, metres of a PNG's black and white
     bool render = true;  ///< --no-render: no pictures
+    /// --discriminate: instead of the figures' table, whether a classifier tells the terrains from the
+    /// --against DEMs window by window (analyze:discriminate); no renderings.
+    bool discriminate = false;
+    std::optional<double> window_m;  ///< --window-m M: the windows' side in metres (--discriminate)
     bool quiet = false;
     int threads = 0;
 };

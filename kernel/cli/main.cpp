@@ -51,6 +51,9 @@ const char* usage_text =
     "                                                  against real DEMs: a table, DIR/analysis.json, charts,\n"
     "                                                  renderings and DIR/README.md (default DIR: analysis/;\n"
     "                                                  docs/analysis.md)\n"
+    "  orogen analyze --discriminate TERRAIN... --against DEM... [--window-m M] [--out DIR]\n"
+    "                                                  can a classifier tell the terrains from the DEMs, window\n"
+    "                                                  by window? DIR/discriminate.json, .txt, .png\n"
     "  orogen list [KIND]                              the nodes (and processes) the loaded plugins provide\n"
     "  orogen help NODE                                a node's inputs and parameters\n"
     "  orogen version                                  kernel, plugin API and plugin versions\n"
@@ -444,13 +447,16 @@ int cmd_analyze(int argc, char** argv, const Session& plugins) {
     const int rc = run_checked(*checked, args, plugins, false);
     if (rc != exit_ok) return rc;
     try {
-        const auto table = read_file(fs::path(a.out) / "analysis.txt");
+        const auto table = read_file(fs::path(a.out) / (a.discriminate ? "discriminate.txt" : "analysis.txt"));
         std::fwrite(table.data(), 1, table.size(), stdout);
     } catch (const Error& e) {
         std::fprintf(stderr, "orogen: error: %s\n", e.what());
         return exit_failed;
     }
-    if (!a.quiet)
+    if (!a.quiet && a.discriminate)
+        std::printf("\nreport: %s, %s\n", (fs::path(a.out) / "discriminate.json").c_str(),
+                    (fs::path(a.out) / "discriminate.png").c_str());
+    else if (!a.quiet)
         std::printf("\nreport: %s (analysis.json, charts%s)\n", (fs::path(a.out) / "README.md").c_str(),
                     a.render ? ", renders/" : "");
     return exit_ok;
