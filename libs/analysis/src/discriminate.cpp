@@ -268,12 +268,13 @@ double median(std::vector<double> v) {
     return v.empty() ? nan : detail::percentile(v, 50.0);
 }
 
-/// Every window of every source: a grid of whole windows centred on each source, rows then columns, skipping
-/// windows with more than max_hole_share holes.
-std::vector<Window> cut_windows(const std::vector<Source>& sources, int n, const DiscriminateOptions& o) {
+/// Every window of every source: a grid of whole windows of window_m metres (in the source's own cells) centred
+/// on each source, rows then columns, skipping windows with more than max_hole_share holes.
+std::vector<Window> cut_windows(const std::vector<Source>& sources, const DiscriminateOptions& o) {
     std::vector<Window> windows;
     for (std::size_t s = 0; s < sources.size(); ++s) {
         const Grid& g = sources[s].grid;
+        const int n = window_cells(o.window_m, g.cell);
         const int across = g.width / n, down = g.height / n;
         const int x0 = (g.width - across * n) / 2, y0 = (g.height - down * n) / 2;
         for (int j = 0; j < down; ++j)
@@ -285,16 +286,19 @@ std::vector<Window> cut_windows(const std::vector<Source>& sources, int n, const
                         holes += !std::isfinite(g.heights[k]) || (g.valid && !g.valid[k]);
                     }
                 if (double(holes) > o.max_hole_share * double(n) * double(n)) continue;
-                windows.push_back({s, x0 + i * n, y0 + j * n, {}, 0.0});
+                windows.push_back({s, x0 + i * n, y0 + j * n, n, {}, 0.0});
             }
     }
     // Each window's figures, from its own copy of the heights: one iteration's alone, so any thread count.
     orogen::parallel_for(0, std::int64_t(windows.size()), 1, [&](std::int64_t begin, std::int64_t end) {
-        std::vector<float> z(std::size_t(n) * std::size_t(n));
-        std::vector<std::uint8_t> valid(z.size());
+        std::vector<float> z;
+        std::vector<std::uint8_t> valid;
         for (auto k = std::size_t(begin); k < std::size_t(end); ++k) {
             Window& win = windows[k];
             const Grid& g = sources[win.source].grid;
+            const int n = win.cells;
+            z.resize(std::size_t(n) * std::size_t(n));
+            valid.resize(z.size());
             for (int y = 0; y < n; ++y)
                 for (int x = 0; x < n; ++x) {
                     const std::size_t from = std::size_t(win.y + y) * std::size_t(g.width) + std::size_t(win.x + x);
@@ -367,8 +371,8 @@ std::string check_sources(const std::vector<Source>& sources, const Discriminate
                       100.0 * o.cell_tolerance, coarse->grid.cell, coarse->grid.cell);
         return text;
     }
-    const double cell = sources.front().grid.cell;
-    const int n = window_cells(o.window_m, cell);
+    const double cell = coarse->grid.cell;
+    const int n = window_cells(o.window_m, cell);  // the fewest samples a window has, in the coarsest cells
     if (n < minimum_window) {
         char text[300];
         std::snprintf(
@@ -379,13 +383,13 @@ std::string check_sources(const std::vector<Source>& sources, const Discriminate
         return text;
     }
     for (const auto& s : sources)
-        if (s.grid.width < n || s.grid.height < n) {
+        if (const int cells = window_cells(o.window_m, s.grid.cell); s.grid.width < cells || s.grid.height < cells) {
             char text[400];
             std::snprintf(text, sizeof text,
                           "%s (%dx%d samples of %.4g m) is smaller than one window of %.4g m (%d samples); give a "
                           "smaller window (--window-m %.0f or less) or leave it out",
-                          s.name.c_str(), s.grid.width, s.grid.height, s.grid.cell, o.window_m, n,
-                          std::floor(double(std::min(s.grid.width, s.grid.height)) * cell));
+                          s.name.c_str(), s.grid.width, s.grid.height, s.grid.cell, o.window_m, cells,
+                          std::floor(double(std::min(s.grid.width, s.grid.height)) * s.grid.cell));
             return text;
         }
     return {};
@@ -395,8 +399,8 @@ Discrimination discriminate(const std::vector<Source>& sources, const Discrimina
     if (const std::string problem = check_sources(sources, o); !problem.empty()) throw std::invalid_argument(problem);
     Discrimination d;
     d.window_cells = window_cells(o.window_m, sources.front().grid.cell);
-    d.window_m = d.window_cells * sources.front().grid.cell;
-    d.windows = cut_windows(sources, d.window_cells, o);
+    d.window_m = o.window_m;
+    d.windows = cut_windows(sources, o);
     std::vector<float> features, labels;
     for (const Window& w : d.windows) {
         for (const double v : w.figures)

@@ -103,8 +103,13 @@ std::string discrimination_text(const analysis::Discrimination& d, std::size_t t
     for (const auto& src : d.sources) (src.real ? real : generated) += 1;
     s << "telling real from generated terrain, window by window (leave one source out; " << real << " real, "
       << generated << " generated)\n";
-    s << "windows of " << d.window_cells << " x " << d.window_cells << " samples (" << fixed(d.window_m, 0) << " m), "
-      << d.windows.size() << " in all\n\n";
+    // Each source's windows in its own cells: list every distinct side.
+    std::vector<int> sides;
+    for (const auto& w : d.windows)
+        if (std::find(sides.begin(), sides.end(), w.cells) == sides.end()) sides.push_back(w.cells);
+    s << "windows of " << fixed(d.window_m, 0) << " m (";
+    for (std::size_t i = 0; i < sides.size(); ++i) s << (i ? ", " : "") << sides[i] << " x " << sides[i] << " samples";
+    s << "), " << d.windows.size() << " in all\n\n";
     s << "balanced accuracy  " << fixed(100.0 * d.balanced_accuracy, 1)
       << " %   (50 %: not told apart; real windows called real " << fixed(100.0 * d.recall_real, 1)
       << " %, generated called generated " << fixed(100.0 * d.recall_generated, 1) << " %)\n\n";
@@ -174,7 +179,9 @@ std::string discrimination_json(const analysis::Discrimination& d) {
 std::vector<std::uint16_t> discrimination_picture(const analysis::Discrimination& d,
                                                   const std::vector<analysis::Source>& sources, const Shown& shown,
                                                   int& width, int& height) {
-    const int n = d.window_cells;
+    int n = 0;  // the thumbnails' slot: the largest window shown
+    for (const auto* row : {&shown.generated_looking, &shown.real_looking})
+        for (const std::size_t k : *row) n = std::max(n, d.windows[k].cells);
     const int columns = int(std::max(shown.generated_looking.size(), shown.real_looking.size()));
     width = std::max(1, columns * n + (columns + 1) * gap);
     height = 2 * n + 3 * gap;
@@ -183,17 +190,18 @@ std::vector<std::uint16_t> discrimination_picture(const analysis::Discrimination
         for (std::size_t c = 0; c < row.size(); ++c) {
             const auto& w = d.windows[row[c]];
             const auto& g = sources[w.source].grid;
-            std::vector<float> z(std::size_t(n) * std::size_t(n));
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x)
-                    z[std::size_t(y) * std::size_t(n) + std::size_t(x)] =
+            const int m = w.cells;  // this window's side, drawn in the top-left of its slot
+            std::vector<float> z(std::size_t(m) * std::size_t(m));
+            for (int y = 0; y < m; ++y)
+                for (int x = 0; x < m; ++x)
+                    z[std::size_t(y) * std::size_t(m) + std::size_t(x)] =
                         g.heights[std::size_t(w.y + y) * std::size_t(g.width) + std::size_t(w.x + x)];
-            const auto shade = hillshade(z, n, g.cell);
+            const auto shade = hillshade(z, m, g.cell);
             const int left = gap + int(c) * (n + gap);
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x)
+            for (int y = 0; y < m; ++y)
+                for (int x = 0; x < m; ++x)
                     picture[std::size_t(top + y) * std::size_t(width) + std::size_t(left + x)] =
-                        shade[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+                        shade[std::size_t(y) * std::size_t(m) + std::size_t(x)];
         }
     };
     draw(shown.generated_looking, gap);

@@ -26,7 +26,7 @@ struct Shown {
 };
 Shown shown_windows(const analysis::Discrimination& d, std::size_t count = 6);
 
-/// An 8-bit grey picture: the generated-looking windows hillshaded in the top row, the real-looking ones in
+/// An 8-bit grey picture: the generated-looking windows hillshaded in the top row (each at its own samples), the real-looking ones in
 /// the bottom row, 8 white samples between them; width and height out.
 std::vector<std::uint16_t> discrimination_picture(const analysis::Discrimination& d,
                                                   const std::vector<analysis::Source>& sources, const Shown& shown,

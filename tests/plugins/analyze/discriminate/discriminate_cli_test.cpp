@@ -15,7 +15,8 @@ namespace {
 using namespace orogen::test;
 
 const fs::path dems = fs::path(OROGEN_SOURCE_DIR) / "data" / "dems";
-const fs::path baspa = dems / "himalaya_baspa_30m.tif", kahurangi = dems / "nz_kahurangi_30m.tif";
+const fs::path baspa = dems / "himalaya_baspa_30m.tif", kahurangi = dems / "nz_kahurangi_30m.tif",
+               rif = dems / "morocco_rif_27m.tif";
 
 /// NAME.f32 + NAME.json in `dir`: side² samples of white noise (±100 m) `cell` metres apart.
 fs::path noise_f32(const TempDir& dir, const std::string& name, int side, double cell, std::uint64_t seed) {
@@ -37,13 +38,15 @@ TEST(DiscriminateCli, TellsWhiteNoiseFromRealRangesAndWritesTheReport) {
     TempDir dir;
     const fs::path a = noise_f32(dir, "noise_a", 400, 30.0, 1), b = noise_f32(dir, "noise_b", 400, 30.0, 2);
     const auto r = run_orogen("analyze --discriminate " + q(a) + " " + q(b) + " --against " + q(baspa) + " " +
-                              q(kahurangi) + " --window-m 1920 --out " + q(dir / "out"));
+                              q(kahurangi) + " " + q(rif) + " --window-m 1920 --out " + q(dir / "out"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     // Told apart at once (a window or two of noise may pass: one noise source is all the other learns from).
     EXPECT_TRUE(std::regex_search(r.out, std::regex("balanced accuracy  (9[5-9]|100)\\.[0-9] %"))) << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("noise_a +generated +36 +[0-9]\\.[0-9] %"))) << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("himalaya_baspa_30m +real +225 +(9[0-9]|100)\\.[0-9] %"))) << r.out;
-    EXPECT_NE(r.out.find("windows of 64 x 64 samples (1920 m)"), std::string::npos) << r.out;
+    // Each source's windows in its own cells: 1920 m is 64 samples of 30 m and 71 of the Rif's 27 m.
+    EXPECT_NE(r.out.find("windows of 1920 m (64 x 64 samples, 71 x 71 samples)"), std::string::npos) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("morocco_rif_27m +real +49 +"))) << r.out;
     EXPECT_NE(r.out.find("the figures that tell apart most"), std::string::npos) << r.out;
     const std::string json = slurp(dir / "out/discriminate.json");
     std::smatch m;
@@ -55,13 +58,16 @@ TEST(DiscriminateCli, TellsWhiteNoiseFromRealRangesAndWritesTheReport) {
     const std::string png = slurp(dir / "out/discriminate.png");
     ASSERT_GT(png.size(), 24u);
     EXPECT_EQ(png.substr(1, 3), "PNG");
-    // Six 64-sample thumbnails a row, 8 samples apart: 6·64 + 7·8 wide, 2·64 + 3·8 high (big-endian in IHDR).
+    // Six thumbnails a row in slots of the largest window shown (64 samples of 30 m, or the Rif's 71 of 27 m),
+    // 8 samples apart: 6·slot + 7·8 wide, 2·slot + 3·8 high (big-endian in IHDR).
     auto be32 = [&](std::size_t at) {
         return (std::uint32_t(std::uint8_t(png[at])) << 24) | (std::uint32_t(std::uint8_t(png[at + 1])) << 16) |
             (std::uint32_t(std::uint8_t(png[at + 2])) << 8) | std::uint32_t(std::uint8_t(png[at + 3]));
     };
-    EXPECT_EQ(be32(16), 6u * 64u + 7u * 8u);
-    EXPECT_EQ(be32(20), 2u * 64u + 3u * 8u);
+    const std::uint32_t slot = (be32(20) - 3u * 8u) / 2u;
+    EXPECT_TRUE(slot == 64u || slot == 71u) << slot;
+    EXPECT_EQ(be32(16), 6u * slot + 7u * 8u);
+    EXPECT_EQ(be32(20), 2u * slot + 3u * 8u);
 }
 
 /// Runs `args`, expects exit 2, `message` in stderr and no report written.

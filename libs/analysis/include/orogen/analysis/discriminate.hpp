@@ -76,7 +76,7 @@ struct Source {
 };
 
 struct DiscriminateOptions {
-    double window_m = 3840.0;  ///< the windows' side in metres (rounded to whole cells of the first source)
+    double window_m = 3840.0;  ///< the windows' side in metres (rounded to whole cells of each source)
     /// Sources are refused when the coarsest cell exceeds the finest by more than this share of it: slopes and
     /// curvature depend on the cell size. 12 %: the 27 m Rif goes with the 30 m ranges, 35 m cells do not.
     double cell_tolerance = 0.12;
@@ -97,6 +97,7 @@ std::string check_sources(const std::vector<Source>& sources, const Discriminate
 struct Window {
     std::size_t source = 0;  ///< index into the sources
     int x = 0, y = 0;  ///< its top-left sample in the source
+    int cells = 0;  ///< its side in samples: window_m in the source's cells
     WindowFigures figures{};
     double p_real = 0.0;  ///< the held-out model's probability that it is real (never trained on its source)
 };
@@ -116,8 +117,8 @@ struct Importance {
 };
 
 struct Discrimination {
-    int window_cells = 0;  ///< the windows' side in samples
-    double window_m = 0.0;  ///< … and in metres (window_cells × the first source's cell)
+    int window_cells = 0;  ///< the windows' side in samples of the first source (each source's: Window::cells)
+    double window_m = 0.0;  ///< the windows' side in metres
     std::vector<Window> windows;  ///< every window, source by source, rows then columns
     std::vector<SourceResult> sources;
     double balanced_accuracy = 0.0;  ///< mean of the two recalls below
