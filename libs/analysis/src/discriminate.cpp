@@ -202,6 +202,11 @@ public:
         }
         // Each class weighs half of the training set, whatever its number of windows.
         const double all = double(rows.size()), generated = all - real;
+        if (real < 1.0 || generated < 1.0)
+            throw std::invalid_argument(
+                "leaving a source out leaves no " + std::string(real < 1.0 ? "real" : "generated") +
+                " window to learn from (the others' windows were all skipped for holes, more than 1 % nodata); "
+                "give sources with fewer holes or a smaller --window-m");
         for (const float l : label) weight.push_back(float(l > 0.5f ? 0.5 * all / real : 0.5 * all / generated));
         Matrix train(data, rows.size());
         train.set("label", label);

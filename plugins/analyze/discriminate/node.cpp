@@ -75,7 +75,11 @@ NodeOutputs run(NodeContext& ctx) {
     analysis::Discrimination d;
     try {
         d = analysis::discriminate(sources, options);
-    } catch (const std::runtime_error& e) { throw Error(e.what()); }
+    } catch (const std::invalid_argument& e) {
+        throw BadInput(e.what());  // too many holes left a kind with no window to learn from
+    } catch (const std::runtime_error& e) {
+        throw Error(e.what());  // XGBoost failed
+    }
     ctx.check_cancelled();
     const std::string json_rel = ctx.text("path");
     const auto stem = std::filesystem::path(json_rel).stem().string();

@@ -7,6 +7,7 @@
 #include <gdal.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -156,6 +157,24 @@ TEST_F(Discriminate, IsTheSameTwiceAndReportsEveryFigure) {
         EXPECT_GE(one.importance[i - 1].gain, one.importance[i].gain);
     EXPECT_EQ(one.window_cells, 64);
     EXPECT_EQ(one.sources.size(), 4u);
+}
+
+TEST_F(Discriminate, SkipsWindowsWithHoles) {
+    // The north half of one source is nodata: only its windows wholly south of row 500 are measured (rows of
+    // windows start at row 20, 64 apart: the eighth and after), 7 of 15 rows of 7.
+    const Dem west = baspa.crop(0, 0, 500, 1000), east = baspa.crop(500, 0, 500, 1000);
+    const Dem a = smoothed(west), b = smoothed(east);
+    std::vector<std::uint8_t> valid(a.z.size(), 1);
+    std::fill(valid.begin(), valid.begin() + 500 * 500, std::uint8_t(0));
+    Grid holed = a.grid();
+    holed.valid = valid.data();
+    const auto d = discriminate(
+        {{"west", west.grid(), true}, {"east", east.grid(), true}, {"a", holed, false}, {"b", b.grid(), false}},
+        options);
+    EXPECT_EQ(d.sources[0].windows, 105u);
+    EXPECT_EQ(d.sources[2].windows, 49u);
+    for (const auto& w : d.windows)
+        if (w.source == 2) EXPECT_GE(w.y, 500);
 }
 
 TEST(DiscriminateChecks, SayWhatIsWrongAndHowToFixIt) {
