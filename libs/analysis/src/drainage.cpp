@@ -142,10 +142,12 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
     }
     measure_valleys(t, o, area, f);
 
-    // Slope–area over the channel cells (terrain_stats.py: A > 1 km² and S > 1e-4).
+    // Slope–area over the channel cells (terrain_stats.py: A > 1 km² and S > 1e-4; without the cells the
+    // fill raised unless o.fit_filled_cells).
     std::vector<double> ca, cs, cl, la, ls, ll;
     for (std::size_t i = 0; i < n; ++i)
-        if (t.valid[i] && area[i] > o.channel_area && r.slope[i] > o.channel_min_slope) {
+        if (t.valid[i] && area[i] > o.channel_area && r.slope[i] > o.channel_min_slope &&
+            (o.fit_filled_cells || !(r.filled[i] > t.z[i]))) {
             ca.push_back(area[i]);
             cs.push_back(r.slope[i]);
             cl.push_back(length[i]);
@@ -155,8 +157,9 @@ void measure_drainage(const Terrain& t, const Options& o, Figures& f) {
         }
     if (ca.size() < minimum_channel_cells) {
         const std::string why = "only " + std::to_string(ca.size()) + " channel cells (draining more than " +
-            area_text(o.channel_area) + ", slope above " + number(o.channel_min_slope) + "); the fit needs " +
-            std::to_string(minimum_channel_cells) + ": the terrain's rivers are too short";
+            area_text(o.channel_area) + ", slope above " + number(o.channel_min_slope) +
+            (o.fit_filled_cells ? "" : ", not filled") + "); the fit needs " + std::to_string(minimum_channel_cells) +
+            ": the terrain's rivers are too short";
         f[FigureId::concavity].why_not = why;
         f[FigureId::steepness].why_not = why;
         f[FigureId::hack_exponent].why_not = why;

@@ -96,8 +96,10 @@ NodeOutputs run(NodeContext& ctx) {
         t.name = names[i];
         t.reference = i >= n - references;
         if (!images.empty()) t.image = images[i];
+        analysis::Options options;
+        options.fit_filled_cells = ctx.text("filled_flats") == "fit";
         t.figures = analysis::measure(
-            {hm.heights().data(), hm.width(), hm.height(), hm.cell(), valid.empty() ? nullptr : valid.data()});
+            {hm.heights().data(), hm.width(), hm.height(), hm.cell(), valid.empty() ? nullptr : valid.data()}, options);
         for (const auto& m : t.figures.values) anything = anything || m.ok();
         ctx.progress(double(i + 1) / double(n + 1));
     }
@@ -188,6 +190,10 @@ OROGEN_PLUGIN("analyze-terrain", "0.1.0", registry) {
                     .help(
                         "a picture per input, comma-separated paths relative to --out, shown side by side on the page"),
                 Param::boolean("charts", true).help("draw the charts (needs gnuplot-nox)"),
+                Param::choice("filled_flats", {"fit", "skip"}, "fit")
+                    .help("whether the channel cells the priority flood raised (filled flats, slope 1e-4 give or "
+                          "take rounding) enter the fits of θ, k_sn and Hack's h: fit as terrain_stats.py, or skip "
+                          "them (steadier across cell sizes and reprojections; docs/analysis.md)"),
             },
         .check = check,
         .run = run,

@@ -44,6 +44,11 @@ struct Grid {
 struct Options {
     double channel_area = 1e6;  ///< m²: drainage area above which a cell is a channel for θ, k_sn and Hack
     double channel_min_slope = 1e-4;  ///< m/m: channel cells at least this steep enter the slope–area fit
+    /// Whether the channel cells the priority flood raised (filled flats: their slope is the fill's gradient,
+    /// ε/cell = 1e-4, which the test S > channel_min_slope keeps or drops by rounding, about half of them) enter
+    /// the fits of θ, k_sn and Hack's h, as in terrain_stats.py. false leaves them out: the fits then no longer
+    /// swing with the cell size (docs/analysis.md, "Real-world rasters").
+    bool fit_filled_cells = true;
     double reference_concavity = 0.45;  ///< θ_ref of the normalised steepness k_sn = S·A^θ_ref (Wobus et al. 2006)
     double network_area =
         1e5;  ///< m²: drainage area above which a cell is on the drainage network (density, hillslopes)
