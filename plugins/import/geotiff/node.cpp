@@ -23,7 +23,7 @@ std::string gib(double bytes) {
 }
 
 geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band, const std::string& holes, double cell,
-                                  const GridSpec& grid) {
+                                  const std::string& square, const GridSpec& grid) {
     geotiff::ReadOptions o;
     o.band = int(band);
     if (resample != "none") {
@@ -34,13 +34,16 @@ geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band
         : holes == "mask"       ? geotiff::Holes::mask
                                 : geotiff::Holes::fill;
     o.cell = cell;
+    o.square = square == "refuse" ? geotiff::Square::refuse : geotiff::Square::warp;
     return o;
 }
 
 NodeOutputs run(NodeContext& ctx) {
-    const auto o =
-        options_from(ctx.text("resample"), ctx.integer("band"), ctx.text("holes"), ctx.real("cell"), ctx.grid());
+    const auto o = options_from(ctx.text("resample"), ctx.integer("band"), ctx.text("holes"), ctx.real("cell"),
+                                ctx.text("square"), ctx.grid());
     auto result = geotiff::read(ctx.input_path("path"), o);
+    if (result.info.warp)
+        ctx.info(geotiff::warp_note(result.info, ctx.text("resample") == "none" ? "cubic" : ctx.text("resample")));
     const double scale = ctx.real("z_scale"), offset = ctx.real("z_offset");
     if (scale != 1.0 || offset != 0.0)
         for (float& h : result.terrain->heights()) h = float(double(h) * scale + offset);
@@ -59,13 +62,18 @@ NodeOutputs run(NodeContext& ctx) {
 void check(CheckContext& ctx) {
     geotiff::RasterInfo info;
     try {
-        info = geotiff::probe(ctx.resolved_path("path"), int(ctx.integer("band")));
+        info = geotiff::probe(ctx.resolved_path("path"), int(ctx.integer("band")), ctx.real("cell"));
     } catch (const BadInput& e) {
         ctx.error(ctx.given("band") ? "band" : "path", e.what());
         return;
     }
-    // The band is read whole before resampling: it and its hole mask must fit.
-    const double bytes = double(info.width) * double(info.height) * 5.0;
+    if (info.warp && ctx.text("square") == "refuse") {
+        ctx.error("square", geotiff::refuse_message(info, ctx.resolved_path("path")));
+        return;
+    }
+    // The band is read whole before resampling (and warped whole to square cells): it and its hole mask must fit.
+    double bytes = double(info.width) * double(info.height) * 5.0;
+    if (info.warp) bytes += double(info.warp->width) * double(info.warp->height) * 9.0;
     if (bytes > physical_memory() / 4) {
         ctx.error("path",
                   "this raster is " + std::to_string(info.width) + "×" + std::to_string(info.height) +
@@ -79,13 +87,14 @@ void check(CheckContext& ctx) {
     if (ctx.real("cell") <= 0.0 && info.cell_metres <= 0.0)
         ctx.error("cell", "the raster has no georeference to take a cell size from; give cell=METRES");
     const bool resampled = ctx.text("resample") != "none";
+    const int width = info.warp ? info.warp->width : info.width, height = info.warp ? info.warp->height : info.height;
     ValueInfo& out = ctx.output();
-    out.width = resampled ? ctx.grid().width : info.width;
-    out.height = resampled ? ctx.grid().height : info.height;
+    out.width = resampled ? ctx.grid().width : width;
+    out.height = resampled ? ctx.grid().height : height;
     if (ctx.real("cell") > 0.0) {
         out.cell = ctx.real("cell");
     } else if (info.cell_metres > 0.0) {
-        out.cell = resampled && out.width > 1 ? info.cell_metres * double(info.width - 1) / double(out.width - 1)
+        out.cell = resampled && out.width > 1 ? info.cell_metres * double(width - 1) / double(out.width - 1)
                                               : info.cell_metres;
     }
     out.layers_known = true;
@@ -102,8 +111,14 @@ OROGEN_PLUGIN("import-geotiff", "0.1.0", registry) {
         .description =
             "One band of any raster GDAL opens, in metres (times z_scale, plus z_offset). By default it is "
             "resampled to the spec's grid, keeping its first and last samples on the grid's corners; "
-            "resample=none keeps the raster's own size. The cell size comes from the georeference (a geographic "
-            "CRS's degrees are converted at the raster's mid latitude) unless cell is given. Nodata samples are "
+            "resample=none keeps the raster's own size. The cell size comes from the georeference unless cell is "
+            "given. "
+            "A raster whose cells are not square in metres (a geographic CRS's degrees, or unequal pixel sides) is "
+            "never stretched: square=warp (the default) first warps it with GDAL's warper (the resample kernel; cubic "
+            "for resample=none) to square cells of its "
+            "longer side (or of cell=) in a local transverse Mercator projection centred on it (a projected raster "
+            "stays in its CRS), saying so in the log, the corners outside it nodata; square=refuse stops with the "
+            "gdalwarp command that would do it. Nodata samples are "
             "filled from their surroundings (holes=fill: layer by layer inward, each the mean of its valid "
             "neighbours), refused (holes=refuse), or filled and marked in a layer 'nodata' (holes=mask, 1 = a hole).",
         .inputs = {},
@@ -117,7 +132,15 @@ OROGEN_PLUGIN("import-geotiff", "0.1.0", registry) {
                 Param::choice("holes", {"fill", "refuse", "mask"}, "fill")
                     .help("what to do with nodata samples; mask fills them and marks them in a layer 'nodata' "
                           "(1 = hole) that analyze:terrain leaves out (needs resample=none)"),
-                Param::real("cell", 0.0).min(0.0).max(1e6).unit("m").help("vertex spacing; 0 = from the file"),
+                Param::real("cell", 0.0)
+                    .min(0.0)
+                    .max(1e6)
+                    .unit("m")
+                    .help("vertex spacing (for non-square cells, the square cell they are warped to); 0 = from the "
+                          "file"),
+                Param::choice("square", {"warp", "refuse"}, "warp")
+                    .help("a raster whose cells are not square metres (degrees, unequal sides): warp it to square "
+                          "cells in a local projection (said in the log), or refuse it"),
                 Param::real("z_scale", 1.0)
                     .min(-1e6)
                     .max(1e6)

@@ -177,17 +177,17 @@ TEST(GeoTiffImport, ResamplingKeepsTheCornersAndALinearSlopeExactly) {
 
 TEST(GeoTiffImport, NodataHolesAreFilledFromTheirSurroundingsOrRefused) {
     TempDir dir;
-    // A geographic SRTM-like tile: 1 arc-second at 46° N, with a hole of nodata.
+    // An SRTM-like Int16 tile of 30 m cells in UTM 32N, with a hole of nodata.
     GDALAllRegister();
     const int n = 61;
     {
         GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
         Dataset ds(gtiff->Create((dir / "dem.tif").c_str(), n, n, 1, GDT_Int16, nullptr));
-        double g[6] = {7.0, 1.0 / 3600, 0, 46.0 + n / 3600.0, 0, -1.0 / 3600};
+        double g[6] = {380000.0, 30.0, 0, 5100000.0, 0, -30.0};
         ds->SetGeoTransform(g);
-        OGRSpatialReference wgs;
-        wgs.importFromEPSG(4326);
-        ds->SetSpatialRef(&wgs);
+        OGRSpatialReference utm;
+        utm.importFromEPSG(32632);
+        ds->SetSpatialRef(&utm);
         std::vector<std::int16_t> v(n * n, 1000);
         for (int y = 20; y < 30; ++y)
             for (int x = 20; x < 33; ++x) v[y * n + x] = -32768;
@@ -199,8 +199,8 @@ TEST(GeoTiffImport, NodataHolesAreFilledFromTheirSurroundingsOrRefused) {
     const auto r = geotiff::read(dir / "dem.tif", o);
     EXPECT_EQ(r.holes_filled, 130u);
     for (float h : r.terrain->heights()) EXPECT_EQ(h, 1000.0f);  // filled from flat ground: flat
-    // 1" of latitude ≈ 30.87 m; of longitude at 46° ≈ 21.5 m: the cell is their mean.
-    EXPECT_NEAR(r.terrain->cell(), 0.5 * (30.87 + 21.48), 0.1);
+    EXPECT_DOUBLE_EQ(r.terrain->cell(), 30.0);
+    EXPECT_FALSE(r.info.warp.has_value());
     o.holes = geotiff::Holes::refuse;
     try {
         geotiff::read(dir / "dem.tif", o);
@@ -211,6 +211,58 @@ TEST(GeoTiffImport, NodataHolesAreFilledFromTheirSurroundingsOrRefused) {
                   std::string::npos)
             << e.what();
     }
+}
+
+TEST(GeoTiffImport, AGeographicTileIsWarpedToSquareMetresNotStretched) {
+    TempDir dir;
+    // 1 arc-second at 46° N: 21.5 m east–west by 30.9 m north–south, a plane rising 1 m a sample eastward
+    // (4.65 % east–west) and 2 m a sample southward (6.48 %).
+    GDALAllRegister();
+    const int n = 61;
+    {
+        GDALDriver* gtiff = GetGDALDriverManager()->GetDriverByName("GTiff");
+        Dataset ds(gtiff->Create((dir / "dem.tif").c_str(), n, n, 1, GDT_Float32, nullptr));
+        double g[6] = {7.0, 1.0 / 3600, 0, 46.0 + n / 3600.0, 0, -1.0 / 3600};
+        ds->SetGeoTransform(g);
+        OGRSpatialReference wgs;
+        wgs.importFromEPSG(4326);
+        ds->SetSpatialRef(&wgs);
+        std::vector<float> v(n * n);
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) v[y * n + x] = float(1000 + x + 2 * y);
+        ASSERT_EQ(ds->GetRasterBand(1)->RasterIO(GF_Write, 0, 0, n, n, v.data(), n, n, GDT_Float32, 0, 0, nullptr),
+                  CE_None);
+    }
+    const auto info = geotiff::probe(dir / "dem.tif");
+    EXPECT_NEAR(info.pixel_x_metres, 21.51, 0.02);  // at the tile's mid latitude, 46.008° N
+    EXPECT_NEAR(info.pixel_y_metres, 30.87, 0.02);
+    ASSERT_TRUE(info.warp.has_value());
+    geotiff::ReadOptions o;
+    o.holes = geotiff::Holes::mask;
+    const auto r = geotiff::read(dir / "dem.tif", o);
+    ASSERT_TRUE(r.info.warp.has_value());
+    EXPECT_EQ(r.terrain->width(), info.warp->width);
+    EXPECT_EQ(r.terrain->height(), info.warp->height);
+    EXPECT_DOUBLE_EQ(r.terrain->cell(), info.pixel_y_metres);  // the longer side
+    EXPECT_NEAR(r.terrain->width() * r.terrain->cell(), n * info.pixel_x_metres, 2 * r.terrain->cell());
+    // The plane's gradients, in metres per metre, where the warp had data on all sides.
+    const int w = r.terrain->width(), h = r.terrain->height();
+    const auto& z = r.terrain->heights();
+    const auto holes = r.terrain->has_layer("nodata") ? r.terrain->layer("nodata").data : nullptr;
+    const double c = r.terrain->cell();
+    int checked = 0;
+    for (int y = 3; y + 3 < h; ++y)
+        for (int x = 3; x + 3 < w; ++x) {
+            bool inside = true;
+            for (int dy = -3; dy <= 3 && holes; ++dy)
+                for (int dx = -3; dx <= 3; ++dx) inside = inside && holes[(y + dy) * w + x + dx] == 0.0f;
+            if (!inside) continue;
+            const std::size_t i = std::size_t(y) * w + x;
+            EXPECT_NEAR((z[i + 1] - z[i - 1]) / (2 * c), 1.0 / info.pixel_x_metres, 2e-3) << x << "," << y;
+            EXPECT_NEAR((z[i + w] - z[i - w]) / (2 * c), 2.0 / info.pixel_y_metres, 2e-3) << x << "," << y;
+            ++checked;
+        }
+    EXPECT_GT(checked, w * h / 2);
 }
 
 TEST(GeoTiffCli, ExportThenImportThroughTheBinaryAndGdalinfoReadsIt) {

@@ -12,7 +12,11 @@
 // Reading: any raster GDAL opens (GeoTIFF, SRTM .hgt, ESRI .asc, USGS .dem,
 // ...), one band, optionally resampled to another size; nodata holes are
 // filled from their surroundings or refused. The cell size comes from the
-// geotransform (metres, or degrees converted at the raster's mid latitude).
+// geotransform. A raster whose cells are not square in metres (a geographic
+// CRS in degrees, or unequal pixel sides) is first warped through GDAL's
+// warper to square cells — in a local transverse Mercator projection centred
+// on it for a geographic CRS — or refused (Square::refuse); it is never
+// stretched.
 //
 // Plain C++ over orogen::Heightmap; the only place GDAL's headers are included
 // is geotiff.cpp.
@@ -70,19 +74,39 @@ struct RasterInfo {
     double geotransform[6] = {0, 1, 0, 0, 0, 1};
     bool has_geotransform = false;
     std::optional<double> nodata;  ///< of the band asked for
-    /// Vertex spacing in metres: the pixel size, converted from degrees at
-    /// the mid latitude for a geographic CRS; 0 if the file has no geotransform.
+    /// The pixel's sides in metres, east–west and north–south (a geographic CRS's degrees converted at the
+    /// raster's centre); 0 if the file has no geotransform.
+    double pixel_x_metres = 0.0, pixel_y_metres = 0.0;
+    /// Vertex spacing in metres as read: the pixel size, or for a raster that is warped to square cells
+    /// (`warp`), the warped cell; 0 if the file has no geotransform.
     double cell_metres = 0.0;
+    /// Set when the cells are not square metres: how read() warps the raster to square cells.
+    struct Warp {
+        int width = 0, height = 0;  ///< the warped raster's samples
+        double cell = 0.0;  ///< m, square
+        std::string why;  ///< "1″ × 1″ of WGS 84: 26.4 m east–west by 30.9 m north–south at 31.30° N"
+        std::string target;  ///< "a local transverse Mercator projection centred at 31.30° N 78.30° E"
+        std::string proj;  ///< the target CRS as a PROJ string (for a gdalwarp command); "" = the raster's own
+    };
+    std::optional<Warp> warp;
 };
 /// Throws orogen::BadInput naming the file if GDAL cannot open it as a
-/// raster, or `band` does not exist.
-RasterInfo probe(const std::filesystem::path& path, int band = 1);
+/// raster, or `band` does not exist. `cell` (m, 0 = the longer side of the pixel) is the square cell a
+/// raster with non-square cells would be warped to.
+RasterInfo probe(const std::filesystem::path& path, int band = 1, double cell = 0.0);
+
+/// What read() did to a raster with non-square cells, as one sentence for the log ("" for square cells).
+std::string warp_note(const RasterInfo& info, const std::string& resample);
+/// Why a raster with non-square cells is refused (Square::refuse), and how to proceed.
+std::string refuse_message(const RasterInfo& info, const std::filesystem::path& path);
 
 enum class Resample { nearest, bilinear, cubic };
 Resample parse_resample(const std::string& name);
 /// What to do with nodata samples: fill them from their surroundings; refuse the file; or fill them and
 /// mark them in a layer `nodata` (1 a hole, 0 data; at the raster's own size only), for analyze:terrain.
 enum class Holes { fill, refuse, mask };
+/// What to do with a raster whose cells are not square in metres: warp it to square cells, or refuse it.
+enum class Square { warp, refuse };
 
 struct ReadOptions {
     int band = 1;
@@ -90,16 +114,21 @@ struct ReadOptions {
     std::optional<std::pair<int, int>> size;
     Resample resample = Resample::bilinear;
     Holes holes = Holes::fill;
-    double cell = 0.0;  ///< metres; 0 = from the file (scaled by the resampling)
+    /// metres; 0 = from the file (scaled by the resampling). For a raster warped to square cells, their size
+    /// (0 = the longer side of the raster's pixel).
+    double cell = 0.0;
+    Square square = Square::warp;
 };
 
 struct ReadResult {
     std::shared_ptr<Heightmap> terrain;
     std::size_t holes_filled = 0;
+    RasterInfo info;  ///< what the file declared (with `warp` set if it was warped to square cells)
 };
 /// Reads one band as heights in metres. Throws orogen::BadInput for a file
 /// GDAL cannot read, holes with Holes::refuse (saying how many and where the
-/// first is), or a raster without a cell size when `cell` is 0.
+/// first is), a raster without a cell size when `cell` is 0, or non-square cells with Square::refuse.
+/// The samples a warp leaves uncovered (the corners of a rotated footprint) are holes like the file's own.
 ReadResult read(const std::filesystem::path& path, const ReadOptions& options);
 
 }  // namespace orogen::geotiff
