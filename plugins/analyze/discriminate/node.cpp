@@ -104,8 +104,9 @@ std::string description() {
         "one whole input out at a time: every window is judged by a model that never saw its input. Writes PATH\n"
         "(JSON), PATH's stem + .txt (the table) and `picture` (PNG: the most generated-looking windows above the\n"
         "most real-looking, hillshaded). The balanced accuracy is the mean of the share of real windows called\n"
-        "real and of generated windows called generated: 50 % when nothing tells them apart. Inputs must share\n"
-        "a cell size within 10 % (docs/analysis.md, \"Telling windows apart\"). Window figures:\n";
+        "real and of generated windows called generated: 50 % when nothing tells them apart. Each input's windows\n"
+        "are window_m in its own cells; the coarsest cell may be at most 12 % coarser than the finest\n"
+        "(docs/analysis.md, \"Telling windows apart\"). Window figures:\n";
     for (const auto& f : analysis::window_figure_table())
         text += "  " + std::string(f.key) + (f.unit.empty() ? "" : " (" + std::string(f.unit) + ")") + ": " +
             std::string(f.definition) + ". [" + std::string(f.source) + "]\n";
