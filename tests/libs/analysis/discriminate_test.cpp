@@ -6,6 +6,7 @@
 
 #include <gdal.h>
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -143,12 +144,17 @@ TEST_F(Discriminate, ACopySmoothedOverThreeCellsIsToldApart) {
     EXPECT_GE(d.balanced_accuracy, 0.85);
 }
 
-TEST_F(Discriminate, IsTheSameTwiceAndReportsEveryFigure) {
+TEST_F(Discriminate, IsTheSameOnOneThreadOrTwoAndReportsEveryFigure) {
     const Dem west = baspa.crop(0, 0, 500, 1000), east = baspa.crop(500, 0, 500, 1000);
     const Dem a = smoothed(west), b = smoothed(east);
     const std::vector<Source> sources = {
         {"west", west.grid(), true}, {"east", east.grid(), true}, {"a", a.grid(), false}, {"b", b.grid(), false}};
-    const auto one = discriminate(sources, options), two = discriminate(sources, options);
+    // Once on one thread, once on two: the same bits (XGBoost runs on one thread whatever the pool).
+    auto run = [&](int threads) {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+        return discriminate(sources, options);
+    };
+    const auto one = run(1), two = run(2);
     ASSERT_EQ(one.windows.size(), two.windows.size());
     for (std::size_t k = 0; k < one.windows.size(); ++k) EXPECT_EQ(one.windows[k].p_real, two.windows[k].p_real);
     EXPECT_EQ(one.balanced_accuracy, two.balanced_accuracy);
