@@ -300,8 +300,8 @@ SquarePlan plan_square(GDALDataset& ds, RasterInfo& info, double cell) {
     const std::string sides = fixed(px, 1) + " m east–west by " + fixed(py, 1) + " m north–south";
     if (info.geographic && source) {
         const double lat = g[3] + g[5] * 0.5 * info.height, lon = g[0] + g[1] * 0.5 * info.width;
-        // A transverse Mercator on the raster's own datum, centred on it: scale 1 along its central
-        // meridian, 1.0003 at 2.5 km... 1.0015 at 60 km east or west of it.
+        // A transverse Mercator on the raster's own datum, centred on it: true to scale along its central
+        // meridian, 1 + x²/2R² = 1.00005 at 60 km east or west of it.
         plan.target.SetProjCS("orogen local transverse Mercator");
         plan.target.CopyGeogCSFrom(source);
         plan.target.SetTM(lat, lon, 1.0, 0.0, 0.0);

@@ -38,12 +38,30 @@ geotiff::ReadOptions options_from(const std::string& resample, std::int64_t band
     return o;
 }
 
+/// Resampling to a grid of other proportions than the raster's spaces the samples unequally along x and y:
+/// said as a warning, never silently.
+void warn_if_stretched(NodeContext& ctx, const geotiff::RasterInfo& info, std::pair<int, int> size) {
+    const int W = info.warp ? info.warp->width : info.width, H = info.warp ? info.warp->height : info.height;
+    const auto [w, h] = size;
+    if (w < 2 || h < 2 || W < 2 || H < 2) return;
+    const double sx = double(W - 1) / double(w - 1), sy = double(H - 1) / double(h - 1);
+    if (std::abs(sx - sy) <= 0.01 * std::max(sx, sy)) return;
+    const int fit_h = int(std::lround(double(H - 1) / sx)) + 1;
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "resampling the raster's " << W << "×" << H << " samples to the grid's " << w << "×" << h
+        << " stretches it: " << sx / sy << " times as far apart east–west as north–south, taken as square; give "
+        << "the grid the raster's proportions (grid " << w << "x" << fit_h << ") or resample=none";
+    ctx.warn(msg.str());
+}
+
 NodeOutputs run(NodeContext& ctx) {
     const auto o = options_from(ctx.text("resample"), ctx.integer("band"), ctx.text("holes"), ctx.real("cell"),
                                 ctx.text("square"), ctx.grid());
     auto result = geotiff::read(ctx.input_path("path"), o);
     if (result.info.warp)
         ctx.info(geotiff::warp_note(result.info, ctx.text("resample") == "none" ? "cubic" : ctx.text("resample")));
+    if (o.size) warn_if_stretched(ctx, result.info, *o.size);
     const double scale = ctx.real("z_scale"), offset = ctx.real("z_offset");
     if (scale != 1.0 || offset != 0.0)
         for (float& h : result.terrain->heights()) h = float(double(h) * scale + offset);

@@ -198,7 +198,8 @@ TEST(RealRasters, NonSquareCellsAreWarpedWithANoteOrRefusedNamingTheFix) {
               "orogen 1\ngrid 9\n"
               "d = import:geotiff(path=\"degrees.tif\", resample=none)\n"
               "o = import:geotiff(path=\"oblong.tif\", resample=none, holes=refuse)\n"
-              "export:raw(d, path=\"d.r32\")\nexport:raw(o, path=\"o.r32\")\n");
+              "s = import:geotiff(path=\"oblong.tif\")\n"
+              "export:raw(d, path=\"d.r32\")\nexport:raw(o, path=\"o.r32\")\nexport:raw(s, path=\"s.r32\")\n");
     RunResult r = run_orogen("run warp.orogen --out out", "", dir.path());
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const std::string log = r.out + r.err;
@@ -214,6 +215,12 @@ TEST(RealRasters, NonSquareCellsAreWarpedWithANoteOrRefusedNamingTheFix) {
               std::string::npos)
         << log;
     EXPECT_NE(slurp(dir / "out/o.r32.json").find("\"cell_size\": 30,"), std::string::npos);
+    // Warped to 54×81 square cells, then resampled to the grid's 9×9: that stretch is said too.
+    EXPECT_NE(log.find("s: warning: resampling the raster's 54×81 samples to the grid's 9×9 stretches it: 0.662 "
+                       "times as far apart east–west as north–south, taken as square; give the grid the raster's "
+                       "proportions (grid 9x13) or resample=none"),
+              std::string::npos)
+        << log;
 
     // square=refuse: exit 2 at check time, the sides and the gdalwarp command that squares them.
     dir.write("refuse.orogen", "orogen 1\ngrid 9\nd = import:geotiff(path=\"degrees.tif\", square=refuse)\n");
