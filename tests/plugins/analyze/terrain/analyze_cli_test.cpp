@@ -66,6 +66,21 @@ TEST(AnalyzeCli, MeasuresADemAndWritesTheReport) {
     EXPECT_FALSE(fs::exists(dir / "report/renders")) << "--no-render";
 }
 
+TEST(AnalyzeCli, SkipFilledFlatsLeavesTheFilledCellsOutOfTheFits) {
+    // The Rif's θ is 0.89 with the filled flats whose slope 1e-4 passes S > 1e-4 by rounding, 0.44 without
+    // them (docs/analysis.md, "Real-world rasters"); the other figures do not move.
+    TempDir dir;
+    const auto r = run_orogen("analyze " + q(rif) + " --skip-filled-flats --no-render --out " + q(dir / "report"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("concavity θ +0\\.44\\n"))) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("median slope +° +19\\.2\\n"))) << r.out;
+    const auto d = run_orogen("analyze " + q(rif) + " --discriminate --skip-filled-flats --against " + q(rif));
+    EXPECT_EQ(d.exit_code, 2);
+    EXPECT_NE(d.err.find("--skip-filled-flats changes the figures' table, which --discriminate does not print"),
+              std::string::npos)
+        << d.err;
+}
+
 TEST(AnalyzeCli, ComparesWithReferencesAndNamesTheNearest) {
     // A smooth dome is far from the Rif on slopes and spectrum, the Rif is inside its own band, and the
     // dome's nearest reference among the Rif and a rougher copy of it is named.
