@@ -79,3 +79,25 @@ function(orogen_check_layering)
     endforeach()
   endforeach()
 endfunction()
+
+# A library's code lives in orogen::<folder>, or in a namespace inside it when the folder holds several
+# things (orogen::formats::raw, orogen::solvers::diffusion): the folder a reader opens is the name they
+# see in the code. Checked at configure time over the folder's headers and sources (namespace lines at the
+# start of a line), so a new library, or a file moved between two, cannot drift.
+function(orogen_check_lib_namespaces dir)  # dir: libs/<folder>
+  get_filename_component(folder "${dir}" NAME)
+  file(GLOB_RECURSE files "${dir}/include/*.hpp" "${dir}/src/*.[ch]pp")
+  foreach(file IN LISTS files)
+    file(STRINGS "${file}" lines REGEX "^namespace orogen([ {]|::)")
+    foreach(line IN LISTS lines)
+      string(REGEX MATCH "^namespace (orogen[A-Za-z0-9_:]*)" _ "${line}")
+      if(NOT CMAKE_MATCH_1 MATCHES "^orogen::${folder}(::|$)")
+        get_filename_component(root "${dir}/../.." ABSOLUTE)
+        file(RELATIVE_PATH rel "${root}" "${file}")
+        message(FATAL_ERROR "${rel}: '${line}': the code of libs/${folder} belongs in namespace "
+                            "orogen::${folder} (or one inside it, orogen::${folder}::NAME); rename the namespace, "
+                            "or move the file to the library its namespace names")
+      endif()
+    endforeach()
+  endforeach()
+endfunction()

@@ -283,8 +283,8 @@ Terrain read_raw(const fs::path& file) {
         throw BadInput("cannot show " + quoted(file) + ": its sidecar " + quoted(sidecar.filename()) +
                        " is missing (a RAW file has no size or height range; export:raw writes both files: copy the "
                        ".json along)");
-    raw::Sidecar info;
-    const std::vector<float> heights = raw::read_raw(file, info);
+    formats::raw::Sidecar info;
+    const std::vector<float> heights = formats::raw::read_raw(file, info);
     Terrain t;
     t.file = file;
     t.width = info.width;

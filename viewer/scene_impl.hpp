@@ -176,7 +176,7 @@ struct Scene::Impl {
     void set_moving(bool on);
 
     /// The mesh's one chunk as VTK polygons with texture coordinates (and normals, for edges).
-    static vtkSmartPointer<vtkPolyData> polydata(const terrain::TerrainMesh& mesh);
+    static vtkSmartPointer<vtkPolyData> polydata(const mesh::TerrainMesh& mesh);
 
     /// Where the mesh is finer than the display decimation: samples
     /// [x0, x1] × [y0, y1] every `step`-th; step 0 = nowhere.
@@ -208,7 +208,7 @@ struct Scene::Impl {
 
     /// Water: triangles whose three corners hold more than 20 cm of water,
     /// raised to the water's surface (height + depth).
-    void build_water(const terrain::TerrainMesh& mesh, const terrain::MeshChunk& chunk);
+    void build_water(const mesh::TerrainMesh& mesh, const mesh::MeshChunk& chunk);
 
     /// The texture's size: every sample, up to `max_texture` a side.
     std::pair<int, int> texture_size() const;

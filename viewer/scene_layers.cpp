@@ -106,7 +106,7 @@ vtkSmartPointer<vtkImageData> Scene::Impl::colour_texture(std::size_t index) {
     };
     constexpr std::int64_t grain = 1 << 16;
     if (index == 0) {
-        if (splat.size() != std::size_t(tw) * th * 4) splat = terrain::bake_splat_texture(grid(), tw, th);
+        if (splat.size() != std::size_t(tw) * th * 4) splat = mesh::bake_splat_texture(grid(), tw, th);
         const std::uint8_t* sp = splat.data();
         parallel_for(0, std::int64_t(tw) * th, grain, [&](std::int64_t a, std::int64_t b) {
             for (std::int64_t i = a; i < b; ++i) lit(i, sp + 4 * i);
@@ -163,7 +163,7 @@ void Scene::Impl::update_shade(int tw, int th) {
             const int y = int(std::lround(double(j) * (t.height - 1) / std::max(th - 1, 1)));
             for (int i = 0; i < tw; ++i) {
                 const int x = int(std::lround(double(i) * (t.width - 1) / std::max(tw - 1, 1)));
-                const auto n = terrain::surface_normal(g, x, y, e);
+                const auto n = mesh::surface_normal(g, x, y, e);
                 const double lit = n[0] * light[0] + n[1] * light[1] + n[2] * light[2];
                 shade[std::size_t(j) * tw + i] = float(0.3 + 0.99 * std::max(lit, 0.0));
             }

@@ -17,7 +17,7 @@ void Scene::Impl::load_terrain() {
 
 std::vector<int> Scene::Impl::kept(int n, int lo, int hi) const {
     std::vector<int> k;
-    for (int i : terrain::kept_indices(n, step))
+    for (int i : mesh::kept_indices(n, step))
         if (i < lo || i > hi || detail.step == 0) k.push_back(i);
     if (detail.step > 0) {
         for (int i = lo; i < hi; i += detail.step) k.push_back(i);
@@ -32,7 +32,7 @@ void Scene::Impl::build_mesh() {
     const Terrain& t = *ground();
     step = full ? 1 : std::max(1, int(std::ceil(double(std::max(t.width, t.height) - 1) / (display_samples - 1))));
     if (full) detail = {};
-    terrain::TerrainMesh mesh = terrain::plan_mesh(grid(), step, 1, 1.0);
+    mesh::TerrainMesh mesh = mesh::plan_mesh(grid(), step, 1, 1.0);
     if (detail.step > 0) {
         mesh.columns = kept(t.width, detail.x0, detail.x1);
         mesh.rows = kept(t.height, detail.y0, detail.y1);
@@ -47,7 +47,7 @@ void Scene::Impl::build_mesh() {
     const int moving_step =
         std::max(2 * step, int(std::ceil(double(std::max(t.width, t.height) - 1) / (moving_samples - 1))));
     has_moving_mesh = detail.step == 0 && moving_step < std::max(t.width, t.height) - 1;
-    if (has_moving_mesh) moving_mapper->SetInputData(polydata(terrain::plan_mesh(grid(), moving_step, 1, 1.0)));
+    if (has_moving_mesh) moving_mapper->SetInputData(polydata(mesh::plan_mesh(grid(), moving_step, 1, 1.0)));
     moving_mapper->ScalarVisibilityOff();
     terrain->SetMapper(moving && has_moving_mesh ? moving_mapper.Get() : terrain_mapper.Get());
     terrain->SetTexture(texture);
@@ -63,26 +63,26 @@ void Scene::Impl::set_moving(bool on) {
     if (ground()) terrain->SetMapper(moving && has_moving_mesh ? moving_mapper.Get() : terrain_mapper.Get());
 }
 
-vtkSmartPointer<vtkPolyData> Scene::Impl::polydata(const terrain::TerrainMesh& mesh) {
-    const terrain::MeshChunk& chunk = mesh.chunks.at(0);
+vtkSmartPointer<vtkPolyData> Scene::Impl::polydata(const mesh::TerrainMesh& mesh) {
+    const mesh::MeshChunk& chunk = mesh.chunks.at(0);
     const std::size_t n = chunk.vertex_count(), triangles = chunk.triangle_count();
     vtkNew<vtkFloatArray> xyz, normals, uv;
     xyz->SetNumberOfComponents(3);
     xyz->SetNumberOfTuples(vtkIdType(n));
-    terrain::chunk_positions(mesh, chunk, {xyz->GetPointer(0), n * 3});
+    mesh::chunk_positions(mesh, chunk, {xyz->GetPointer(0), n * 3});
     normals->SetName("Normals");
     normals->SetNumberOfComponents(3);
     normals->SetNumberOfTuples(vtkIdType(n));
-    terrain::chunk_normals(mesh, chunk, {normals->GetPointer(0), n * 3});
+    mesh::chunk_normals(mesh, chunk, {normals->GetPointer(0), n * 3});
     uv->SetName("uv");
     uv->SetNumberOfComponents(2);
     uv->SetNumberOfTuples(vtkIdType(n));
-    terrain::chunk_texcoords(mesh, chunk, std::span<float>{uv->GetPointer(0), n * 2});
+    mesh::chunk_texcoords(mesh, chunk, std::span<float>{uv->GetPointer(0), n * 2});
     vtkNew<vtkTypeInt32Array> offsets, connectivity;
     offsets->SetNumberOfTuples(vtkIdType(triangles + 1));
     for (std::size_t i = 0; i <= triangles; ++i) offsets->SetValue(vtkIdType(i), std::int32_t(3 * i));
     connectivity->SetNumberOfTuples(vtkIdType(triangles * 3));
-    terrain::chunk_indices(chunk, {reinterpret_cast<std::uint32_t*>(connectivity->GetPointer(0)), triangles * 3});
+    mesh::chunk_indices(chunk, {reinterpret_cast<std::uint32_t*>(connectivity->GetPointer(0)), triangles * 3});
     vtkNew<vtkPoints> points;
     points->SetData(xyz);
     vtkNew<vtkCellArray> polys;
@@ -130,7 +130,7 @@ bool Scene::Impl::refine() {
 
 Scene::Impl::Detail Scene::Impl::detail_in_view(int width_px, int height_px) const {
     const Terrain& t = *ground();
-    const std::vector<int> cols = terrain::kept_indices(t.width, step), rows = terrain::kept_indices(t.height, step);
+    const std::vector<int> cols = mesh::kept_indices(t.width, step), rows = mesh::kept_indices(t.height, step);
     const std::size_t nc = cols.size(), nr = rows.size();
     // world (X east, Y up × exaggeration, Z south) → clip coordinates
     vtkMatrix4x4* m = renderer->GetActiveCamera()->GetCompositeProjectionTransformMatrix(
@@ -195,7 +195,7 @@ Scene::Impl::Detail Scene::Impl::detail_in_view(int width_px, int height_px) con
     return d;
 }
 
-void Scene::Impl::build_water(const terrain::TerrainMesh& mesh, const terrain::MeshChunk& chunk) {
+void Scene::Impl::build_water(const mesh::TerrainMesh& mesh, const mesh::MeshChunk& chunk) {
     const float* w = ground()->layer("water");
     water->SetVisibility(false);
     if (!w) return;
@@ -207,7 +207,7 @@ void Scene::Impl::build_water(const terrain::TerrainMesh& mesh, const terrain::M
     points->SetNumberOfPoints(vtkIdType(cols) * rows);
     for (int j = 0; j < rows; ++j)
         for (int i = 0; i < cols; ++i) {
-            const auto p = terrain::position(mesh, mesh.columns[i], mesh.rows[j]);
+            const auto p = mesh::position(mesh, mesh.columns[i], mesh.rows[j]);
             points->SetPoint(vtkIdType(j) * cols + i, p[0], p[1] + depth(i, j), p[2]);
         }
     vtkNew<vtkCellArray> polys;

@@ -1,5 +1,5 @@
 // bench-links: TBB::tbb orogen_solvers
-// One hillslope-diffusion step (orogen::diffusion::Solver::step) at 1025² and
+// One hillslope-diffusion step (orogen::solvers::diffusion::Solver::step) at 1025² and
 // 4097², per scheme, on 1 and 2 threads. Target (2 cores): 1025² ≤ 15 ms.
 #include <orogen/solvers/diffusion.hpp>
 
@@ -20,12 +20,12 @@ void BM_diffusion_step(benchmark::State& state) {
     std::vector<double> h(std::size_t(n) * n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) h[std::size_t(y) * n + x] = 300.0 * random::uniform(1, x, y) + 0.5 * x;
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = 0.01;
-    s.scheme = diffusion::Scheme(state.range(1) & 1);
+    s.scheme = solvers::diffusion::Scheme(state.range(1) & 1);
     s.critical_slope = state.range(1) == 2 ? 1.2 : 0.0;
     s.fixed = {true, true, true, true};
-    diffusion::Solver solver(n, n, 30.0, s);
+    solvers::diffusion::Solver solver(n, n, 30.0, s);
     for (auto _ : state) {
         solver.step(h.data(), 1e4);
         benchmark::ClobberMemory();

@@ -57,7 +57,7 @@ static void BM_SplatTexture(benchmark::State& state) {
     const auto& h = bench::terrain(4097);
     const int t = int(state.range(0));
     for (auto _ : state) {
-        auto rgba = terrain::bake_splat_texture(ConstGridView(h.data(), 4097, 4097, 20.0), t, t);
+        auto rgba = mesh::bake_splat_texture(ConstGridView(h.data(), 4097, 4097, 20.0), t, t);
         benchmark::DoNotOptimize(orogen::encode_rgba_png(rgba, t, t, 1));
     }
 }
@@ -65,16 +65,16 @@ BENCHMARK(BM_SplatTexture)->Arg(2048)->Unit(benchmark::kMillisecond)->UseRealTim
 
 static void BM_MeshData(benchmark::State& state) {
     const auto& h = bench::terrain(4097);
-    const auto mesh = terrain::plan_mesh(ConstGridView(h.data(), 4097, 4097, 20.0), 1, 0, 1.0);
+    const auto mesh = mesh::plan_mesh(ConstGridView(h.data(), 4097, 4097, 20.0), 1, 0, 1.0);
     std::vector<float> f;
     std::vector<std::uint16_t> u;
     for (auto _ : state)
         for (const auto& c : mesh.chunks) {
             f.resize(c.vertex_count() * 3);
-            terrain::chunk_positions(mesh, c, f);
-            terrain::chunk_normals(mesh, c, f);
+            mesh::chunk_positions(mesh, c, f);
+            mesh::chunk_normals(mesh, c, f);
             u.resize(c.triangle_count() * 3);
-            terrain::chunk_indices(c, std::span<std::uint16_t>(u));
+            mesh::chunk_indices(c, std::span<std::uint16_t>(u));
             benchmark::DoNotOptimize(f.data());
         }
 }

@@ -11,7 +11,7 @@ static void BM_Raw(benchmark::State& state) {
     const int n = 4097;
     const auto& h = bench::terrain(n);
     const auto file = bench::scratch() / (state.range(0) == 16 ? "t.r16" : "t.r32");
-    for (auto _ : state) raw::write_raw({h.data(), n, n, 20.0}, file);
+    for (auto _ : state) formats::raw::write_raw({h.data(), n, n, 20.0}, file);
     std::filesystem::remove(file);
     std::filesystem::remove(file.string() + ".json");
 }

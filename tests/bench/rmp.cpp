@@ -47,10 +47,10 @@ void BM_Range(benchmark::State& state) {
     // One call as the plate simulation makes per collision: a 600-sample line.
     std::vector<float> data(std::size_t(kSize) * kSize, 0.0f);
     GridView v{data.data(), kSize, kSize, 1.0};
-    rmp::RangeParams p;
+    relief::RangeParams p;
     p.cones = int(state.range(0));
     std::uint64_t seed = 1;
-    for (auto _ : state) { benchmark::DoNotOptimize(rmp::raise_range(v, {200, 300}, {800, 700}, p, seed++)); }
+    for (auto _ : state) { benchmark::DoNotOptimize(relief::raise_range(v, {200, 300}, {800, 700}, p, seed++)); }
 }
 
 }  // namespace
@@ -70,8 +70,8 @@ namespace {
 // The cone method's parts: drawing + read-back alone, for one diagram.
 void BM_ConeDraw(benchmark::State& state) {
     rmp::ConeRenderer renderer(kSize, kSize);
-    const auto sites = rmp::random_sites(int(state.range(0)), kSize, kSize, 5);
-    auto radii = rmp::SiteIndex(sites, kSize, kSize).cell_radius_bounds();
+    const auto sites = relief::random_sites(int(state.range(0)), kSize, kSize, 5);
+    auto radii = relief::SiteIndex(sites, kSize, kSize).cell_radius_bounds();
     double area = 0;
     for (double& r : radii) area += 3.2154 * (r + 1) * (r + 1);  // 12-gon footprint
     for (auto _ : state) benchmark::DoNotOptimize(renderer.render(sites, radii).data());

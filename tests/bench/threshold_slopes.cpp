@@ -1,5 +1,5 @@
 // bench-links: TBB::tbb orogen_solvers
-// The landslide limit (orogen::threshold::limit_slopes) at 1025², on 1 and 2 threads:
+// The landslide limit (orogen::solvers::threshold::limit_slopes) at 1025², on 1 and 2 threads:
 //  * from_rough: rough relief (0-600 m of noise on a 0.5 m/cell ramp) limited to 33° from scratch;
 //  * after_uplift: a surface already at its limit raised 30 m inside fixed sides (one step of
 //    0.5 mm/yr over 6e4 yr, as erode:stream-power's landslides see it each step), limited again.
@@ -42,7 +42,7 @@ void limit_copies(benchmark::State& state, const std::vector<double>& start, con
         state.PauseTiming();
         auto h = start;
         state.ResumeTiming();
-        const auto r = threshold::limit_slopes(h.data(), kSide, kSide, kCell, {kSlope}, fixed.data());
+        const auto r = solvers::threshold::limit_slopes(h.data(), kSide, kSide, kCell, {kSlope}, fixed.data());
         benchmark::DoNotOptimize(r);
         state.counters["rounds"] = r.rounds;
     }
@@ -58,7 +58,7 @@ void BM_threshold_after_uplift(benchmark::State& state) {
     tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(state.range(0)));
     auto limited = rough();
     const auto fixed = sides();
-    threshold::limit_slopes(limited.data(), kSide, kSide, kCell, {kSlope}, fixed.data());
+    solvers::threshold::limit_slopes(limited.data(), kSide, kSide, kCell, {kSlope}, fixed.data());
     for (std::size_t i = 0; i < limited.size(); ++i)
         if (!fixed[i]) limited[i] += 30.0;
     limit_copies(state, limited, fixed);

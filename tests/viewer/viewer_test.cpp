@@ -118,9 +118,9 @@ TEST_F(Viewer, ScreenshotShowsTheSplatColoursWhereExpected) {
     // Looking down, north up: the plain (lowest band: sand) on the left, the
     // plateau (highest band: snow) on the right, the steep slope rock.
     const auto west = patch(p, 70, 160), east = patch(p, 250, 160);
-    EXPECT_LT(distance(west, terrain::sand_colour), 30) << west[0] << " " << west[1] << " " << west[2];
-    EXPECT_LT(distance(east, terrain::snow_colour), 30) << east[0] << " " << east[1] << " " << east[2];
-    for (const auto& other : {terrain::grass_colour, terrain::rock_colour, terrain::snow_colour})
+    EXPECT_LT(distance(west, mesh::sand_colour), 30) << west[0] << " " << west[1] << " " << west[2];
+    EXPECT_LT(distance(east, mesh::snow_colour), 30) << east[0] << " " << east[1] << " " << east[2];
+    for (const auto& other : {mesh::grass_colour, mesh::rock_colour, mesh::snow_colour})
         EXPECT_GT(distance(west, other), 45);
     // Not an empty picture: the terrain covers the middle, the background the corners differ from it.
     EXPECT_GT(distance(patch(p, 160, 160), patch(p, 6, 6)), 20);
@@ -170,7 +170,7 @@ TEST_F(Viewer, VtpRawAndPngTerrainsShowTheSameSplat) {
     const auto h = plain_and_plateau();
     write_vti(dir / "t.vti", h, 65, 65);
     vtk::write_heightmap(ConstGridView(h.data(), 65, 65, 10.0), {}, dir / "t.vtp");
-    raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
+    formats::raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
     {  // a 16-bit PNG heightmap: no units, but the same bands (flat plain and plateau)
         std::vector<std::uint16_t> grey(h.size());
         for (std::size_t i = 0; i < h.size(); ++i) grey[i] = std::uint16_t(std::lround(h[i] / 100.0 * 65535));
@@ -570,7 +570,7 @@ TEST_F(Viewer, BadInputGivesOneClearErrorAndExit2) {
                ".vti, .vtp, .pvd, .glb, .gltf, .png (16-bit heightmap), .r16, .r32 (with their .json sidecar), "
                ".tif/.tiff (GeoTIFF), .vrt and the .json index of export:tiles, and .orogen specs)");
     const auto h = plain_and_plateau();
-    raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
+    formats::raw::write_raw(ConstGridView(h.data(), 65, 65, 10.0), dir / "t.r16");
     fs::remove(dir / "t.r16.json");
     expect("t.r16",
            "cannot show 't.r16': its sidecar 't.r16.json' is missing (a RAW file has no size or height range; "

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-namespace orogen::png_export {
+namespace orogen::formats::png {
 
 Range range_of(ConstGridView grid) {
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
@@ -60,4 +60,4 @@ std::vector<std::uint16_t> hillshade(ConstGridView h, int bits, double azimuth_d
     return out;
 }
 
-}  // namespace orogen::png_export
+}  // namespace orogen::formats::png

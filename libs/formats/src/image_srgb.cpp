@@ -7,7 +7,7 @@
 #include <cmath>
 #include <string>
 
-namespace orogen::png_export {
+namespace orogen::formats::srgb {
 
 Tonemap parse_tonemap(std::string_view name) {
     if (name == "clamp") return Tonemap::clamp;
@@ -69,4 +69,4 @@ std::vector<std::uint8_t> to_srgb8(const Image& image, Tonemap tonemap, double e
     return out;
 }
 
-}  // namespace orogen::png_export
+}  // namespace orogen::formats::srgb

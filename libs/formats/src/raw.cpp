@@ -18,7 +18,7 @@
 
 namespace fs = std::filesystem;
 
-namespace orogen::raw {
+namespace orogen::formats::raw {
 
 Format format_of(const fs::path& file) {
     const std::string ext = file.extension().string();
@@ -105,11 +105,11 @@ Written write_raw(ConstGridView h, const fs::path& target, std::optional<Range> 
     return w;
 }
 
-}  // namespace orogen::raw
+}  // namespace orogen::formats::raw
 
 // ------------------------------------------------------------------ reading
 
-namespace orogen::raw {
+namespace orogen::formats::raw {
 
 Sidecar parse_sidecar(std::string_view text, const std::string& name) {
     const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
@@ -220,4 +220,4 @@ std::vector<float> read_raw(const fs::path& file, Sidecar& info) {
     return heights;
 }
 
-}  // namespace orogen::raw
+}  // namespace orogen::formats::raw

@@ -183,14 +183,13 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
                        "' has another extension");
     if (options.texture_size < 1) throw BadInput("texture must be at least 1 pixel");
 
-    const terrain::TerrainMesh mesh =
-        terrain::plan_mesh(heights, options.decimate, options.chunks, options.vertical_scale);
+    const mesh::TerrainMesh mesh = mesh::plan_mesh(heights, options.decimate, options.chunks, options.vertical_scale);
 
     // Texture: no larger than the terrain's tile count (more pixels than tiles add nothing).
     const int tw = std::max(1, std::min(options.texture_size, heights.width - 1));
     const int th = std::max(1, std::min(options.texture_size, heights.height - 1));
     const std::vector<std::uint8_t> png =
-        encode_rgba_png(terrain::bake_splat_texture(heights, tw, th), tw, th, kTextureLevel);
+        encode_rgba_png(mesh::bake_splat_texture(heights, tw, th), tw, th, kTextureLevel);
 
     // Buffer layout: per chunk positions, normals, texcoords, indices; then the PNG.
     std::vector<ChunkViews> views;
@@ -227,7 +226,7 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
                                           [&](const auto& c) { return c.row_begin == mesh.chunks[0].row_begin; }));
     for (std::size_t i = 0; i < mesh.chunks.size(); ++i) {
         const auto& v = views[i];
-        const auto bounds = terrain::chunk_bounds(mesh, mesh.chunks[i]);
+        const auto bounds = mesh::chunk_bounds(mesh, mesh.chunks[i]);
         const int pos =
             add_accessor(model, add_view(model, v.positions, v.vertex_count * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
                          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, v.vertex_count, false);
@@ -291,11 +290,11 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
             using T = std::remove_pointer_t<decltype(type)>;
             return std::span<T>(reinterpret_cast<T*>(bytes + offset), n);
         };
-        terrain::chunk_positions(mesh, c, as(0, (float*)nullptr, v.vertex_count * 3));
-        terrain::chunk_normals(mesh, c, as(v.vertex_count * 12, (float*)nullptr, v.vertex_count * 3));
-        terrain::chunk_texcoords(mesh, c, as(v.vertex_count * 24, (std::uint16_t*)nullptr, v.vertex_count * 2));
-        if (v.index16) terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint16_t*)nullptr, v.index_count));
-        else terrain::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
+        mesh::chunk_positions(mesh, c, as(0, (float*)nullptr, v.vertex_count * 3));
+        mesh::chunk_normals(mesh, c, as(v.vertex_count * 12, (float*)nullptr, v.vertex_count * 3));
+        mesh::chunk_texcoords(mesh, c, as(v.vertex_count * 24, (std::uint16_t*)nullptr, v.vertex_count * 2));
+        if (v.index16) mesh::chunk_indices(c, as(v.vertex_count * 28, (std::uint16_t*)nullptr, v.index_count));
+        else mesh::chunk_indices(c, as(v.vertex_count * 28, (std::uint32_t*)nullptr, v.index_count));
         const std::size_t used = v.vertex_count * 28 + index_bytes, size = chunk_bytes(v);
         std::fill(bytes + used, bytes + size, std::uint8_t(0));
         return size;
@@ -326,7 +325,7 @@ std::size_t write_mesh(const MeshData& mesh, std::span<const std::uint8_t> png, 
     const std::size_t vertices = mesh.positions.size() / 3;
     if (mesh.normals.size() != 3 * vertices || mesh.texcoords.size() != 2 * vertices || mesh.indices.size() % 3)
         throw Error("internal error: a mesh whose attributes disagree on its vertex count");
-    const bool index16 = vertices <= terrain::max_16bit_vertices;
+    const bool index16 = vertices <= mesh::max_16bit_vertices;
     const std::size_t pos = 0, nrm = pos + vertices * 12, uv = nrm + vertices * 12, idx = uv + vertices * 4;
     const std::size_t index_bytes = mesh.indices.size() * (index16 ? 2 : 4);
     const std::size_t png_offset = align4(idx + index_bytes), buffer_length = align4(png_offset + png.size());

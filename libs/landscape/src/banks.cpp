@@ -72,16 +72,29 @@ constexpr RightShare make_right_share() {
 }
 constexpr RightShare kRightShare = make_right_share();
 
+/// What push_one reads and writes besides the cell: the window's arrays (bank_pushes).
+struct PushInputs {
+    double kappa;  // banks.erosion
+    const BankAreaFactor& factor;
+    int W, H;
+    const std::int8_t* dir;
+    const double *area, *incised;
+    double *rp, *lp;  // the right and left pushes, written
+};
+
 /// One cell's right and left pushes (bank_pushes). `Inner`: the cell is not on the window's edge, so
 /// its eight neighbours are read without bounds checks; the same arithmetic and ties either way.
 template <bool Inner>
-inline void push_one(double kappa, const BankAreaFactor& factor, int W, int H, int x, std::int64_t y,
-                     const std::int8_t* dir, const double* area, const double* incised, double* rp, double* lp) {
+inline void push_one(const PushInputs& push, int x, std::int64_t y) {
+    const int W = push.W, H = push.H;
+    const std::int8_t* const dir = push.dir;
+    const double *const area = push.area, *const incised = push.incised;
+    double *const rp = push.rp, *const lp = push.lp;
     const std::size_t i = std::size_t(y) * std::size_t(W) + std::size_t(x);
     const int out = dir[i];
     rp[i] = lp[i] = 0.0;
     if (out < 0 || !(incised[i] > 0.0)) return;
-    const double amount = kappa * factor(area[i]) * incised[i];
+    const double amount = push.kappa * push.factor(area[i]) * incised[i];
     // The main donor: the neighbour sending its water here that drains the most (ties: the lowest
     // neighbour code, the same on any tiling); `in` is its own direction code, (k + 4) mod 8.
     int in = -1;
@@ -193,17 +206,33 @@ inline double lower_one(const LowerInputs& in, int x, std::int64_t y) {
     return h;
 }
 
+/// What relayed_one reads besides the cell (lower_relayed): the relay, the window's outlets and heights,
+/// the neighbours' offsets by direction code, the floor's rise over one cell (m), and the next relay or null.
+struct RelayInputs {
+    const BankRelay& relay;
+    const std::uint8_t* outlet;
+    int W, H;
+    const double* heights;
+    const std::int64_t* off;
+    double rise;
+    BankRelay* next;
+};
+
 /// One cell's new height (lower_relayed): the lowest that any neighbour passing a push on towards it
 /// brings it to, not below that push's floor. With `next`, a cell so lowered to within kAtFloor of that
 /// floor by a push with passes onward left passes it on once more, straight on (its floor rising by the
 /// floor slope over one more step, `rise` over one cell), with one pass fewer left.
 template <bool Inner, bool Next>
-inline double relayed_one(const BankRelay& relay, const std::uint8_t* outlet, int W, int H, int x, std::int64_t y,
-                          const double* heights, const std::int64_t* off, double rise, BankRelay* next) {
+inline double relayed_one(const RelayInputs& in, int x, std::int64_t y) {
+    const BankRelay& relay = in.relay;
+    const int W = in.W, H = in.H;
+    const double* const heights = in.heights;
+    const std::int64_t* const off = in.off;
+    BankRelay* const next = in.next;
     const std::size_t l = std::size_t(y) * std::size_t(W) + std::size_t(x);
     const double hl = heights[l];
     if constexpr (Next) next->out[l] = -1;
-    if (outlet && outlet[l]) return hl;
+    if (in.outlet && in.outlet[l]) return hl;
     double h = hl;
     std::int64_t from = -1;  // the neighbour whose push brought the cell lowest (ties: the lowest code)
     for (int k = 0; k < 8; ++k) {
@@ -222,7 +251,7 @@ inline double relayed_one(const BankRelay& relay, const std::uint8_t* outlet, in
             const int out = relay.out[j];
             next->out[l] = std::int8_t(out);
             next->push[l] = relay.push[j];
-            next->floor[l] = relay.floor[j] + rise * ((out & 1) ? kSqrt2 : 1.0);
+            next->floor[l] = relay.floor[j] + in.rise * ((out & 1) ? kSqrt2 : 1.0);
             next->onward[l] = std::int8_t(relay.onward[j] - 1);
         }
     }
@@ -258,15 +287,10 @@ void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWin
         right.assign(n, 0.0);
         left.assign(n, 0.0);
     }
-    double* const rp = right.data();
-    double* const lp = left.data();
-    const int W = w.width, H = w.height;
-    const double kappa = banks.erosion;
-    parallel_for(w.y0, w.y1, 16, [=, &factor](std::int64_t yb, std::int64_t ye) {
+    const PushInputs in{banks.erosion, factor, w.width, w.height, dir, area, incised, right.data(), left.data()};
+    parallel_for(w.y0, w.y1, 16, [&in, &w](std::int64_t yb, std::int64_t ye) {
         for (std::int64_t y = yb; y < ye; ++y)
-            each_cell_of_row(w, y, [&](int x, auto inner) {
-                push_one<decltype(inner)::value>(kappa, factor, W, H, x, y, dir, area, incised, rp, lp);
-            });
+            each_cell_of_row(w, y, [&](int x, auto inner) { push_one<decltype(inner)::value>(in, x, y); });
     });
 }
 
@@ -305,17 +329,16 @@ double lower_rows(const BankWindow& w, double cell, double* heights, std::vector
 
 }  // namespace
 
-double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
-                   const double* left, const double* area, const std::uint8_t* outlet, double cell, double* heights,
-                   std::vector<double>& scratch, BankRelay* relay) {
+double lower_banks(const Banks& banks, const BankWindow& w, const D8Flow& flow, const BankPushes& pushes, double cell,
+                   double* heights, std::vector<double>& scratch, BankRelay* relay) {
     const std::int64_t W = w.width;
     LowerInputs in{w.width,
                    w.height,
-                   dir,
-                   right,
-                   left,
-                   area,
-                   outlet,
+                   flow.dir,
+                   pushes.right,
+                   pushes.left,
+                   flow.area,
+                   flow.outlet,
                    banks.wide_area,
                    std::min(banks.onward_passes(), 16),
                    {},
@@ -365,6 +388,7 @@ double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& r
             }
         }
     });
+    const RelayInputs in{relay, outlet, w.width, w.height, heights, off, rise, next};
     std::vector<std::size_t> targets;
     for (const auto& list : rows) targets.insert(targets.end(), list.begin(), list.end());
     std::sort(targets.begin(), targets.end());
@@ -375,23 +399,21 @@ double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& r
         const std::int64_t y = std::int64_t(l / std::size_t(W));
         const bool inner = x > 0 && y > 0 && x + 1 < w.width && y + 1 < w.height;
         const double before = heights[l];
-        const double h = inner
-            ? (next ? relayed_one<true, true>(relay, outlet, w.width, w.height, x, y, heights, off, rise, next)
-                    : relayed_one<true, false>(relay, outlet, w.width, w.height, x, y, heights, off, rise, nullptr))
-            : (next ? relayed_one<false, true>(relay, outlet, w.width, w.height, x, y, heights, off, rise, next)
-                    : relayed_one<false, false>(relay, outlet, w.width, w.height, x, y, heights, off, rise, nullptr));
+        const double h = inner ? (next ? relayed_one<true, true>(in, x, y) : relayed_one<true, false>(in, x, y))
+                               : (next ? relayed_one<false, true>(in, x, y) : relayed_one<false, false>(in, x, y));
         heights[l] = h;
         removed += before - h;
     }
     return removed * cell * cell;
 }
 
-void BankEroder::erode(const Banks& banks, int width, int height, double cell, const std::int8_t* dir,
-                       const double* area, const double* lowering, const std::uint8_t* outlets, double* heights) {
+void BankEroder::erode(const Banks& banks, int width, int height, double cell, const D8Flow& flow,
+                       const double* lowering, double* heights) {
     if (!factor_) factor_.emplace(banks, cell);
     const BankWindow w{width, height, 0, 0, width, height};
-    bank_pushes(banks, *factor_, w, dir, area, lowering, right_, left_);
-    lower_banks(banks, w, dir, right_.data(), left_.data(), area, outlets, cell, heights, scratch_, &relay_);
+    const std::uint8_t* const outlets = flow.outlet;
+    bank_pushes(banks, *factor_, w, flow.dir, flow.area, lowering, right_, left_);
+    lower_banks(banks, w, flow, {right_.data(), left_.data()}, cell, heights, scratch_, &relay_);
     if (!banks.wide()) return;
     // Each pass lowers the cells the last one pushes on to and, but for the last, fills the other relay
     // with what they pass on in turn.

@@ -87,9 +87,10 @@ double lower_to_floodplains(const Floodplain& fp, double cell, std::size_t n, co
     return removed * cell * cell;
 }
 
-double carve_floodplains(const Floodplain& fp, int width, int height, double cell, const std::int8_t* dir,
-                         const double* area, const std::uint8_t* outlet, double* heights, std::vector<double>& nearest,
-                         std::vector<double>& floor) {
+double carve_floodplains(const Floodplain& fp, int width, int height, double cell, const D8Flow& flow, double* heights,
+                         std::vector<double>& nearest, std::vector<double>& floor) {
+    const std::int8_t* const dir = flow.dir;
+    const double* const area = flow.area;
     // Every river's height is read before any cell is lowered.
     std::vector<FloodplainSource> sources;
     for (int y = 0; y < height; ++y)
@@ -103,7 +104,8 @@ double carve_floodplains(const Floodplain& fp, int width, int height, double cel
                 sources.push_back({std::int64_t(i), heights[i], reach});
         }
     stamp_floodplains(sources, width, {0, 0, width, height}, nearest, floor);
-    return lower_to_floodplains(fp, cell, std::size_t(width) * std::size_t(height), nearest, floor, outlet, heights);
+    return lower_to_floodplains(fp, cell, std::size_t(width) * std::size_t(height), nearest, floor, flow.outlet,
+                                heights);
 }
 
 }  // namespace orogen::landscape

@@ -248,8 +248,10 @@ double Beds::landslide_slope(double s) const {
 
 double Beds::erodibility_factor(double s) const { return std::pow(erodibility_contrast, 0.5 - s); }
 
-void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0, double cell,
-                 std::vector<double>& offsets) {
+void bed_offsets(const Beds& beds, const CellBlock& block, std::vector<double>& offsets) {
+    const std::size_t count = block.count;
+    const int width = block.width, x0 = block.x0, y0 = block.y0;
+    const double cell = block.cell;
     offsets.resize(beds.layered() ? count : 0);
     if (!beds.layered()) return;
     // The faults of every lattice square within reach of the block, drawn once (Beds::fault draws the 25
@@ -280,9 +282,196 @@ void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0,
     });
 }
 
-void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
-             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors,
-             RockMemo* memo) {
+namespace {
+
+constexpr std::int64_t kNoKey = std::numeric_limits<std::int64_t>::min();  // a memo entry never recalled
+
+/// The beds the cells lie in this step, from the lowest to the highest, with one more each side: their
+/// bases and classes drawn once into a table rather than hashed per cell (bed_at and class_of's own
+/// expressions, so the same bits). Empty when the rock is not layered, or when the heights span more than
+/// kMaxBeds beds or are not finite: then each cell falls back on class_of.
+struct BedTable {
+    std::int64_t first = 0;
+    std::vector<double> base;
+    std::vector<int> klass;
+};
+
+BedTable bed_table(const Beds& beds, const CellBlock& block, const RockInputs& at) {
+    BedTable table;
+    if (!beds.layered()) return table;
+    constexpr std::int64_t kMaxBeds = std::int64_t(1) << 20;
+    const std::size_t count = block.count;
+    // The range of q, by blocks on every thread (min and max: the same whatever the order).
+    constexpr std::int64_t kBlock = 1 << 16;
+    const std::int64_t blocks = (std::int64_t(count) + kBlock - 1) / kBlock;
+    std::vector<double> block_lo(static_cast<std::size_t>(blocks)), block_hi(static_cast<std::size_t>(blocks));
+    parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
+        for (std::int64_t b = b0; b < b1; ++b) {
+            double l = std::numeric_limits<double>::infinity(), h = -l;
+            const std::size_t e = std::min(count, std::size_t((b + 1) * kBlock));
+            for (std::size_t i = std::size_t(b * kBlock); i < e; ++i) {
+                const double q = (at.heights[i] - at.uplifted[i]) + at.offsets[i];
+                l = std::min(l, q), h = std::max(h, q);
+            }
+            block_lo[std::size_t(b)] = l, block_hi[std::size_t(b)] = h;
+        }
+    });
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::int64_t b = 0; b < blocks; ++b)
+        lo = std::min(lo, block_lo[std::size_t(b)]), hi = std::max(hi, block_hi[std::size_t(b)]);
+    const double thickness = beds.thickness;
+    if (!(lo <= hi && (hi - lo) / thickness < double(kMaxBeds))) return table;
+    table.first = static_cast<std::int64_t>(std::floor(lo / thickness)) - 1;
+    const std::int64_t beds_in = static_cast<std::int64_t>(std::floor(hi / thickness)) + 2 - table.first + 1;
+    table.base.resize(std::size_t(beds_in));
+    table.klass.resize(std::size_t(beds_in));
+    for (std::int64_t j = 0; j < beds_in; ++j) {
+        table.base[std::size_t(j)] = beds.bed_base(table.first + j);
+        table.klass[std::size_t(j)] = int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(table.first + j)));
+    }
+    return table;
+}
+
+/// With facies, each tabled bed's draws at the corners of the lattice cells the block covers (class_of's
+/// draws), and each column's and row of cells' place on the lattice. Off (`on` false) when the table
+/// would hold more than a few corners per cell (many thin beds, a short facies length): then each cell
+/// draws its own corners (class_of), which costs less than drawing them all.
+struct FaciesTable {
+    bool on = false;
+    std::vector<double> corner;
+    std::vector<LatticeAt> column_at, row_at;
+    std::int64_t a_lo = 0, b_lo = 0, a_count = 0, b_count = 0;
+};
+
+FaciesTable facies_table(const Beds& beds, const CellBlock& block, const BedTable& bed_table) {
+    FaciesTable t;
+    if (!beds.facies() || bed_table.base.empty()) return t;
+    const int rows = int(block.count / std::size_t(block.width));
+    for (int c = 0; c < block.width; ++c) t.column_at.push_back(lattice_at(beds, double(block.x0 + c) * block.cell));
+    for (int r = 0; r < rows; ++r) t.row_at.push_back(lattice_at(beds, double(block.y0 + r) * block.cell));
+    t.a_lo = t.column_at.front().node, t.b_lo = t.row_at.front().node;
+    t.a_count = t.column_at.back().node + 2 - t.a_lo, t.b_count = t.row_at.back().node + 2 - t.b_lo;
+    const std::size_t bed_count = bed_table.base.size();
+    t.on = double(bed_count) * double(t.a_count) * double(t.b_count) <= 4.0 * double(block.count) + 65536.0;
+    if (!t.on) return t;
+    t.corner.resize(bed_count * std::size_t(t.a_count * t.b_count));
+    const std::uint64_t s = random::hash(beds.seed, kFaciesSalt);
+    // Each corner is its own draw: the rows of corners (a bed's row bb) in parallel, the same bits.
+    parallel_for(0, std::int64_t(bed_count) * t.b_count, 16, [&](std::int64_t r0, std::int64_t r1) {
+        for (std::int64_t r = r0; r < r1; ++r) {
+            const std::int64_t j = r / t.b_count, bb = r % t.b_count;
+            for (std::int64_t a = 0; a < t.a_count; ++a)
+                t.corner[std::size_t(r) * std::size_t(t.a_count) + std::size_t(a)] =
+                    facies_node(s, bed_table.first + j, t.a_lo + a, t.b_lo + bb);
+        }
+    });
+    return t;
+}
+
+/// One call of rock_at: what it knows before the cells, for the loop over them (rock_of_cells).
+struct RockPass {
+    const Beds& beds;
+    const CellBlock& block;
+    const RockInputs& at;
+    const BedTable& tabled;
+    const FaciesTable& facies;
+    bool layered, blocky, vary_slope, vary_k, recall;
+    std::int64_t* keys;  // the memo's, or null
+    double slope_of[Beds::kStrengths], factor_of[Beds::kStrengths];  // by strength class: a tan and a pow each
+    double* slopes;
+    double* factors;
+};
+
+/// The cell's bed (from the table when it lies in it: bed_at's answer); `j` its row of the table and
+/// `in_table` whether it has one.
+std::int64_t bed_of(const RockPass& p, double q, std::size_t& j, bool& in_table) {
+    const BedTable& t = p.tabled;
+    const std::int64_t last = t.first + std::int64_t(t.base.size()) - 1;
+    const double index = std::floor(q / p.beds.thickness);
+    in_table = index > double(t.first) && index < double(last) && (p.facies.on || !p.beds.facies());
+    if (!in_table) return p.beds.bed_at(q);
+    j = std::size_t(static_cast<std::int64_t>(index) - t.first);
+    if (p.beds.thickness_spread > 0.0) {
+        if (q < t.base[j]) --j;
+        else if (q >= t.base[j + 1]) ++j;
+    }
+    return t.first + std::int64_t(j);
+}
+
+/// Cells [b, e) of the pass: each one's class, then its slope (with its joint block) and factor.
+void rock_of_cells(const RockPass& p, std::int64_t b, std::int64_t e) {
+    const Beds& beds = p.beds;
+    const int width = p.block.width, x0 = p.block.x0, y0 = p.block.y0;
+    const double cell = p.block.cell;
+    // The joint blocks: one per cell and cell-deep slice of rock height, keyed by the cell's place in the
+    // whole grid (the same on any tiling). No block stands steeper than the landslide angles' 80°.
+    const std::uint64_t block_seed = random::hash(beds.seed, kBlockSalt);
+    const double steepest = std::tan(80.0 * std::numbers::pi / 180.0);
+    for (std::int64_t i = b; i < e; ++i) {
+        const double zeta = p.at.heights[i] - p.at.uplifted[i];
+        const double q = p.layered ? zeta + p.at.offsets[i] : 0.0;
+        std::size_t j = 0;
+        bool tabled = false;
+        const std::int64_t bed = p.layered ? bed_of(p, q, j, tabled) : 0;
+        double slice = 0.0;
+        std::int64_t block_key = 0;
+        if (p.blocky) {
+            slice = std::floor(zeta / cell);
+            block_key = std::abs(slice) < 0x1p62 ? static_cast<std::int64_t>(slice) : 0;
+        }
+        // The memo's key: the bed (32 bits), the block slice (24) and the bed's class here (8), when the bed
+        // and slice fit and the height is finite. The same bed keeps its class (its facies do not change
+        // with height); a new slice draws only its block again.
+        static_assert(Beds::kStrengths <= 256, "a class in the key's 8 bits");
+        constexpr std::int64_t kBedFits = std::int64_t(1) << 31, kSliceFits = std::int64_t(1) << 23;
+        std::int64_t* const keys = p.keys;
+        const bool keyed = keys && std::isfinite(zeta) && std::isfinite(q) && bed > -kBedFits && bed < kBedFits &&
+            block_key > -kSliceFits && block_key < kSliceFits;
+        const std::uint64_t place =
+            keyed ? (std::uint64_t(bed) << 32) | (std::uint64_t(std::uint32_t(block_key) & 0xffffffu) << 8) : 0;
+        const bool same_bed = keyed && p.recall && keys[i] != kNoKey && (std::uint64_t(keys[i]) >> 32) == (place >> 32);
+        if (same_bed && (std::uint64_t(keys[i]) & ~std::uint64_t(0xff)) == place) continue;  // the same rock
+        int k = Beds::kStrengths / 2;
+        if (same_bed) {
+            k = int(std::uint64_t(keys[i]) & 0xffu);
+        } else if (p.layered) {
+            // In the table, unless its facies have no table of corners; otherwise (a height outside the
+            // table, many corners) the cell's bed and facies are drawn directly.
+            if (tabled) {
+                k = p.tabled.klass[j];
+                if (p.facies.on) {
+                    const FaciesTable& f = p.facies;
+                    const LatticeAt& u = f.column_at[std::size_t(i % width)];
+                    const LatticeAt& v = f.row_at[std::size_t(i / width)];
+                    const double* n0 = f.corner.data() +
+                        (j * std::size_t(f.b_count) + std::size_t(v.node - f.b_lo)) * std::size_t(f.a_count) +
+                        std::size_t(u.node - f.a_lo);
+                    const double* n1 = n0 + f.a_count;
+                    k = facies_class(beds, k, n0[0], n0[1], n1[0], n1[1], u, v);
+                }
+            } else {
+                k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
+            }
+        }
+        if (keys) keys[i] = keyed ? std::int64_t(place | std::uint64_t(k)) : kNoKey;
+        if (p.vary_slope) {
+            double slope = p.slope_of[k];
+            if (p.blocky) {
+                const double u = random::uniform(block_seed, std::uint64_t(x0 + int(i % width)),
+                                                 std::uint64_t(y0 + int(i / width)), std::uint64_t(block_key));
+                slope = std::min(slope * (1.0 + beds.block_spread * u), steepest);
+            }
+            p.slopes[std::size_t(i)] = slope;
+        }
+        if (p.vary_k) p.factors[std::size_t(i)] = p.factor_of[k];
+    }
+}
+
+}  // namespace
+
+void rock_at(const Beds& beds, const CellBlock& block, const RockInputs& at, std::vector<double>& slopes,
+             std::vector<double>& factors, RockMemo* memo) {
+    const std::size_t count = block.count;
     const bool layered = beds.layered();
     const bool blocky = beds.angle > 0.0 && beds.block_spread > 0.0;
     const bool vary_slope = (layered && beds.angle > 0.0 && beds.angle_spread > 0.0) || blocky;
@@ -293,166 +482,32 @@ void rock_at(const Beds& beds, const double* heights, const double* uplifted, co
     slopes.resize(vary_slope ? count : 0);
     factors.resize(vary_k ? count : 0);
     if (!vary_slope && !vary_k) return;
-    constexpr std::int64_t kNoKey = std::numeric_limits<std::int64_t>::min();  // never recalled
     if (memo && !recall) memo->key.assign(count, kNoKey);
-    std::int64_t* const keys = memo ? memo->key.data() : nullptr;
-    // A bed's strength is one of kStrengths classes: the slopes and factors come from a table (a tan and
-    // a pow per class, not per cell and step).
-    constexpr int kStrengths = Beds::kStrengths;
-    double slope_of[kStrengths], factor_of[kStrengths];
-    for (int k = 0; k < kStrengths; ++k) {
-        const double s = (k + 0.5) / double(kStrengths);
-        slope_of[k] = beds.landslide_slope(s);
-        factor_of[k] = beds.erodibility_factor(s);
+    const BedTable tabled = bed_table(beds, block, at);
+    const FaciesTable facies = facies_table(beds, block, tabled);
+    RockPass pass{beds,
+                  block,
+                  at,
+                  tabled,
+                  facies,
+                  layered,
+                  blocky,
+                  vary_slope,
+                  vary_k,
+                  recall,
+                  memo ? memo->key.data() : nullptr,
+                  {},
+                  {},
+                  slopes.data(),
+                  factors.data()};
+    // A bed's strength is one of kStrengths classes: the slopes and factors come from a table (a tan and a
+    // pow per class, not per cell and step).
+    for (int k = 0; k < Beds::kStrengths; ++k) {
+        const double s = (k + 0.5) / double(Beds::kStrengths);
+        pass.slope_of[k] = beds.landslide_slope(s);
+        pass.factor_of[k] = beds.erodibility_factor(s);
     }
-    // The beds the cells lie in this step, from the lowest to the highest, with one more each side: their
-    // bases and classes drawn once into a table rather than hashed per cell (bed_at and class_of's own
-    // expressions, so the same bits). A cell outside the table (a height not finite, or a range of more
-    // than kMaxBeds beds) falls back on class_of.
-    constexpr std::int64_t kMaxBeds = std::int64_t(1) << 20;
-    const double thickness = beds.thickness;
-    std::int64_t first = 0;
-    std::vector<double> base;
-    std::vector<int> klass;
-    if (layered) {
-        // The range of q, by blocks on every thread (min and max: the same whatever the order).
-        constexpr std::int64_t kBlock = 1 << 16;
-        const std::int64_t blocks = (std::int64_t(count) + kBlock - 1) / kBlock;
-        std::vector<double> block_lo(static_cast<std::size_t>(blocks)), block_hi(static_cast<std::size_t>(blocks));
-        parallel_for(0, blocks, 1, [&](std::int64_t b0, std::int64_t b1) {
-            for (std::int64_t b = b0; b < b1; ++b) {
-                double l = std::numeric_limits<double>::infinity(), h = -l;
-                const std::size_t e = std::min(count, std::size_t((b + 1) * kBlock));
-                for (std::size_t i = std::size_t(b * kBlock); i < e; ++i) {
-                    const double q = (heights[i] - uplifted[i]) + offsets[i];
-                    l = std::min(l, q), h = std::max(h, q);
-                }
-                block_lo[std::size_t(b)] = l, block_hi[std::size_t(b)] = h;
-            }
-        });
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (std::int64_t b = 0; b < blocks; ++b)
-            lo = std::min(lo, block_lo[std::size_t(b)]), hi = std::max(hi, block_hi[std::size_t(b)]);
-        if (lo <= hi && (hi - lo) / thickness < double(kMaxBeds)) {
-            first = static_cast<std::int64_t>(std::floor(lo / thickness)) - 1;
-            const std::int64_t beds_in = static_cast<std::int64_t>(std::floor(hi / thickness)) + 2 - first + 1;
-            base.resize(std::size_t(beds_in));
-            klass.resize(std::size_t(beds_in));
-            for (std::int64_t j = 0; j < beds_in; ++j) {
-                base[std::size_t(j)] = beds.bed_base(first + j);
-                klass[std::size_t(j)] = int(random::below(Beds::kStrengths, beds.seed, std::uint64_t(first + j)));
-            }
-        }
-    }
-    // With facies, each bed's draws at the corners of the lattice cells the block covers, likewise in a
-    // table (class_of's draws), and each column's and row of cells' place on the lattice. Not when the
-    // table would hold more than a few corners per cell (many thin beds, a short facies length): then
-    // each cell draws its own corners (class_of), which costs less than drawing them all.
-    bool facies = false;
-    std::vector<double> corner;
-    std::vector<LatticeAt> column_at, row_at;
-    std::int64_t a_lo = 0, b_lo = 0, a_count = 0, b_count = 0;
-    if (beds.facies() && !base.empty()) {
-        const int rows = int(count / std::size_t(width));
-        for (int c = 0; c < width; ++c) column_at.push_back(lattice_at(beds, double(x0 + c) * cell));
-        for (int r = 0; r < rows; ++r) row_at.push_back(lattice_at(beds, double(y0 + r) * cell));
-        a_lo = column_at.front().node, b_lo = row_at.front().node;
-        a_count = column_at.back().node + 2 - a_lo, b_count = row_at.back().node + 2 - b_lo;
-        facies = double(base.size()) * double(a_count) * double(b_count) <= 4.0 * double(count) + 65536.0;
-    }
-    if (facies) {
-        corner.resize(base.size() * std::size_t(a_count * b_count));
-        const std::uint64_t s = random::hash(beds.seed, kFaciesSalt);
-        // Each corner is its own draw: the rows of corners (a bed's row bb) in parallel, the same bits.
-        parallel_for(0, std::int64_t(base.size()) * b_count, 16, [&](std::int64_t r0, std::int64_t r1) {
-            for (std::int64_t r = r0; r < r1; ++r) {
-                const std::int64_t j = r / b_count, bb = r % b_count;
-                for (std::int64_t a = 0; a < a_count; ++a)
-                    corner[std::size_t(r) * std::size_t(a_count) + std::size_t(a)] =
-                        facies_node(s, first + j, a_lo + a, b_lo + bb);
-            }
-        });
-    }
-    const bool uneven = beds.thickness_spread > 0.0;
-    const std::int64_t last = first + std::int64_t(base.size()) - 1;
-    // The joint blocks: one per cell and cell-deep slice of rock height, keyed by the cell's place in the
-    // whole grid (the same on any tiling). No block stands steeper than the landslide angles' 80°.
-    const std::uint64_t block_seed = random::hash(beds.seed, kBlockSalt);
-    const double steepest = std::tan(80.0 * std::numbers::pi / 180.0);
-    parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) {
-        for (std::int64_t i = b; i < e; ++i) {
-            const double zeta = heights[i] - uplifted[i];
-            // The cell's bed (from the table when it lies in it: bed_at's answer) and block slice.
-            const double q = layered ? zeta + offsets[i] : 0.0;
-            std::int64_t bed = 0;
-            bool tabled = false;
-            std::size_t j = 0;
-            if (layered) {
-                const double index = std::floor(q / thickness);
-                tabled = index > double(first) && index < double(last) && (facies || !beds.facies());
-                if (tabled) {
-                    j = std::size_t(static_cast<std::int64_t>(index) - first);
-                    if (uneven) {
-                        if (q < base[j]) --j;
-                        else if (q >= base[j + 1]) ++j;
-                    }
-                    bed = first + std::int64_t(j);
-                } else {
-                    bed = beds.bed_at(q);
-                }
-            }
-            double slice = 0.0;
-            std::int64_t block_key = 0;
-            if (blocky) {
-                slice = std::floor(zeta / cell);
-                block_key = std::abs(slice) < 0x1p62 ? static_cast<std::int64_t>(slice) : 0;
-            }
-            // The memo's key: the bed (32 bits), the block slice (24) and the bed's class here (8), when
-            // the bed and slice fit and the height is finite. The same bed keeps its class (its facies do
-            // not change with height); a new slice draws only its block again.
-            static_assert(Beds::kStrengths <= 256, "a class in the key's 8 bits");
-            constexpr std::int64_t kBedFits = std::int64_t(1) << 31, kSliceFits = std::int64_t(1) << 23;
-            const bool keyed = keys && std::isfinite(zeta) && std::isfinite(q) && bed > -kBedFits && bed < kBedFits &&
-                block_key > -kSliceFits && block_key < kSliceFits;
-            const std::uint64_t place =
-                keyed ? (std::uint64_t(bed) << 32) | (std::uint64_t(std::uint32_t(block_key) & 0xffffffu) << 8) : 0;
-            const bool same_bed =
-                keyed && recall && keys[i] != kNoKey && (std::uint64_t(keys[i]) >> 32) == (place >> 32);
-            if (same_bed && (std::uint64_t(keys[i]) & ~std::uint64_t(0xff)) == place) continue;  // the same rock
-            int k = kStrengths / 2;
-            if (same_bed) {
-                k = int(std::uint64_t(keys[i]) & 0xffu);
-            } else if (layered) {
-                // In the table, unless its facies have no table of corners; otherwise (a height outside the
-                // table, many corners) the cell's bed and facies are drawn directly.
-                if (tabled) {
-                    k = klass[j];
-                    if (facies) {
-                        const LatticeAt& u = column_at[std::size_t(i % width)];
-                        const LatticeAt& v = row_at[std::size_t(i / width)];
-                        const double* n0 = corner.data() +
-                            (j * std::size_t(b_count) + std::size_t(v.node - b_lo)) * std::size_t(a_count) +
-                            std::size_t(u.node - a_lo);
-                        const double* n1 = n0 + a_count;
-                        k = facies_class(beds, k, n0[0], n0[1], n1[0], n1[1], u, v);
-                    }
-                } else {
-                    k = class_of(beds, q, double(x0 + int(i % width)) * cell, double(y0 + int(i / width)) * cell);
-                }
-            }
-            if (keys) keys[i] = keyed ? std::int64_t(place | std::uint64_t(k)) : kNoKey;
-            if (vary_slope) {
-                double slope = slope_of[k];
-                if (blocky) {
-                    const double u = random::uniform(block_seed, std::uint64_t(x0 + int(i % width)),
-                                                     std::uint64_t(y0 + int(i / width)), std::uint64_t(block_key));
-                    slope = std::min(slope * (1.0 + beds.block_spread * u), steepest);
-                }
-                slopes[std::size_t(i)] = slope;
-            }
-            if (vary_k) factors[std::size_t(i)] = factor_of[k];
-        }
-    });
+    parallel_for(0, std::int64_t(count), 1 << 14, [&](std::int64_t b, std::int64_t e) { rock_of_cells(pass, b, e); });
 }
 
 }  // namespace orogen::landscape

@@ -41,7 +41,7 @@ Model::Model(int width, int height, double cell, std::vector<double> heights, st
     pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
     uplifted_.assign(h_.size(), 0.0);
     if (settings.diffusivity > 0.0)
-        diffusion_ = std::make_unique<diffusion::Solver>(width, height, cell, hillslope_settings(settings));
+        diffusion_ = std::make_unique<solvers::diffusion::Solver>(width, height, cell, hillslope_settings(settings));
 }
 
 std::vector<double> area_power_table(double cell, double m, double inv_ac) {
@@ -51,10 +51,10 @@ std::vector<double> area_power_table(double cell, double m, double inv_ac) {
     return t;
 }
 
-diffusion::Settings hillslope_settings(const Settings& settings) {
-    diffusion::Settings ds;
+solvers::diffusion::Settings hillslope_settings(const Settings& settings) {
+    solvers::diffusion::Settings ds;
     ds.diffusivity = settings.diffusivity;
-    ds.scheme = diffusion::Scheme::implicit;
+    ds.scheme = solvers::diffusion::Scheme::implicit;
     ds.fixed = {settings.open.north, settings.open.east, settings.open.south, settings.open.west};
     return ds;
 }
@@ -158,9 +158,9 @@ std::int64_t Model::step(double dt) {
             for (const auto& [i, v] : sink) h[i] = v;  // the declared sink stays at base level
         }
         // 4. Implicit incision (and deposition), in the rock each cell shows now, by rivers and glaciers.
-        if (bed_offset_.empty()) bed_offsets(settings_.rock, n, width_, 0, 0, cell_, bed_offset_);
-        rock_at(settings_.rock, h, uplifted_.data(), bed_offset_.data(), n, width_, 0, 0, cell_, rock_slopes_, rock_k_,
-                &rock_memo_);
+        const CellBlock grid{n, width_, 0, 0, cell_};
+        if (bed_offset_.empty()) bed_offsets(settings_.rock, grid, bed_offset_);
+        rock_at(settings_.rock, grid, {h, uplifted_.data(), bed_offset_.data()}, rock_slopes_, rock_k_, &rock_memo_);
         if (settings_.glaciers.any()) glacial_factors(sub);
         if (settings_.banks.any()) bank_before_.assign(h_.begin(), h_.end());
         if (settings_.deposition > 0.0) incise_with_deposition(sub);
@@ -171,14 +171,15 @@ std::int64_t Model::step(double dt) {
                 bank_dir_.resize(n);
                 for (std::size_t i = 0; i < n; ++i) bank_dir_[i] = std::int8_t(flow_.direction(std::int64_t(i)));
             }
-            carve_floodplains(settings_.floodplain, width_, height_, cell_, bank_dir_.data(), flow_.area().data(),
-                              flow_.outlets().data(), h, floodplain_nearest_, floodplain_floor_);
+            carve_floodplains(settings_.floodplain, width_, height_, cell_,
+                              {bank_dir_.data(), flow_.area().data(), flow_.outlets().data()}, h, floodplain_nearest_,
+                              floodplain_floor_);
         }
         if (settings_.glaciers.any())
             carve_troughs(settings_.glaciers, h, ice_, flow_.receivers().data(), width_, height_, cell_);
         // 5. Landslides: what the incision left steeper than the threshold slides away (outlets stay).
         if (settings_.rock.angle > 0.0)
-            threshold::limit_slopes(
+            solvers::threshold::limit_slopes(
                 h, width_, height_, cell_,
                 {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
                 flow_.outlets().data(), nullptr, &slope_scratch_);
@@ -197,8 +198,8 @@ void Model::erode_banks() {
             bank_dir_[std::size_t(i)] = std::int8_t(flow_.direction(i));
         }
     });
-    banks_.erode(settings_.banks, width_, height_, cell_, bank_dir_.data(), flow_.area().data(), bank_before_.data(),
-                 flow_.outlets().data(), h_.data());
+    banks_.erode(settings_.banks, width_, height_, cell_,
+                 {bank_dir_.data(), flow_.area().data(), flow_.outlets().data()}, bank_before_.data(), h_.data());
 }
 
 void Model::glacial_factors(double dt) {

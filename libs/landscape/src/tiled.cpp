@@ -143,7 +143,7 @@ TiledModel::TiledModel(Tiling& tiles, double cell, std::vector<double> heights, 
     pow_table_ = area_power_table(cell, settings.area_exponent, inverse_channel_area(settings));
     uplifted_.assign(n, 0.0);
     if (settings.diffusivity > 0.0)
-        diffusion_ = std::make_unique<diffusion::Solver>(tiles, cell, hillslope_settings(settings));
+        diffusion_ = std::make_unique<solvers::diffusion::Solver>(tiles, cell, hillslope_settings(settings));
 }
 
 std::int64_t TiledModel::global(std::size_t l) const {
@@ -736,9 +736,10 @@ std::int64_t TiledModel::step(double dt) {
         }
         // 4. Implicit incision, receivers first (Model::incise, the same arithmetic), in the rock each cell
         // shows.
-        if (bed_offset_.empty()) bed_offsets(settings_.rock, n, own_.width, own_.x0, own_.y0, cell_, bed_offset_);
-        rock_at(settings_.rock, h_.data(), uplifted_.data(), bed_offset_.data(), n, own_.width, own_.x0, own_.y0, cell_,
-                rock_slopes_, rock_k_, &rock_memo_);
+        const CellBlock own{n, own_.width, own_.x0, own_.y0, cell_};
+        if (bed_offset_.empty()) bed_offsets(settings_.rock, own, bed_offset_);
+        rock_at(settings_.rock, own, {h_.data(), uplifted_.data(), bed_offset_.data()}, rock_slopes_, rock_k_,
+                &rock_memo_);
         const double K = settings_.erodibility, m = settings_.area_exponent, ns = settings_.slope_exponent;
         const double a0 = cell_ * cell_, inv_a0 = 1.0 / a0;
         const double c1 = K * sub / std::pow(cell_, ns), c2 = K * sub / std::pow(cell_ * kSqrt2, ns);
@@ -762,7 +763,7 @@ std::int64_t TiledModel::step(double dt) {
         if (settings_.floodplain.any()) plane_floodplains();
         // 5. Landslides across the tiles (Model::step): the same greatest fixed point, so the same bits.
         if (settings_.rock.angle > 0.0)
-            threshold::limit_slopes(
+            solvers::threshold::limit_slopes(
                 tiles_, h_.data(), cell_,
                 {settings_.rock.landslide_slope(0.5), rock_slopes_.empty() ? nullptr : rock_slopes_.data()},
                 outlet_.data(), nullptr, &slope_scratch_);
@@ -813,8 +814,8 @@ void TiledModel::erode_banks(const std::vector<double>& before) {
                 bank_left_);
     double* second[] = {bank_right_.data(), bank_left_.data()};
     joined([&] { return tiles_.exchange(std::span<double* const>(second)); });
-    lower_banks(settings_.banks, w, bank_code_.data(), bank_right_.data(), bank_left_.data(), bank_area_.data(),
-                bank_outlet_.data(), cell_, bank_h_.data(), bank_scratch_, &bank_relay_);
+    lower_banks(settings_.banks, w, {bank_code_.data(), bank_area_.data(), bank_outlet_.data()},
+                {bank_right_.data(), bank_left_.data()}, cell_, bank_h_.data(), bank_scratch_, &bank_relay_);
     if (settings_.banks.wide()) {  // what the halo's banks pass on, pass after pass (as Model::erode_banks)
         const int passes = settings_.banks.onward_passes();
         BankRelay *relay = &bank_relay_, *next = &bank_relay2_;

@@ -65,10 +65,10 @@ struct UpliftInputs {
     void smooth(std::vector<double>& rate) const {
         const double sigma = src.smoothing;
         if (!(sigma > 0.0)) return;
-        diffusion::Settings ds;
+        solvers::diffusion::Settings ds;
         ds.diffusivity = 1.0;
-        diffusion::Solver blur = tiles ? diffusion::Solver(*tiles, hm.cell(), ds)
-                                       : diffusion::Solver(hm.width(), hm.height(), hm.cell(), ds);
+        solvers::diffusion::Solver blur = tiles ? solvers::diffusion::Solver(*tiles, hm.cell(), ds)
+                                                : solvers::diffusion::Solver(hm.width(), hm.height(), hm.cell(), ds);
         for (int k = 0; k < 4; ++k) blur.step(rate.data(), 0.125 * sigma * sigma);
     }
     /// The uplift falls towards the open sides (the sides held at base level) over uplift_edge_taper

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstring>
 
-namespace orogen::terrain {
+namespace orogen::mesh {
 
 std::vector<int> kept_indices(int n, int step) {
     if (n < 1 || step < 1) throw Error("kept_indices: need n >= 1 and step >= 1");
@@ -290,4 +290,4 @@ std::vector<std::uint8_t> bake_splat_texture(ConstGridView h, int tw, int th) {
     return rgba;
 }
 
-}  // namespace orogen::terrain
+}  // namespace orogen::mesh

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 void convex_row_spans(std::span<const Point2> v, int width, int height, std::vector<RowSpan>& out) {
     constexpr double eps = 1e-7;  // samples: a vertex on the border belongs to the polygon
@@ -55,4 +55,4 @@ void add_spans(Window w, std::span<const RowSpan> spans, float amount, GridView*
     }
 }
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

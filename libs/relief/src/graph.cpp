@@ -9,7 +9,7 @@
 #include <numbers>
 #include <unordered_map>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 namespace {
 
@@ -251,4 +251,4 @@ std::vector<int> depth_first_order(const Arrangement& g, int start) {
     return order;
 }
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

@@ -11,7 +11,7 @@
 #include <limits>
 #include <unordered_map>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 namespace {
 
@@ -145,4 +145,4 @@ int raise_range(GridView terrain, GridWindow grid, Point2 a, Point2 b, const Ran
     return int(cells.size());
 }
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <limits>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 namespace {
 
@@ -309,4 +309,4 @@ std::vector<std::int32_t> label_grid(const SiteIndex& index) {
     return labels;
 }
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
-namespace orogen::diffusion {
+namespace orogen::solvers::diffusion {
 
 namespace {
 
@@ -50,7 +50,7 @@ void strips(int first, int count, const Pass& pass) {
 Solver::Solver(int width, int height, double cell, const Settings& settings)
     : W_(width), H_(height), x0_(0), y0_(0), tw_(width), th_(height), cell_(cell), settings_(settings) {
     if (width < 1 || height < 1 || !(cell > 0.0))
-        throw std::invalid_argument("diffusion::Solver: empty grid or cell <= 0");
+        throw std::invalid_argument("solvers::diffusion::Solver: empty grid or cell <= 0");
     scratch_.resize(std::size_t(width) * std::size_t(height));
     if (settings.critical_slope > 0.0) {
         scratch2_.resize(scratch_.size());
@@ -407,4 +407,4 @@ double total(const double* heights, std::size_t count) {
     });
 }
 
-}  // namespace orogen::diffusion
+}  // namespace orogen::solvers::diffusion

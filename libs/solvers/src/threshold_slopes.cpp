@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <vector>
 
-namespace orogen::threshold {
+namespace orogen::solvers::threshold {
 namespace {
 
 constexpr double kSqrt2 = 1.4142135623730951;
@@ -368,4 +368,4 @@ Result limit_slopes(Tiling& tiles, double* heights, double cell, const Slopes& s
     return result;
 }
 
-}  // namespace orogen::threshold
+}  // namespace orogen::solvers::threshold

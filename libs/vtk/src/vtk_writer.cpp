@@ -237,8 +237,8 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     }
     AtomicFile file(target);
 
-    const terrain::TerrainMesh mesh = terrain::plan_mesh(heights, o.decimate, 1, o.vertical_scale);
-    const terrain::MeshChunk& chunk = mesh.chunks.at(0);
+    const mesh::TerrainMesh mesh = mesh::plan_mesh(heights, o.decimate, 1, o.vertical_scale);
+    const mesh::MeshChunk& chunk = mesh.chunks.at(0);
     const std::size_t n = chunk.vertex_count(), triangles = chunk.triangle_count();
     if (triangles * 3 > std::size_t(std::numeric_limits<std::int32_t>::max()))
         throw BadInput("the mesh has " + std::to_string(triangles) +
@@ -246,7 +246,7 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     vtkNew<vtkFloatArray> xyz;
     xyz->SetNumberOfComponents(3);
     xyz->SetNumberOfTuples(vtkIdType(n));
-    terrain::chunk_positions(mesh, chunk, {xyz->GetPointer(0), n * 3});
+    mesh::chunk_positions(mesh, chunk, {xyz->GetPointer(0), n * 3});
     turn_in_place(xyz->GetPointer(0), n, o.up);
     vtkNew<vtkPoints> points;
     points->SetData(xyz);
@@ -254,13 +254,13 @@ void write_heightmap(ConstGridView heights, std::span<const NamedGrid> layers, c
     normals->SetName("Normals");
     normals->SetNumberOfComponents(3);
     normals->SetNumberOfTuples(vtkIdType(n));
-    terrain::chunk_normals(mesh, chunk, {normals->GetPointer(0), n * 3});
+    mesh::chunk_normals(mesh, chunk, {normals->GetPointer(0), n * 3});
     turn_in_place(normals->GetPointer(0), n, o.up);
     vtkNew<vtkTypeInt32Array> offsets, connectivity;
     offsets->SetNumberOfTuples(vtkIdType(triangles + 1));
     for (std::size_t t = 0; t <= triangles; ++t) offsets->SetValue(vtkIdType(t), std::int32_t(3 * t));
     connectivity->SetNumberOfTuples(vtkIdType(triangles * 3));
-    terrain::chunk_indices(chunk, {reinterpret_cast<std::uint32_t*>(connectivity->GetPointer(0)), triangles * 3});
+    mesh::chunk_indices(chunk, {reinterpret_cast<std::uint32_t*>(connectivity->GetPointer(0)), triangles * 3});
     vtkNew<vtkCellArray> polys;
     polys->SetData(offsets, connectivity);
     vtkNew<vtkPolyData> poly;

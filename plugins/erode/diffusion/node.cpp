@@ -17,7 +17,7 @@ namespace {
 using namespace orogen;
 
 /// "nesw"-style side letters → which sides are fixed; false if a letter is not one of n e s w.
-bool parse_sides(const std::string& text, diffusion::FixedSides& out) {
+bool parse_sides(const std::string& text, solvers::diffusion::FixedSides& out) {
     out = {};
     if (text == "none") return true;
     if (text == "all") {
@@ -38,9 +38,9 @@ bool parse_sides(const std::string& text, diffusion::FixedSides& out) {
 
 NodeOutputs run(NodeContext& ctx) {
     auto hm = ctx.take_heightmap(0);
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = ctx.real("diffusivity");
-    s.scheme = ctx.text("scheme") == "adi" ? diffusion::Scheme::adi : diffusion::Scheme::implicit;
+    s.scheme = ctx.text("scheme") == "adi" ? solvers::diffusion::Scheme::adi : solvers::diffusion::Scheme::implicit;
     parse_sides(ctx.text("fixed"), s.fixed);
     const double sc = ctx.real("critical_angle");
     s.critical_slope = sc > 0.0 ? std::tan(sc * std::numbers::pi / 180.0) : 0.0;
@@ -52,8 +52,8 @@ NodeOutputs run(NodeContext& ctx) {
     // In a tiled run (mpirun) the heightmap is this rank's tile and the solver sweeps across the tiles
     // (diffusion.hpp): the same bits as one process, the tile's share of the memory.
     Tiling* tiles = ctx.tiling();
-    diffusion::Solver solver =
-        tiles ? diffusion::Solver(*tiles, hm->cell(), s) : diffusion::Solver(hm->width(), hm->height(), hm->cell(), s);
+    solvers::diffusion::Solver solver = tiles ? solvers::diffusion::Solver(*tiles, hm->cell(), s)
+                                              : solvers::diffusion::Solver(hm->width(), hm->height(), hm->cell(), s);
     // A sample's index in the whole grid, for the messages.
     auto sample = [&](std::size_t k) {
         if (!tiles) return std::int64_t(k);
@@ -107,7 +107,7 @@ NodeOutputs run(NodeContext& ctx) {
 }
 
 void check(CheckContext& ctx) {
-    diffusion::FixedSides f;
+    solvers::diffusion::FixedSides f;
     if (!parse_sides(ctx.text("fixed"), f))
         ctx.error("fixed",
                   "'" + ctx.text("fixed") +

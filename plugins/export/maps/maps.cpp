@@ -37,8 +37,8 @@ std::vector<std::uint8_t> splat_map(ConstGridView h) {
     parallel_for(0, h.height, 8, [&](std::int64_t y0, std::int64_t y1) {
         for (int y = int(y0); y < int(y1); ++y)
             for (int x = 0; x < h.width; ++x) {
-                const float ny = terrain::surface_normal(h, x, y, 1.0)[1];
-                const terrain::SplatWeights s = terrain::splat_weights(h.at(x, y), lo, hi, ny);
+                const float ny = mesh::surface_normal(h, x, y, 1.0)[1];
+                const mesh::SplatWeights s = mesh::splat_weights(h.at(x, y), lo, hi, ny);
                 const float w[4] = {s.sand, s.grass, s.rock, s.snow};
                 round_to_total(w, 255, &rgba[(std::size_t(y) * std::size_t(h.width) + std::size_t(x)) * 4]);
             }
@@ -54,7 +54,7 @@ std::vector<std::uint8_t> normal_map(ConstGridView h, double vertical_scale, Gre
         for (int y = int(y0); y < int(y1); ++y)
             for (int x = 0; x < h.width; ++x) {
                 // World normal, Y up and Z south → tangent space X east, Y north (or south), Z up.
-                const auto n = terrain::surface_normal(h, x, y, vertical_scale);
+                const auto n = mesh::surface_normal(h, x, y, vertical_scale);
                 std::uint8_t* p = &rgba[(std::size_t(y) * std::size_t(h.width) + std::size_t(x)) * 4];
                 p[0] = encode(n[0]);
                 p[1] = encode(-n[2] * north);

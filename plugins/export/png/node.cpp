@@ -87,7 +87,7 @@ std::pair<float, float> quantiles(ConstGridView grid, double lo, double hi) {
 
 /// A soft light from the heights: 0.55 in shadow to 1 facing the light, so colours stay readable.
 std::vector<float> soft_light(ConstGridView heights, double azimuth, double elevation) {
-    const std::vector<std::uint16_t> shade = png_export::hillshade(heights, 16, azimuth, elevation);
+    const std::vector<std::uint16_t> shade = formats::png::hillshade(heights, 16, azimuth, elevation);
     std::vector<float> light(shade.size());
     for (std::size_t i = 0; i < shade.size(); ++i) light[i] = 0.55f + 0.45f * float(shade[i]) / 65535.0f;
     return light;
@@ -193,8 +193,8 @@ std::vector<float> log_scaled(ConstGridView grid) {
 /// Splat colour (sand, grass, rock, snow by height and slope, as the glTF
 /// texture) times a soft hillshade: 35 % ambient light plus 65 % Lambert.
 std::vector<std::uint8_t> relief_map(ConstGridView heights, double azimuth, double elevation) {
-    std::vector<std::uint8_t> rgba = terrain::bake_splat_texture(heights, heights.width, heights.height);
-    const std::vector<std::uint16_t> shade = png_export::hillshade(heights, 16, azimuth, elevation);
+    std::vector<std::uint8_t> rgba = mesh::bake_splat_texture(heights, heights.width, heights.height);
+    const std::vector<std::uint16_t> shade = formats::png::hillshade(heights, 16, azimuth, elevation);
     for (std::size_t i = 0; i < shade.size(); ++i) {
         const float light = 0.35f + 0.65f * float(shade[i]) / 65535.0f;
         for (int c = 0; c < 3; ++c)
@@ -207,7 +207,7 @@ NodeOutputs run(NodeContext& ctx) {
     if (ctx.input(0).type() == ValueType::image) {
         const Image& image = *ctx.input(0).image();
         const auto rgba =
-            png_export::to_srgb8(image, png_export::parse_tonemap(ctx.text("tonemap")), ctx.real("exposure"));
+            formats::srgb::to_srgb8(image, formats::srgb::parse_tonemap(ctx.text("tonemap")), ctx.real("exposure"));
         AtomicFile file(ctx.output_path(ctx.text("path")));
         write_rgba_png(file.stream(), image.width, image.height, rgba, int(ctx.integer("compression")));
         file.commit();
@@ -239,7 +239,7 @@ NodeOutputs run(NodeContext& ctx) {
     const int bits = int(ctx.integer("bits"));
     std::vector<std::uint16_t> samples;
     if (ctx.flag("hillshade")) {
-        samples = png_export::hillshade(hm.view(), bits, ctx.real("azimuth"), ctx.real("elevation"));
+        samples = formats::png::hillshade(hm.view(), bits, ctx.real("azimuth"), ctx.real("elevation"));
     } else {
         ConstGridView grid = layer.empty() || layer == "height" ? hm.view() : hm.layer(layer);
         std::vector<float> logs;
@@ -247,7 +247,7 @@ NodeOutputs run(NodeContext& ctx) {
             logs = log_scaled(grid);
             grid = ConstGridView(logs.data(), grid.width, grid.height, grid.cell);
         }
-        samples = png_export::quantise(grid, bits, png_export::range_of(grid));
+        samples = formats::png::quantise(grid, bits, formats::png::range_of(grid));
     }
     AtomicFile file(ctx.output_path(ctx.text("path")));
     write_gray_png(file.stream(), hm.width(), hm.height(), bits, samples, int(ctx.integer("compression")));

@@ -10,10 +10,11 @@ using namespace orogen;
 
 NodeOutputs run(NodeContext& ctx) {
     const auto& hm = ctx.input(0).heightmap();
-    std::optional<raw::Range> range;
-    if (ctx.real("low") != 0.0 || ctx.real("high") != 0.0) range = raw::Range{ctx.real("low"), ctx.real("high")};
+    std::optional<formats::raw::Range> range;
+    if (ctx.real("low") != 0.0 || ctx.real("high") != 0.0)
+        range = formats::raw::Range{ctx.real("low"), ctx.real("high")};
     const std::string& path = ctx.text("path");
-    const auto w = raw::write_raw(hm->view(), ctx.output_path(path), range);
+    const auto w = formats::raw::write_raw(hm->view(), ctx.output_path(path), range);
     if (w.clamped > 0)
         ctx.warn(std::to_string(w.clamped) + " samples lie outside low..high and were clamped to its ends");
     ctx.info("wrote " + path + " and " + path + ".json (heights " + std::to_string(w.range.low) + " to " +

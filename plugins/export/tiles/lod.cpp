@@ -292,7 +292,7 @@ std::vector<std::uint8_t> chunk_texture(const Chunk& c, const Samples& s, double
             const double gx = slope(all_x, p.near, s.xs, cell, [&](int a) { return s.at(std::size_t(a), q.near); });
             const double gz = slope(all_y, q.near, s.ys, cell, [&](int b) { return s.at(p.near, std::size_t(b)); });
             const double ny = 1.0 / std::sqrt(gx * gx + 1.0 + gz * gz);  // the true terrain's slope
-            const auto rgb = terrain::splat_colour(terrain::splat_weights(float(height), lo, hi, float(ny)));
+            const auto rgb = mesh::splat_colour(mesh::splat_weights(float(height), lo, hi, float(ny)));
             std::uint8_t* o = &rgba[(std::size_t(j) * std::size_t(tw) + std::size_t(i)) * 4];
             o[0] = rgb[0];
             o[1] = rgb[1];

@@ -7,7 +7,7 @@
 // Level 0 is the engine tiles of tiles.hpp at full resolution: tile_size
 // samples a side, neighbours sharing their edge samples. Level k keeps the
 // samples at multiples of 2^k (and always the grid's last row and column,
-// as terrain::kept_indices does), and one of its chunks covers 2 × 2 chunks
+// as mesh::kept_indices does), and one of its chunks covers 2 × 2 chunks
 // of level k − 1, so every chunk has at most tile_size × tile_size vertices.
 // The top level is a single chunk.
 //

@@ -73,7 +73,7 @@ NodeOutputs run_pyramid(NodeContext& ctx, const Heightmap& hm, Tiling* tiling) {
     const std::filesystem::path index_path = ctx.text("path");
     const std::filesystem::path folder = index_path.parent_path();
     if (width < 2 || height < 2) throw BadInput("export:tiles: the terrain needs at least 2 × 2 samples");
-    const raw::Range range = raw::min_max(hm.view());
+    const formats::raw::Range range = formats::raw::min_max(hm.view());
     float lo = float(range.low), hi = float(range.high);
     if (tiling) {  // the whole grid's (float minima and maxima are exact in any order)
         lo = tiling->reduce(lo, Tiling::Reduce::min);
@@ -180,9 +180,9 @@ NodeOutputs run(NodeContext& ctx) {
     index.tile_size = tile_size;
     index.cell = hm.cell();
     if (ctx.real("low") != 0.0 || ctx.real("high") != 0.0) {
-        index.range = raw::Range{ctx.real("low"), ctx.real("high")};
+        index.range = formats::raw::Range{ctx.real("low"), ctx.real("high")};
     } else {
-        index.range = raw::min_max(hm.view());
+        index.range = formats::raw::min_max(hm.view());
         if (tiling) {  // the whole grid's (float minima and maxima are exact in any order)
             float lo = float(index.range.low), hi = float(index.range.high);
             lo = tiling->reduce(lo, Tiling::Reduce::min);
@@ -247,7 +247,8 @@ NodeOutputs run(NodeContext& ctx) {
                     std::memcpy(bytes.data(), samples.data(), bytes.size());  // little-endian x86-64 and ARM
                     file.write(bytes);
                 } else {
-                    const std::vector<std::uint16_t> q = raw::quantize16(view, index.range, &clamped[std::size_t(i)]);
+                    const std::vector<std::uint16_t> q =
+                        formats::raw::quantize16(view, index.range, &clamped[std::size_t(i)]);
                     if (format == Format::png16) {
                         write_gray_png(file.stream(), t.width, t.height, 16, q, level);
                     } else {

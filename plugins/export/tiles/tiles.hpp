@@ -46,7 +46,7 @@ struct Index {
     Format format = Format::png16;
     int width = 0, height = 0, tile_size = 0;
     double cell = 1.0;  ///< m
-    raw::Range range;  ///< png16 / r16: the heights of 0 and 65535, m (the same for every tile)
+    formats::raw::Range range;  ///< png16 / r16: the heights of 0 and 65535, m (the same for every tile)
     std::vector<Tile> tiles;
 };
 

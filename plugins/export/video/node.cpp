@@ -35,7 +35,7 @@ NodeOutputs run(NodeContext& ctx) {
     s.codec = video::codec_for(ctx.text("path"));
     s.fps = ctx.real("fps");
     s.quality = int(ctx.integer("quality"));
-    s.tonemap = png_export::parse_tonemap(ctx.text("tonemap"));
+    s.tonemap = formats::srgb::parse_tonemap(ctx.text("tonemap"));
     s.exposure = ctx.real("exposure");
     const std::size_t n = frames.size();
     video::encode_video(

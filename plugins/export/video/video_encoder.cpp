@@ -203,7 +203,7 @@ void encode_video(const std::filesystem::path& target, std::size_t count,
             throw BadInput("export:video: frame " + std::to_string(i) + " is " + std::to_string(image.width) + " × " +
                            std::to_string(image.height) + " but the first was " + std::to_string(width) + " × " +
                            std::to_string(height) + "; every frame must have the same size");
-        const std::vector<std::uint8_t> rgba = png_export::to_srgb8(image, s.tonemap, s.exposure);
+        const std::vector<std::uint8_t> rgba = formats::srgb::to_srgb8(image, s.tonemap, s.exposure);
         image = Image{};  // the float frame is not needed any more
         check(av_frame_make_writable(st.picture), "to reuse a frame");
         const std::uint8_t* src[1] = {rgba.data()};

@@ -52,7 +52,7 @@ struct VideoSettings {
     double fps = 30.0;  ///< frames per second
     /// Quality: H.264 constant rate factor (0 lossless .. 51; 18 looks lossless) / MPEG-2 quantiser (2 best .. 31).
     int quality = 18;
-    png_export::Tonemap tonemap = png_export::Tonemap::aces;  ///< as export:png, so frames match the PNGs
+    formats::srgb::Tonemap tonemap = formats::srgb::Tonemap::aces;  ///< as export:png, so frames match the PNGs
     double exposure = 0.0;
 };
 

@@ -20,6 +20,10 @@
 
 namespace orogen::rmp {
 
+using relief::cell_amount;
+using relief::random_sites;
+using relief::SiteIndex;
+
 namespace {
 
 // Cones are drawn as fans of this many segments circumscribing the circle;

@@ -24,7 +24,7 @@ std::shared_ptr<Heightmap> base_or_grid(NodeContext& ctx) {
 
 /// Where `hm` lies in the whole grid (all of it in one process), and the whole grid's size.
 struct Placed {
-    rmp::Window window;
+    relief::Window window;
     int width, height;
 };
 Placed placed(NodeContext& ctx, Heightmap& hm) {
@@ -230,7 +230,7 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
             const Placed whole = placed(ctx, *hm);
             const Point2 a = rmp::to_samples(ctx.point("from"), whole.width, whole.height);
             const Point2 b = rmp::to_samples(ctx.point("to"), whole.width, whole.height);
-            rmp::RangeParams p;
+            relief::RangeParams p;
             p.cones = int(ctx.integer("cones"));
             p.height = ctx.real("height");
             p.jitter = ctx.real("jitter");
@@ -240,8 +240,8 @@ OROGEN_PLUGIN("generate-rmp", "0.1.0", registry) {
             const std::uint64_t seed = node_seed(ctx);
             const Placed at = placed(ctx, *hm);  // in a tiled run, this rank's tile of the whole grid's range
             for (int k = 0; k < iterations; ++k) {
-                rmp::raise_range(hm->view(), rmp::GridWindow{at.width, at.height, at.window.x0, at.window.y0}, a, b, p,
-                                 rmp::iteration_seed(seed, k), ctx.flag("uplift") ? &uplift : nullptr);
+                relief::raise_range(hm->view(), relief::GridWindow{at.width, at.height, at.window.x0, at.window.y0}, a,
+                                    b, p, rmp::iteration_seed(seed, k), ctx.flag("uplift") ? &uplift : nullptr);
                 ctx.check_cancelled();
                 ctx.progress(double(k + 1) / iterations);
             }

@@ -12,6 +12,9 @@
 
 namespace orogen::rmp {
 
+// The cuts, arrangements, spans and sites these methods raise with (libs/relief).
+using namespace orogen::relief;
+
 void validate(const RmpParams& p) {
     if (p.peaks.empty()) throw BadInput("rmp: give at least one peak");
     for (const Point2& q : p.peaks)

@@ -55,7 +55,7 @@ void rmp_voronoi(GridView terrain, const RmpParams& params, std::uint64_t seed, 
 /// The same mountain of a width × height grid, added only to `window` (a rank's tile in a tiled run):
 /// each of its samples gets the bits the whole grid gets there (every iteration draws the whole
 /// grid's diagram, which costs its sites, and adds only the window's part of the raised cells).
-void rmp_voronoi(Window window, int width, int height, const RmpParams& params, std::uint64_t seed,
+void rmp_voronoi(relief::Window window, int width, int height, const RmpParams& params, std::uint64_t seed,
                  const IterationHook& hook = {});
 
 /// Graph-based RMP: faces of `cuts` random lines; from each peak's face the
@@ -63,7 +63,7 @@ void rmp_voronoi(Window window, int width, int height, const RmpParams& params, 
 /// orogen::BadInput if an iteration makes fewer faces than `regions`.
 void rmp_graph(GridView terrain, const RmpParams& params, std::uint64_t seed, const IterationHook& hook = {});
 /// The same, added only to `window` of a width × height grid (as rmp_voronoi's window form).
-void rmp_graph(Window window, int width, int height, const RmpParams& params, std::uint64_t seed,
+void rmp_graph(relief::Window window, int width, int height, const RmpParams& params, std::uint64_t seed,
                const IterationHook& hook = {});
 
 }  // namespace orogen::rmp

@@ -24,7 +24,7 @@ OROGEN_PLUGIN("import-raw", "0.1.0", registry) {
         .check =
             [](CheckContext& ctx) {
                 try {
-                    const raw::Sidecar s = raw::read_raw_header(ctx.resolved_path("path"));
+                    const formats::raw::Sidecar s = formats::raw::read_raw_header(ctx.resolved_path("path"));
                     ctx.output().width = s.width;
                     ctx.output().height = s.height;
                     ctx.output().cell = ctx.real("cell") > 0 ? ctx.real("cell") : s.cell;
@@ -32,8 +32,8 @@ OROGEN_PLUGIN("import-raw", "0.1.0", registry) {
                 } catch (const BadInput& e) { ctx.error("path", e.what()); }
             },
         .run = [](NodeContext& ctx) -> NodeOutputs {
-            raw::Sidecar s;
-            std::vector<float> heights = raw::read_raw(ctx.input_path("path"), s);
+            formats::raw::Sidecar s;
+            std::vector<float> heights = formats::raw::read_raw(ctx.input_path("path"), s);
             auto hm = std::make_shared<Heightmap>(s.width, s.height, ctx.real("cell") > 0 ? ctx.real("cell") : s.cell);
             hm->heights() = std::move(heights);
             ctx.progress(1.0);

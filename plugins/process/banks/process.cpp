@@ -19,8 +19,9 @@ public:
         (void)dt;
         if (!banks_.any()) return;
         const FlowGraph& flow = state.flow();
-        eroder_.erode(banks_, state.width(), state.height(), state.cell(), flow.directions.data(), flow.area.data(),
-                      state.field("incision").data(), state.outlets().data(), state.field(kElevation).data());
+        eroder_.erode(banks_, state.width(), state.height(), state.cell(),
+                      {flow.directions.data(), flow.area.data(), state.outlets().data()},
+                      state.field("incision").data(), state.field(kElevation).data());
     }
 
 private:

@@ -37,7 +37,7 @@ public:
 
 private:
     landscape::CreepSpec s_;
-    std::optional<diffusion::Solver> solver_;
+    std::optional<solvers::diffusion::Solver> solver_;
 };
 
 }  // namespace

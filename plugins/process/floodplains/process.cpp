@@ -18,9 +18,9 @@ public:
         (void)dt;
         if (!fp_.any()) return;
         const FlowGraph& flow = state.flow();
-        landscape::carve_floodplains(fp_, state.width(), state.height(), state.cell(), flow.directions.data(),
-                                     flow.area.data(), state.outlets().data(), state.field(kElevation).data(), nearest_,
-                                     floor_);
+        landscape::carve_floodplains(fp_, state.width(), state.height(), state.cell(),
+                                     {flow.directions.data(), flow.area.data(), state.outlets().data()},
+                                     state.field(kElevation).data(), nearest_, floor_);
     }
 
 private:

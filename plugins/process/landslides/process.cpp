@@ -23,9 +23,9 @@ public:
     void step(ProcessState& state, double dt) override {
         (void)dt;
         const std::vector<double>& slopes = state.field("threshold_slope");
-        const auto r = threshold::limit_slopes(state.field(kElevation).data(), state.width(), state.height(),
-                                               state.cell(), {uniform_, slopes.empty() ? nullptr : slopes.data()},
-                                               state.outlets().data(), nullptr, &scratch_);
+        const auto r = solvers::threshold::limit_slopes(
+            state.field(kElevation).data(), state.width(), state.height(), state.cell(),
+            {uniform_, slopes.empty() ? nullptr : slopes.data()}, state.outlets().data(), nullptr, &scratch_);
         removed_ += r.removed;
         cell2_ = state.cell() * state.cell();
     }
@@ -38,7 +38,7 @@ public:
 
 private:
     double uniform_ = 0.0;  // tan of the angle
-    threshold::Scratch scratch_;  // the limit's working grids, kept between steps
+    solvers::threshold::Scratch scratch_;  // the limit's working grids, kept between steps
     double removed_ = 0.0;  // m, summed over the cells
     double cell2_ = 0.0;  // m²
 };

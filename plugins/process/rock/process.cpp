@@ -21,10 +21,11 @@ public:
     void step(ProcessState& state, double dt) override {
         (void)dt;
         const std::size_t n = state.size();
-        if (offsets_.empty()) landscape::bed_offsets(beds_, n, state.width(), 0, 0, state.cell(), offsets_);
-        landscape::rock_at(beds_, state.field(kElevation).data(), state.field(kUplifted).data(), offsets_.data(), n,
-                           state.width(), 0, 0, state.cell(), state.field("threshold_slope"),
-                           state.field("erodibility_factor"), &memo_);
+        const landscape::CellBlock grid{n, state.width(), 0, 0, state.cell()};
+        if (offsets_.empty()) landscape::bed_offsets(beds_, grid, offsets_);
+        landscape::rock_at(beds_, grid,
+                           {state.field(kElevation).data(), state.field(kUplifted).data(), offsets_.data()},
+                           state.field("threshold_slope"), state.field("erodibility_factor"), &memo_);
     }
 
 private:

@@ -76,8 +76,8 @@ std::array<std::array<float, 3>, 4> Style::default_materials() {
     // Vegetation seen from the air is darker and more olive than the exports' map green (#567d3a), which
     // read as a lawn in the lit scene; sand, rock and snow are the exports'.
     constexpr std::array<std::uint8_t, 3> vegetation{88, 104, 56};
-    const std::array<std::array<std::uint8_t, 3>, 4> srgb{terrain::sand_colour, vegetation, terrain::rock_colour,
-                                                          terrain::snow_colour};
+    const std::array<std::array<std::uint8_t, 3>, 4> srgb{mesh::sand_colour, vegetation, mesh::rock_colour,
+                                                          mesh::snow_colour};
     for (std::size_t i = 0; i < 4; ++i)
         for (std::size_t c = 0; c < 3; ++c) m[i][c] = gl::srgb_to_linear(srgb[i][c]);
     return m;
@@ -219,7 +219,7 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
     if (m.width < 2 || m.height < 2)
         throw BadInput("render:terrain: the heightmap is " + std::to_string(m.width) + " × " +
                        std::to_string(m.height) + " samples; it needs at least 2 × 2");
-    terrain::validate(style_.splat);
+    mesh::validate(style_.splat);
     const auto span = m.terrain->view().span();
     m.lo = m.hi = span[0];
     for (float h : span) {

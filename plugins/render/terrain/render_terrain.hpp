@@ -39,7 +39,7 @@ struct Camera {
 
 /// How the terrain looks.
 struct Style {
-    terrain::SplatRules splat;  ///< the bands and slopes (the thesis's by default)
+    mesh::SplatRules splat;  ///< the bands and slopes (the thesis's by default)
     /// Linear albedo of sand, grass, rock, snow (default: terrain_mesh.hpp's sRGB colours, decoded, with a darker
     /// olive for the vegetation).
     std::array<std::array<float, 3>, 4> materials = default_materials();

@@ -7,7 +7,7 @@
 #include <orogen/error.hpp>
 #include <orogen/parallel.hpp>
 #include <orogen/random.hpp>
-#include <orogen/relief/range.hpp>  // orogen::rmp::raise_range (libs/relief)
+#include <orogen/relief/range.hpp>  // orogen::relief::raise_range (libs/relief)
 
 #include <box2d/box2d.h>
 
@@ -138,9 +138,10 @@ void draw_stamp(const ReliefStamp& stamp, const Params& params, BoundaryRelief& 
         case ReliefStamp::Kind::subduction: relief.add_subduction(stamp.a, stamp.b, stamp.toward_light); break;
         case ReliefStamp::Kind::rift: relief.add_rift(stamp.a, stamp.b); break;
         case ReliefStamp::Kind::cells: {
-            const rmp::RangeParams range{params.cones, params.height, params.jitter};
-            rmp::raise_range(terrain, rmp::GridWindow{relief.width(), relief.height(), at.x0, at.y0}, stamp.a, stamp.b,
-                             range, stamp.seed, uplift);
+            const orogen::relief::RangeParams range{params.cones, params.height, params.jitter};
+            orogen::relief::raise_range(terrain,
+                                        orogen::relief::GridWindow{relief.width(), relief.height(), at.x0, at.y0},
+                                        stamp.a, stamp.b, range, stamp.seed, uplift);
             break;
         }
     }

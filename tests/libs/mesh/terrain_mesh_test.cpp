@@ -12,7 +12,7 @@
 #include <numeric>
 
 using namespace orogen;
-using namespace orogen::terrain;
+using namespace orogen::mesh;
 
 TEST(TerrainMesh, KeptIndicesKeepEveryKthAndTheLast) {
     EXPECT_EQ(kept_indices(10, 3), (std::vector<int>{0, 3, 6, 9}));

@@ -9,7 +9,7 @@
 #include <set>
 
 using namespace orogen;
-using namespace orogen::rmp;
+using namespace orogen::relief;
 
 namespace {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 using namespace orogen;
-using namespace orogen::rmp;
+using namespace orogen::relief;
 
 namespace {
 

@@ -8,7 +8,7 @@
 #include <limits>
 
 using namespace orogen;
-using namespace orogen::rmp;
+using namespace orogen::relief;
 
 namespace {
 

@@ -39,16 +39,16 @@ double roughness(const std::vector<double>& v, int w) {
     return s / double(v.size());
 }
 
-class Schemes : public ::testing::TestWithParam<diffusion::Scheme> {};
+class Schemes : public ::testing::TestWithParam<solvers::diffusion::Scheme> {};
 
 TEST_P(Schemes, ClosedSidesKeepTheVolumeToRoundOff) {
     const int w = 67, h = 45;
     auto v = rough(w, h, 3, 500.0);
     const double before = sum(v), rough_before = roughness(v, w);
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = 0.05;
     s.scheme = GetParam();
-    diffusion::Solver solver(w, h, 30.0, s);
+    solvers::diffusion::Solver solver(w, h, 30.0, s);
     for (int i = 0; i < 40; ++i) solver.step(v.data(), 5e4);  // r = D dt / cell² ≈ 2.8 per step
     EXPECT_NEAR(sum(v), before, 1e-11 * std::abs(before));
     // It did diffuse: the cell-to-cell roughness is mostly gone.
@@ -63,10 +63,10 @@ TEST_P(Schemes, StepSpreadsAsTheErrorFunction) {
     std::vector<double> v(std::size_t(w) * h);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) v[std::size_t(y) * w + x] = x * cell < x0 ? H : 0.0;
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = D;
     s.scheme = GetParam();
-    diffusion::Solver solver(w, h, cell, s);
+    solvers::diffusion::Solver solver(w, h, cell, s);
     const double t = 2e5, dt = 2e3;  // sqrt(D t) = 63 m ≈ 6 cells; r = 0.4
     for (int i = 0; i < int(t / dt); ++i) solver.step(v.data(), dt);
     double worst = 0.0;
@@ -80,9 +80,10 @@ TEST_P(Schemes, StepSpreadsAsTheErrorFunction) {
     EXPECT_GT(v[std::size_t(2) * w + 206], 0.5);
 }
 
-INSTANTIATE_TEST_SUITE_P(Diffusion, Schemes, ::testing::Values(diffusion::Scheme::implicit, diffusion::Scheme::adi),
+INSTANTIATE_TEST_SUITE_P(Diffusion, Schemes,
+                         ::testing::Values(solvers::diffusion::Scheme::implicit, solvers::diffusion::Scheme::adi),
                          [](const auto& info) {
-                             return info.param == diffusion::Scheme::implicit ? "implicit" : "adi";
+                             return info.param == solvers::diffusion::Scheme::implicit ? "implicit" : "adi";
                          });
 
 TEST(Diffusion, ImplicitKeepsTheMaximumPrincipleAtHugeSteps) {
@@ -90,9 +91,9 @@ TEST(Diffusion, ImplicitKeepsTheMaximumPrincipleAtHugeSteps) {
     auto v = rough(w, h, 11, 300.0);
     const auto [lo0, hi0] = std::minmax_element(v.begin(), v.end());
     const double lo = *lo0, hi = *hi0;
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = 1.0;
-    diffusion::Solver solver(w, h, 1.0, s);
+    solvers::diffusion::Solver solver(w, h, 1.0, s);
     solver.step(v.data(), 1e6);  // r = 1e6
     for (double x : v) {
         ASSERT_TRUE(std::isfinite(x));
@@ -109,11 +110,11 @@ TEST(Diffusion, FixedSidesKeepTheirHeightsAndOpenTheVolume) {
     auto v = rough(w, h, 5, 100.0);
     for (int x = 0; x < w; ++x) v[std::size_t(x)] = -500.0;  // the north side: a low base level
     const auto before = v;
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = 0.1;
     s.fixed.north = true;
     s.fixed.west = true;
-    diffusion::Solver solver(w, h, 10.0, s);
+    solvers::diffusion::Solver solver(w, h, 10.0, s);
     for (int i = 0; i < 20; ++i) solver.step(v.data(), 1e4);
     for (int x = 0; x < w; ++x) EXPECT_EQ(v[std::size_t(x)], before[std::size_t(x)]);
     for (int y = 0; y < h; ++y) EXPECT_EQ(v[std::size_t(y) * w], before[std::size_t(y) * w]);
@@ -128,11 +129,11 @@ TEST(Diffusion, CriticalSlopeDiffusionConservesAndFlattensSteepSlopesFaster) {
         for (int x = 0; x < w; ++x) lin[std::size_t(y) * w + x] = 300.0 - 10.0 * std::abs(x - 29.5);
     nonlin = lin;
     const double before = sum(lin);
-    diffusion::Settings s;
+    solvers::diffusion::Settings s;
     s.diffusivity = 0.01;
-    diffusion::Solver a(w, h, 10.0, s);
+    solvers::diffusion::Solver a(w, h, 10.0, s);
     s.critical_slope = 1.1;  // 48°
-    diffusion::Solver b(w, h, 10.0, s);
+    solvers::diffusion::Solver b(w, h, 10.0, s);
     for (int i = 0; i < 50; ++i) {
         a.step(lin.data(), 1e3);
         b.step(nonlin.data(), 1e3);
@@ -149,15 +150,15 @@ TEST(Diffusion, SameBitsOnOneAndTwoThreads) {
     for (int t = 0; t < 2; ++t) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(t + 1));
         auto v = rough(w, h, 9, 200.0);
-        diffusion::Settings s;
+        solvers::diffusion::Settings s;
         s.diffusivity = 0.03;
-        s.scheme = diffusion::Scheme::adi;
+        s.scheme = solvers::diffusion::Scheme::adi;
         s.fixed.east = true;
-        diffusion::Solver solver(w, h, 20.0, s);
+        solvers::diffusion::Solver solver(w, h, 20.0, s);
         for (int i = 0; i < 5; ++i) solver.step(v.data(), 1e4);
-        s.scheme = diffusion::Scheme::implicit;
+        s.scheme = solvers::diffusion::Scheme::implicit;
         s.critical_slope = 0.8;
-        diffusion::Solver nl(w, h, 20.0, s);
+        solvers::diffusion::Solver nl(w, h, 20.0, s);
         for (int i = 0; i < 5; ++i) nl.step(v.data(), 1e4);
         results[t] = std::move(v);
     }

@@ -53,7 +53,7 @@ double bound_at(const std::vector<double>& v, int w, int h, int x, int y, double
     for (const auto& [sx, sy] : {std::pair{1, 0}, std::pair{-1, 0}, std::pair{0, 1}, std::pair{0, -1}})
         for (int side : {-1, 1}) {  // the diagonal beside the straight neighbour (sx, sy)
             const int dx = sx != 0 ? sx : side, dy = sy != 0 ? sy : side;
-            best = std::min(best, threshold::edge_bound(at(sx, sy), at(dx, dy), step));
+            best = std::min(best, solvers::threshold::edge_bound(at(sx, sy), at(dx, dy), step));
         }
     return best;
 }
@@ -85,7 +85,7 @@ TEST(ThresholdSlopes, AFixedPointOnAHighPlateauBecomesARoundCone) {
     std::vector<std::uint8_t> fixed(v.size(), 0);
     v[std::size_t(cy) * w + cx] = 0.0;
     fixed[std::size_t(cy) * w + cx] = 1;
-    const auto r = threshold::limit_slopes(v.data(), w, h, cell, {slope}, fixed.data());
+    const auto r = solvers::threshold::limit_slopes(v.data(), w, h, cell, {slope}, fixed.data());
     double worst = 0.0, worst_octagon = 0.0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -126,7 +126,7 @@ TEST(ThresholdSlopes, ValleySidesAreHeldAtTheThresholdWhateverTheValleysAzimuth)
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x)
                 if (fixed[std::size_t(y) * w + x]) river.emplace_back(x, y);
-        threshold::limit_slopes(v.data(), w, h, cell, {slope}, fixed.data());
+        solvers::threshold::limit_slopes(v.data(), w, h, cell, {slope}, fixed.data());
         double worst = 0.0;
         for (int y = 30; y < h - 30; ++y)
             for (int x = 30; x < w - 30; ++x) {
@@ -149,7 +149,7 @@ TEST(ThresholdSlopes, AFixedRiverLeavesPlanarValleySidesAtTheThreshold) {
     for (int y = 0; y < h; ++y) v[std::size_t(y) * w] = 0.0, fixed[std::size_t(y) * w] = 1;
     double removed_by_vertex = 0.0;
     std::vector<double> removed(v.size(), 0.0);
-    const auto r = threshold::limit_slopes(v.data(), w, h, cell, {slope}, fixed.data(), removed.data());
+    const auto r = solvers::threshold::limit_slopes(v.data(), w, h, cell, {slope}, fixed.data(), removed.data());
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             EXPECT_NEAR(v[std::size_t(y) * w + x], std::min(200.0, slope * cell * x), 1e-9) << x << "," << y;
@@ -172,7 +172,7 @@ TEST(ThresholdSlopes, RoughReliefEndsAtTheThresholdWithoutPitsAndNothingRaised) 
         for (int x = 0; x < w; ++x)
             slope[std::size_t(y) * w + x] = std::tan((((x + y) / 9) % 2 ? 45.0 : 25.0) * M_PI / 180.0);
     auto v = before;
-    threshold::limit_slopes(v.data(), w, h, cell, {0.0, slope.data()});
+    solvers::threshold::limit_slopes(v.data(), w, h, cell, {0.0, slope.data()});
     std::int64_t lowered = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -204,7 +204,7 @@ TEST(ThresholdSlopes, TheSameBitsAsAJacobiIterationAndOnOneAndTwoThreads) {
     // 601 columns: the vertical sweeps run in strips of 256 columns, which meet at two seams.
     // Working memory kept between calls (as a model keeps it between steps) changes no bit, though
     // it comes to each call holding the last one's grids, of another size.
-    threshold::Scratch kept;
+    solvers::threshold::Scratch kept;
     for (const auto [w, h] : {std::pair{97, 64}, std::pair{601, 47}, std::pair{97, 64}}) {
         const double cell = 25.0;
         const auto start = rough(w, h, 11, 600.0);
@@ -214,13 +214,13 @@ TEST(ThresholdSlopes, TheSameBitsAsAJacobiIterationAndOnOneAndTwoThreads) {
         for (int threads : {1, 2}) {
             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
             auto v = start;
-            threshold::limit_slopes(v.data(), w, h, cell, {0.0, slope.data()});
+            solvers::threshold::limit_slopes(v.data(), w, h, cell, {0.0, slope.data()});
             EXPECT_EQ(0, std::memcmp(v.data(), reference.data(), v.size() * sizeof(double)))
                 << w << " x " << h << ", " << threads << " threads";
             auto with_kept = start;
             std::vector<double> removed(start.size(), 0.0);
-            const auto result = threshold::limit_slopes(with_kept.data(), w, h, cell, {0.0, slope.data()}, nullptr,
-                                                        removed.data(), &kept);
+            const auto result = solvers::threshold::limit_slopes(with_kept.data(), w, h, cell, {0.0, slope.data()},
+                                                                 nullptr, removed.data(), &kept);
             EXPECT_EQ(0, std::memcmp(with_kept.data(), reference.data(), v.size() * sizeof(double)))
                 << w << " x " << h << ", " << threads << " threads, working memory kept";
             std::int64_t lowered = 0;
@@ -235,9 +235,9 @@ TEST(ThresholdSlopes, TheSameBitsAsAJacobiIterationAndOnOneAndTwoThreads) {
 
 TEST(ThresholdSlopes, ABadSlopeOrCellIsRefused) {
     std::vector<double> v(16, 0.0);
-    EXPECT_THROW(threshold::limit_slopes(v.data(), 4, 4, 30.0, {0.0}), std::invalid_argument);
-    EXPECT_THROW(threshold::limit_slopes(v.data(), 4, 4, 30.0, {std::nan("")}), std::invalid_argument);
-    EXPECT_THROW(threshold::limit_slopes(v.data(), 4, 4, 0.0, {0.5}), std::invalid_argument);
+    EXPECT_THROW(solvers::threshold::limit_slopes(v.data(), 4, 4, 30.0, {0.0}), std::invalid_argument);
+    EXPECT_THROW(solvers::threshold::limit_slopes(v.data(), 4, 4, 30.0, {std::nan("")}), std::invalid_argument);
+    EXPECT_THROW(solvers::threshold::limit_slopes(v.data(), 4, 4, 0.0, {0.5}), std::invalid_argument);
 }
 
 }  // namespace

@@ -50,8 +50,8 @@ int main(int argc, char** argv) {
     }
     std::vector<float> eroded(h.size());
     sim.write_terrain(GridView{eroded.data(), n, n, cell});
-    const auto shade = png_export::hillshade(ConstGridView(eroded.data(), n, n, cell), 8, 315, 45);
-    const auto range = png_export::range_of(ConstGridView(eroded.data(), n, n, cell));
+    const auto shade = formats::png::hillshade(ConstGridView(eroded.data(), n, n, cell), 8, 315, 45);
+    const auto range = formats::png::range_of(ConstGridView(eroded.data(), n, n, cell));
     const int scale = 4;  // pixels per cell
     const int W = (n - 1) * scale + 1;
     std::vector<std::uint8_t> rgba(std::size_t(W) * W * 4);

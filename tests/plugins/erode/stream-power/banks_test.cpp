@@ -83,7 +83,7 @@ TEST(Banks, AStraightRiverLowersEachBankByHalfItsShare) {
     EXPECT_DOUBLE_EQ(v.right[at(1, 2)], 3.0);
     EXPECT_DOUBLE_EQ(v.left[at(1, 2)], 3.0);
     EXPECT_EQ(v.right[at(4, 2)], 0.0);  // the root drains nowhere: no push
-    const double removed = lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr,
+    const double removed = lower_banks(b, v.w, {v.dir.data(), v.area.data(), nullptr}, {v.right.data(), v.left.data()},
                                        30.0, v.heights.data(), v.scratch);
     for (int x = 0; x < kW; ++x) {
         const double bank = x + 1 < kW ? 97.0 : 100.0;  // beside the root nothing pushes
@@ -118,7 +118,7 @@ TEST(Banks, ABankStopsAboveItsRiverAtTheFloorSlopeAndOutletsStay) {
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     std::vector<std::uint8_t> outlet(kW * kH, 0);
     outlet[at(0, 3)] = 1;
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), outlet.data(), 30.0,
+    lower_banks(b, v.w, {v.dir.data(), v.area.data(), outlet.data()}, {v.right.data(), v.left.data()}, 30.0,
                 v.heights.data(), v.scratch);
     EXPECT_DOUBLE_EQ(v.heights[at(1, 1)], 3.0);
     EXPECT_DOUBLE_EQ(v.heights[at(2, 1)], 2.0);
@@ -191,7 +191,7 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     b.erosion = 4.0;  // 4 m a side, 2 m on each flanking cell
     b.area = 1e4;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
+    lower_banks(b, v.w, {v.dir.data(), v.area.data(), nullptr}, {v.right.data(), v.left.data()}, 30.0, v.heights.data(),
                 v.scratch);
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 98.0) << k;
     // The diagonal neighbours lie √2 cells off the river's line (the receiver and the donor on it): untouched.
@@ -200,7 +200,7 @@ TEST(Banks, ADiagonalRiverPushesHalfOnEachEdgeNeighbourFlankingIt) {
     b.erosion = 400.0;
     b.floor_slope = 0.1;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
+    lower_banks(b, v.w, {v.dir.data(), v.area.data(), nullptr}, {v.right.data(), v.left.data()}, 30.0, v.heights.data(),
                 v.scratch);
     for (int k = 0; k < 8; k += 2) EXPECT_DOUBLE_EQ(v.heights[at(2 + kDx[k], 2 + kDy[k])], 3.0) << k;
 }
@@ -220,7 +220,7 @@ Window wide_river(double erosion, double wide_area, double bank = 3.0) {
     b.wide_area = wide_area;
     bank_pushes(b, BankAreaFactor(b, 30.0), v.w, v.dir.data(), v.area.data(), v.incised.data(), v.right, v.left);
     BankRelay relay;
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), nullptr, 30.0, v.heights.data(),
+    lower_banks(b, v.w, {v.dir.data(), v.area.data(), nullptr}, {v.right.data(), v.left.data()}, 30.0, v.heights.data(),
                 v.scratch, &relay);
     if (b.wide()) lower_relayed(b, v.w, relay, nullptr, 30.0, v.heights.data());
     return v;
@@ -276,7 +276,7 @@ TEST(Banks, ADiagonalRiverPushesOnAcrossItsFlowAndOutletsStay) {
     BankRelay relay;
     std::vector<std::uint8_t> outlet(kW * kH, 0);
     outlet[at(4, 0)] = 1;
-    lower_banks(b, v.w, v.dir.data(), v.right.data(), v.left.data(), v.area.data(), outlet.data(), 30.0,
+    lower_banks(b, v.w, {v.dir.data(), v.area.data(), outlet.data()}, {v.right.data(), v.left.data()}, 30.0,
                 v.heights.data(), v.scratch, &relay);
     EXPECT_EQ(relay.out[at(1, 3)], 3);  // on the river's right, onward to the south-west
     EXPECT_EQ(relay.out[at(3, 1)], 7);  // on its left, onward to the north-east
@@ -471,7 +471,7 @@ TEST(Floodplain, CellsWithinTheHalfWidthFallToTheirNearestRiverPlusTheSlope) {
     const Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
     std::vector<double> nearest, floor;
     const double removed =
-        carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), nullptr, r.heights.data(), nearest, floor);
+        carve_floodplains(fp, r.w, r.h, 30.0, {r.dir.data(), r.area.data(), nullptr}, r.heights.data(), nearest, floor);
     for (int x = 0; x + 1 < r.w; ++x) {  // the last cell is a root: its floodplain is none
         EXPECT_DOUBLE_EQ(r.at(x, 5), 50.0 - x) << "the river stays";
         for (int d : {1, 2}) {
@@ -483,7 +483,7 @@ TEST(Floodplain, CellsWithinTheHalfWidthFallToTheirNearestRiverPlusTheSlope) {
     EXPECT_GT(removed, 0.0);
     // A river draining less than floodplain_area has none.
     RiverRow small(0.9e6);
-    carve_floodplains(fp, small.w, small.h, 30.0, small.dir.data(), small.area.data(), nullptr, small.heights.data(),
+    carve_floodplains(fp, small.w, small.h, 30.0, {small.dir.data(), small.area.data(), nullptr}, small.heights.data(),
                       nearest, floor);
     EXPECT_DOUBLE_EQ(small.at(3, 4), 100.0);
 }
@@ -497,7 +497,7 @@ TEST(Floodplain, OnlyReachesGentlerThanTheMaxSlopePlaneAFloor) {
     Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
     fp.max_slope = std::tan(3.0 * std::numbers::pi / 180.0);
     std::vector<double> nearest, floor;
-    carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), nullptr, r.heights.data(), nearest, floor);
+    carve_floodplains(fp, r.w, r.h, 30.0, {r.dir.data(), r.area.data(), nullptr}, r.heights.data(), nearest, floor);
     for (int x = 0; x <= 7; ++x)
         for (int y : {3, 4, 6, 7}) EXPECT_DOUBLE_EQ(r.at(x, y), 100.0) << "gorge: " << x << " " << y;
     for (int x = 10; x + 1 < r.w; ++x) {
@@ -510,7 +510,7 @@ TEST(Floodplain, OnlyReachesGentlerThanTheMaxSlopePlaneAFloor) {
     for (int x = 0; x < every.w; ++x)
         every.heights[std::size_t(5) * every.w + x] = x < 10 ? 70.0 - 4.0 * x : 40.0 - (x - 10);
     fp.max_slope = 0.0;
-    carve_floodplains(fp, every.w, every.h, 30.0, every.dir.data(), every.area.data(), nullptr, every.heights.data(),
+    carve_floodplains(fp, every.w, every.h, 30.0, {every.dir.data(), every.area.data(), nullptr}, every.heights.data(),
                       nearest, floor);
     EXPECT_DOUBLE_EQ(every.at(3, 4), 70.0 - 12.0 + 0.5);
 }
@@ -530,7 +530,8 @@ TEST(Floodplain, TheNearestRiverSetsACellNotTheLowestAndOutletsStay) {
     outlet[std::size_t(6) * r.w + 10] = 1;
     const Floodplain fp{1e6, 30.0, 0.5, 0.5 / 30.0};
     std::vector<double> nearest, floor;
-    carve_floodplains(fp, r.w, r.h, 30.0, r.dir.data(), r.area.data(), outlet.data(), r.heights.data(), nearest, floor);
+    carve_floodplains(fp, r.w, r.h, 30.0, {r.dir.data(), r.area.data(), outlet.data()}, r.heights.data(), nearest,
+                      floor);
     for (int x = 1; x + 1 < r.w; ++x) {
         if (x == 10) continue;
         EXPECT_DOUBLE_EQ(r.at(x, 6), 50.0 - x + 0.5) << x << ": the upper arm's floor, not the lower arm's";

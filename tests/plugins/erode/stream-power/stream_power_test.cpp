@@ -339,7 +339,7 @@ TEST(Beds, FaultsStepTheBedsAcrossTheirTracesAndDieAwayFromThem) {
         const int width = 150, height = 90;
         const double cell = 30.0;
         std::vector<double> offsets;
-        bed_offsets(beds, std::size_t(width * height), width, x0, y0, cell, offsets);
+        bed_offsets(beds, {std::size_t(width * height), width, x0, y0, cell}, offsets);
         for (int i = 0; i < width * height; ++i)
             ASSERT_EQ(offsets[std::size_t(i)], beds.offset((x0 + i % width) * cell, (y0 + i / width) * cell))
                 << "cell " << i << " of the block at " << x0 << ", " << y0;
@@ -444,8 +444,8 @@ TEST(Beds, EachCellTakesItsOwnBedsSlopeAndErodibility) {
         beds.thickness_spread = spread;
         beds.facies_length = facies;  // lattice cells of 700 m: a block of 64 × 48 cells of 30 m spans several
         beds.facies_share = 0.6;
-        bed_offsets(beds, n, width, 5, 9, 30.0, offsets);
-        rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 5, 9, 30.0, slopes, factors);
+        bed_offsets(beds, {n, width, 5, 9, 30.0}, offsets);
+        rock_at(beds, {n, width, 5, 9, 30.0}, {heights.data(), uplifted.data(), offsets.data()}, slopes, factors);
         ASSERT_EQ(slopes.size(), n);
         ASSERT_EQ(factors.size(), n);
         for (std::size_t i = 0; i < n; ++i) {
@@ -474,8 +474,8 @@ TEST(Beds, JointBlocksStandUpToTheSpreadSteeperThanTheirBedAndTileAlike) {
         const std::size_t n = std::size_t(width * height);
         std::vector<double> heights(n), uplifted(n, 0.0), offsets, slopes, factors;
         for (std::size_t i = 0; i < n; ++i) heights[i] = 900.0 * std::cos(0.011 * double(i)) + 0.3 * double(i);
-        bed_offsets(beds, n, width, 0, 0, 30.0, offsets);
-        rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 0, 0, 30.0, slopes, factors);
+        bed_offsets(beds, {n, width, 0, 0, 30.0}, offsets);
+        rock_at(beds, {n, width, 0, 0, 30.0}, {heights.data(), uplifted.data(), offsets.data()}, slopes, factors);
         ASSERT_EQ(slopes.size(), n) << "joint blocks vary the slope even in one rock";
         double lowest_share = 1.0, highest_share = 0.0, sum = 0.0;
         for (std::size_t i = 0; i < n; ++i) {
@@ -495,8 +495,8 @@ TEST(Beds, JointBlocksStandUpToTheSpreadSteeperThanTheirBedAndTileAlike) {
         std::vector<double> h2, u2, o2, s2, f2;
         for (int y = 0; y < height; ++y)
             for (int x = half; x < width; ++x) h2.push_back(heights[std::size_t(y * width + x)]), u2.push_back(0.0);
-        bed_offsets(beds, h2.size(), width - half, half, 0, 30.0, o2);
-        rock_at(beds, h2.data(), u2.data(), o2.data(), h2.size(), width - half, half, 0, 30.0, s2, f2);
+        bed_offsets(beds, {h2.size(), width - half, half, 0, 30.0}, o2);
+        rock_at(beds, {h2.size(), width - half, half, 0, 30.0}, {h2.data(), u2.data(), o2.data()}, s2, f2);
         for (int y = 0; y < height; ++y)
             for (int x = half; x < width; ++x)
                 ASSERT_EQ(s2[std::size_t(y * (width - half) + x - half)], slopes[std::size_t(y * width + x)])
@@ -533,15 +533,15 @@ TEST(Beds, ARememberedRockIsTheRockDrawnAfresh) {
             heights[i] = 1200.0 * std::sin(0.21 * double(i)) + 0.7 * double(i);
             uplifted[i] = 50.0 + 0.02 * double(i);
         }
-        bed_offsets(beds, n, width, 3, 7, 30.0, offsets);
+        bed_offsets(beds, {n, width, 3, 7, 30.0}, offsets);
         RockMemo memo;
         for (int call = 0; call < 12; ++call) {
             for (std::size_t i = 0; i < n; ++i) heights[i] -= double(i % 7) * (i % 3 == 0 ? 9.0 : 0.4);
             heights[29] = call == 4 ? std::numeric_limits<double>::quiet_NaN() : 100.0 - call;
             if (call == 8) slopes.clear(), factors.clear();  // arrays the memo did not fill: drawn afresh
-            rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 3, 7, 30.0, slopes, factors,
+            rock_at(beds, {n, width, 3, 7, 30.0}, {heights.data(), uplifted.data(), offsets.data()}, slopes, factors,
                     &memo);
-            rock_at(beds, heights.data(), uplifted.data(), offsets.data(), n, width, 3, 7, 30.0, fresh_slopes,
+            rock_at(beds, {n, width, 3, 7, 30.0}, {heights.data(), uplifted.data(), offsets.data()}, fresh_slopes,
                     fresh_factors);
             ASSERT_EQ(slopes.size(), fresh_slopes.size());
             ASSERT_EQ(factors.size(), fresh_factors.size());

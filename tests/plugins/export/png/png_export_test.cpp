@@ -18,8 +18,8 @@ namespace fs = std::filesystem;
 
 TEST(Hillshade, FlatTerrainReadsTheSineOfTheElevation) {
     std::vector<float> flat(9 * 9, 120.0f);
-    const auto s8 = png_export::hillshade({flat.data(), 9, 9, 10.0}, 8, 315, 45);
-    const auto s16 = png_export::hillshade({flat.data(), 9, 9, 10.0}, 16, 315, 30);
+    const auto s8 = formats::png::hillshade({flat.data(), 9, 9, 10.0}, 8, 315, 45);
+    const auto s16 = formats::png::hillshade({flat.data(), 9, 9, 10.0}, 16, 315, 30);
     for (auto v : s8) EXPECT_EQ(v, 180);  // round(sin 45° · 255)
     const long expected16 = std::lround(std::sin(30.0 * 3.14159265358979323846 / 180.0) * 65535.0);
     EXPECT_EQ(expected16, 32767);  // sin 30° is 0.49999999999999994 in doubles
@@ -35,8 +35,8 @@ TEST(Hillshade, SlopesFacingTheLightAreBrighterAndAFaceTowardsItIsWhite) {
             east[std::size_t(y * n + x)] = float(x * 2.0);  // 2 m cells: rises 1 m per m to the east
             west[std::size_t(y * n + x)] = float(-x * 2.0);
         }
-    const auto lit = png_export::hillshade({east.data(), n, n, 2.0}, 8, 270, 45);
-    const auto dark = png_export::hillshade({west.data(), n, n, 2.0}, 8, 270, 45);
+    const auto lit = formats::png::hillshade({east.data(), n, n, 2.0}, 8, 270, 45);
+    const auto dark = formats::png::hillshade({west.data(), n, n, 2.0}, 8, 270, 45);
     // Facing the light: normal (−1, 0, 1)/√2 · light (−cos45, 0, sin45) = 1.
     EXPECT_EQ(lit[3 * n + 3], 255);
     // Facing away at 45° with the light at 45°: grazing, 0.
@@ -45,7 +45,7 @@ TEST(Hillshade, SlopesFacingTheLightAreBrighterAndAFaceTowardsItIsWhite) {
     std::vector<float> south(n * n);
     for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) south[std::size_t(y * n + x)] = float(y * 2.0);
-    EXPECT_NEAR(png_export::hillshade({south.data(), n, n, 2.0}, 8, 270, 45)[3 * n + 3], 127.5, 0.5);  // 0.5 · 255
+    EXPECT_NEAR(formats::png::hillshade({south.data(), n, n, 2.0}, 8, 270, 45)[3 * n + 3], 127.5, 0.5);  // 0.5 · 255
 }
 
 TEST(PngExportCli, SixteenBitHeightsLayersAndHillshadeRoundTrip) {
@@ -81,7 +81,7 @@ TEST(PngExportCli, SixteenBitHeightsLayersAndHillshadeRoundTrip) {
     // The hillshade is the core's, written as 8-bit.
     const GrayImage shade = read_gray_png(dir / "out" / "shade.png");
     EXPECT_EQ(shade.bits, 8);
-    EXPECT_EQ(shade.samples, png_export::hillshade({h.data(), 97, 97, 15.0}, 8, 135, 35));
+    EXPECT_EQ(shade.samples, formats::png::hillshade({h.data(), 97, 97, 15.0}, 8, 135, 35));
 }
 
 TEST(PngExportCli, ALogScaleSpreadsALayersOrdersOfMagnitudeOverTheGreys) {

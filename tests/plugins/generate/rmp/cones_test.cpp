@@ -12,6 +12,7 @@
 
 using namespace orogen;
 using namespace orogen::rmp;
+using namespace orogen::relief;
 
 TEST(RmpCones, ConesDrawTheExactVoronoiDiagram) {
     const int w = 129, h = 97;

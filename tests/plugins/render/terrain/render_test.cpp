@@ -108,7 +108,7 @@ TEST(Splatting, TheShaderFollowsTheRulesOfSplatWeights) {
     const auto colours = Style::default_materials();
     for (int x = 2; x < 126; ++x) {
         const float h = float((x + 0.5) / 128.0 * (n - 1));
-        const terrain::SplatWeights w = terrain::splat_weights(h, 0, float(n - 1), 0.995f);
+        const mesh::SplatWeights w = mesh::splat_weights(h, 0, float(n - 1), 0.995f);
         const float want_g =
             w.sand * colours[0][1] + w.grass * colours[1][1] + w.rock * colours[2][1] + w.snow * colours[3][1];
         const float got_g = im.rgba32f[4 * std::size_t(64 * 128 + x) + 1];
@@ -509,7 +509,7 @@ TEST(Golden, TheSceneMatchesItsGoldenImageAndRepeatsExactly) {
     const Image a = golden_scene(), b = golden_scene();
     ASSERT_EQ(a.rgba32f.size(), b.rgba32f.size());
     EXPECT_TRUE(a.rgba32f == b.rgba32f) << "the same scene rendered twice differs";
-    const auto bytes = png_export::to_srgb8(a, png_export::Tonemap::aces, 0);
+    const auto bytes = formats::srgb::to_srgb8(a, formats::srgb::Tonemap::aces, 0);
     const std::filesystem::path golden =
         std::filesystem::path(OROGEN_SOURCE_DIR) / "tests/plugins/render/terrain/golden_scene.png";
     if (std::getenv("OROGEN_UPDATE_GOLDEN")) {

@@ -95,7 +95,7 @@ TEST(Video, TheFirstFrameMatchesThePngOfTheSameFrame) {
     TempDir dir;
     const Turntable t;
     video::encode_video(dir / "t.mp4", 6, [&](std::size_t i) { return t.frame(i, 128, 96); }, {.fps = 30});
-    const auto png = png_export::to_srgb8(t.frame(0, 128, 96), png_export::Tonemap::aces, 0);
+    const auto png = formats::srgb::to_srgb8(t.frame(0, 128, 96), formats::srgb::Tonemap::aces, 0);
     // FFmpeg decodes frame 0 to RGB with the matrix the file is tagged with.
     const std::string raw = run("ffmpeg -v error -i " + q(dir / "t.mp4") +
                                 " -frames:v 1 -vf scale=in_color_matrix=bt601:in_range=tv -f rawvideo -pix_fmt rgba -");

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace orogen::png_export {
+namespace orogen::formats::png {
 
 struct Range {
     float low = 0.0f, high = 0.0f;
@@ -30,4 +30,4 @@ std::vector<std::uint16_t> quantise(ConstGridView grid, int bits, Range range);
 std::vector<std::uint16_t> hillshade(ConstGridView heights, int bits, double azimuth_degrees, double elevation_degrees,
                                      double vertical_scale = 1.0);
 
-}  // namespace orogen::png_export
+}  // namespace orogen::formats::png

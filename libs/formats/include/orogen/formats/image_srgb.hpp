@@ -10,7 +10,7 @@
 #include <string_view>
 #include <vector>
 
-namespace orogen::png_export {
+namespace orogen::formats::srgb {
 
 enum class Tonemap {
     clamp,  ///< values above 1 clip
@@ -26,4 +26,4 @@ Tonemap parse_tonemap(std::string_view name);
 /// An 8-bit image is returned as it is.
 std::vector<std::uint8_t> to_srgb8(const Image& image, Tonemap tonemap, double exposure_stops);
 
-}  // namespace orogen::png_export
+}  // namespace orogen::formats::srgb

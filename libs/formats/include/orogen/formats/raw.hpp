@@ -17,7 +17,7 @@
 #include <string>
 #include <vector>
 
-namespace orogen::raw {
+namespace orogen::formats::raw {
 
 enum class Format { r16, r32 };
 
@@ -72,4 +72,4 @@ Sidecar read_raw_header(const std::filesystem::path& file);
 /// read_raw_header(), then the samples, a row at a time, as heights in metres (r16 dequantised).
 std::vector<float> read_raw(const std::filesystem::path& file, Sidecar& info);
 
-}  // namespace orogen::raw
+}  // namespace orogen::formats::raw

@@ -36,7 +36,7 @@
 // plus the floor slope over 2r. Its valley floor is then about five cells
 // wide rather than three, as real floors widen downstream (10 m above
 // rivers draining 1 km², real 30 m DEMs' valleys are 90–150 m wide;
-// tools/texture_figures.py). The cell across the river finds the push it
+// tools/figures/texture_figures.py). The cell across the river finds the push it
 // passes on as it settles (lower_banks) and the cell beyond reads it from
 // its neighbour (lower_relayed): a reach of two cells with a halo of one,
 // and one more exchange between. Rivers draining more than
@@ -54,6 +54,7 @@
 // tile with a halo of one cell computes its own cells exactly (tiled.cpp).
 #pragma once
 
+#include "flow.hpp"
 #include "onset.hpp"
 
 #include <cmath>
@@ -135,15 +136,21 @@ struct BankWindow {
 void bank_pushes(const Banks& banks, const BankAreaFactor& factor, const BankWindow& w, const std::int8_t* dir,
                  const double* area, const double* incised, std::vector<double>& right, std::vector<double>& left);
 
-/// Second pass: lowers each computed cell by what its neighbours push on it,
+/// The pushes bank_pushes wrote (window-indexed), as lower_banks reads them.
+struct BankPushes {
+    const double* right = nullptr;
+    const double* left = nullptr;
+};
+
+/// Second pass (`flow`: the window's directions, areas and outlets, D8Flow): lowers each computed cell by
+/// what its neighbours push on it,
 /// not below the one pushing hardest plus banks.floor_slope over one cell; `outlet` cells (window-indexed, or null)
 /// stay. With banks.wide() and a `relay` (sized to the window), also fills it for the computed cells: a
 /// cell straight across a river draining at least banks.wide_area (`area`), left within half a metre of
 /// its floor, passes that river's push on that side onward (banks.hpp). Returns the volume removed over
 /// the computed cells, m³.
-double lower_banks(const Banks& banks, const BankWindow& w, const std::int8_t* dir, const double* right,
-                   const double* left, const double* area, const std::uint8_t* outlet, double cell, double* heights,
-                   std::vector<double>& scratch, BankRelay* relay = nullptr);
+double lower_banks(const Banks& banks, const BankWindow& w, const D8Flow& flow, const BankPushes& pushes, double cell,
+                   double* heights, std::vector<double>& scratch, BankRelay* relay = nullptr);
 
 /// Third pass (banks.wide()): lowers each computed cell to the lowest that a neighbour passing a push
 /// on towards it brings it (`relay` as lower_banks filled it, a tile's halo exchanged), not below that
@@ -159,10 +166,11 @@ double lower_relayed(const Banks& banks, const BankWindow& w, const BankRelay& r
 /// (the whole-grid Model and the banks process).
 class BankEroder {
 public:
-    /// `dir` each cell's direction to its receiver (kDx/kDy), −1 at a root; `area` drainage area (m²);
-    /// `lowering` what the incision lowered each cell by (m, ≥ 0); `outlets` stay; lowers `heights`.
-    void erode(const Banks& banks, int width, int height, double cell, const std::int8_t* dir, const double* area,
-               const double* lowering, const std::uint8_t* outlets, double* heights);
+    /// `flow` each cell's direction to its receiver (kDx/kDy, −1 at a root), drainage area (m²) and whether
+    /// it is an outlet (which stays); `lowering` what the incision lowered each cell by (m, ≥ 0); lowers
+    /// `heights`.
+    void erode(const Banks& banks, int width, int height, double cell, const D8Flow& flow, const double* lowering,
+               double* heights);
 
 private:
     std::optional<BankAreaFactor> factor_;  // 1 − e^(−A/A_b), built at the first step

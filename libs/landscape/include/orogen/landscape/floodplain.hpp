@@ -31,6 +31,8 @@
 // window (TiledModel::plane_floodplains).
 #pragma once
 
+#include "flow.hpp"
+
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -78,11 +80,10 @@ void stamp_floodplains(std::span<const FloodplainSource> sources, int grid_width
 double lower_to_floodplains(const Floodplain& fp, double cell, std::size_t n, const std::vector<double>& nearest,
                             const std::vector<double>& floor, const std::uint8_t* outlet, double* heights);
 
-/// Lowers the `width` × `height` grid's `heights` (m, row-major) to the floodplains of its rivers (above):
-/// `dir` the D8 direction code of each cell's receiver (−1: none), `area` its drainage area (m²), `outlet`
-/// (or null) the cells that stay. `nearest` and `floor` are scratch (resized). Returns the volume removed, m³.
-double carve_floodplains(const Floodplain& fp, int width, int height, double cell, const std::int8_t* dir,
-                         const double* area, const std::uint8_t* outlet, double* heights, std::vector<double>& nearest,
-                         std::vector<double>& floor);
+/// Lowers the `width` × `height` grid's `heights` (m, row-major) to the floodplains of its rivers (above),
+/// the rivers and the cells that stay as `flow` gives them. `nearest` and `floor` are scratch (resized).
+/// Returns the volume removed, m³.
+double carve_floodplains(const Floodplain& fp, int width, int height, double cell, const D8Flow& flow, double* heights,
+                         std::vector<double>& nearest, std::vector<double>& floor);
 
 }  // namespace orogen::landscape

@@ -52,6 +52,15 @@ inline constexpr int kDx[8] = {1, 1, 0, -1, -1, -1, 0, 1};
 inline constexpr int kDy[8] = {0, 1, 1, 1, 0, -1, -1, -1};
 inline constexpr double kSqrt2 = 1.4142135623730951;  ///< a diagonal step, in cells
 
+/// A grid's D8 flow as the banks and the floodplains read it, each array a value per cell (row-major):
+/// `dir` the direction code of the cell's receiver (kDx/kDy; −1: none), `area` its drainage area (m²),
+/// `outlet` the cells that stay where they are (non-zero), or null for none.
+struct D8Flow {
+    const std::int8_t* dir = nullptr;
+    const double* area = nullptr;
+    const std::uint8_t* outlet = nullptr;
+};
+
 /// Steepest-descent direction of the cells x = 1 … W−2 of a row `c` (W
 /// heights) between rows `up` (north) and `dn` (south), into dir_out[x] as a
 /// double: 0–7 (kDx/kDy), −1 with no lower neighbour. The drop per metre is

@@ -106,10 +106,16 @@ struct Beds {
     double erodibility_factor(double s) const;
 };
 
-/// Beds::offset of each of the `count` cells of a width-`width` block whose first cell is (x0, y0) of the
-/// grid, cells `cell` metres apart; left empty when the rock is not layered. Computed once per run.
-void bed_offsets(const Beds& beds, std::size_t count, int width, int x0, int y0, double cell,
-                 std::vector<double>& offsets);
+/// A block of a grid's cells: `count` cells, `width` to a row, the first at (x0, y0) of the grid, cells
+/// `cell` metres apart (the whole grid in one process; a tile's own cells in a tiled run).
+struct CellBlock {
+    std::size_t count = 0;
+    int width = 0, x0 = 0, y0 = 0;
+    double cell = 1.0;
+};
+
+/// Beds::offset of each cell of `block`; left empty when the rock is not layered. Computed once per run.
+void bed_offsets(const Beds& beds, const CellBlock& block, std::vector<double>& offsets);
 
 /// What rock_at found in each cell last time: the bed, the cell-deep slice of rock height and the bed's
 /// strength class there. A cell still in both shows the same rock, so its slope and factor are kept; one
@@ -120,12 +126,18 @@ struct RockMemo {
     std::vector<std::int64_t> key;
 };
 
-/// Each cell's landslide slope (tan) and erodibility factor, from its height, the uplift it received and
-/// its bed_offsets (all `count` values) of a width-`width` block whose first cell is (x0, y0) of the grid,
-/// cells `cell` metres apart (the joint blocks are a cell wide and deep). `slopes` / `factors` are resized;
-/// either is left empty when it would be uniform. With a `memo` (see RockMemo) the same values, sooner.
-void rock_at(const Beds& beds, const double* heights, const double* uplifted, const double* offsets, std::size_t count,
-             int width, int x0, int y0, double cell, std::vector<double>& slopes, std::vector<double>& factors,
-             RockMemo* memo = nullptr);
+/// What rock_at reads of each cell of the block: its height, the uplift it received and its bed_offsets
+/// (block.count values each).
+struct RockInputs {
+    const double* heights = nullptr;
+    const double* uplifted = nullptr;
+    const double* offsets = nullptr;
+};
+
+/// Each cell's landslide slope (tan) and erodibility factor in `block` (the joint blocks are a cell wide
+/// and deep). `slopes` / `factors` are resized; either is left empty when it would be uniform. With a
+/// `memo` (see RockMemo) the same values, sooner.
+void rock_at(const Beds& beds, const CellBlock& block, const RockInputs& at, std::vector<double>& slopes,
+             std::vector<double>& factors, RockMemo* memo = nullptr);
 
 }  // namespace orogen::landscape

@@ -257,10 +257,10 @@ private:
     std::vector<double> h_, uplift_, uplifted_;
     FlowRouter flow_;
     std::vector<double> pow_table_;  // (c·cell²)^m for c cells of drainage area, c < 2^16
-    std::unique_ptr<diffusion::Solver> diffusion_;
+    std::unique_ptr<solvers::diffusion::Solver> diffusion_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     RockMemo rock_memo_;  // the bed and slice each cell showed (rock_at)
-    threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
+    solvers::threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::vector<double> bank_before_;  // banks: heights before the incision, then its lowering
     std::vector<std::int8_t>
@@ -330,7 +330,7 @@ std::vector<double> area_power_table(double cell, double m, double inv_ac);
 /// 1/A_c of the settings, or 0 without a channel area.
 inline double inverse_channel_area(const Settings& s) { return s.channel_area > 0.0 ? 1.0 / s.channel_area : 0.0; }
 /// The hillslope diffusion a step applies: implicit, open sides fixed, closed sides closed.
-diffusion::Settings hillslope_settings(const Settings& settings);
+solvers::diffusion::Settings hillslope_settings(const Settings& settings);
 
 /// The share of the uplift vertex (x, y) of a width × height grid (cells of `cell` m) keeps when the
 /// uplift falls to zero towards the open sides over `taper` metres: smoothstep(d/taper), d the distance

@@ -156,7 +156,7 @@ private:
     Settings settings_;
     std::vector<double> rock_slopes_, rock_k_;  // the rock each cell shows this step (rock_at), or empty
     RockMemo rock_memo_;  // the bed and slice each cell showed (rock_at)
-    threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
+    solvers::threshold::Scratch slope_scratch_;  // the landslide limit's working grids, kept between steps
     std::vector<double> bed_offset_;  // each cell's Beds::offset (the dip's and the folds' part), once
     std::int64_t sink_ = -1;  // every side closed: the outlet (whole-grid index)
     std::vector<double> h_, uplift_, uplifted_;
@@ -191,7 +191,7 @@ private:
     std::vector<double> floodplain_grown_, floodplain_nearest_, floodplain_floor_;
     std::vector<FloodplainSource> floodplain_mine_, floodplain_all_;
     std::vector<double> pow_table_;
-    std::unique_ptr<diffusion::Solver> diffusion_;
+    std::unique_ptr<solvers::diffusion::Solver> diffusion_;
     std::int64_t pits_ = 0;
     int rounds_ = 0;
     double joining_s_ = 0.0;

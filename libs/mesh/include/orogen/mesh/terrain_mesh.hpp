@@ -24,7 +24,7 @@
 #include <span>
 #include <vector>
 
-namespace orogen::terrain {
+namespace orogen::mesh {
 
 /// Sample indices kept along an axis of `n` samples when keeping every
 /// `step`-th vertex: 0, step, 2·step, ... and always n − 1 (so the mesh keeps
@@ -144,4 +144,4 @@ std::array<std::uint8_t, 3> splat_colour(const SplatWeights& w);
 /// (unexaggerated) terrain.
 std::vector<std::uint8_t> bake_splat_texture(ConstGridView heights, int texture_width, int texture_height);
 
-}  // namespace orogen::terrain
+}  // namespace orogen::mesh

@@ -8,7 +8,7 @@
 #include <span>
 #include <vector>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 /// Vertices x0..x1 (inclusive) of grid row y.
 struct RowSpan {
@@ -32,4 +32,4 @@ struct Window {
 /// `also`, if given, has the window's size and gets the same additions.
 void add_spans(Window w, std::span<const RowSpan> spans, float amount, GridView* also = nullptr);
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

@@ -19,7 +19,7 @@
 #include <span>
 #include <vector>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 /// An infinite line through `point` along `direction`.
 struct Line {
@@ -58,4 +58,4 @@ int face_containing(const Arrangement& arrangement, Point2 p);
 /// neighbours taken in ascending index order, as the thesis's DFS.
 std::vector<int> depth_first_order(const Arrangement& arrangement, int start);
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

@@ -16,7 +16,7 @@
 
 #include <cstdint>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 struct RangeParams {
     int cones = 100;  // Voronoi sites over the whole grid
@@ -43,4 +43,4 @@ struct GridWindow {
 int raise_range(GridView terrain, GridWindow grid, Point2 a, Point2 b, const RangeParams& params, std::uint64_t seed,
                 GridView* uplift = nullptr);
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

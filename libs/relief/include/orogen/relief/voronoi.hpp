@@ -21,7 +21,7 @@
 #include <span>
 #include <vector>
 
-namespace orogen::rmp {
+namespace orogen::relief {
 
 /// `count` sites uniformly over [0, width-1] × [0, height-1] (sample
 /// coordinates); site i is a pure function of (seed, i), so any method that
@@ -110,4 +110,4 @@ double cell_amount(double height, double jitter, std::uint64_t seed, int site);
 /// tests and the full-diagram pictures). Row-major, width × height.
 std::vector<std::int32_t> label_grid(const SiteIndex& index);
 
-}  // namespace orogen::rmp
+}  // namespace orogen::relief

@@ -34,7 +34,7 @@
 #include <functional>
 #include <vector>
 
-namespace orogen::diffusion {
+namespace orogen::solvers::diffusion {
 
 enum class Scheme {
     implicit,  ///< locally one-dimensional backward Euler (monotone, first order)
@@ -108,4 +108,4 @@ private:
 /// Σ heights over a grid (fixed order: the same double every time).
 double total(const double* heights, std::size_t count);
 
-}  // namespace orogen::diffusion
+}  // namespace orogen::solvers::diffusion

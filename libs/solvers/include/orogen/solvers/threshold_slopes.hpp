@@ -49,7 +49,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace orogen::threshold {
+namespace orogen::solvers::threshold {
 
 /// The lowest height (m) the points strictly between a straight neighbour at `axial` and the
 /// diagonal neighbour beside it at `diagonal` let a vertex keep, the threshold rising `step` =
@@ -106,4 +106,4 @@ Result limit_slopes(double* heights, int width, int height, double cell, const S
 Result limit_slopes(Tiling& tiles, double* heights, double cell, const Slopes& slopes,
                     const std::uint8_t* fixed = nullptr, double* removed = nullptr, Scratch* scratch = nullptr);
 
-}  // namespace orogen::threshold
+}  // namespace orogen::solvers::threshold
