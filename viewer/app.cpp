@@ -9,6 +9,7 @@
 #include "scene.hpp"
 
 #include <orogen/error.hpp>
+#include <orogen/session.hpp>
 
 #include <X11/Xlib.h>
 #include <vtkCallbackCommand.h>
@@ -218,7 +219,10 @@ fs::path self_dir() {
     return ec ? fs::path() : exe.parent_path();
 }
 
-/// A run of `orogen run SPEC --out DIR`, stdout and stderr into a log file.
+/// A run of `orogen run SPEC --out DIR`, stdout and stderr into a log file. The spec is checked first in
+/// this process, through the kernel's Session (App::check_spec); the run itself is a child process: the
+/// render passes draw through OSMesa's GL, whose gl* symbols would resolve to VTK's X GL in this process,
+/// and a run that fails hard must not take the viewer, and the last good terrain, with it.
 class SpecRun {
 public:
     SpecRun(const fs::path& orogen, const fs::path& spec, const fs::path& out) : log_(out / ".orogen-view.log") {
@@ -299,6 +303,10 @@ public:
             orogen_ = o_.orogen.empty() ? self_dir() / "orogen" : o_.orogen;
             if (o_.orogen.empty() && !fs::exists(orogen_)) orogen_ = "orogen";
             if (!o_.watch) {
+                if (const std::string problems = check_spec(); !problems.empty()) {
+                    std::cerr << problems;
+                    return 2;
+                }
                 SpecRun run(orogen_, *o_.spec, out_);
                 const int code = *run.finished(true);
                 if (code != 0) {
@@ -372,6 +380,7 @@ private:
     fs::path out_, orogen_;
     bool temporary_out_ = false;
     std::unique_ptr<SpecRun> running_;
+    std::unique_ptr<Session> session_;  // the kernel, to check the spec before each run (check_spec)
     fs::file_time_type spec_time_{};
     std::uintmax_t spec_size_ = 0;
     int reloads_ = 0;
@@ -493,10 +502,29 @@ private:
         return (uptime - start) * 1000.0;
     }
 
+    /// The spec's mistakes, every one at once with file:line:col and the count line, as `orogen run` would
+    /// report them into out_ ("" if there are none), from the kernel's Session: a spec that cannot run is
+    /// not run. The plugins are loaded once, from the folder of the orogen the runs use.
+    std::string check_spec() {
+        if (!session_) {
+            std::error_code ec;
+            session_ = std::make_unique<Session>(fs::exists(orogen_, ec) ? orogen_ : self_dir() / "orogen-view");
+        }
+        CheckSettings settings;
+        settings.out_dir = out_;
+        const Checked checked = session_->check(SpecText::read(*o_.spec), settings);
+        return checked.ok() ? std::string() : checked.report().text_with_count();
+    }
+
     void start_run() {
         std::error_code ec;
         spec_time_ = fs::last_write_time(*o_.spec, ec);
         spec_size_ = fs::file_size(*o_.spec, ec);
+        std::string problems;
+        try {
+            problems = check_spec();
+        } catch (const std::exception& e) { problems = std::string(e.what()) + "\n"; }  // unreadable mid-save
+        if (!problems.empty()) return finish_run(2, problems);  // shown at once, over the last good terrain
         running_ = std::make_unique<SpecRun>(orogen_, *o_.spec, out_);
     }
 
