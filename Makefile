@@ -132,7 +132,7 @@ asan-configure: setup
 	  -DCMAKE_C_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=address,undefined -fno-sanitize-recover=all" \
 	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined $(SAN_LD)" -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined $(SAN_LD)" \
 	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined $(SAN_LD)" \
-	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF -DOROGEN_FUZZ=ON '-DOROGEN_ONLY=$(ASAN_ONLY)' $(SAN_CMAKE) >/dev/null
+	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF -DOROGEN_BUILD_FIGURES=OFF -DOROGEN_FUZZ=ON '-DOROGEN_ONLY=$(ASAN_ONLY)' $(SAN_CMAKE) >/dev/null
 
 tsan: setup
 	@cmake -S . -B $(TSAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_C_COMPILER=clang-14 -DCMAKE_CXX_COMPILER=clang++-14 \
@@ -140,7 +140,7 @@ tsan: setup
 	  -DCMAKE_C_FLAGS_SANITIZE="$(SAN_FLAGS) -fsanitize=thread,undefined -fno-sanitize-recover=all" \
 	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread,undefined $(SAN_LD)" -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=thread,undefined $(SAN_LD)" \
 	  -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=thread,undefined $(SAN_LD)" \
-	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF '-DOROGEN_ONLY=$(TSAN_ONLY)' $(SAN_CMAKE) >/dev/null
+	  -DOROGEN_BUILD_BENCHMARKS=OFF -DOROGEN_BUILD_VIEWER=OFF -DOROGEN_BUILD_FIGURES=OFF '-DOROGEN_ONLY=$(TSAN_ONLY)' $(SAN_CMAKE) >/dev/null
 	cmake --build $(TSAN_BUILD) -j$(JOBS)
 	cd $(TSAN_BUILD) && ctest --output-on-failure --no-tests=error -j$(JOBS) -LE 'pipelines|fuzz' -E '^out_of_tree_(plugin|process)$$|$(TSAN_SKIP)'
 

@@ -1,4 +1,4 @@
-"""tools/texture_figures.py on surfaces whose answers are known, and on bad input."""
+"""tools/figures/texture_figures.py on surfaces whose answers are known, and on bad input."""
 import os
 import pathlib
 import subprocess
@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-TOOL = pathlib.Path(os.environ["OROGEN_SOURCE_DIR"]) / "tools" / "texture_figures.py"
+TOOL = pathlib.Path(os.environ["OROGEN_SOURCE_DIR"]) / "tools" / "figures" / "texture_figures.py"
 CELL = 30.0
 
 

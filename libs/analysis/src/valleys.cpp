@@ -4,7 +4,7 @@
 // floodplains and lakes would dilute how sharp the bottoms are); valley width, where the median
 // cross-section of all of them stands Options::valley_rise above the river (the floodplains count:
 // they are the widest floors); and how fast that width grows with the drainage area.
-// tools/texture_figures.py measured the first two first, with D8 on the unfilled heights: every pit
+// tools/figures/texture_figures.py measured the first two first, with D8 on the unfilled heights: every pit
 // stopped the area there, so it saw only the channels above the first pit, about half of them and none
 // draining more than ~10 km² (the widest valleys).
 #include "detail.hpp"
