@@ -54,7 +54,7 @@ void BM_stream_power_step(benchmark::State& state) {
     s.banks.erosion = double(state.range(5));  // rivers cut their banks (banks.hpp); 0: none
     s.banks.area = 3e4;
     // wide 1: floors five cells wide along rivers draining 0.3 km²; 2: and seven from 1 km²; 3: and on to fifteen
-    // (bank_widest_floor, as pipelines/kahurangi.orogen had until stop 48; thirteen since)
+    // (bank_widest_floor, as pipelines/kahurangi.orogen had until bf73596, 2026-12-06; thirteen since)
     s.banks.wide_area = state.range(6) ? 3e5 : 0.0;
     s.banks.wider_area = state.range(6) >= 2 ? 1e6 : 0.0;
     s.banks.widest_floor = state.range(6) >= 3 ? 15 : 0;

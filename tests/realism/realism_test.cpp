@@ -109,8 +109,8 @@ void expect_inside_the_bands(const std::string& spec_name, const std::string& ex
         EXPECT_LE(v, b.high) << info.key << " (" << spec_name << " " << extra << ")";
     }
     // The rivers have cut their banks, the steepest debris has slumped to 40° (a 25 m drop a cell) and the
-    // soil has crept over it: no slot one cell wide deeper than 32 m (28.4 m on six seeds since stop 43, the
-    // soil settling after the slump; 38 m before, with the slump last; 142 m before the slump).
+    // soil has crept over it: no slot one cell wide deeper than 32 m (28.4 m on six seeds since 446f07a of
+    // 2026-12-05, the soil settling after the slump; 38 m before, with the slump last; 142 m before the slump).
     EXPECT_LE(deepest_slot(h, kSide), 32.0) << spec_name << " " << extra;
 }
 
@@ -217,11 +217,11 @@ TEST_P(RangePreset, IsClosestToTheRangeItIsNamedAfter) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Pipelines, RangePreset,
-                         // Seed 42's distances over the 20 figures since stop 45 (17 before): Himalaya 1.10 with
-                         // facies and floors to eleven cells since stop 49 (1.17 before; 0.84), Rif 0.52 with its
-                         // floodplains since stop 47 (0.89 before them; 0.75),
-                         // Raukumara 0.73 with facies every 300 m since stop 49 (0.79 before; 0.65), Kahurangi
-                         // 0.65 (0.67 with stop 48's facies over 3 km; 0.50), Mont Blanc 1.15 with its banks (1.68
+                         // Seed 42's distances over the 20 figures since 4c3b145 (17 before): Himalaya 1.10 with
+                         // facies and floors to eleven cells since ab1f0bc (1.17 before; 0.84), Rif 0.52 with its
+                         // floodplains since 94ff187 (0.89 before them; 0.75),
+                         // Raukumara 0.73 with facies every 300 m since d041076 (0.79 before; 0.65), Kahurangi
+                         // 0.65 (0.67 with bf73596's facies over 3 km; 0.50), Mont Blanc 1.15 with its banks (1.68
                          // without, nearest the Andes).
                          testing::Values(Preset{"himalaya", "himalaya_baspa_30m", 1.2},
                                          Preset{"rif", "morocco_rif_27m", 0.65},
