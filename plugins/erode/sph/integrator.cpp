@@ -55,7 +55,8 @@ Simulation::Impl::Impl(ConstGridView terrain_in, const Settings& settings, std::
 /// of the cell sums over all of them (lanes of kLanes, out-of-support ones masked).
 void Simulation::Impl::density_pass() {
     const auto& soa = p.soa;
-    const float h = kernel.h, h2 = kernel.h2, inv_h = kernel.inv_h, w_norm = kernel.w_norm;
+    const float h = kernel.h, w_norm = kernel.w_norm;
+    const Support support{kernel.h2, kernel.inv_h};
     const float mass = fluid.mass, rho0 = fluid.rho0;
     parallel_for(0, std::int64_t(cells.cells()), kCellGrain, [&](std::int64_t c0, std::int64_t c1) {
         FlushDenormals ftz;
@@ -75,8 +76,9 @@ void Simulation::Impl::density_pass() {
             float* const to[3] = {X, Y, Z};
             std::size_t k = gather3(from, to, run, nr);
             for (; k < mp; ++k) X[k] = Y[k] = Z[k] = kFar;
+            const DensityCandidates cand{X, Y, Z};
             for (std::size_t i = cells.cell_begin(c); i < cells.cell_begin(c + 1); ++i) {
-                float rho = mass * (w_norm * density_sum(X, Y, Z, mp, soa[0][i], soa[1][i], soa[2][i], h2, inv_h));
+                float rho = mass * (w_norm * density_sum(cand, mp, soa[0][i], soa[1][i], soa[2][i], support));
                 // The terrain as the fluid's rest lattice continued behind it (Akinci et al. 2012's boundary
                 // particles, summed once into a table): without it a particle on the ground misses half its
                 // kernel and the fluid crowds against the ground.
@@ -112,7 +114,8 @@ void Simulation::Impl::force_pass() {
     const auto& soa = p.soa;
     const float g = float(-s.gravity);
     const float visc_k = 2.0f * fluid.alpha_c_hs;
-    const float rho0 = fluid.rho0, h2 = kernel.h2, inv_h = kernel.inv_h, visc_eps = fluid.visc_eps;
+    const float rho0 = fluid.rho0;
+    const ForceConstants fk{Support{kernel.h2, kernel.inv_h}, fluid.visc_eps, visc_k};
     const float scale = -fluid.mass * kernel.grad_norm * kernel.inv_h;  // force_sum's result → m/s²
     const std::size_t ncell = cells.cells();
     const std::int64_t blocks = (std::int64_t(ncell) + kCellGrain - 1) / kCellGrain;
@@ -142,9 +145,10 @@ void Simulation::Impl::force_pass() {
                 const ForceCandidates cand{f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7]};
                 for (std::size_t i = cells.cell_begin(c); i < cells.cell_begin(c + 1); ++i) {
                     const float pi = p.pterm[i];
+                    const ForceParticle me{soa[0][i], soa[1][i], soa[2][i], soa[3][i],
+                                           soa[4][i], soa[5][i], pi,        p.density[i]};
                     float sum[3];
-                    force_sum(cand, mp, soa[0][i], soa[1][i], soa[2][i], soa[3][i], soa[4][i], soa[5][i], pi,
-                              p.density[i], h2, inv_h, visc_eps, visc_k, sum);
+                    force_sum(cand, mp, me, fk, sum);
                     // The ground pushes back with the particle's own pressure (mirrored): −(2 p/ρ²) ρ0 ∇Φ.
                     const float wall = 2.0f * pi * rho0;
                     const Vec3& push = p.wall_push[i];

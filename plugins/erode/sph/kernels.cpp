@@ -20,8 +20,11 @@ inline float lane_sum(float* a) {
 }  // namespace
 
 OROGEN_SPH_CLONES
-float density_sum(const float* __restrict cx, const float* __restrict cy, const float* __restrict cz, std::size_t m,
-                  float px, float py, float pz, float h2, float inv_h) {
+float density_sum(const DensityCandidates& c, std::size_t m, float px, float py, float pz, Support support) {
+    const float* __restrict cx = c.x;
+    const float* __restrict cy = c.y;
+    const float* __restrict cz = c.z;
+    const float h2 = support.h2, inv_h = support.inv_h;
     float acc[kLanes] = {};
     for (std::size_t k = 0; k < m; k += kLanes)
         for (std::size_t l = 0; l < kLanes; ++l) {
@@ -47,8 +50,11 @@ void pressure_terms(const float* __restrict rho, float* __restrict pterm, std::s
 }
 
 OROGEN_SPH_CLONES
-void force_sum(const ForceCandidates& c, std::size_t m, float px, float py, float pz, float vx, float vy, float vz,
-               float pi, float rhoi, float h2, float inv_h, float visc_eps, float visc_k, float out[3]) {
+void force_sum(const ForceCandidates& c, std::size_t m, const ForceParticle& p, const ForceConstants& fk,
+               float out[3]) {
+    // The particle and the constants in locals (registers through the loop; no store can alias them).
+    const float px = p.x, py = p.y, pz = p.z, vx = p.vx, vy = p.vy, vz = p.vz, pi = p.pterm, rhoi = p.rho;
+    const float h2 = fk.support.h2, inv_h = fk.support.inv_h, visc_eps = fk.visc_eps, visc_k = fk.visc_k;
     float ax[kLanes] = {}, ay[kLanes] = {}, az[kLanes] = {};
     const float* __restrict X = c.x;
     const float* __restrict Y = c.y;

@@ -68,11 +68,20 @@ struct CubicSpline {
     }
 };
 
+/// The support as the neighbour sums use it: h² (m²) and 1/h (1/m).
+struct Support {
+    float h2, inv_h;
+};
+
+/// A cell's candidate positions for the density pass (structure of arrays, kLanes-padded).
+struct DensityCandidates {
+    const float *x, *y, *z;
+};
+
 /// Σ over candidates within the support of the cubic spline's shape
 /// (W / w_norm, dimensionless) at (px, py, pz). The candidate arrays hold `m`
 /// entries, a multiple of kLanes (padded with far-away points).
-float density_sum(const float* __restrict cx, const float* __restrict cy, const float* __restrict cz, std::size_t m,
-                  float px, float py, float pz, float h2, float inv_h);
+float density_sum(const DensityCandidates& c, std::size_t m, float px, float py, float pz, Support support);
 
 /// Tait's equation of state, p = B((ρ/ρ0)⁷ − 1) clamped at 0 (Pa), stored as p/ρ² (m⁵/(kg·s²)) for the
 /// force pass, for `count` particles.
@@ -83,12 +92,23 @@ struct ForceCandidates {
     const float *x, *y, *z, *vx, *vy, *vz, *pterm, *rho;
 };
 
+/// The particle a force sum is for: position (m), velocity (m/s), p/ρ² (m⁵/(kg·s²)) and ρ (kg/m³).
+struct ForceParticle {
+    float x, y, z, vx, vy, vz, pterm, rho;
+};
+
+/// The force pass's constants: the support, and Monaghan's viscosity as force_sum uses it (visc_eps the
+/// 0.01 (h/2)² that keeps Π finite, m²; visc_k = 2 α c0 h/2, m²/s).
+struct ForceConstants {
+    Support support;
+    float visc_eps, visc_k;
+};
+
 /// Σ_j (p_i/ρ_i² + p_j/ρ_j² + Π_ij) · shape'(q) / r · r_ij over the candidates
 /// within the support (shape' the cubic spline's derivative without its
 /// normalisation): particle i's pressure + viscosity acceleration in m/s² is
 /// −m · grad_norm / h times the result, applied by the caller. One division
 /// per pair: Π's two denominators and 1/r share it.
-void force_sum(const ForceCandidates& c, std::size_t m, float px, float py, float pz, float vx, float vy, float vz,
-               float pi, float rhoi, float h2, float inv_h, float visc_eps, float visc_k, float out[3]);
+void force_sum(const ForceCandidates& c, std::size_t m, const ForceParticle& p, const ForceConstants& fk, float out[3]);
 
 }  // namespace orogen::sph
