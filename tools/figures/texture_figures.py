@@ -29,7 +29,7 @@ channels, not flats):
 The first three are measured here rather than in `orogen analyze` because they
 are still being judged: the first depends on the DEM's vertical resolution, the
 second counts the DEM's own noise. The last two are `orogen analyze` figures
-since stop 45 (`channel_curvature`, `valley_width`), measured there on the
+since `4c3b145`, 2026-12-06 (`channel_curvature`, `valley_width`), measured there on the
 whole network: the D8 here runs on the unfilled heights, so every pit stops the
 drainage area and they see only the channels above the first pit (about half,
 none draining more than ~10 km²). They stay here to compare with earlier notes.
