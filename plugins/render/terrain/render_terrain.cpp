@@ -2,6 +2,8 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include "render_terrain.hpp"
 
+#include "atmosphere.hpp"
+
 #include "orogen_shaders.hpp"
 
 #include <orogen/error.hpp>
@@ -89,12 +91,69 @@ double bytes_per_pixel(int samples) {
     return double(samples) * (8 + 4) + 16 * 3 + 0.25 * (16 + 4);
 }
 
+/// The simulation's layers as one RGBA texture per sample (empty when the heightmap has none of them):
+/// R river cover — a river of width w = river_width·(A / river_area)^0.5 m (A the drained area) is a disc
+/// of diameter w at each of its samples, its cover the disc's share of the cell around each sample it
+/// reaches (so a river narrower than a cell still shows, faintly) —; G wetness, log10 of the drained area
+/// from 10 cells (0) to river_area (1); B deposit, from 0.5 to 5 m of debris or sediment settled (0..1).
+std::vector<float> simulation_layers(const Heightmap& hm, const Style& st) {
+    const int w = hm.width(), h = hm.height();
+    const double cell = hm.cell();
+    const bool drained = !st.drainage_layer.empty() && hm.has_layer(st.drainage_layer);
+    const char* deposit_layer = hm.has_layer("deposited") ? "deposited"
+        : hm.has_layer("sediment")                        ? "sediment"
+        : hm.has_layer("eroded")                          ? "eroded"
+                                                          : nullptr;
+    if (!drained && !deposit_layer) return {};
+    std::vector<float> out(4 * hm.size(), 0.0f);
+    if (deposit_layer) {
+        const ConstGridView d = hm.layer(deposit_layer);
+        for (std::size_t i = 0; i < hm.size(); ++i)
+            out[4 * i + 2] = float(std::clamp((double(d.data[i]) - 0.5) / 4.5, 0.0, 1.0));
+    }
+    if (!drained) return out;
+    const ConstGridView area = hm.layer(st.drainage_layer);
+    const double wet_from = std::log10(10.0 * cell * cell),
+                 wet_to = std::log10(std::max(st.river_area, 20 * cell * cell));
+    for (std::size_t i = 0; i < hm.size(); ++i) {
+        const double a = std::max(double(area.data[i]), 1.0);
+        out[4 * i + 1] = float(std::clamp((std::log10(a) - wet_from) / (wet_to - wet_from), 0.0, 1.0));
+    }
+    if (st.river_width <= 0) return out;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const double a = double(area.at(x, y));
+            if (!(a >= st.river_area)) continue;
+            const double radius = 0.5 * st.river_width * std::sqrt(a / st.river_area) / cell;  // samples
+            if (radius <= 0.5) {  // narrower than a cell: its share of the cell's width
+                float& c = out[4 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
+                c = std::max(c, float(2.0 * radius));
+                continue;
+            }
+            const int reach = int(std::ceil(radius));
+            for (int dy = -reach; dy <= reach; ++dy)
+                for (int dx = -reach; dx <= reach; ++dx) {
+                    const int xx = x + dx, yy = y + dy;
+                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+                    const float cover = float(std::clamp(radius + 0.5 - std::hypot(double(dx), double(dy)), 0.0, 1.0));
+                    float& c = out[4 * (std::size_t(yy) * std::size_t(w) + std::size_t(xx))];
+                    c = std::max(c, cover);
+                }
+        }
+    return out;
+}
+
 struct TerrainRenderer::Impl {
     std::shared_ptr<const Heightmap> terrain;
     int width = 0, height = 0;  // samples
     float lo = 0, hi = 0;  // height range, m
     bool has_water = false;
     GLuint heights = 0, surface = 0, vao = 0;
+    GLuint sim_layers = 0;  // simulation_layers(), or 0 when the heightmap has none
+    // The sky's table and the light it gives, kept while the sun and the camera's altitude stay (a turntable).
+    GLuint sky_texture = 0;
+    std::optional<std::array<double, 5>> sky_key;  // sun x y z, altitude, haze
+    glm::vec3 sky_sun_colour{0.0f}, sky_ambient{0.0f}, sky_scale{0.0f};
     // The grid's triangle strips in four drawing orders (Order), each built on first use: drawn nearest rows
     // first, the depth test rejects most hidden fragments before the splatting shader runs for them.
     std::array<GLuint, 4> indices{};
@@ -111,7 +170,7 @@ struct TerrainRenderer::Impl {
 
     ~Impl() {
         gl::Lock lock("render:terrain");
-        GLuint textures[] = {heights, surface, shadow_depth};
+        GLuint textures[] = {heights, surface, shadow_depth, sim_layers, sky_texture};
         for (GLuint t : textures)
             if (t) glDeleteTextures(1, &t);
         for (GLuint b : indices)
@@ -189,6 +248,7 @@ struct TerrainRenderer::Impl {
     void refuse_a_view_of_nothing(const Frame& f) const;
     void set_grid(GLuint program, const glm::mat4& view_projection, double exaggeration) const;
     void prepare_shadow_map(const Frame& f, const Style& st);
+    void prepare_sky(Frame& f, const Style& st);
     void draw_sky(const Frame& f) const;
     void draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored, GLuint seen);
     void draw_particles(const Frame& f, const Style& st, const Camera& camera, const ParticleFrame& particles);
@@ -270,6 +330,17 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
 
+    const std::vector<float> sim = simulation_layers(*m.terrain, style_);
+    if (!sim.empty()) {
+        glGenTextures(1, &m.sim_layers);
+        glBindTexture(GL_TEXTURE_2D, m.sim_layers);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.width, m.height, 0, GL_RGBA, GL_FLOAT, sim.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // the shader's B-spline taps
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+
     glGenVertexArrays(1, &m.vao);
     gl::check_errors("render:terrain", "uploading the terrain");
 }
@@ -278,34 +349,41 @@ TerrainRenderer::~TerrainRenderer() = default;
 
 namespace {
 
-/// The sun, the sky and the haze of one frame: the uniforms every lit pass shares.
+/// The sun, the sky and the air of one frame: the uniforms every lit pass shares. The sky's table is
+/// integrated once per sun and camera altitude (TerrainRenderer::Impl::prepare_sky) and set here.
 struct Light {
     glm::dvec3 sun;  // unit, towards the sun
-    glm::vec3 sun_colour;  // linear, times the intensity
-    glm::vec3 zenith, horizon, ambient;  // linear
-    float fog_density = 0;  // 1/m
+    Atmosphere air;
+    glm::vec3 sun_colour{0.0f};  // linear: the sunlight at the terrain per π (a white surface facing it)
+    glm::vec3 ambient{0.0f};  // linear: the sky's light on a horizontal surface per π
+    glm::vec3 sky_scale{0.0f};  // the sun's irradiance above the air, the sky table's unit
+    float sea_y = 0, exaggeration = 1;  // world y of the sea level; vertical exaggeration
+    GLuint sky_texture = 0;
 
-    Light(const Style& st, double radius) {
-        sun = direction(st.sun_azimuth, st.sun_elevation);
-        sun_colour = glm::vec3(1.0f, 0.93f, 0.82f) * float(st.sun_intensity);
-        // Sky: bluer at the zenith, warmer and paler at the horizon when the sun is low.
-        const float low = float(std::clamp(1.0 - st.sun_elevation / 45.0, 0.0, 1.0));
-        zenith = glm::mix(glm::vec3(0.05f, 0.14f, 0.42f), glm::vec3(0.08f, 0.16f, 0.38f), low);
-        horizon = glm::mix(glm::vec3(0.42f, 0.52f, 0.68f), glm::vec3(0.62f, 0.52f, 0.46f), low * 0.5f);
-        ambient = (zenith * 0.6f + horizon * 0.4f) * 0.9f;
-        fog_density = float(st.haze / std::max(2.0 * radius, 1e-6));
-    }
+    explicit Light(const Style& st) : sun(direction(st.sun_azimuth, st.sun_elevation)) { air.haze = st.haze; }
 
-    /// The light's uniforms on `p`, seen from `eye`; `disc` 1 draws the sun's disc (the sky pass only).
+    /// The light's uniforms on `p`; `disc` 1 draws the sun's disc (the sky pass only). Binds the sky table
+    /// to texture unit 5.
     void set_on(GLuint p, float disc, const glm::dvec3& eye) const {
         set(p, "sun_direction", glm::vec3(sun));
         set(p, "sun_colour", sun_colour);
-        set(p, "sky_zenith", zenith);
-        set(p, "sky_horizon", horizon);
         set(p, "sun_disc", disc);
-        set(p, "fog_density", fog_density);
         set(p, "ambient_colour", ambient);
         set(p, "eye", glm::vec3(eye));
+        set(p, "sky_scale", sky_scale);
+        set(p, "air_sea_y", sea_y);
+        set(p, "air_exaggeration", exaggeration);
+        set(p, "rayleigh_scattering",
+            glm::vec3(float(air.rayleigh[0]), float(air.rayleigh[1]), float(air.rayleigh[2])));
+        set(p, "mie_scattering", float(air.mie_scattering * air.haze));
+        set(p, "mie_extinction", float(air.mie_extinction * air.haze));
+        set(p, "rayleigh_height", float(air.rayleigh_height));
+        set(p, "mie_height", float(air.mie_height));
+        set(p, "mie_g", float(air.mie_g));
+        glActiveTexture(GL_TEXTURE5);
+        glBindTexture(GL_TEXTURE_2D, sky_texture);
+        glActiveTexture(GL_TEXTURE0);
+        set(p, "sky_table", 5);
     }
 };
 
@@ -390,7 +468,7 @@ TerrainRenderer::Impl::Frame TerrainRenderer::Impl::frame_box(int frame_width, i
     f.radius = glm::length(f.box_max - f.box_min) * 0.5;
     f.aspect = double(frame_width) / double(std::max(frame_height, 1));
     f.shaded = st.output == Style::Output::beauty;
-    f.light.emplace(st, f.radius);
+    f.light.emplace(st);
     return f;
 }
 
@@ -606,8 +684,49 @@ void TerrainRenderer::Impl::prepare_shadow_map(const Frame& f, const Style& st) 
     shadow_stride = stride;
 }
 
+/// The sky's table for the sun and the camera's altitude (kept from the last frame when they are the same),
+/// and the light it gives: the sunlight through the air to the terrain's mean altitude, relative to the
+/// sun at the zenith there (so `sun_intensity` stays the light of a high sun), and the sky's light.
+void TerrainRenderer::Impl::prepare_sky(Frame& f, const Style& st) {
+    Light& light = *f.light;
+    light.exaggeration = float(f.exag);
+    light.sea_y = float(st.sea_level * f.exag);
+    const double altitude = std::max(f.eye.y / f.exag - st.sea_level, 1.0);
+    const std::array<double, 5> key{light.sun.x, light.sun.y, light.sun.z, altitude, st.haze};
+    if (!sky_texture || sky_key != key) {
+        const SkyTable table = sky_table(light.air, {light.sun.x, light.sun.y, light.sun.z}, altitude);
+        const double ground = std::max(0.5 * double(lo + hi) - st.sea_level, 0.0);
+        const auto slant = transmittance(light.air, ground, light.sun.y);
+        const auto zenith = transmittance(light.air, ground, 1.0);
+        for (int c = 0; c < 3; ++c) {
+            sky_sun_colour[c] = float(st.sun_intensity * slant[std::size_t(c)] / zenith[std::size_t(c)]);
+            sky_scale[c] = float(std::numbers::pi * st.sun_intensity / zenith[std::size_t(c)]);
+            // the sky's light, and the sunlight the ground around reflects into the shade (albedo 0.15)
+            sky_ambient[c] = float(sky_scale[c] * table.irradiance[std::size_t(c)] / std::numbers::pi +
+                                   0.15 * sky_sun_colour[c] * std::max(light.sun.y, 0.0));
+        }
+        if (!sky_texture) glGenTextures(1, &sky_texture);
+        glBindTexture(GL_TEXTURE_2D, sky_texture);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, table.width, table.height, 0, GL_RGB, GL_FLOAT, table.rgb.data());
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);  // the azimuth turns around
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        sky_key = key;
+    }
+    light.sky_texture = sky_texture;
+    light.sun_colour = sky_sun_colour;
+    light.ambient = sky_ambient;
+    light.sky_scale = sky_scale;
+}
+
 /// The sky, which also clears the colour.
 void TerrainRenderer::Impl::draw_sky(const Frame& f) const {
+    if (!f.shaded) {  // albedo and normals: mid grey behind the terrain (the normal pass's zero vector)
+        glClearColor(0.5f, 0.5f, 0.5f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT);
+        return;
+    }
     const GLuint program = programs().sky;
     glUseProgram(program);
     f.light->set_on(program, 1.0f, f.eye);
@@ -636,11 +755,16 @@ void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const 
     set(program, "shadow_map", 1);
     set_grid(program, matrix, f.exag);
     f.light->set_on(program, 0.0f, f.eye);
-    set(program, "height_min", lo);
-    set(program, "height_max", hi);
-    const float starts[4] = {0.0f, st.splat.band_start[0], st.splat.band_start[1], st.splat.band_start[2]};
-    glUniform1fv(loc(program, "band_start"), 4, starts);
-    set(program, "blend_fraction", st.splat.blend_fraction);
+    set(program, "sea_altitude", float(st.sea_level));
+    set(program, "has_sea", st.sea ? 1 : 0);
+    set(program, "beach_height", float(st.beach_height));
+    set(program, "tree_line", float(st.tree_line));
+    set(program, "snow_line", float(st.snow_line));
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D, sim_layers);
+    glActiveTexture(GL_TEXTURE0);
+    set(program, "layers", 4);
+    set(program, "has_layers", sim_layers ? 1 : 0);
     set(program, "slope_start", st.splat.slope_start);
     set(program, "slope_full", st.splat.slope_full);
     float materials[12];
@@ -812,6 +936,7 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     glPrimitiveRestartIndex(0xFFFFFFFFu);
     glDisable(GL_CULL_FACE);
 
+    m.prepare_sky(f, st);
     f.light_view_projection = light_matrix(f.light->sun, f.centre, f.radius, f.box_min, f.box_max);
     m.prepare_shadow_map(f, st);
     mark(&Timings::shadow);
