@@ -102,6 +102,8 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
             a.discriminate = true;
         } else if (arg == "--no-render") {
             a.render = false;
+        } else if (arg == "--fit-filled-flats") {
+            a.fit_filled_flats = true;
         } else if (arg == "--skip-filled-flats") {
             a.skip_filled_flats = true;
         } else if (arg == "--quiet" || arg == "-q") {
@@ -118,8 +120,10 @@ std::string parse_analyze_args(int argc, char** argv, AnalyzeArgs& a) {
             : "analyze needs a terrain to measure before --against (the files after it are references)";
     if (references && a.against.empty()) return "--against needs at least one reference DEM after it";
     if (a.window_m && !a.discriminate) return "--window-m is the window of --discriminate; add --discriminate";
-    if (a.skip_filled_flats && a.discriminate)
-        return "--skip-filled-flats changes the figures' table, which --discriminate does not print; drop one";
+    if (a.fit_filled_flats && a.skip_filled_flats)
+        return "--fit-filled-flats and --skip-filled-flats contradict each other; give one (skip is the default)";
+    if (a.fit_filled_flats && a.discriminate)
+        return "--fit-filled-flats changes the figures' table, which --discriminate does not print; drop one";
     if (a.discriminate) {
         if (a.files.size() < 2 || a.against.size() < 2)
             return "--discriminate leaves one source out at a time, so it needs at least two generated terrains "
@@ -230,7 +234,7 @@ ComposedSpec compose_analyze_spec(const AnalyzeArgs& args) {
     for (std::size_t i = 0; i < values.size(); ++i) s << (i ? ", " : "") << values[i];
     s << ", names=" << literal(names) << ", references=" << args.against.size()
       << ", path=\"analysis.json\", page=\"README.md\"";
-    if (args.skip_filled_flats) s << ", filled_flats=skip";
+    if (args.fit_filled_flats) s << ", filled_flats=fit";
     if (args.render) s << ", images=" << literal(images);
     s << ")\n";
     if (args.render) {

@@ -19,9 +19,11 @@ struct AnalyzeArgs {
     std::optional<double> cell;  ///< --cell M: the cell size of every file (m)
     std::optional<std::pair<double, double>> heights;  ///< --heights LOW:HIGH, metres of a PNG's black and white
     bool render = true;  ///< --no-render: no pictures
-    /// --skip-filled-flats: the channel cells the priority flood raised stay out of the θ, k_sn and Hack fits
-    /// (analyze:terrain's filled_flats=skip; docs/analysis.md, "Real-world rasters")
-    bool skip_filled_flats = false;
+    /// --fit-filled-flats: the channel cells the priority flood raised enter the θ, k_sn and Hack fits, as in
+    /// terrain_stats.py (analyze:terrain's filled_flats=fit; docs/analysis.md, "Real-world rasters"). By
+    /// default (--skip-filled-flats) they stay out.
+    bool fit_filled_flats = false;
+    bool skip_filled_flats = false;  ///< --skip-filled-flats given (the default, spelled out)
     /// --discriminate: instead of the figures' table, whether a classifier tells the terrains from the
     /// --against DEMs window by window (analyze:discriminate); no renderings.
     bool discriminate = false;

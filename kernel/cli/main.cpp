@@ -47,7 +47,7 @@ const char* usage_text =
     "                  [--allow-outside-out] [--cache DIR | --no-cache] [--cache-size SIZE] [--tiles RxC]\n"
     "  orogen check SPEC [--out DIR] [--set NAME.PARAM=VALUE]...   parse and check only; prints every diagnostic\n"
     "  orogen analyze FILE... [--against DEM...] [--out DIR] [--cell M] [--heights LOW:HIGH] [--no-render]\n"
-    "                 [--skip-filled-flats] [--threads N] [--quiet]\n"
+    "                 [--fit-filled-flats] [--threads N] [--quiet]\n"
     "                                                  measure terrains (slopes, hypsometry, spectrum, rivers...)\n"
     "                                                  against real DEMs: a table, DIR/analysis.json, charts,\n"
     "                                                  renderings and DIR/README.md (default DIR: analysis/;\n"

@@ -190,10 +190,10 @@ OROGEN_PLUGIN("analyze-terrain", "0.1.0", registry) {
                     .help(
                         "a picture per input, comma-separated paths relative to --out, shown side by side on the page"),
                 Param::boolean("charts", true).help("draw the charts (needs gnuplot-nox)"),
-                Param::choice("filled_flats", {"fit", "skip"}, "fit")
+                Param::choice("filled_flats", {"fit", "skip"}, "skip")
                     .help("whether the channel cells the priority flood raised (filled flats, slope 1e-4 give or "
-                          "take rounding) enter the fits of θ, k_sn and Hack's h: fit as terrain_stats.py, or skip "
-                          "them (steadier across cell sizes and reprojections; docs/analysis.md)"),
+                          "take rounding) enter the fits of θ, k_sn and Hack's h: skip them (steady across cell "
+                          "sizes and reprojections), or fit them as terrain_stats.py does (docs/analysis.md)"),
             },
         .check = check,
         .run = run,

@@ -227,7 +227,7 @@ TEST(Figures, ParallelRiversAtSteadyStateGiveTheirConcavityAndSteepness) {
     for (std::size_t b = 0; b < f.slope_area.x.size(); ++b) EXPECT_GT(f.slope_area.y[b], 0.0);
 }
 
-TEST(Figures, FilledFlatsCanBeLeftOutOfTheSlopeAreaFits) {
+TEST(Figures, FilledFlatsAreLeftOutOfTheSlopeAreaFits) {
     // One river down the middle column between walls 1000 m high that drain into it (the cell in row y
     // drains 3(y + 1) cells), at stream power's steady state, with a lake dug into rows 60–69 5 m below its
     // outlet. The priority flood fills the lake to a surface sloping 1e-4 (ε = 1e-4·cell a cell), which the
@@ -240,10 +240,10 @@ TEST(Figures, FilledFlatsCanBeLeftOutOfTheSlopeAreaFits) {
         column[std::size_t(y)] = column[std::size_t(y + 1)] + ks * std::pow(3.0 * (y + 1) * cell * cell, -theta) * cell;
     for (int y = 60; y < 70; ++y) column[std::size_t(y)] = column[70] - 5.0;
     const auto z = field(w, h, [&](int x, int y) { return column[std::size_t(y)] + (x == 1 ? 0.0 : 1000.0); });
-    Options o;
-    o.fit_filled_cells = false;
-    const Figures f = measure({z.data(), w, h, cell}, o);
+    // That is the default; fit_filled_cells = true is terrain_stats.py's.
+    const Figures f = measure({z.data(), w, h, cell});
     ASSERT_TRUE(f[concavity].ok()) << f[concavity].why_not;
+    EXPECT_FALSE(Options{}.fit_filled_cells);
 
     // The channel cells (A > 1 km²) of the river, but the lake's: S to the cell below, on the filled heights.
     const double eps = 1e-4 * cell;
@@ -265,7 +265,9 @@ TEST(Figures, FilledFlatsCanBeLeftOutOfTheSlopeAreaFits) {
     EXPECT_NEAR(f[concavity].value, -sas / saa, 1e-9);
     // The lake's cells are in the other fit only as far as rounding lets them (0 … 10 of them), and nothing
     // else changes.
-    const Figures all = measure({z.data(), w, h, cell});
+    Options o;
+    o.fit_filled_cells = true;
+    const Figures all = measure({z.data(), w, h, cell}, o);
     EXPECT_GE(all.slope_area_fit.points, la.size());
     EXPECT_LE(all.slope_area_fit.points, la.size() + 10);
     EXPECT_EQ(f[slope_p90].value, all[slope_p90].value);
@@ -471,8 +473,8 @@ TEST(Figures, ATerrainTooSmallForAFigureSaysWhichAndWhyAndMeasuresTheRest) {
     EXPECT_EQ(f[spectral_exponent].why_not,
               "the terrain (10x8) is narrower than 32 samples: too few wavenumbers in 4 … n/4 to fit");
     EXPECT_EQ(f[concavity].why_not,
-              "only 0 channel cells (draining more than 1 km², slope above 0.0001); the fit needs 51: the "
-              "terrain's rivers are too short");
+              "only 0 channel cells (draining more than 1 km², slope above 0.0001, not filled); the fit needs 51: "
+              "the terrain's rivers are too short");
     EXPECT_EQ(f[local_relief].why_not, "the terrain (10x8) is 0.21 km across, less than the 2.00 km window");
     EXPECT_EQ(f[drainage_density].why_not, "no cell drains more than 0.1 km² (the terrain covers 0.072 km²)");
     EXPECT_TRUE(std::isnan(f[concavity].value));

@@ -46,11 +46,12 @@ TEST(AnalyzeCli, MeasuresADemAndWritesTheReport) {
     TempDir dir;
     const auto r = run_orogen("analyze " + q(rif) + " --no-render --out " + q(dir / "report"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    // The table on stdout, one row per figure, as terrain_stats.py measures the Rif (reference-stats.txt).
+    // The table on stdout, one row per figure, as terrain_stats.py measures the Rif (reference-stats.txt), but
+    // θ: without the filled flats, 0.44 (the script's 0.89 with them; --fit-filled-flats below).
     EXPECT_NE(r.out.find("median slope"), std::string::npos) << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("median slope +° +19\\.2\\n"))) << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("spectral β +4\\.73\\n"))) << r.out;
-    EXPECT_TRUE(std::regex_search(r.out, std::regex("concavity θ +0\\.89\\n"))) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("concavity θ +0\\.44\\n"))) << r.out;
     const std::string json = slurp(dir / "report/analysis.json");
     EXPECT_NEAR(figure(json, "morocco_rif_27m", "hypsometric_integral"), 0.444, 0.0006);
     EXPECT_NE(json.find("\"definition\": "), std::string::npos);
@@ -66,17 +67,26 @@ TEST(AnalyzeCli, MeasuresADemAndWritesTheReport) {
     EXPECT_FALSE(fs::exists(dir / "report/renders")) << "--no-render";
 }
 
-TEST(AnalyzeCli, SkipFilledFlatsLeavesTheFilledCellsOutOfTheFits) {
-    // The Rif's θ is 0.89 with the filled flats whose slope 1e-4 passes S > 1e-4 by rounding, 0.44 without
-    // them (docs/analysis.md, "Real-world rasters"); the other figures do not move.
+TEST(AnalyzeCli, FitFilledFlatsTakesTheFilledCellsIntoTheFitsAsTerrainStatsPy) {
+    // The Rif's θ is 0.44 without the filled flats (the default), 0.89 with those whose slope 1e-4 passes
+    // S > 1e-4 by rounding, as terrain_stats.py (docs/analysis.md, "Real-world rasters"); the other figures do
+    // not move.
     TempDir dir;
-    const auto r = run_orogen("analyze " + q(rif) + " --skip-filled-flats --no-render --out " + q(dir / "report"));
+    const auto r = run_orogen("analyze " + q(rif) + " --fit-filled-flats --no-render --out " + q(dir / "report"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
-    EXPECT_TRUE(std::regex_search(r.out, std::regex("concavity θ +0\\.44\\n"))) << r.out;
+    EXPECT_TRUE(std::regex_search(r.out, std::regex("concavity θ +0\\.89\\n"))) << r.out;
     EXPECT_TRUE(std::regex_search(r.out, std::regex("median slope +° +19\\.2\\n"))) << r.out;
-    const auto d = run_orogen("analyze " + q(rif) + " --discriminate --skip-filled-flats --against " + q(rif));
+    // --skip-filled-flats is the default spelled out.
+    const auto s = run_orogen("analyze " + q(rif) + " --skip-filled-flats --no-render --out " + q(dir / "skip"));
+    ASSERT_EQ(s.exit_code, 0) << s.err;
+    EXPECT_TRUE(std::regex_search(s.out, std::regex("concavity θ +0\\.44\\n"))) << s.out;
+    const auto both = run_orogen("analyze " + q(rif) + " --fit-filled-flats --skip-filled-flats --no-render");
+    EXPECT_EQ(both.exit_code, 2);
+    EXPECT_NE(both.err.find("--fit-filled-flats and --skip-filled-flats contradict each other"), std::string::npos)
+        << both.err;
+    const auto d = run_orogen("analyze " + q(rif) + " --discriminate --fit-filled-flats --against " + q(rif));
     EXPECT_EQ(d.exit_code, 2);
-    EXPECT_NE(d.err.find("--skip-filled-flats changes the figures' table, which --discriminate does not print"),
+    EXPECT_NE(d.err.find("--fit-filled-flats changes the figures' table, which --discriminate does not print"),
               std::string::npos)
         << d.err;
 }

@@ -40,15 +40,16 @@ struct Grid {
     const std::uint8_t* valid = nullptr;
 };
 
-/// Thresholds of the figures. The defaults are those of terrain_stats.py.
+/// Thresholds of the figures. The defaults are those of terrain_stats.py, but for fit_filled_cells.
 struct Options {
     double channel_area = 1e6;  ///< m²: drainage area above which a cell is a channel for θ, k_sn and Hack
     double channel_min_slope = 1e-4;  ///< m/m: channel cells at least this steep enter the slope–area fit
     /// Whether the channel cells the priority flood raised (filled flats: their slope is the fill's gradient,
     /// ε/cell = 1e-4, which the test S > channel_min_slope keeps or drops by rounding, about half of them) enter
-    /// the fits of θ, k_sn and Hack's h, as in terrain_stats.py. false leaves them out: the fits then no longer
-    /// swing with the cell size (docs/analysis.md, "Real-world rasters").
-    bool fit_filled_cells = true;
+    /// the fits of θ, k_sn and Hack's h. false (the default) leaves them out, so the fits do not swing with the
+    /// cell size or a reprojection; true is terrain_stats.py's definition (docs/analysis.md, "Real-world
+    /// rasters").
+    bool fit_filled_cells = false;
     double reference_concavity = 0.45;  ///< θ_ref of the normalised steepness k_sn = S·A^θ_ref (Wobus et al. 2006)
     double network_area =
         1e5;  ///< m²: drainage area above which a cell is on the drainage network (density, hillslopes)
