@@ -110,7 +110,9 @@ float mie_phase(float c) {  // Cornette–Shanks
 }
 
 vec3 sky_colour(vec3 dir, float with_disc) {
-    float elevation = asin(clamp(dir.y, -1.0, 1.0));
+    // Below the horizon a ray ends on the ground past the drawn world (the table's value there is the air's
+    // glow over a black ground): the horizon's colour, which the far air in front of the ground tends to.
+    float elevation = asin(clamp(dir.y, 0.0, 1.0));
     float v = 0.5 + 0.5 * sign(elevation) * sqrt(abs(elevation) / (0.5 * PI));
     float u = atan(dir.x, -dir.z) / (2.0 * PI);  // clockwise from north; the table wraps around
     vec3 sky = texture(sky_table, vec2(u, v)).rgb * sky_scale;

@@ -25,6 +25,7 @@ uniform int output_mode;               // 0 beauty, 1 albedo, 2 normal
 // wetness (0..1, log of the drained area), deposit (0..1, sediment and landslide debris), unused
 uniform sampler2D layers;
 uniform int has_layers;
+uniform int beyond;                    // > 0: the world past the map's edge (terrain.vert), not over the map
 // light
 uniform sampler2DShadow shadow_map;
 uniform mat4 light_view_projection;
@@ -85,6 +86,8 @@ vec4 exposure(vec4 w, float normal_y, float hollow, float ridge, float wet, floa
 void main() {
     // texture_scale units per pixel, taken before any branch (derivatives need the whole 2 × 2 quad)
     float footprint = max(length(dFdx(world.xz)), length(dFdy(world.xz))) / texture_scale;
+    vec3 facet = normalize(cross(dFdy(world), dFdx(world)));  // the drawn triangle's normal (exaggerated)
+    facet *= sign(facet.y + 1e-9);
     if (wall_normal != vec3(0.0)) {
         // The skirt: layered earth and rock, lit like the rest.
         vec2 q = vec2(dot(world.xz, wall_normal.zx), world.y) / texture_scale;
@@ -101,6 +104,9 @@ void main() {
     float hl = height_at(s - vec2(1.0, 0.0)), hr = height_at(s + vec2(1.0, 0.0));
     float hu = height_at(s - vec2(0.0, 1.0)), hd = height_at(s + vec2(0.0, 1.0));
     vec2 gradient = vec2(hr - hl, hd - hu) / (2.0 * cell);  // m/m, true terrain
+    // A sea's coast and a plain past the edge fade away from the clamped edge heights: their slope is the
+    // drawn surface's (the clamped texture's would stripe them); a mirrored map keeps the texture's.
+    if (beyond == 1 || beyond == 2) gradient = -facet.xz / max(facet.y, 1e-3) / exaggeration;
     vec3 true_normal = normalize(vec3(-gradient.x, 1.0, -gradient.y));
     vec3 n = normalize(vec3(-gradient.x * exaggeration, 1.0, -gradient.y * exaggeration));
     float h = world.y / exaggeration;
@@ -111,7 +117,8 @@ void main() {
     float fine = fbm_filtered(p * 40.0, 2, footprint * 40.0);
     // Exposure: curvature at two scales (3 and 9 samples), and how much the slope faces the sun and the
     // north (−1 away, 1 towards: the sine of the slope times the cosine of the aspect).
-    float concave = 0.5 * (below_ring(s, h, 3.0) + below_ring(s, h, 9.0));
+    // (Past the edge the ground is coarse and far: no curvature, and no shadow from the map.)
+    float concave = beyond > 0 ? 0.0 : 0.5 * (below_ring(s, h, 3.0) + below_ring(s, h, 9.0));
     float hollow = smoothstep(0.015, 0.12, concave), ridge = smoothstep(0.015, 0.12, -concave);
     // (Below about 6° the aspect hardly changes the light a slope gets: not counted.)
     float tilted = smoothstep(0.1, 0.5, length(true_normal.xz));
@@ -156,12 +163,16 @@ void main() {
     vec3 lp = ls.xyz / ls.w * 0.5 + 0.5;
     float lit = 0.0;
     float bias = 0.0015;
-    lit += texture(shadow_map, vec3(lp.xy, lp.z - bias));
-    lit += texture(shadow_map, vec3(lp.xy + vec2(shadow_texel, 0.0), lp.z - bias));
-    lit += texture(shadow_map, vec3(lp.xy - vec2(shadow_texel, 0.0), lp.z - bias));
-    lit += texture(shadow_map, vec3(lp.xy + vec2(0.0, shadow_texel), lp.z - bias));
-    lit += texture(shadow_map, vec3(lp.xy - vec2(0.0, shadow_texel), lp.z - bias));
-    lit /= 5.0;
+    if (beyond == 0) {  // the world beyond lies outside the shadow map's box: lit
+        lit += texture(shadow_map, vec3(lp.xy, lp.z - bias));
+        lit += texture(shadow_map, vec3(lp.xy + vec2(shadow_texel, 0.0), lp.z - bias));
+        lit += texture(shadow_map, vec3(lp.xy - vec2(shadow_texel, 0.0), lp.z - bias));
+        lit += texture(shadow_map, vec3(lp.xy + vec2(0.0, shadow_texel), lp.z - bias));
+        lit += texture(shadow_map, vec3(lp.xy - vec2(0.0, shadow_texel), lp.z - bias));
+        lit /= 5.0;
+    }
+    // Past the shadow map's box (the world beyond the edge) nothing of the map casts a shadow.
+    if (beyond > 0 || any(lessThan(lp, vec3(0.0))) || any(greaterThan(lp, vec3(1.0)))) lit = 1.0;
     float lambert = max(dot(n, sun_direction), 0.0);
     // The sky's light reaches less of a hollow and more of a ridge (ambient occlusion from the curvature).
     float sky_seen = clamp(1.0 - 0.55 * hollow + 0.2 * ridge, 0.35, 1.2);

@@ -88,6 +88,10 @@ std::vector<Param> style_params() {
             .help("aerosols in the air, times a clear day's (Mie scattering: the glow around the sun, the haze "
                   "between the ridges; 0: only the air's Rayleigh scattering)"),
         Param::boolean("sea", false).help("draw a sea at sea_level"),
+        Param::choice("beyond", {"auto", "none", "sea", "plain", "mirror"}, "auto")
+            .help("the world past the map's edge: sea (the land falls below the sea past a coast), plain (the "
+                  "edge's heights fade to their mean), mirror (the map mirrored, fading far away), none (a "
+                  "slab with a skirt); auto: sea with sea=true, else none"),
         Param::real("sea_level", 0.0).unit("m").help("height of the sea (with sea=true)"),
         Param::real("sea_fraction", -1.0)
             .min(-1)
@@ -199,6 +203,12 @@ Style style_from(NodeContext& ctx) {
     s.sun_intensity = ctx.real("sun_intensity");
     s.haze = ctx.real("haze");
     s.sea = ctx.flag("sea");
+    const std::string& beyond = ctx.text("beyond");
+    s.beyond = beyond == "none" ? Style::Beyond::none
+        : beyond == "sea"       ? Style::Beyond::sea
+        : beyond == "plain"     ? Style::Beyond::plain
+        : beyond == "mirror"    ? Style::Beyond::mirror
+                                : Style::Beyond::automatic;
     s.sea_level = ctx.real("sea_level");
     s.sea_fraction = ctx.real("sea_fraction");
     s.water_layer = ctx.text("water_layer");

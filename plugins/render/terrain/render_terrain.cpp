@@ -147,6 +147,7 @@ struct TerrainRenderer::Impl {
     std::shared_ptr<const Heightmap> terrain;
     int width = 0, height = 0;  // samples
     float lo = 0, hi = 0;  // height range, m
+    double edge_height = 0;  // m, the mean of the edge's samples
     bool has_water = false;
     GLuint heights = 0, surface = 0, vao = 0;
     GLuint sim_layers = 0;  // simulation_layers(), or 0 when the heightmap has none
@@ -251,6 +252,7 @@ struct TerrainRenderer::Impl {
     void prepare_sky(Frame& f, const Style& st);
     void draw_sky(const Frame& f) const;
     void draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored, GLuint seen);
+    void draw_beyond(const Frame& f, const Style& st, GLuint program);
     void draw_particles(const Frame& f, const Style& st, const Camera& camera, const ParticleFrame& particles);
     gl::Target draw_reflection(const Frame& f, const Style& st, GLuint scene_fbo);
     void draw_water(const Frame& f, const Style& st, const gl::Target& reflection, bool reflect);
@@ -286,6 +288,16 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
         if (!std::isfinite(h)) throw BadInput("render:terrain: the heightmap holds NaN or infinite heights");
         m.lo = std::min(m.lo, h);
         m.hi = std::max(m.hi, h);
+    }
+    if (style_.beyond == Style::Beyond::automatic)
+        style_.beyond = style_.sea ? Style::Beyond::sea : Style::Beyond::none;
+    if (style_.beyond == Style::Beyond::sea) style_.sea = true;
+    {  // the mean height of the edge's samples: where a plain or a mirrored map settles
+        const ConstGridView g = m.terrain->view();
+        double sum = 0;
+        for (int x = 0; x < m.width; ++x) sum += double(g.at(x, 0)) + double(g.at(x, m.height - 1));
+        for (int y = 0; y < m.height; ++y) sum += double(g.at(0, y)) + double(g.at(m.width - 1, y));
+        m.edge_height = sum / double(2 * (m.width + m.height));
     }
     if (style_.sea_fraction >= 0) style_.sea_level = m.lo + style_.sea_fraction * double(m.hi - m.lo);
     if (style_.texture_scale <= 0) style_.texture_scale = std::max(m.extent_x(), m.extent_z()) / 8.0;
@@ -593,12 +605,16 @@ void TerrainRenderer::Impl::place_camera(Frame& f, const Camera& camera, const S
 /// Near and far around the terrain's bounding sphere (out to the horizon with a sea).
 void TerrainRenderer::Impl::set_clip_planes(Frame& f, const Style& st) const {
     const double to_centre = glm::length(f.centre - f.eye);
-    f.far_plane = to_centre + f.radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
+    const bool horizon = st.sea || (f.shaded && st.beyond != Style::Beyond::none);
+    f.far_plane = to_centre + f.radius * (horizon ? 41.0 : 1.05);  // a sea or the world beyond: the horizon
     f.near_plane = std::max(std::max(to_centre - f.radius, 0.0) * 0.8, f.far_plane * 2e-5);
     // The sea comes up to the camera: a ray at most 60° off the view axis meets it no nearer (along the
     // axis) than half the camera's height above it, so keep the near plane inside that.
     if (st.sea && f.eye.y > st.sea_level * f.exag)
         f.near_plane = std::max(std::min(f.near_plane, 0.5 * (f.eye.y - st.sea_level * f.exag)), f.far_plane * 2e-6);
+    // So does the ground past the edge (no higher than the map's highest point).
+    if (horizon && f.eye.y > hi * f.exag)
+        f.near_plane = std::max(std::min(f.near_plane, 0.5 * (f.eye.y - hi * f.exag)), f.far_plane * 2e-6);
 }
 
 /// Looking at nothing: every corner of the terrain's box outside one clip plane.
@@ -785,11 +801,41 @@ void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const 
     if (seen) glEndQuery(GL_ANY_SAMPLES_PASSED);
     glDisable(GL_CULL_FACE);
     glFrontFace(GL_CCW);
+    // The skirt stays under the world beyond: it fills the cracks between the map's edge and the coarser grid.
+    if (f.shaded && st.beyond != Style::Beyond::none) draw_beyond(f, st, program);
     set(program, "floor_height", float(f.floor_height * f.exag));
     for (int edge = 0; edge < 4; ++edge) {
         set(program, "skirt_edge", edge);
         glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? kept.x : kept.y));
     }
+}
+
+/// The world past the map's edge (Style::beyond; terrain.vert's beyond grid) with the terrain's program,
+/// out to the horizon: 28 times the terrain's radius (its corners stay inside the far plane, at 41).
+void TerrainRenderer::Impl::draw_beyond(const Frame& f, const Style& st, GLuint program) {
+    constexpr int kCells = 160;  // quads per side: about 16 across the map itself, coarse far away
+    const int mode = st.beyond == Style::Beyond::sea ? 1 : st.beyond == Style::Beyond::plain ? 2 : 3;
+    set(program, "skirt_edge", -1);
+    set(program, "beyond", mode);
+    set(program, "beyond_cells", kCells);
+    set(program, "beyond_reach", float(f.radius * 28.0));
+    set(program, "edge_height", float(edge_height));
+    set(program, "sea_floor", float(std::min(double(lo), st.sea_level) - 0.08 * std::max(double(hi - lo), 1.0)));
+    set(program, "has_layers", 0);  // the layers' edge would run on as stripes
+    glBindTexture(GL_TEXTURE_2D, heights);
+    const GLint wrap = mode == 3 ? GL_MIRRORED_REPEAT : GL_CLAMP_TO_EDGE;
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
+    for (GLenum c : {GL_CLIP_DISTANCE1, GL_CLIP_DISTANCE2, GL_CLIP_DISTANCE3}) glEnable(c);
+    for (int side = 0; side < 4; ++side) {  // north, south, west, east of the map, each clipped to its side
+        set(program, "beyond_side", side);
+        glDrawArrays(GL_TRIANGLES, 0, 6 * kCells * kCells);
+    }
+    for (GLenum c : {GL_CLIP_DISTANCE1, GL_CLIP_DISTANCE2, GL_CLIP_DISTANCE3}) glDisable(c);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    set(program, "beyond", 0);
+    set(program, "has_layers", sim_layers ? 1 : 0);
 }
 
 /// Particles: lit spheres (points).

@@ -64,6 +64,12 @@ struct Style {
     double haze = 1.0;  ///< aerosols, times a clear day's (0: the air's Rayleigh scattering only)
     bool sea = false;  ///< a sea at sea_level
     double sea_level = 0.0;  ///< m
+    /// The world past the map's edge, so the map is no slab with cut edges and every camera sees a horizon:
+    /// automatic (sea with a sea, else none: a plain costs the 1080p frame a third more), none (the slab and its skirt), sea (the ground falls below
+    /// the sea past a coast; turns the sea on), plain (the edge's heights fade to their mean), mirror (the map
+    /// mirrored at its edges, fading to the mean far away). Drawn in the lit picture only.
+    enum class Beyond { automatic, none, sea, plain, mirror };
+    Beyond beyond = Beyond::automatic;
     double sea_fraction = -1.0;  ///< if ≥ 0: the sea at this fraction of the height range instead of sea_level
     std::string water_layer = "water";  ///< water from this layer when the heightmap has it ("" none)
     double water_min_depth = 0.05;  ///< m: thinner water layers are not drawn

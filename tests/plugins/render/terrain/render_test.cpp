@@ -583,3 +583,40 @@ TEST(Sky, TheHorizonIsBrighterAndWhiterThanTheZenithAndTheSunsSideWhiter) {
     EXPECT_GT(low[0] / low[2], 2.0 * high[0] / high[2]);
     EXPECT_GT(t.irradiance[2], t.irradiance[0]) << "the sky's light is blue";
 }
+
+// Issue 51, part 2: no slab floating in the sky. Seen from afar (the map a small part of the frame), the rows
+// at the bottom of the frame lie past the map's edge: with beyond=none they are the sky behind the slab, with
+// beyond=sea they are sea (darker than the sky above the horizon, blue), with beyond=plain ground (redder
+// than the sky).
+TEST(Beyond, ThePicturesBottomPastTheMapsEdgeIsSeaOrGroundNotSky) {
+    const int n = 65;
+    auto hm = grid(n, 30.0, 0.0f);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            hm->view().at(x, y) = float(std::max(0.0, 300.0 - 12.0 * std::hypot(x - 32.0, y - 32.0)) + 5.0);
+    Camera c;
+    c.distance = 8000;
+    c.elevation = 30;
+    auto render = [&](Style::Beyond beyond) {
+        Style s;
+        s.beyond = beyond;
+        return TerrainRenderer(hm, s).render(96, 64, c);
+    };
+    const Image none = render(Style::Beyond::none), sea = render(Style::Beyond::sea),
+                plain = render(Style::Beyond::plain);
+    auto row_mean = [](const Image& im, int y) {
+        std::array<double, 3> m{};
+        for (int x = 0; x < im.width; ++x)
+            for (int k = 0; k < 3; ++k)
+                m[k] += im.rgba32f[4 * std::size_t(y * im.width + x) + std::size_t(k)] / im.width;
+        return m;
+    };
+    const auto sky = row_mean(none, 0), bare = row_mean(none, 62), water = row_mean(sea, 62),
+               ground = row_mean(plain, 62);
+    auto luminance = [](const std::array<double, 3>& m) { return 0.2126 * m[0] + 0.7152 * m[1] + 0.0722 * m[2]; };
+    // beyond=none: the bottom is sky (the slab floats), as bright as the sky within a third
+    EXPECT_NEAR(luminance(bare) / luminance(sky), 1.0, 0.35);
+    EXPECT_LT(luminance(water), 0.8 * luminance(bare)) << "the sea is darker than the sky";
+    EXPECT_GT(water[2], water[0]) << "the sea is blue";
+    EXPECT_GT(ground[0] / ground[2], 1.3 * bare[0] / bare[2]) << "the plain is ground, not sky";
+}
