@@ -118,7 +118,8 @@ void main() {
     // Exposure: curvature at two scales (3 and 9 samples), and how much the slope faces the sun and the
     // north (−1 away, 1 towards: the sine of the slope times the cosine of the aspect).
     // (Past the edge the ground is coarse and far: no curvature, and no shadow from the map.)
-    float concave = beyond > 0 ? 0.0 : 0.5 * (below_ring(s, h, 3.0) + below_ring(s, h, 9.0));
+    float concave = 0.0;
+    if (beyond == 0) concave = 0.5 * (below_ring(s, h, 3.0) + below_ring(s, h, 9.0));
     float hollow = smoothstep(0.015, 0.12, concave), ridge = smoothstep(0.015, 0.12, -concave);
     // (Below about 6° the aspect hardly changes the light a slope gets: not counted.)
     float tilted = smoothstep(0.1, 0.5, length(true_normal.xz));
@@ -126,7 +127,10 @@ void main() {
     float north = -true_normal.z / max(length(true_normal.xz), 1e-6) * tilted;
     // The simulation's layers: rivers, wetness (drained area), deposits (sediment, landslide debris). The
     // B-spline keeps 4/9 of a one-sample river: its cover is scaled back up (and wide rivers' edges sharpen).
-    vec4 sim = has_layers == 1 ? bspline(layers, s, vec2(grid)) : vec4(0.0);
+    vec4 sim = vec4(0.0);
+#ifdef SIMULATION_LAYERS  // a second program for heightmaps with layers: llvmpipe runs both sides of a branch
+    if (has_layers == 1) sim = bspline(layers, s, vec2(grid));
+#endif
     float river = clamp(sim.r * 2.25, 0.0, 1.0), wet = clamp(sim.g, 0.0, 1.0), deposit = clamp(sim.b, 0.0, 1.0);
     float shore = h - sea_altitude, z = shore + jitter * (broad + 0.5 * fine);  // m above the sea
     vec4 w = exposure(splat(z, shore, true_normal.y, sunward, north), true_normal.y, hollow, ridge, wet, z,
@@ -181,10 +185,12 @@ void main() {
     vec3 v = normalize(eye - world);
     float spec = pow(max(dot(reflect(-sun_direction, n), v), 0.0), 24.0) * w.w * 0.25 * lit;
     vec3 c = albedo * light + sun_colour * spec;
+#ifdef SIMULATION_LAYERS
     if (river > 0.0) {  // calm water mirrors the sky (Schlick's Fresnel, n = 1.33)
         vec3 r = reflect(-v, vec3(0.0, 1.0, 0.0));
         float fresnel = 0.02 + 0.98 * pow(1.0 - max(v.y, 0.0), 5.0);
         c += river * fresnel * sky_colour(r, 0.0);
     }
+#endif
     colour = vec4(apply_fog(c, -v, distance(eye, world)), 1.0);
 }

@@ -42,13 +42,23 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // The programs, compiled once per process (in the one shared context).
 struct Programs {
     GLuint sky = 0, terrain = 0, shadow = 0, water = 0, particles = 0;
+    GLuint terrain_layers = 0;  // the terrain's with SIMULATION_LAYERS: rivers, wetness and scree from layers
 };
+
+/// `source` with `#define name` after its #version line.
+std::string with_define(const char* source, const char* name) {
+    std::string s(source);
+    const std::size_t line = s.find('\n');
+    return s.insert(line + 1, std::string("#define ") + name + "\n");
+}
 
 const Programs& programs() {
     static Programs p = [] {
         Programs q;
         q.sky = gl::link_program("render:terrain sky", shaders::fullscreen_vert, shaders::sky_frag);
         q.terrain = gl::link_program("render:terrain", shaders::terrain_vert, shaders::terrain_frag);
+        const std::string layered = with_define(shaders::terrain_frag, "SIMULATION_LAYERS");
+        q.terrain_layers = gl::link_program("render:terrain layers", shaders::terrain_vert, layered.c_str());
         q.shadow = gl::link_program("render:terrain shadow map", shaders::terrain_vert, shaders::shadow_frag);
         q.water = gl::link_program("render:terrain water", shaders::water_vert, shaders::water_frag);
         q.particles = gl::link_program("render:terrain particles", shaders::particles_vert, shaders::particles_frag);
@@ -756,7 +766,7 @@ void TerrainRenderer::Impl::draw_sky(const Frame& f) const {
 /// `seen`: a query that learns whether any of the surface (not the skirt) reached the frame.
 void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored,
                                          GLuint seen) {
-    const GLuint program = programs().terrain;
+    const GLuint program = sim_layers ? programs().terrain_layers : programs().terrain;
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
@@ -884,14 +894,15 @@ gl::Target TerrainRenderer::Impl::draw_reflection(const Frame& f, const Style& s
         glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
     const Programs& prog = programs();
     glEnable(GL_CLIP_DISTANCE0);
-    for (GLuint p : {prog.shadow, prog.terrain})
+    for (GLuint p : {prog.shadow, prog.terrain, prog.terrain_layers})
         glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
     // Lit from the mirrored eye; the strips' order is the same (the mirror keeps x and z).
     Frame mirrored = f;
     mirrored.eye = glm::dvec3(mirror * glm::dvec4(f.eye, 1.0));
     draw_terrain(mirrored, st, glm::mat4(f.view_projection * mirror), true, 0);
     glDisable(GL_CLIP_DISTANCE0);
-    for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
+    for (GLuint p : {prog.shadow, prog.terrain, prog.terrain_layers})
+        glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
     glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
     glViewport(0, 0, f.width, f.height);
     return reflection;
