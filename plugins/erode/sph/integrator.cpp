@@ -58,6 +58,8 @@ void Simulation::Impl::density_pass() {
     const float h = kernel.h, w_norm = kernel.w_norm;
     const Support support{kernel.h2, kernel.inv_h};
     const float mass = fluid.mass, rho0 = fluid.rho0;
+    const bool closed = s.boundary == Boundary::closed && terrain.width() >= 2 && terrain.height() >= 2;
+    const double far_x = terrain.extent_x() - double(h), far_z = terrain.extent_z() - double(h);
     parallel_for(0, std::int64_t(cells.cells()), kCellGrain, [&](std::int64_t c0, std::int64_t c1) {
         FlushDenormals ftz;
         std::vector<float>& bx = scratch.buf[0];
@@ -85,18 +87,18 @@ void Simulation::Impl::density_pass() {
                 float phi = 0.0f;
                 Vec3 push{0.0f, 0.0f, 0.0f};
                 const double x = soa[0][i], y = soa[1][i], z = soa[2][i];
-                // Only the terrain: the map's side walls (closed boundary) stay geometric. With them as walls
-                // too (and the quadrant where two meet subtracted once), Martin & Moyce's dam break in its
-                // narrow tank ran 30 % ahead of the measurements; see docs/erosion.md.
                 int ti, tj;
                 double fx, fz;
                 terrain.tile(x, z, ti, tj, fx, fz);
                 const double above = y - terrain.surface_in(ti, tj, fx, fz);
+                double ground = double(h), nrm[3] = {0.0, 1.0, 0.0};
                 if (above < double(h)) {
-                    double nrm[3];
                     terrain.normal_in(ti, tj, fx, fz, nrm);
-                    walls.add(above * nrm[1], nrm[0], nrm[1], nrm[2], phi, push);  // the distance to the tangent plane
+                    ground = above * nrm[1];  // the distance to the tangent plane
+                    walls.add(ground, nrm[0], nrm[1], nrm[2], phi, push);
                 }
+                // The map's edges as walls too (closed boundary), the same lattice behind them.
+                if (closed && (x < h || z < h || x > far_x || z > far_z)) side_walls(x, z, ground, nrm, phi, push);
                 p.wall_push[i] = push;
                 p.density[i] = rho + rho0 * phi;
             }
@@ -106,6 +108,37 @@ void Simulation::Impl::density_pass() {
         const std::uint32_t first = cells.cell_begin(std::size_t(c0)), last = cells.cell_begin(std::size_t(c1));
         pressure_terms(p.density.data() + first, p.pterm.data() + first, last - first, rho0, fluid.B);
     });
+}
+
+/// The map's edges (closed boundary) as walls for a particle at (x, z) within the support of one: the fluid's
+/// rest lattice behind each (WallTable::add), and, where two walls meet (two edges, or an edge and the
+/// ground at distance `ground` with unit normal `nrm`), the quadrant behind both counted once; where the
+/// ground and two edges meet, the octant behind all three as well.
+void Simulation::Impl::side_walls(double x, double z, double ground, const double nrm[3], float& phi,
+                                  Vec3& push) const {
+    static constexpr double kNormals[4][3] = {{1.0, 0.0, 0.0}, {-1.0, 0.0, 0.0}, {0.0, 0.0, 1.0}, {0.0, 0.0, -1.0}};
+    const double hh = double(kernel.h);
+    const double dist[4] = {std::max(x, 0.0), std::max(terrain.extent_x() - x, 0.0), std::max(z, 0.0),
+                            std::max(terrain.extent_z() - z, 0.0)};
+    bool near[4];
+    for (int w = 0; w < 4; ++w) {
+        near[w] = dist[w] < hh;
+        if (near[w]) walls.add(dist[w], kNormals[w][0], kNormals[w][1], kNormals[w][2], phi, push);
+    }
+    const bool on_ground = ground < hh;
+    if (on_ground)
+        for (int w = 0; w < 4; ++w)
+            if (near[w]) walls.subtract_quadrant(dist[w], ground, kNormals[w], nrm, phi, push);
+    for (int a = 0; a < 2; ++a)  // an x wall and a z wall (parallel walls' half-spaces do not overlap)
+        for (int b = 2; b < 4; ++b) {
+            if (!near[a] || !near[b]) continue;
+            walls.subtract_quadrant(dist[a], dist[b], kNormals[a], kNormals[b], phi, push);
+            if (on_ground) {
+                const double d[3] = {dist[a], dist[b], ground};
+                const double* const n[3] = {kNormals[a], kNormals[b], nrm};
+                walls.add_octant(d, n, phi, push);
+            }
+        }
 }
 
 /// Pressure, viscosity, the ground's push and gravity, a cell at a time as

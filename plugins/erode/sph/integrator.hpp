@@ -43,6 +43,7 @@ struct Simulation::Impl {
     float max_acc = 0.0f;  // m/s², the largest acceleration of the last force pass
 
     void density_pass();
+    void side_walls(double x, double z, double ground, const double nrm[3], float& phi, Vec3& push) const;
     void force_pass();
     bool integrate(float dt);
     void settle();

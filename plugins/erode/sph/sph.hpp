@@ -32,7 +32,10 @@
 // the normal interpolated bilinearly from the tile's four vertex normals;
 // finally any particle below the triangulated surface (a tile edge the ray
 // missed, a deposit that grew under it) is lifted onto it. No particle ever
-// ends a sub-step below the surface.
+// ends a sub-step below the surface. Near the ground (and, with a closed
+// boundary, the map's edges) a particle's density and pressure push include
+// the fluid's rest lattice continued behind them (WallTable), so a particle
+// at rest against a wall, an edge or a corner reads the interior's density.
 //
 // Erosion (conserving): a particle in contact (within its radius of the
 // surface) has a capacity C = Kc · V · |v_t| · max(sin α, min_slope) (V its
@@ -61,7 +64,7 @@ struct ParticleFrame;
 namespace orogen::sph {
 
 enum class Boundary {
-    closed,  ///< the map's edges are walls
+    closed,  ///< the map's edges are walls, with the terrain's boundary term (the rest lattice behind them)
     open,  ///< particles that cross an edge leave (with their sediment) and are counted
 };
 

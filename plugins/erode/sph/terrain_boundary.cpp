@@ -60,7 +60,10 @@ void TerrainBoundary::refresh_normals() {
 
 void WallTable::tabulate(const CubicSpline& kernel, float volume) {
     h_ = kernel.h;
+    kernel_ = kernel;
     const double spacing = std::cbrt(double(volume));
+    spacing_ = spacing;
+    volume_ = double(volume);
     const int reach = int(std::ceil(double(kernel.h) / spacing)) + 1;
     auto layer = [&](double z, double& phi, double& area) {  // one lattice layer at distance z behind
         for (int a = -reach; a <= reach; ++a)
@@ -78,6 +81,52 @@ void WallTable::tabulate(const CubicSpline& kernel, float volume) {
         phi_[std::size_t(k)] = float(phi);
         area_[std::size_t(k)] = float(area);
     }
+}
+
+void WallTable::corner_sum(int walls, const double d[3], double& phi, double area[3]) const {
+    const double s = spacing_, h = double(kernel_.h), h2 = double(kernel_.h2);
+    const int reach = int(std::ceil(h / s)) + 1;
+    // Behind a wall: layers at d + s/2, d + 3s/2, ... (as in tabulate); along the edge (2 walls): the
+    // particle's own column and reach columns either side.
+    int lo[3];
+    for (int k = 0; k < 3; ++k) lo[k] = k < walls ? 0 : -reach;
+    phi = 0.0;
+    area[0] = area[1] = area[2] = 0.0;
+    for (int i = lo[0]; i <= reach; ++i)
+        for (int j = lo[1]; j <= reach; ++j)
+            for (int l = lo[2]; l <= reach; ++l) {
+                const int idx[3] = {i, j, l};
+                double u[3], r2 = 0.0;
+                for (int k = 0; k < 3; ++k) {
+                    u[k] = k < walls ? d[k] + (0.5 + idx[k]) * s : idx[k] * s;
+                    r2 += u[k] * u[k];
+                }
+                if (r2 >= h2) continue;
+                phi += volume_ * double(kernel_.kernel(float(r2)));
+                const double g = -volume_ * double(kernel_.grad(float(r2)));  // −(dW/dr)/r ≥ 0
+                for (int k = 0; k < walls; ++k) area[k] += g * u[k];
+            }
+}
+
+void WallTable::subtract_quadrant(double d1, double d2, const double n1[3], const double n2[3], float& phi,
+                                  Vec3& push) const {
+    const double d[3] = {std::max(d1, 0.0), std::max(d2, 0.0), 0.0};
+    double f, a[3];
+    corner_sum(2, d, f, a);
+    phi -= float(f);
+    push.x -= float(a[0] * n1[0] + a[1] * n2[0]);
+    push.y -= float(a[0] * n1[1] + a[1] * n2[1]);
+    push.z -= float(a[0] * n1[2] + a[1] * n2[2]);
+}
+
+void WallTable::add_octant(const double d[3], const double* const n[3], float& phi, Vec3& push) const {
+    const double dd[3] = {std::max(d[0], 0.0), std::max(d[1], 0.0), std::max(d[2], 0.0)};
+    double f, a[3];
+    corner_sum(3, dd, f, a);
+    phi += float(f);
+    push.x += float(a[0] * n[0][0] + a[1] * n[1][0] + a[2] * n[2][0]);
+    push.y += float(a[0] * n[0][1] + a[1] * n[1][1] + a[2] * n[2][1]);
+    push.z += float(a[0] * n[0][2] + a[1] * n[1][2] + a[2] * n[2][2]);
 }
 
 }  // namespace orogen::sph

@@ -267,7 +267,22 @@ public:
         push.z += area * float(nz);
     }
 
+    /// Where two walls meet (the map's side walls with each other or with the ground), both half-spaces hold
+    /// the quadrant behind the two: add() counted it twice. Subtract it once, at distances d1, d2 (m, ≥ 0) in
+    /// front of walls with unit normals n1, n2 (taken as perpendicular): its lattice points (d1 + s/2 + i·s,
+    /// d2 + s/2 + j·s) behind them, columns aligned with the particle along the edge, summed directly (a few
+    /// dozen points, only for particles within the support of two walls).
+    void subtract_quadrant(double d1, double d2, const double n1[3], const double n2[3], float& phi, Vec3& push) const;
+    /// Where three walls meet (a corner of the map's floor), the octant behind all three was added three times
+    /// by add() and subtracted three times by subtract_quadrant(): add it back once (inclusion–exclusion).
+    void add_octant(const double d[3], const double* const n[3], float& phi, Vec3& push) const;
+
 private:
+    /// Σ V·W and Σ V·(−∂W/∂d_k) over the lattice points behind `walls` (2 or 3) walls at distances d (m).
+    void corner_sum(int walls, const double d[3], double& phi, double area[3]) const;
+
+    CubicSpline kernel_;
+    double spacing_ = 0, volume_ = 0;  // the fluid's rest lattice: m, m³
     float h_ = 0;  // the kernel's support, m
     std::array<float, kSteps + 1> phi_{}, area_{};
 };
