@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
         dat << "\n\n# Martin & Moyce height: tau eta\n";
         for (const HeightPoint& p : kMartinMoyceHeight) dat << p.tau << ' ' << p.eta << '\n';
         dat.close();
-        std::string plot = "set terminal pngcairo size 1200,500 font 'Sans,11'\nset output '" + out +
+        std::string plot =
+            "set terminal pngcairo size 1200,500 font 'Sans,11'\nset termoption noenhanced\nset output '" + out +
             ".png'\nset multiplot layout 1,2\nset grid\nset key top left\n"
             "set xlabel 'T = t·√(2g/a)'\nset ylabel 'front Z = x/a'\nset xrange [0:3]\n"
             "plot '" +
