@@ -81,71 +81,35 @@ vec4 bspline(sampler2D tex, vec2 s, vec2 size) {
            g1.y * (g0.x * texture(tex, vec2(t0.x, t1.y)) + g1.x * texture(tex, vec2(t1.x, t1.y)));
 }
 
-// The sky and the air: single scattering by the air (Rayleigh), its aerosols (Mie) and ozone, over a
-// spherical Earth. The sky's radiance per direction is looked up in a table the CPU integrates once per sun
-// and camera altitude (atmosphere.cpp; Nishita et al. 1993, Hillaire 2020's sky-view table); the air in
-// front of the terrain and the sea is the same scattering along the view ray, in closed form for layers of
-// air thinning exponentially with altitude (Hoffman and Preetham 2002, with height). `dir` is a unit view
-// ray, y up.
+// The sky: a gradient from a hazy horizon to a deeper zenith, brighter and
+// warmer towards the sun (single-scattering look), and the sun's disc (HDR,
+// so the bloom makes it glow). `dir` is a unit view ray, y up.
 uniform vec3 sun_direction;   // unit, towards the sun
-uniform vec3 sun_colour;      // linear: the sunlight reaching the terrain, per π (a white surface facing it)
-uniform vec3 ambient_colour;  // linear: the sky's light on a horizontal surface, per π
+uniform vec3 sun_colour;      // linear, times intensity
+uniform vec3 sky_zenith;      // linear
+uniform vec3 sky_horizon;     // linear
 uniform float sun_disc;       // 1 draws the disc, 0 only its glow (reflections, fog)
-uniform sampler2D sky_table;  // RGB radiance per unit sun irradiance; u azimuth from north, v sqrt-mapped elevation
-uniform vec3 sky_scale;       // the sun's irradiance above the air (the table's unit)
-uniform vec3 eye;             // world position of the camera
-uniform float air_sea_y;      // world y of the sea level (altitude 0 for the air's density)
-uniform float air_exaggeration;
-uniform vec3 rayleigh_scattering;  // 1/m at sea level (also its extinction)
-uniform float mie_scattering, mie_extinction;  // 1/m at sea level, times the haze
-uniform float rayleigh_height, mie_height;     // m, scale heights
-uniform float mie_g;
-
-const float PI = 3.14159265;
-
-float rayleigh_phase(float c) { return 3.0 / (16.0 * PI) * (1.0 + c * c); }
-float mie_phase(float c) {  // Cornette–Shanks
-    float g2 = mie_g * mie_g;
-    return 3.0 / (8.0 * PI) * (1.0 - g2) * (1.0 + c * c) / ((2.0 + g2) * pow(1.0 + g2 - 2.0 * mie_g * c, 1.5));
-}
 
 vec3 sky_colour(vec3 dir, float with_disc) {
-    // Below the horizon a ray ends on the ground past the drawn world (the table's value there is the air's
-    // glow over a black ground): the horizon's colour, which the far air in front of the ground tends to.
-    float elevation = asin(clamp(dir.y, 0.0, 1.0));
-    float v = 0.5 + 0.5 * sign(elevation) * sqrt(abs(elevation) / (0.5 * PI));
-    float u = atan(dir.x, -dir.z) / (2.0 * PI);  // clockwise from north; the table wraps around
-    vec3 sky = texture(sky_table, vec2(u, v)).rgb * sky_scale;
-    float mu = dot(dir, sun_direction);
-    // the sun's disc (0.27° across), limb-darkened a little; HDR so the bloom makes it glow
+    float up = max(dir.y, 0.0);
+    vec3 sky = mix(sky_horizon, sky_zenith, pow(up, 0.35));
+    // Below the horizon the haze lies over the ground or the sea, not the bright sky: darker and a little
+    // bluer from the horizon down (over a tenth of a degree, so the horizon is a line, not a step of pixels),
+    // so that a far sea reads as sea under the sky rather than melting into it.
+    if (dir.y < 0.0) {
+        vec3 below = sky_horizon * vec3(0.70, 0.76, 0.84) * (1.0 - 0.2 * min(-dir.y * 3.0, 1.0));
+        sky = mix(sky_horizon, below, smoothstep(0.0, 0.002, -dir.y));
+    }
+    float mu = max(dot(dir, sun_direction), 0.0);
+    vec3 glow = sun_colour * (0.25 * pow(mu, 8.0) + 0.6 * pow(mu, 64.0) + 0.3 * pow(mu, 600.0));
     vec3 disc = sun_colour * 40.0 * smoothstep(0.99996, 0.99999, mu) * with_disc;
-    return sky + disc;
+    return sky + glow * 0.5 + disc;
 }
 
-// Mean density (relative to sea level) of an exponential layer of scale height `H` between altitudes a, b.
-float mean_density(float a, float b, float H) {
-    float d = b - a;
-    return abs(d) > 1.0 ? H * (exp(-a / H) - exp(-b / H)) / d : exp(-0.5 * (a + b) / H);
-}
-
-// Aerial perspective: what the air between the eye and a surface `distance` away along `view_dir` lets
-// through (transmittance, per channel) and what it scatters in (the sunlight and the sky's light).
-void air(vec3 view_dir, float distance, out vec3 transmit, out vec3 inscatter) {
-    vec3 p = eye + view_dir * distance;
-    float a = max((eye.y - air_sea_y) / air_exaggeration, 0.0), b = max((p.y - air_sea_y) / air_exaggeration, 0.0);
-    float r = mean_density(a, b, rayleigh_height), m = mean_density(a, b, mie_height);
-    vec3 extinction = rayleigh_scattering * r + mie_extinction * m;
-    transmit = exp(-extinction * distance);
-    float c = dot(view_dir, sun_direction);
-    vec3 scatter_sun = rayleigh_scattering * r * rayleigh_phase(c) + mie_scattering * m * mie_phase(c);
-    vec3 scatter_all = rayleigh_scattering * r + mie_scattering * m;
-    vec3 share = (1.0 - transmit) / max(extinction, vec3(1e-12));
-    // sunlight: π·sun_colour is its irradiance; the sky's light, isotropic: π·ambient / 4π
-    inscatter = share * (PI * sun_colour * scatter_sun + 0.25 * ambient_colour * scatter_all);
-}
-
+// Aerial perspective: the farther a surface, the more of the sky's colour in
+// the view direction replaces it (optical depth = fog_density × distance).
+uniform float fog_density;  // 1/m
 vec3 apply_fog(vec3 colour, vec3 view_dir, float distance) {
-    vec3 transmit, inscatter;
-    air(view_dir, distance, transmit, inscatter);
-    return colour * transmit + inscatter;
+    float f = 1.0 - exp(-fog_density * distance);
+    return mix(colour, sky_colour(view_dir, 0.0), f);
 }

@@ -1,7 +1,9 @@
 #version 450 core
 #include "common.glsl"
 in vec3 centre;
+uniform vec3 eye;
 uniform vec3 particle_colour;  // linear albedo
+uniform vec3 ambient_colour;
 out vec4 colour;
 void main() {
     vec2 d = gl_PointCoord * 2.0 - 1.0;

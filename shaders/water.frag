@@ -11,6 +11,7 @@
 // curve where the smoothed wet field crosses one half, faded over a pixel, not
 // the cells' or the mesh's edges.
 in vec3 world;
+uniform vec3 eye;
 uniform float time;              // s, moves the waves
 uniform float wave_height;       // m
 uniform vec3 water_colour;       // linear, the colour of deep water in daylight
@@ -18,6 +19,7 @@ uniform float clarity;           // m: depth at which 1/e of the ground shows
 uniform sampler2D reflection;    // the terrain mirrored in the water plane (linear RGBA, alpha = coverage)
 uniform int has_reflection;
 uniform vec2 viewport;           // pixels
+uniform vec3 ambient_colour;
 uniform int sea_plane;           // 1: depth = sea level − ground (heights), deep beyond the terrain
 uniform float sea_level;
 uniform sampler2D heights;
@@ -87,11 +89,9 @@ void main() {
     float transmitted = exp(-water_depth / clarity - silt);  // of the ground's light
     vec3 c = fresnel * reflected + (1.0 - fresnel) * (1.0 - transmitted) * body;
     float alpha = (1.0 - fresnel) * transmitted;
-    // the air: the ground under the water was drawn through it already, so the water's own light fades
-    // with the transmittance and only the (1 − alpha) it hides of the ground's in-scattered light is added
-    vec3 transmit, inscatter;
-    air(-v, distance(eye, world), transmit, inscatter);
-    c = c * transmit + inscatter * (1.0 - alpha);
+    // fog: the water's own light and what shows through fade alike
+    float f = 1.0 - exp(-fog_density * distance(eye, world));
+    c = mix(c, sky_colour(-v, 0.0) * (1.0 - alpha), f);
     // at the shore the water fades out over a pixel: edge of it over the ground
-    colour = sea_plane == 1 ? vec4(c, alpha) : vec4(c * edge, 1.0 - edge * (1.0 - alpha));
+    colour = sea_plane == 1 ? vec4(c, alpha * (1.0 - f)) : vec4(c * edge, 1.0 - edge * (1.0 - alpha * (1.0 - f)));
 }

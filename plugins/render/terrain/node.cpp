@@ -83,15 +83,10 @@ std::vector<Param> style_params() {
         Param::real("sun_azimuth", 250.0).min(0).max(360).unit("°").help("sun bearing, clockwise from north"),
         Param::real("sun_elevation", 22.0).min(-90).max(90).unit("°").help("sun height above the horizon"),
         Param::real("sun_intensity", 2.4).min(0).help("sunlight strength (linear; the sky's light is fixed)"),
-        Param::real("haze", 1.0)
+        Param::real("haze", 0.3)
             .min(0)
-            .help("aerosols in the air, times a clear day's (Mie scattering: the glow around the sun, the haze "
-                  "between the ridges; 0: only the air's Rayleigh scattering)"),
+            .help("aerial perspective: optical depth of the air across the terrain's diagonal"),
         Param::boolean("sea", false).help("draw a sea at sea_level"),
-        Param::choice("beyond", {"auto", "none", "sea", "plain", "mirror"}, "auto")
-            .help("the world past the map's edge: sea (the land falls below the sea past a coast), plain (the "
-                  "edge's heights fade to their mean), mirror (the map mirrored, fading far away), none (a "
-                  "slab with a skirt); auto: sea with sea=true, else none"),
         Param::real("sea_level", 0.0).unit("m").help("height of the sea (with sea=true)"),
         Param::real("sea_fraction", -1.0)
             .min(-1)
@@ -108,28 +103,19 @@ std::vector<Param> style_params() {
             .help("the sea mirrors the terrain, drawn at this fraction of the frame's size (0: it reflects the sky "
                   "only)"),
         Param::real("time", 0.0).unit("s").help("moves the waves"),
-        Param::real("beach_height", 3.0).unit("m").help("sand on gentle shores up to this altitude above the sea"),
-        Param::real("tree_line", 2200.0)
-            .unit("m")
-            .help("altitude above the sea where vegetation gives way to bare ground (±250 m; higher facing the "
-                  "sun)"),
-        Param::real("snow_line", 2800.0)
-            .unit("m")
-            .help("altitude above the sea of lying snow on gentle slopes (lower facing north and away from the "
-                  "sun)"),
+        Param::real("grass_from", 0.25)
+            .min(0, true)
+            .max(1, true)
+            .help("fraction of the height range where grass starts"),
+        Param::real("rock_from", 0.5).min(0, true).max(1, true).help("... where rock starts"),
+        Param::real("snow_from", 0.75).min(0, true).max(1, true).help("... where snow starts"),
+        Param::real("blend", 0.5).min(0).max(1).help("each band blends in from the one below over this part of it"),
         Param::real("rock_slope_start", 0.75)
             .min(0)
             .max(1)
             .help("surface normal y below which rock covers grass and snow ..."),
         Param::real("rock_slope_full", 0.5).min(0).max(1).help("... and at which it covers them fully"),
-        Param::real("jitter", 60.0).min(0).unit("m").help("noise on the altitude lines (tree and snow line)"),
-        Param::string("drainage_layer", "drainage")
-            .help("rivers and wet ground from this layer's drained area when the heightmap has it (\"\": none)"),
-        Param::real("river_area", 2e6).min(0, true).unit("m²").help("drained area where a river is drawn"),
-        Param::real("river_width", 25.0)
-            .min(0)
-            .unit("m")
-            .help("a river's width at river_area, growing as the square root of the area (0: no rivers)"),
+        Param::real("jitter", 0.03).min(0).max(0.5).help("noise on the height bands, fraction of the height range"),
         Param::real("texture_scale", 0.0)
             .min(0)
             .unit("m")
@@ -154,8 +140,8 @@ std::vector<Param> style_params() {
 }
 
 void check_style(CheckContext& ctx) {
-    if (!(ctx.real("tree_line") < ctx.real("snow_line")))
-        ctx.error("snow_line", "the snow line must lie above the tree line");
+    if (!(ctx.real("grass_from") < ctx.real("rock_from") && ctx.real("rock_from") < ctx.real("snow_from")))
+        ctx.error("rock_from", "the bands must start in order: grass_from < rock_from < snow_from");
     if (!(ctx.real("rock_slope_full") < ctx.real("rock_slope_start")))
         ctx.error("rock_slope_full",
                   "rock_slope_full (normal y where rock covers fully) must be below rock_slope_start");
@@ -183,12 +169,8 @@ void check_frame(CheckContext& ctx) {
 
 Style style_from(NodeContext& ctx) {
     Style s;
-    s.beach_height = ctx.real("beach_height");
-    s.tree_line = ctx.real("tree_line");
-    s.snow_line = ctx.real("snow_line");
-    s.drainage_layer = ctx.text("drainage_layer");
-    s.river_area = ctx.real("river_area");
-    s.river_width = ctx.real("river_width");
+    s.splat.band_start = {float(ctx.real("grass_from")), float(ctx.real("rock_from")), float(ctx.real("snow_from"))};
+    s.splat.blend_fraction = float(ctx.real("blend"));
     s.splat.slope_start = float(ctx.real("rock_slope_start"));
     s.splat.slope_full = float(ctx.real("rock_slope_full"));
     const auto defaults = Style::default_materials();
@@ -203,12 +185,6 @@ Style style_from(NodeContext& ctx) {
     s.sun_intensity = ctx.real("sun_intensity");
     s.haze = ctx.real("haze");
     s.sea = ctx.flag("sea");
-    const std::string& beyond = ctx.text("beyond");
-    s.beyond = beyond == "none" ? Style::Beyond::none
-        : beyond == "sea"       ? Style::Beyond::sea
-        : beyond == "plain"     ? Style::Beyond::plain
-        : beyond == "mirror"    ? Style::Beyond::mirror
-                                : Style::Beyond::automatic;
     s.sea_level = ctx.real("sea_level");
     s.sea_fraction = ctx.real("sea_fraction");
     s.water_layer = ctx.text("water_layer");
@@ -341,10 +317,8 @@ OROGEN_PLUGIN("render-terrain", "0.1.0", registry) {
         .name = "terrain",
         .summary = "draw the terrain (splatting, shadows, sky, water, haze) as a linear HDR image, through OSMesa",
         .description =
-            "Materials by altitude above the sea, slope and aspect (sand on shores, vegetation below the tree\n"
-            "line, snow above the snow line on gentle and north-facing ground, rock on steep faces) and from the\n"
-            "simulation's layers (rivers and wet ground from 'drainage', scree where 'eroded' deposited), with slope "
-            "and exposure (steep faces rock at any height, vegetation in hollows, bare\n"
+            "The thesis's texture splatting (sand, grass, rock, snow by height; steep slopes turn grass and snow\n"
+            "to rock), with slope and exposure (steep faces rock at any height, vegetation in hollows, bare\n"
             "ridges, sun-facing slopes drier) and procedural textures, lit by the sun (shadow map) and the sky,\n"
             "with water from the 'water' layer (smooth shores) or a sea, and aerial perspective. Renders headless "
             "(Mesa's llvmpipe, no display).\n"

@@ -2,8 +2,6 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include "render_terrain.hpp"
 
-#include "atmosphere.hpp"
-
 #include "orogen_shaders.hpp"
 
 #include <orogen/error.hpp>
@@ -42,23 +40,13 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 // The programs, compiled once per process (in the one shared context).
 struct Programs {
     GLuint sky = 0, terrain = 0, shadow = 0, water = 0, particles = 0;
-    GLuint terrain_layers = 0;  // the terrain's with SIMULATION_LAYERS: rivers, wetness and scree from layers
 };
-
-/// `source` with `#define name` after its #version line.
-std::string with_define(const char* source, const char* name) {
-    std::string s(source);
-    const std::size_t line = s.find('\n');
-    return s.insert(line + 1, std::string("#define ") + name + "\n");
-}
 
 const Programs& programs() {
     static Programs p = [] {
         Programs q;
         q.sky = gl::link_program("render:terrain sky", shaders::fullscreen_vert, shaders::sky_frag);
         q.terrain = gl::link_program("render:terrain", shaders::terrain_vert, shaders::terrain_frag);
-        const std::string layered = with_define(shaders::terrain_frag, "SIMULATION_LAYERS");
-        q.terrain_layers = gl::link_program("render:terrain layers", shaders::terrain_vert, layered.c_str());
         q.shadow = gl::link_program("render:terrain shadow map", shaders::terrain_vert, shaders::shadow_frag);
         q.water = gl::link_program("render:terrain water", shaders::water_vert, shaders::water_frag);
         q.particles = gl::link_program("render:terrain particles", shaders::particles_vert, shaders::particles_frag);
@@ -101,70 +89,12 @@ double bytes_per_pixel(int samples) {
     return double(samples) * (8 + 4) + 16 * 3 + 0.25 * (16 + 4);
 }
 
-/// The simulation's layers as one RGBA texture per sample (empty when the heightmap has none of them):
-/// R river cover — a river of width w = river_width·(A / river_area)^0.5 m (A the drained area) is a disc
-/// of diameter w at each of its samples, its cover the disc's share of the cell around each sample it
-/// reaches (so a river narrower than a cell still shows, faintly) —; G wetness, log10 of the drained area
-/// from 10 cells (0) to river_area (1); B deposit, from 0.5 to 5 m of debris or sediment settled (0..1).
-std::vector<float> simulation_layers(const Heightmap& hm, const Style& st) {
-    const int w = hm.width(), h = hm.height();
-    const double cell = hm.cell();
-    const bool drained = !st.drainage_layer.empty() && hm.has_layer(st.drainage_layer);
-    const char* deposit_layer = hm.has_layer("deposited") ? "deposited"
-        : hm.has_layer("sediment")                        ? "sediment"
-        : hm.has_layer("eroded")                          ? "eroded"
-                                                          : nullptr;
-    if (!drained && !deposit_layer) return {};
-    std::vector<float> out(4 * hm.size(), 0.0f);
-    if (deposit_layer) {
-        const ConstGridView d = hm.layer(deposit_layer);
-        for (std::size_t i = 0; i < hm.size(); ++i)
-            out[4 * i + 2] = float(std::clamp((double(d.data[i]) - 0.5) / 4.5, 0.0, 1.0));
-    }
-    if (!drained) return out;
-    const ConstGridView area = hm.layer(st.drainage_layer);
-    const double wet_from = std::log10(10.0 * cell * cell),
-                 wet_to = std::log10(std::max(st.river_area, 20 * cell * cell));
-    for (std::size_t i = 0; i < hm.size(); ++i) {
-        const double a = std::max(double(area.data[i]), 1.0);
-        out[4 * i + 1] = float(std::clamp((std::log10(a) - wet_from) / (wet_to - wet_from), 0.0, 1.0));
-    }
-    if (st.river_width <= 0) return out;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const double a = double(area.at(x, y));
-            if (!(a >= st.river_area)) continue;
-            const double radius = 0.5 * st.river_width * std::sqrt(a / st.river_area) / cell;  // samples
-            if (radius <= 0.5) {  // narrower than a cell: its share of the cell's width
-                float& c = out[4 * (std::size_t(y) * std::size_t(w) + std::size_t(x))];
-                c = std::max(c, float(2.0 * radius));
-                continue;
-            }
-            const int reach = int(std::ceil(radius));
-            for (int dy = -reach; dy <= reach; ++dy)
-                for (int dx = -reach; dx <= reach; ++dx) {
-                    const int xx = x + dx, yy = y + dy;
-                    if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-                    const float cover = float(std::clamp(radius + 0.5 - std::hypot(double(dx), double(dy)), 0.0, 1.0));
-                    float& c = out[4 * (std::size_t(yy) * std::size_t(w) + std::size_t(xx))];
-                    c = std::max(c, cover);
-                }
-        }
-    return out;
-}
-
 struct TerrainRenderer::Impl {
     std::shared_ptr<const Heightmap> terrain;
     int width = 0, height = 0;  // samples
     float lo = 0, hi = 0;  // height range, m
-    double edge_height = 0;  // m, the mean of the edge's samples
     bool has_water = false;
     GLuint heights = 0, surface = 0, vao = 0;
-    GLuint sim_layers = 0;  // simulation_layers(), or 0 when the heightmap has none
-    // The sky's table and the light it gives, kept while the sun and the camera's altitude stay (a turntable).
-    GLuint sky_texture = 0;
-    std::optional<std::array<double, 5>> sky_key;  // sun x y z, altitude, haze
-    glm::vec3 sky_sun_colour{0.0f}, sky_ambient{0.0f}, sky_scale{0.0f};
     // The grid's triangle strips in four drawing orders (Order), each built on first use: drawn nearest rows
     // first, the depth test rejects most hidden fragments before the splatting shader runs for them.
     std::array<GLuint, 4> indices{};
@@ -181,7 +111,7 @@ struct TerrainRenderer::Impl {
 
     ~Impl() {
         gl::Lock lock("render:terrain");
-        GLuint textures[] = {heights, surface, shadow_depth, sim_layers, sky_texture};
+        GLuint textures[] = {heights, surface, shadow_depth};
         for (GLuint t : textures)
             if (t) glDeleteTextures(1, &t);
         for (GLuint b : indices)
@@ -259,10 +189,8 @@ struct TerrainRenderer::Impl {
     void refuse_a_view_of_nothing(const Frame& f) const;
     void set_grid(GLuint program, const glm::mat4& view_projection, double exaggeration) const;
     void prepare_shadow_map(const Frame& f, const Style& st);
-    void prepare_sky(Frame& f, const Style& st);
     void draw_sky(const Frame& f) const;
     void draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored, GLuint seen);
-    void draw_beyond(const Frame& f, const Style& st, GLuint program);
     void draw_particles(const Frame& f, const Style& st, const Camera& camera, const ParticleFrame& particles);
     gl::Target draw_reflection(const Frame& f, const Style& st, GLuint scene_fbo);
     void draw_water(const Frame& f, const Style& st, const gl::Target& reflection, bool reflect);
@@ -298,16 +226,6 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
         if (!std::isfinite(h)) throw BadInput("render:terrain: the heightmap holds NaN or infinite heights");
         m.lo = std::min(m.lo, h);
         m.hi = std::max(m.hi, h);
-    }
-    if (style_.beyond == Style::Beyond::automatic)
-        style_.beyond = style_.sea ? Style::Beyond::sea : Style::Beyond::none;
-    if (style_.beyond == Style::Beyond::sea) style_.sea = true;
-    {  // the mean height of the edge's samples: where a plain or a mirrored map settles
-        const ConstGridView g = m.terrain->view();
-        double sum = 0;
-        for (int x = 0; x < m.width; ++x) sum += double(g.at(x, 0)) + double(g.at(x, m.height - 1));
-        for (int y = 0; y < m.height; ++y) sum += double(g.at(0, y)) + double(g.at(m.width - 1, y));
-        m.edge_height = sum / double(2 * (m.width + m.height));
     }
     if (style_.sea_fraction >= 0) style_.sea_level = m.lo + style_.sea_fraction * double(m.hi - m.lo);
     if (style_.texture_scale <= 0) style_.texture_scale = std::max(m.extent_x(), m.extent_z()) / 8.0;
@@ -352,17 +270,6 @@ TerrainRenderer::TerrainRenderer(std::shared_ptr<const Heightmap> terrain, Style
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     }
 
-    const std::vector<float> sim = simulation_layers(*m.terrain, style_);
-    if (!sim.empty()) {
-        glGenTextures(1, &m.sim_layers);
-        glBindTexture(GL_TEXTURE_2D, m.sim_layers);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, m.width, m.height, 0, GL_RGBA, GL_FLOAT, sim.data());
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);  // the shader's B-spline taps
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    }
-
     glGenVertexArrays(1, &m.vao);
     gl::check_errors("render:terrain", "uploading the terrain");
 }
@@ -371,41 +278,34 @@ TerrainRenderer::~TerrainRenderer() = default;
 
 namespace {
 
-/// The sun, the sky and the air of one frame: the uniforms every lit pass shares. The sky's table is
-/// integrated once per sun and camera altitude (TerrainRenderer::Impl::prepare_sky) and set here.
+/// The sun, the sky and the haze of one frame: the uniforms every lit pass shares.
 struct Light {
     glm::dvec3 sun;  // unit, towards the sun
-    Atmosphere air;
-    glm::vec3 sun_colour{0.0f};  // linear: the sunlight at the terrain per π (a white surface facing it)
-    glm::vec3 ambient{0.0f};  // linear: the sky's light on a horizontal surface per π
-    glm::vec3 sky_scale{0.0f};  // the sun's irradiance above the air, the sky table's unit
-    float sea_y = 0, exaggeration = 1;  // world y of the sea level; vertical exaggeration
-    GLuint sky_texture = 0;
+    glm::vec3 sun_colour;  // linear, times the intensity
+    glm::vec3 zenith, horizon, ambient;  // linear
+    float fog_density = 0;  // 1/m
 
-    explicit Light(const Style& st) : sun(direction(st.sun_azimuth, st.sun_elevation)) { air.haze = st.haze; }
+    Light(const Style& st, double radius) {
+        sun = direction(st.sun_azimuth, st.sun_elevation);
+        sun_colour = glm::vec3(1.0f, 0.93f, 0.82f) * float(st.sun_intensity);
+        // Sky: bluer at the zenith, warmer and paler at the horizon when the sun is low.
+        const float low = float(std::clamp(1.0 - st.sun_elevation / 45.0, 0.0, 1.0));
+        zenith = glm::mix(glm::vec3(0.05f, 0.14f, 0.42f), glm::vec3(0.08f, 0.16f, 0.38f), low);
+        horizon = glm::mix(glm::vec3(0.42f, 0.52f, 0.68f), glm::vec3(0.62f, 0.52f, 0.46f), low * 0.5f);
+        ambient = (zenith * 0.6f + horizon * 0.4f) * 0.9f;
+        fog_density = float(st.haze / std::max(2.0 * radius, 1e-6));
+    }
 
-    /// The light's uniforms on `p`; `disc` 1 draws the sun's disc (the sky pass only). Binds the sky table
-    /// to texture unit 5.
+    /// The light's uniforms on `p`, seen from `eye`; `disc` 1 draws the sun's disc (the sky pass only).
     void set_on(GLuint p, float disc, const glm::dvec3& eye) const {
         set(p, "sun_direction", glm::vec3(sun));
         set(p, "sun_colour", sun_colour);
+        set(p, "sky_zenith", zenith);
+        set(p, "sky_horizon", horizon);
         set(p, "sun_disc", disc);
+        set(p, "fog_density", fog_density);
         set(p, "ambient_colour", ambient);
         set(p, "eye", glm::vec3(eye));
-        set(p, "sky_scale", sky_scale);
-        set(p, "air_sea_y", sea_y);
-        set(p, "air_exaggeration", exaggeration);
-        set(p, "rayleigh_scattering",
-            glm::vec3(float(air.rayleigh[0]), float(air.rayleigh[1]), float(air.rayleigh[2])));
-        set(p, "mie_scattering", float(air.mie_scattering * air.haze));
-        set(p, "mie_extinction", float(air.mie_extinction * air.haze));
-        set(p, "rayleigh_height", float(air.rayleigh_height));
-        set(p, "mie_height", float(air.mie_height));
-        set(p, "mie_g", float(air.mie_g));
-        glActiveTexture(GL_TEXTURE5);
-        glBindTexture(GL_TEXTURE_2D, sky_texture);
-        glActiveTexture(GL_TEXTURE0);
-        set(p, "sky_table", 5);
     }
 };
 
@@ -490,7 +390,7 @@ TerrainRenderer::Impl::Frame TerrainRenderer::Impl::frame_box(int frame_width, i
     f.radius = glm::length(f.box_max - f.box_min) * 0.5;
     f.aspect = double(frame_width) / double(std::max(frame_height, 1));
     f.shaded = st.output == Style::Output::beauty;
-    f.light.emplace(st);
+    f.light.emplace(st, f.radius);
     return f;
 }
 
@@ -615,16 +515,12 @@ void TerrainRenderer::Impl::place_camera(Frame& f, const Camera& camera, const S
 /// Near and far around the terrain's bounding sphere (out to the horizon with a sea).
 void TerrainRenderer::Impl::set_clip_planes(Frame& f, const Style& st) const {
     const double to_centre = glm::length(f.centre - f.eye);
-    const bool horizon = st.sea || (f.shaded && st.beyond != Style::Beyond::none);
-    f.far_plane = to_centre + f.radius * (horizon ? 41.0 : 1.05);  // a sea or the world beyond: the horizon
+    f.far_plane = to_centre + f.radius * (st.sea ? 40.0 : 1.05);  // a sea reaches the horizon
     f.near_plane = std::max(std::max(to_centre - f.radius, 0.0) * 0.8, f.far_plane * 2e-5);
     // The sea comes up to the camera: a ray at most 60° off the view axis meets it no nearer (along the
     // axis) than half the camera's height above it, so keep the near plane inside that.
     if (st.sea && f.eye.y > st.sea_level * f.exag)
         f.near_plane = std::max(std::min(f.near_plane, 0.5 * (f.eye.y - st.sea_level * f.exag)), f.far_plane * 2e-6);
-    // So does the ground past the edge (no higher than the map's highest point).
-    if (horizon && f.eye.y > hi * f.exag)
-        f.near_plane = std::max(std::min(f.near_plane, 0.5 * (f.eye.y - hi * f.exag)), f.far_plane * 2e-6);
 }
 
 /// Looking at nothing: every corner of the terrain's box outside one clip plane.
@@ -710,49 +606,8 @@ void TerrainRenderer::Impl::prepare_shadow_map(const Frame& f, const Style& st) 
     shadow_stride = stride;
 }
 
-/// The sky's table for the sun and the camera's altitude (kept from the last frame when they are the same),
-/// and the light it gives: the sunlight through the air to the terrain's mean altitude, relative to the
-/// sun at the zenith there (so `sun_intensity` stays the light of a high sun), and the sky's light.
-void TerrainRenderer::Impl::prepare_sky(Frame& f, const Style& st) {
-    Light& light = *f.light;
-    light.exaggeration = float(f.exag);
-    light.sea_y = float(st.sea_level * f.exag);
-    const double altitude = std::max(f.eye.y / f.exag - st.sea_level, 1.0);
-    const std::array<double, 5> key{light.sun.x, light.sun.y, light.sun.z, altitude, st.haze};
-    if (!sky_texture || sky_key != key) {
-        const SkyTable table = sky_table(light.air, {light.sun.x, light.sun.y, light.sun.z}, altitude);
-        const double ground = std::max(0.5 * double(lo + hi) - st.sea_level, 0.0);
-        const auto slant = transmittance(light.air, ground, light.sun.y);
-        const auto zenith = transmittance(light.air, ground, 1.0);
-        for (int c = 0; c < 3; ++c) {
-            sky_sun_colour[c] = float(st.sun_intensity * slant[std::size_t(c)] / zenith[std::size_t(c)]);
-            sky_scale[c] = float(std::numbers::pi * st.sun_intensity / zenith[std::size_t(c)]);
-            // the sky's light, and the sunlight the ground around reflects into the shade (albedo 0.15)
-            sky_ambient[c] = float(sky_scale[c] * table.irradiance[std::size_t(c)] / std::numbers::pi +
-                                   0.15 * sky_sun_colour[c] * std::max(light.sun.y, 0.0));
-        }
-        if (!sky_texture) glGenTextures(1, &sky_texture);
-        glBindTexture(GL_TEXTURE_2D, sky_texture);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, table.width, table.height, 0, GL_RGB, GL_FLOAT, table.rgb.data());
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);  // the azimuth turns around
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-        sky_key = key;
-    }
-    light.sky_texture = sky_texture;
-    light.sun_colour = sky_sun_colour;
-    light.ambient = sky_ambient;
-    light.sky_scale = sky_scale;
-}
-
 /// The sky, which also clears the colour.
 void TerrainRenderer::Impl::draw_sky(const Frame& f) const {
-    if (!f.shaded) {  // albedo and normals: mid grey behind the terrain (the normal pass's zero vector)
-        glClearColor(0.5f, 0.5f, 0.5f, 1.0f);
-        glClear(GL_COLOR_BUFFER_BIT);
-        return;
-    }
     const GLuint program = programs().sky;
     glUseProgram(program);
     f.light->set_on(program, 1.0f, f.eye);
@@ -766,7 +621,7 @@ void TerrainRenderer::Impl::draw_sky(const Frame& f) const {
 /// `seen`: a query that learns whether any of the surface (not the skirt) reached the frame.
 void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const glm::mat4& matrix, bool mirrored,
                                          GLuint seen) {
-    const GLuint program = sim_layers ? programs().terrain_layers : programs().terrain;
+    const GLuint program = programs().terrain;
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
@@ -781,16 +636,11 @@ void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const 
     set(program, "shadow_map", 1);
     set_grid(program, matrix, f.exag);
     f.light->set_on(program, 0.0f, f.eye);
-    set(program, "sea_altitude", float(st.sea_level));
-    set(program, "has_sea", st.sea ? 1 : 0);
-    set(program, "beach_height", float(st.beach_height));
-    set(program, "tree_line", float(st.tree_line));
-    set(program, "snow_line", float(st.snow_line));
-    glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D, sim_layers);
-    glActiveTexture(GL_TEXTURE0);
-    set(program, "layers", 4);
-    set(program, "has_layers", sim_layers ? 1 : 0);
+    set(program, "height_min", lo);
+    set(program, "height_max", hi);
+    const float starts[4] = {0.0f, st.splat.band_start[0], st.splat.band_start[1], st.splat.band_start[2]};
+    glUniform1fv(loc(program, "band_start"), 4, starts);
+    set(program, "blend_fraction", st.splat.blend_fraction);
     set(program, "slope_start", st.splat.slope_start);
     set(program, "slope_full", st.splat.slope_full);
     float materials[12];
@@ -811,41 +661,11 @@ void TerrainRenderer::Impl::draw_terrain(const Frame& f, const Style& st, const 
     if (seen) glEndQuery(GL_ANY_SAMPLES_PASSED);
     glDisable(GL_CULL_FACE);
     glFrontFace(GL_CCW);
-    // The skirt stays under the world beyond: it fills the cracks between the map's edge and the coarser grid.
-    if (f.shaded && st.beyond != Style::Beyond::none) draw_beyond(f, st, program);
     set(program, "floor_height", float(f.floor_height * f.exag));
     for (int edge = 0; edge < 4; ++edge) {
         set(program, "skirt_edge", edge);
         glDrawArrays(GL_TRIANGLE_STRIP, 0, 2 * (edge % 2 == 0 ? kept.x : kept.y));
     }
-}
-
-/// The world past the map's edge (Style::beyond; terrain.vert's beyond grid) with the terrain's program,
-/// out to the horizon: 28 times the terrain's radius (its corners stay inside the far plane, at 41).
-void TerrainRenderer::Impl::draw_beyond(const Frame& f, const Style& st, GLuint program) {
-    constexpr int kCells = 160;  // quads per side: about 16 across the map itself, coarse far away
-    const int mode = st.beyond == Style::Beyond::sea ? 1 : st.beyond == Style::Beyond::plain ? 2 : 3;
-    set(program, "skirt_edge", -1);
-    set(program, "beyond", mode);
-    set(program, "beyond_cells", kCells);
-    set(program, "beyond_reach", float(f.radius * 28.0));
-    set(program, "edge_height", float(edge_height));
-    set(program, "sea_floor", float(std::min(double(lo), st.sea_level) - 0.08 * std::max(double(hi - lo), 1.0)));
-    set(program, "has_layers", 0);  // the layers' edge would run on as stripes
-    glBindTexture(GL_TEXTURE_2D, heights);
-    const GLint wrap = mode == 3 ? GL_MIRRORED_REPEAT : GL_CLAMP_TO_EDGE;
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
-    for (GLenum c : {GL_CLIP_DISTANCE1, GL_CLIP_DISTANCE2, GL_CLIP_DISTANCE3}) glEnable(c);
-    for (int side = 0; side < 4; ++side) {  // north, south, west, east of the map, each clipped to its side
-        set(program, "beyond_side", side);
-        glDrawArrays(GL_TRIANGLES, 0, 6 * kCells * kCells);
-    }
-    for (GLenum c : {GL_CLIP_DISTANCE1, GL_CLIP_DISTANCE2, GL_CLIP_DISTANCE3}) glDisable(c);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    set(program, "beyond", 0);
-    set(program, "has_layers", sim_layers ? 1 : 0);
 }
 
 /// Particles: lit spheres (points).
@@ -894,15 +714,14 @@ gl::Target TerrainRenderer::Impl::draw_reflection(const Frame& f, const Style& s
         glm::scale(glm::dmat4(1.0), glm::dvec3(1, -1, 1));
     const Programs& prog = programs();
     glEnable(GL_CLIP_DISTANCE0);
-    for (GLuint p : {prog.shadow, prog.terrain, prog.terrain_layers})
+    for (GLuint p : {prog.shadow, prog.terrain})
         glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 1.0f, 0.0f, float(-water_y));
     // Lit from the mirrored eye; the strips' order is the same (the mirror keeps x and z).
     Frame mirrored = f;
     mirrored.eye = glm::dvec3(mirror * glm::dvec4(f.eye, 1.0));
     draw_terrain(mirrored, st, glm::mat4(f.view_projection * mirror), true, 0);
     glDisable(GL_CLIP_DISTANCE0);
-    for (GLuint p : {prog.shadow, prog.terrain, prog.terrain_layers})
-        glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
+    for (GLuint p : {prog.shadow, prog.terrain}) glProgramUniform4f(p, loc(p, "clip_plane"), 0.0f, 0.0f, 0.0f, 0.0f);
     glBindFramebuffer(GL_FRAMEBUFFER, scene_fbo);
     glViewport(0, 0, f.width, f.height);
     return reflection;
@@ -993,7 +812,6 @@ Image TerrainRenderer::render(int width, int height, const Camera& camera, const
     glPrimitiveRestartIndex(0xFFFFFFFFu);
     glDisable(GL_CULL_FACE);
 
-    m.prepare_sky(f, st);
     f.light_view_projection = light_matrix(f.light->sun, f.centre, f.radius, f.box_min, f.box_max);
     m.prepare_shadow_map(f, st);
     mark(&Timings::shadow);

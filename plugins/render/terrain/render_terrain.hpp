@@ -39,37 +39,19 @@ struct Camera {
 
 /// How the terrain looks.
 struct Style {
-    /// The slopes at which rock covers vegetation and snow (slope_start, slope_full; the thesis's); the
-    /// renderer's bands are altitudes above the sea (below), not the exports' fractions of the height range.
-    mesh::SplatRules splat;
-    double beach_height = 3.0;  ///< m above the sea: sand on gentle shores below it (with a sea)
-    double tree_line = 2200.0;  ///< m above the sea: vegetation thins out to bare ground over ±250 m around it
-    double snow_line = 2800.0;  ///< m above the sea: lying snow on gentle slopes (±250 m by aspect)
+    mesh::SplatRules splat;  ///< the bands and slopes (the thesis's by default)
     /// Linear albedo of sand, grass, rock, snow (default: terrain_mesh.hpp's sRGB colours, decoded, with a darker
     /// olive for the vegetation).
     std::array<std::array<float, 3>, 4> materials = default_materials();
-    double jitter = 60.0;  ///< m: noise on the altitude lines, so they do not follow contours
-    /// The simulation's layers: rivers where the drained area (m²) of `drainage_layer` passes `river_area`,
-    /// `river_width` m wide there and wider as the square root of the area (hydraulic geometry, w ∝ Q^0.5);
-    /// wetter, greener ground as the area grows; scree where `eroded` (> 0: deposited), `deposited` or
-    /// `sediment` says debris settled.
-    std::string drainage_layer = "drainage";
-    double river_area = 2e6;  ///< m²
-    double river_width = 25.0;  ///< m, at river_area
+    double jitter = 0.03;  ///< noise on the height bands, fraction of the height range
     double texture_scale = 0.0;  ///< m, size of the coarsest texture features; 0: an eighth of the terrain's width
     double exaggeration = 1.0;  ///< vertical scale
     double sun_azimuth = 250.0;  ///< degrees clockwise from north
     double sun_elevation = 22.0;  ///< degrees above the horizon
     double sun_intensity = 2.4;  ///< linear multiplier of the sun's (slightly warm) colour
-    double haze = 1.0;  ///< aerosols, times a clear day's (0: the air's Rayleigh scattering only)
+    double haze = 0.3;  ///< optical depth of the air across the terrain's diagonal (0: clear)
     bool sea = false;  ///< a sea at sea_level
     double sea_level = 0.0;  ///< m
-    /// The world past the map's edge, so the map is no slab with cut edges and every camera sees a horizon:
-    /// automatic (sea with a sea, else none: a plain costs the 1080p frame a third more), none (the slab and its skirt), sea (the ground falls below
-    /// the sea past a coast; turns the sea on), plain (the edge's heights fade to their mean), mirror (the map
-    /// mirrored at its edges, fading to the mean far away). Drawn in the lit picture only.
-    enum class Beyond { automatic, none, sea, plain, mirror };
-    Beyond beyond = Beyond::automatic;
     double sea_fraction = -1.0;  ///< if ≥ 0: the sea at this fraction of the height range instead of sea_level
     std::string water_layer = "water";  ///< water from this layer when the heightmap has it ("" none)
     double water_min_depth = 0.05;  ///< m: thinner water layers are not drawn

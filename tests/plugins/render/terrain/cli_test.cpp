@@ -50,7 +50,7 @@ TEST(RenderCli, BadSizesFieldsOfViewAndCamerasExitTwo) {
         {"render:terrain(hill, camera=look-at, from=(0.5, 0.5), from_height=-100)", "inside the terrain"},
         {"render:terrain(hill, camera=look-at, from=(0.5, 3), to=(0.5, 9), from_height=600)",
          "sees none of the terrain"},
-        {"render:terrain(hill, tree_line=3000, snow_line=2000)", "above the tree line"},
+        {"render:terrain(hill, grass_from=0.6, rock_from=0.5)", "in order"},
         // Issue 32, item 8: an orbit from below shows the underside; one inside the box looking up, the sky.
         {"render:terrain(hill, width=32, height=32, elevation=-60)", "below the terrain"},
         {"render:terrain(hill, width=32, height=32, target=(0.02, 0.02), distance=1, elevation=-80)",
