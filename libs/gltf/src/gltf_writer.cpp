@@ -29,6 +29,9 @@
 #include <optional>
 #include <sstream>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 namespace fs = std::filesystem;
 
 namespace orogen::gltf {
@@ -111,8 +114,42 @@ void add_splat_material(tinygltf::Model& model, std::size_t png_offset, std::siz
 /// Write `model` to `target` (.glb, or .gltf with its buffer beside it as <stem>.bin), atomically. The
 /// model's one buffer is left empty: its buffer_length bytes are streamed by `payload_writer` (see the
 /// top of this file).
+/// Starts the disk writing what a large file holds so far, without waiting for it (Linux's
+/// sync_file_range): the fsync of AtomicFile::commit then waits only for the last few chunks rather than
+/// the whole file, and the disk writes while the next chunks are computed. Page-cache writeback is per
+/// file, so a read-only descriptor of the temporary file serves. Errors are left to commit's fsync, which
+/// reports them; where the call is unsupported this only loses the overlap.
+class Writeback {
+public:
+    explicit Writeback(AtomicFile& file) : file_(file), fd_(::open(file.temporary().c_str(), O_RDONLY | O_CLOEXEC)) {}
+    ~Writeback() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    Writeback(const Writeback&) = delete;
+    Writeback& operator=(const Writeback&) = delete;
+    /// After `written` bytes of the file: start writing what was not yet started.
+    void start(std::uint64_t written) {
+        if (fd_ < 0 || written <= started_) return;
+        file_.stream().flush();
+        ::sync_file_range(fd_, off64_t(started_), off64_t(written - started_), SYNC_FILE_RANGE_WRITE);
+        started_ = written;
+    }
+
+private:
+    AtomicFile& file_;
+    int fd_;
+    std::uint64_t started_ = 0;
+};
+
+/// The binary payload's writer: its stream, and `written(n)` after each large piece, n the payload's bytes
+/// so far, which starts that much on its way to the disk (Writeback).
+struct Payload {
+    std::ostream& out;
+    std::function<void(std::uint64_t)> written;
+};
+
 void write_document(const tinygltf::Model& model, std::size_t buffer_length, const fs::path& target,
-                    const std::function<void(std::ostream&)>& payload_writer) {
+                    const std::function<void(Payload&)>& payload_writer) {
     const bool binary = target.extension() == ".glb";
     // Serialise with tinygltf (as a GLB without payload) and take its JSON chunk.
     std::string json;
@@ -164,7 +201,11 @@ void write_document(const tinygltf::Model& model, std::size_t buffer_length, con
         bin_file.emplace(bin_target);
         payload = &bin_file->stream();
     }
-    payload_writer(*payload);
+    AtomicFile& payload_file = bin_file ? *bin_file : main_file;
+    const std::uint64_t payload_start = binary ? std::uint64_t(payload->tellp()) : 0;
+    Writeback writeback(payload_file);
+    Payload p{*payload, [&](std::uint64_t n) { writeback.start(payload_start + n); }};
+    payload_writer(p);
     if (bin_file) {
         AtomicFile* files[] = {&*bin_file, &main_file};  // the .bin in place before the .gltf names it
         commit_all(files);
@@ -299,7 +340,9 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
         std::fill(bytes + used, bytes + size, std::uint8_t(0));
         return size;
     };
-    write_document(model, buffer_length, target, [&](std::ostream& payload) {
+    write_document(model, buffer_length, target, [&](Payload& out) {
+        std::ostream& payload = out.out;
+        std::uint64_t written = 0;
         // Chunk i is built into buffers[i % 2]; chunk i + 1's build starts once chunk i - 1, the last user of
         // its buffer, has been written.
         std::future<std::size_t> next = std::async(std::launch::async, build, 0, buffers[0].get());
@@ -310,6 +353,8 @@ Summary write_gltf(ConstGridView heights, const Options& options, const fs::path
             summary.vertices += views[i].vertex_count;
             summary.triangles += mesh.chunks[i].triangle_count();
             payload.write(reinterpret_cast<const char*>(buffers[i % 2].get()), std::streamsize(size));
+            written += size;
+            out.written(written);  // the disk writes this chunk while the next ones are built
         }
         payload.write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
         write_zeros(payload, buffer_length - png_offset - png.size());
@@ -365,7 +410,8 @@ std::size_t write_mesh(const MeshData& mesh, std::span<const std::uint8_t> png, 
     model.scenes.push_back(scene);
     model.defaultScene = 0;
 
-    write_document(model, buffer_length, target, [&](std::ostream& out) {
+    write_document(model, buffer_length, target, [&](Payload& payload) {
+        std::ostream& out = payload.out;
         write_span(out, mesh.positions);
         write_span(out, mesh.normals);
         write_span(out, mesh.texcoords);
