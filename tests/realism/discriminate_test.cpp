@@ -8,6 +8,8 @@
 #include <gdal.h>
 #include <gtest/gtest.h>
 
+#include "shipped_dem.hpp"
+
 #include "orogen_test.hpp"
 
 #include <cstdio>
@@ -35,22 +37,8 @@ struct Dem {
 };
 
 Dem read_dem(const std::string& name) {
-    GDALAllRegister();
-    Dem dem{name, {}, 0, 0, 0.0};
-    const fs::path path = fs::path(OROGEN_SOURCE_DIR) / "data" / "dems" / (name + ".tif");
-    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
-    if (!ds) return dem;
-    dem.width = GDALGetRasterXSize(ds);
-    dem.height = GDALGetRasterYSize(ds);
-    double transform[6];
-    GDALGetGeoTransform(ds, transform);
-    dem.cell = transform[1];
-    dem.z.resize(std::size_t(dem.width) * std::size_t(dem.height));
-    if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, dem.width, dem.height, dem.z.data(), dem.width,
-                     dem.height, GDT_Float32, 0, 0) != CE_None)
-        dem.width = 0;
-    GDALClose(ds);
-    return dem;
+    ShippedDem shipped = read_shipped_dem(name);
+    return {name, std::move(shipped.z), shipped.width, shipped.height, shipped.cell};
 }
 
 TEST(Discriminate, TheDefaultPipelineIsNoEasierToTellFromRealRanges) {

@@ -6,6 +6,8 @@
 
 #include <gdal.h>
 #include <gtest/gtest.h>
+
+#include "shipped_dem.hpp"
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -35,21 +37,10 @@ struct Dem {
 };
 
 Dem read_dem(const std::string& name) {
-    GDALAllRegister();
+    orogen::test::ShippedDem shipped = orogen::test::read_shipped_dem(name);
     Dem dem;
-    const fs::path path = fs::path(OROGEN_SOURCE_DIR) / "data" / "dems" / (name + ".tif");
-    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
-    if (!ds) return dem;
-    dem.width = GDALGetRasterXSize(ds);
-    dem.height = GDALGetRasterYSize(ds);
-    double transform[6];
-    GDALGetGeoTransform(ds, transform);
-    dem.cell = transform[1];
-    dem.z.resize(std::size_t(dem.width) * std::size_t(dem.height));
-    if (GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, dem.width, dem.height, dem.z.data(), dem.width,
-                     dem.height, GDT_Float32, 0, 0) != CE_None)
-        dem.width = 0;
-    GDALClose(ds);
+    dem.z = std::move(shipped.z);
+    dem.width = shipped.width, dem.height = shipped.height, dem.cell = shipped.cell;
     return dem;
 }
 
