@@ -8,6 +8,8 @@
 #include <gdal.h>
 #include <gtest/gtest.h>
 
+#include "shipped_dem.hpp"
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -22,11 +24,7 @@ using namespace orogen::analysis;
 using enum FigureId;
 namespace fs = std::filesystem;
 
-struct Dem {
-    std::vector<float> z;
-    int width = 0, height = 0;
-    double cell = 0.0;
-};
+using Dem = orogen::test::ShippedDem;
 
 /// What terrain_stats.py printed for one DEM.
 struct Expected {
@@ -77,23 +75,7 @@ void expect_agreement(const std::string& name, const Dem& dem, const Expected& e
     }
 }
 
-Dem read_geotiff(const fs::path& path) {
-    GDALAllRegister();
-    Dem dem;
-    GDALDatasetH ds = GDALOpen(path.c_str(), GA_ReadOnly);
-    if (!ds) return dem;
-    dem.width = GDALGetRasterXSize(ds);
-    dem.height = GDALGetRasterYSize(ds);
-    double gt[6];
-    GDALGetGeoTransform(ds, gt);
-    dem.cell = gt[1];
-    dem.z.resize(std::size_t(dem.width) * std::size_t(dem.height));
-    const CPLErr err = GDALRasterIO(GDALGetRasterBand(ds, 1), GF_Read, 0, 0, dem.width, dem.height, dem.z.data(),
-                                    dem.width, dem.height, GDT_Float32, 0, 0);
-    GDALClose(ds);
-    if (err != CE_None) dem.z.clear();
-    return dem;
-}
+Dem read_geotiff(const fs::path& path) { return orogen::test::read_geotiff_dem(path); }
 
 /// NAME.f32 (little-endian float32, rows north to south) with NAME.json's nx, ny, dx_m.
 Dem read_f32(const fs::path& json) {
